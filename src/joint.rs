@@ -1,0 +1,452 @@
+//! The clearance joint in a Rapier world: a revolute hinge whose radial play is left to the
+//! contact law. [`ClearanceJointSet::apply`] is the per-step force hook.
+
+use crate::error::{Error, Result};
+use crate::kinematics::{BodyMotion, ContactMode, ForcePair, JournalState, contact_force, journal_state, stable_step};
+use crate::laws::{BearingGeometry, FrictionModel, ImprovedLiu, NormalContact, NormalForceLaw, NormalModel};
+use crate::ledger::{ForceLedger, Wrench, ensure_mass_properties, world_center_of_mass};
+use rapier3d_f64::math::Vector;
+use rapier3d_f64::prelude::{
+    GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, IntegrationParameters, JointAxesMask, RigidBody,
+    RigidBodyHandle, RigidBodySet,
+};
+
+/// What holds the degrees of freedom the contact law does not (axial translation and the two tilts).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum OutOfPlaneLock {
+    /// A Rapier `GenericJoint` locking the axial translation and the two tilts, relative to the
+    /// bodies (works for any axis and any body motion). The default.
+    #[default]
+    Joint,
+    /// Nothing: the caller guarantees planar motion (e.g. with `LockedAxes` on the bodies).
+    None,
+}
+
+/// Builds a [`ClearanceJoint`] with chained setters, like Rapier's `RevoluteJointBuilder`.
+/// Body 1 carries the bearing (hole), body 2 the journal (pin).
+///
+/// ```
+/// use clearance_joint::prelude::*;
+/// let geometry = BearingGeometry::from_clearance(0.010, 0.5e-3, 0.016).unwrap();
+/// let law = ImprovedLiu::new(1.137e11, 0.016, 0.5e-3, 1.0, 1e-4, MaxDamping::Eta(0.01)).unwrap();
+/// let joint = ClearanceJointBuilder::new(Vector::new(0.0, -1.0, 0.0), geometry, NormalModel::ImprovedLiu(law))
+///     .local_anchor1(Vector::new(0.4, 0.0, 0.4))
+///     .local_anchor2(Vector::new(0.0, 0.0, 0.4))
+///     .friction(FrictionModel::Bai(Bai::DRY))
+///     .build()
+///     .unwrap();
+/// assert_eq!(joint.geometry().clearance(), 0.5e-3);
+/// ```
+#[derive(Clone, Debug)]
+pub struct ClearanceJointBuilder {
+    joint: ClearanceJoint,
+}
+
+impl ClearanceJointBuilder {
+    /// A joint about `axis` (in body 1's frame; also used for body 2 unless
+    /// [`local_axis2`](Self::local_axis2) is set) with the given geometry and normal law,
+    /// frictionless, anchors at both bodies' origins.
+    pub fn new(axis: Vector, geometry: BearingGeometry, normal_law: NormalModel) -> Self {
+        ClearanceJointBuilder {
+            joint: ClearanceJoint {
+                name: String::from("clearance joint"),
+                local_axis1: axis,
+                local_axis2: axis,
+                local_anchor1: Vector::ZERO,
+                local_anchor2: Vector::ZERO,
+                geometry,
+                normal_law,
+                friction_law: FrictionModel::None,
+                min_impact_speed: 1e-4,
+                lock: OutOfPlaneLock::Joint,
+                body1: RigidBodyHandle::invalid(),
+                body2: RigidBodyHandle::invalid(),
+                lock_handle: None,
+                contact: ContactHistory::default(),
+                report: ClearanceReport::default(),
+                prepared: false,
+            },
+        }
+    }
+    /// Bearing centre in body 1's frame.
+    pub fn local_anchor1(mut self, anchor: Vector) -> Self {
+        self.joint.local_anchor1 = anchor;
+        self
+    }
+    /// Journal centre in body 2's frame.
+    pub fn local_anchor2(mut self, anchor: Vector) -> Self {
+        self.joint.local_anchor2 = anchor;
+        self
+    }
+    /// Hinge axis in body 2's frame (defaults to the axis given to [`new`](Self::new)).
+    pub fn local_axis2(mut self, axis: Vector) -> Self {
+        self.joint.local_axis2 = axis;
+        self
+    }
+    /// The friction law (default: none).
+    pub fn friction(mut self, friction: FrictionModel) -> Self {
+        self.joint.friction_law = friction;
+        self
+    }
+    /// Floor on the impact velocity `delta_dot0` of the hysteresis laws, m/s (default 1e-4): a
+    /// contact that begins at a vanishing speed would otherwise get unbounded damping.
+    pub fn min_impact_speed(mut self, speed: f64) -> Self {
+        self.joint.min_impact_speed = speed;
+        self
+    }
+    /// What locks the out-of-plane degrees of freedom (default [`OutOfPlaneLock::Joint`]).
+    pub fn lock(mut self, lock: OutOfPlaneLock) -> Self {
+        self.joint.lock = lock;
+        self
+    }
+    /// A name used in error messages and outputs.
+    pub fn name(mut self, name: impl Into<String>) -> Self {
+        self.joint.name = name.into();
+        self
+    }
+    /// Validates and returns the joint.
+    pub fn build(mut self) -> Result<ClearanceJoint> {
+        let j = &mut self.joint;
+        j.local_axis1 = unit_axis("local_axis1", j.local_axis1)?;
+        j.local_axis2 = unit_axis("local_axis2", j.local_axis2)?;
+        for (field, v) in [("local_anchor1", j.local_anchor1), ("local_anchor2", j.local_anchor2)] {
+            if !v.is_finite() {
+                return Err(Error::invalid(field, format!("must be finite (got {v:?})")));
+            }
+        }
+        crate::error::positive("min_impact_speed", j.min_impact_speed)?;
+        Ok(self.joint)
+    }
+}
+
+fn unit_axis(field: &str, axis: Vector) -> Result<Vector> {
+    let n = axis.length();
+    if !n.is_finite() || n < 1e-12 {
+        return Err(Error::invalid(field, format!("must be a finite, non-zero vector (got {axis:?})")));
+    }
+    Ok(axis / n)
+}
+
+/// State carried between steps: whether a contact is on, and its impact velocity.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct ContactHistory {
+    in_contact: bool,
+    compressing: bool,
+    impact_rate: f64,
+}
+
+/// What the hook computed for one joint at its last application.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ClearanceReport {
+    /// Journal state (eccentricity, penetration, rates).
+    pub state: JournalState,
+    /// Motion mode.
+    pub mode: ContactMode,
+    /// Whether a contact began at this application (an impact onset).
+    pub onset: bool,
+    /// `delta_dot0` of the current contact (0 in free flight), m/s.
+    pub impact_rate: f64,
+    /// The force pair applied.
+    pub force: ForcePair,
+    /// Largest stable step for the contact as linearised now (infinite in free flight), s.
+    pub max_stable_dt: f64,
+    /// Linearised natural frequency of the contact, rad/s.
+    pub omega: f64,
+    /// Linearised damping ratio of the contact.
+    pub zeta: f64,
+    /// Effective mass of the two bodies along the contact normal, kg.
+    pub effective_mass: f64,
+}
+
+/// A revolute hinge with radial clearance between two Rapier rigid bodies.
+#[derive(Clone, Debug)]
+pub struct ClearanceJoint {
+    name: String,
+    local_axis1: Vector,
+    local_axis2: Vector,
+    local_anchor1: Vector,
+    local_anchor2: Vector,
+    geometry: BearingGeometry,
+    normal_law: NormalModel,
+    friction_law: FrictionModel,
+    min_impact_speed: f64,
+    lock: OutOfPlaneLock,
+    body1: RigidBodyHandle,
+    body2: RigidBodyHandle,
+    lock_handle: Option<ImpulseJointHandle>,
+    contact: ContactHistory,
+    report: ClearanceReport,
+    prepared: bool,
+}
+
+impl ClearanceJoint {
+    /// The joint's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+    /// Bearing body.
+    pub fn body1(&self) -> RigidBodyHandle {
+        self.body1
+    }
+    /// Journal body.
+    pub fn body2(&self) -> RigidBodyHandle {
+        self.body2
+    }
+    /// Radial geometry.
+    pub fn geometry(&self) -> &BearingGeometry {
+        &self.geometry
+    }
+    /// Normal law.
+    pub fn normal_law(&self) -> &NormalModel {
+        &self.normal_law
+    }
+    /// Friction law.
+    pub fn friction_law(&self) -> &FrictionModel {
+        &self.friction_law
+    }
+    /// Hinge axis in body 1's frame (unit).
+    pub fn local_axis1(&self) -> Vector {
+        self.local_axis1
+    }
+    /// Hinge axis in body 2's frame (unit).
+    pub fn local_axis2(&self) -> Vector {
+        self.local_axis2
+    }
+    /// Bearing centre in body 1's frame.
+    pub fn local_anchor1(&self) -> Vector {
+        self.local_anchor1
+    }
+    /// Journal centre in body 2's frame.
+    pub fn local_anchor2(&self) -> Vector {
+        self.local_anchor2
+    }
+    /// The Rapier joint locking the out-of-plane motion, if any.
+    pub fn lock_handle(&self) -> Option<ImpulseJointHandle> {
+        self.lock_handle
+    }
+    /// What the hook computed at its last application.
+    pub fn report(&self) -> &ClearanceReport {
+        &self.report
+    }
+    /// Elastic energy stored in the contact at the last application, J.
+    pub fn elastic_energy(&self) -> f64 {
+        self.normal_law.elastic_energy(self.report.state.penetration)
+    }
+
+    fn evaluate(&mut self, bodies: &RigidBodySet) -> Option<(Wrench, Wrench)> {
+        let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
+        let (m1, m2) = (motion(rb1), motion(rb2));
+        let axis = *rb1.rotation() * self.local_axis1;
+        let p_i = *rb1.position() * self.local_anchor1;
+        let p_j = *rb2.position() * self.local_anchor2;
+        let state = journal_state(&self.geometry, p_i, p_j, axis, &m1, &m2);
+
+        // Contact history: record delta_dot0 at onset (MODEL.md §2), classify the mode.
+        let onset = state.penetration > 0.0 && !self.contact.in_contact;
+        if state.penetration > 0.0 {
+            if onset {
+                self.contact = ContactHistory {
+                    in_contact: true,
+                    compressing: true,
+                    impact_rate: state.penetration_rate.max(self.min_impact_speed),
+                };
+            } else if state.penetration_rate <= 0.0 {
+                self.contact.compressing = false;
+            }
+        } else {
+            self.contact = ContactHistory::default();
+        }
+        let mode = match (self.contact.in_contact, self.contact.compressing) {
+            (false, _) => ContactMode::FreeFlight,
+            (true, true) => ContactMode::Impact,
+            (true, false) => ContactMode::Continuous,
+        };
+        let force = contact_force(&state, self.contact.impact_rate, &self.normal_law, &self.friction_law);
+
+        // Linearised contact for the step-size limit.
+        let effective_mass = 1.0 / (inverse_mass_along(rb1, state.contact_point, state.normal) + inverse_mass_along(rb2, state.contact_point, state.normal));
+        let (max_stable_dt, omega, zeta) = if state.penetration > 0.0 {
+            let c = NormalContact { penetration: state.penetration, penetration_rate: state.penetration_rate, impact_rate: self.contact.impact_rate };
+            let mut stiffness = self.normal_law.tangent_stiffness(state.penetration);
+            if let NormalModel::ImprovedLiu(law) = &self.normal_law {
+                stiffness += ImprovedLiu::damping_slope(law, state.penetration) * state.penetration_rate;
+            }
+            stable_step(stiffness, self.normal_law.damping_coefficient(&c), effective_mass)
+        } else {
+            (f64::INFINITY, 0.0, 0.0)
+        };
+        self.report = ClearanceReport {
+            state,
+            mode,
+            onset,
+            impact_rate: self.contact.impact_rate,
+            force,
+            max_stable_dt,
+            omega,
+            zeta,
+            effective_mass,
+        };
+        let f = force.on_journal;
+        let w2 = Wrench { body: self.body2, force: f, torque: (force.point - m2.center_of_mass).cross(f) };
+        let w1 = Wrench { body: self.body1, force: -f, torque: (force.point - m1.center_of_mass).cross(-f) };
+        Some((w1, w2))
+    }
+}
+
+fn motion(rb: &RigidBody) -> BodyMotion {
+    BodyMotion { center_of_mass: world_center_of_mass(rb), linvel: rb.linvel(), angvel: rb.angvel() }
+}
+
+/// `1/m + (r x n) . I^-1 (r x n)` of a dynamic body for a unit force along `n` at `point`;
+/// 0 for fixed and kinematic bodies.
+fn inverse_mass_along(rb: &RigidBody, point: Vector, n: Vector) -> f64 {
+    if !rb.is_dynamic() {
+        return 0.0;
+    }
+    let mp = &rb.mass_properties().local_mprops;
+    let rn = (point - world_center_of_mass(rb)).cross(n);
+    mp.inv_mass + rn.dot(mp.world_inv_inertia(rb.rotation()) * rn)
+}
+
+/// Handle of a joint in a [`ClearanceJointSet`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct ClearanceJointHandle(pub usize);
+
+/// All clearance joints of a world, and the per-step force hook.
+#[derive(Clone, Debug, Default)]
+pub struct ClearanceJointSet {
+    joints: Vec<ClearanceJoint>,
+    ledger: ForceLedger,
+    wrenches: Vec<Wrench>,
+}
+
+impl ClearanceJointSet {
+    /// An empty set.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds `joint` between `body1` (bearing) and `body2` (journal). With
+    /// [`OutOfPlaneLock::Joint`] it also inserts into `impulse_joints` the Rapier joint that locks
+    /// the axial translation and the two tilts.
+    pub fn insert(
+        &mut self,
+        body1: RigidBodyHandle,
+        body2: RigidBodyHandle,
+        mut joint: ClearanceJoint,
+        impulse_joints: &mut ImpulseJointSet,
+    ) -> ClearanceJointHandle {
+        joint.body1 = body1;
+        joint.body2 = body2;
+        if joint.lock == OutOfPlaneLock::Joint {
+            let lock = GenericJointBuilder::new(JointAxesMask::LIN_X | JointAxesMask::ANG_Y | JointAxesMask::ANG_Z)
+                .local_axis1(joint.local_axis1)
+                .local_axis2(joint.local_axis2)
+                .local_anchor1(joint.local_anchor1)
+                .local_anchor2(joint.local_anchor2)
+                .contacts_enabled(false)
+                .build();
+            joint.lock_handle = Some(impulse_joints.insert(body1, body2, lock, true));
+        }
+        self.joints.push(joint);
+        ClearanceJointHandle(self.joints.len() - 1)
+    }
+
+    /// Removes the joint's forces from its bodies (and its lock joint from `impulse_joints`) and
+    /// returns it. Handles of the joints after it shift down by one.
+    pub fn remove(&mut self, handle: ClearanceJointHandle, bodies: &mut RigidBodySet, impulse_joints: &mut ImpulseJointSet) -> Option<ClearanceJoint> {
+        if handle.0 >= self.joints.len() {
+            return None;
+        }
+        let mut joint = self.joints.remove(handle.0);
+        if let Some(lock) = joint.lock_handle.take() {
+            impulse_joints.remove(lock, true);
+        }
+        // Re-apply the rest so the removed joint's last forces are taken back.
+        self.wrenches.clear();
+        self.ledger.replace(bodies, std::iter::empty());
+        Some(joint)
+    }
+
+    /// The joint behind `handle`.
+    pub fn get(&self, handle: ClearanceJointHandle) -> Option<&ClearanceJoint> {
+        self.joints.get(handle.0)
+    }
+
+    /// All joints with their handles.
+    pub fn iter(&self) -> impl Iterator<Item = (ClearanceJointHandle, &ClearanceJoint)> {
+        self.joints.iter().enumerate().map(|(i, j)| (ClearanceJointHandle(i), j))
+    }
+
+    /// Number of joints.
+    pub fn len(&self) -> usize {
+        self.joints.len()
+    }
+
+    /// Whether the set is empty.
+    pub fn is_empty(&self) -> bool {
+        self.joints.is_empty()
+    }
+
+    /// The force hook: call before every `PhysicsPipeline::step`. It evaluates every joint from
+    /// the bodies' current poses and velocities and replaces the forces it applied at the
+    /// previous call with the new contact and friction forces (your own user forces are left
+    /// alone).
+    ///
+    /// Errors (after applying the forces):
+    /// - `num_solver_iterations` is not 1: Rapier's substeps hold the hook's force constant
+    ///   across substeps and the scheme then gains energy at every impact.
+    /// - [`Error::StepTooLarge`]: `dt` exceeds the stability limit of a contact as linearised now.
+    pub fn apply(&mut self, bodies: &mut RigidBodySet, params: &IntegrationParameters) -> Result<()> {
+        self.wrenches.clear();
+        for joint in &mut self.joints {
+            if !joint.prepared {
+                ensure_mass_properties(bodies, None, joint.body1);
+                ensure_mass_properties(bodies, None, joint.body2);
+                joint.prepared = true;
+            }
+            if let Some((w1, w2)) = joint.evaluate(bodies) {
+                self.wrenches.push(w1);
+                self.wrenches.push(w2);
+            }
+        }
+        self.ledger.replace(bodies, self.wrenches.iter().copied());
+        if params.num_solver_iterations != 1 && !self.joints.is_empty() {
+            return Err(Error::invalid(
+                "num_solver_iterations",
+                format!(
+                    "must be 1 with clearance joints (got {}): Rapier's substeps hold the hook's force \
+                     constant over the whole step and the scheme gains energy at every impact",
+                    params.num_solver_iterations
+                ),
+            ));
+        }
+        self.check_step(params.dt)
+    }
+
+    /// Checks `dt` against every joint's current stability limit.
+    pub fn check_step(&self, dt: f64) -> Result<()> {
+        for j in &self.joints {
+            let r = &j.report;
+            if dt > r.max_stable_dt {
+                return Err(Error::StepTooLarge {
+                    field: "dt".into(),
+                    hinge: j.name.clone(),
+                    dt,
+                    dt_max: r.max_stable_dt,
+                    t: f64::NAN,
+                    penetration_um: r.state.penetration * 1e6,
+                    omega: r.omega,
+                    zeta: r.zeta,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Smallest stability limit over all joints at the last application (infinite when no
+    /// joint is in contact), s.
+    pub fn max_stable_dt(&self) -> f64 {
+        self.joints.iter().map(|j| j.report.max_stable_dt).fold(f64::INFINITY, f64::min)
+    }
+}

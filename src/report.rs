@@ -1,0 +1,155 @@
+//! Run summaries (`summary.json`), result files and the printed comparison table.
+
+use crate::error::{Error, Result};
+use crate::output::write_atomic;
+use crate::sim::{HingeMetrics, Invariants, RunResult, Twin};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// `summary.json`: the run and, for each twin, metrics computed from every internal step.
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    /// Scene name.
+    pub scene: String,
+    /// Step, s.
+    pub dt_s: f64,
+    /// Simulated time, s.
+    pub end_s: f64,
+    /// Per twin (`ideal`, `clearance`).
+    pub twins: BTreeMap<String, TwinSummary>,
+}
+
+/// Metrics of one twin.
+#[derive(Clone, Debug, Serialize)]
+pub struct TwinSummary {
+    /// Internal steps.
+    pub steps: u64,
+    /// Wall time of the run, s (both twins share one world and one clock).
+    pub wall_s: f64,
+    /// Final angle of every body (about the reference axis) and hinge (relative), deg.
+    pub final_angles_deg: BTreeMap<String, f64>,
+    /// Largest joint force over all hinges, N.
+    pub peak_joint_force_n: f64,
+    /// Contact onsets over all hinges.
+    pub impacts: u64,
+    /// Earliest contact onset, s (null without contact).
+    pub first_impact_t_s: Option<f64>,
+    /// Peak force of that first contact, N.
+    pub first_impact_peak_n: Option<f64>,
+    /// Largest penetration over all hinges, um.
+    pub max_penetration_um: f64,
+    /// Relative drift of total linear momentum.
+    pub linear_momentum_drift: f64,
+    /// Relative drift of total angular momentum.
+    pub angular_momentum_drift: f64,
+    /// Energy invariants.
+    pub invariants: Invariants,
+    /// Per hinge.
+    pub hinges: BTreeMap<String, HingeMetrics>,
+}
+
+impl TwinSummary {
+    /// Summarises `twin`.
+    pub fn of(twin: &Twin, steps: u64, wall_s: f64) -> TwinSummary {
+        let hinges = twin.hinge_metrics();
+        let first = hinges.values().filter_map(|m| Some((m.first_impact_t_s?, m.first_impact_peak_n?))).min_by(|a, b| a.0.total_cmp(&b.0));
+        TwinSummary {
+            steps,
+            wall_s,
+            final_angles_deg: twin.final_angles_deg(),
+            peak_joint_force_n: hinges.values().map(|m| m.peak_force_n).fold(0.0, f64::max),
+            impacts: hinges.values().map(|m| m.impacts).sum(),
+            first_impact_t_s: first.map(|f| f.0),
+            first_impact_peak_n: first.map(|f| f.1),
+            max_penetration_um: hinges.values().map(|m| m.max_penetration_um).fold(0.0, f64::max),
+            linear_momentum_drift: twin.invariants.linear_momentum_drift,
+            angular_momentum_drift: twin.invariants.angular_momentum_drift,
+            invariants: twin.invariants.clone(),
+            hinges,
+        }
+    }
+}
+
+impl RunResult {
+    /// The summary of this run.
+    pub fn summary(&self) -> Summary {
+        Summary {
+            scene: self.scene.name.clone(),
+            dt_s: self.scene.run.dt_s,
+            end_s: self.scene.run.end_s,
+            twins: self.twins.iter().map(|t| (t.kind.name().to_string(), TwinSummary::of(t, self.steps, self.wall_s))).collect(),
+        }
+    }
+
+    /// The twin of `kind`, if built.
+    pub fn twin(&self, kind: crate::sim::TwinKind) -> Option<&Twin> {
+        self.twins.iter().find(|t| t.kind == kind)
+    }
+
+    /// Writes `<twin>.csv` for each twin and `summary.json` into `dir`, each file whole or not
+    /// at all. All CSVs are rendered (and checked finite) before anything is written.
+    pub fn write(&self, dir: &Path) -> Result<Summary> {
+        let csvs: Vec<(String, String)> = self.twins.iter().map(|t| Ok((format!("{}.csv", t.kind.name()), t.table.to_csv()?))).collect::<Result<_>>()?;
+        let summary = self.summary();
+        let json = summary_json(&summary)?;
+        for (name, text) in &csvs {
+            write_atomic(&dir.join(name), text.as_bytes())?;
+        }
+        write_atomic(&dir.join("summary.json"), json.as_bytes())?;
+        Ok(summary)
+    }
+}
+
+/// Pretty JSON of a summary; refuses non-finite numbers (JSON has none).
+pub fn summary_json(summary: &Summary) -> Result<String> {
+    let value = serde_json::to_value(summary).map_err(|e| Error::invalid("summary", e.to_string()))?;
+    fn check(v: &serde_json::Value, path: &str) -> Result<()> {
+        match v {
+            // serde_json writes non-finite floats as null; a metric that should be a number must not be.
+            serde_json::Value::Object(o) => o.iter().try_for_each(|(k, c)| check(c, &format!("{path}.{k}"))),
+            serde_json::Value::Array(a) => a.iter().enumerate().try_for_each(|(i, c)| check(c, &format!("{path}[{i}]"))),
+            _ => Ok(()),
+        }
+    }
+    check(&value, "summary")?;
+    for twin in summary.twins.values() {
+        let nums = [twin.peak_joint_force_n, twin.max_penetration_um, twin.linear_momentum_drift, twin.angular_momentum_drift, twin.invariants.energy_growth];
+        if nums.iter().chain(twin.final_angles_deg.values()).any(|x| !x.is_finite()) {
+            return Err(Error::Diverged { t: summary.end_s, reason: "non-finite metric in the summary".into() });
+        }
+    }
+    serde_json::to_string_pretty(&value).map_err(|e| Error::invalid("summary", e.to_string()))
+}
+
+/// A short side-by-side table of the twins for the terminal.
+pub fn comparison_table(summary: &Summary) -> String {
+    let twins: Vec<(&String, &TwinSummary)> = summary.twins.iter().rev().collect(); // ideal, clearance
+    let mut rows: Vec<(String, Vec<String>)> = Vec::new();
+    if let Some((_, first)) = twins.first() {
+        for name in first.final_angles_deg.keys() {
+            rows.push((format!("final {name} angle (deg)"), twins.iter().map(|(_, t)| format!("{:.4}", t.final_angles_deg[name])).collect()));
+        }
+    }
+    let opt = |x: Option<f64>, p: usize| x.map_or("-".to_string(), |v| format!("{v:.p$}"));
+    rows.push(("peak joint force (N)".into(), twins.iter().map(|(_, t)| format!("{:.4}", t.peak_joint_force_n)).collect()));
+    rows.push(("impacts".into(), twins.iter().map(|(_, t)| t.impacts.to_string()).collect()));
+    rows.push(("first impact (s)".into(), twins.iter().map(|(_, t)| opt(t.first_impact_t_s, 4)).collect()));
+    rows.push(("first impact peak (N)".into(), twins.iter().map(|(_, t)| opt(t.first_impact_peak_n, 3)).collect()));
+    rows.push(("max penetration (um)".into(), twins.iter().map(|(_, t)| format!("{:.3}", t.max_penetration_um)).collect()));
+    rows.push(("momentum drift lin/ang".into(), twins.iter().map(|(_, t)| format!("{:.1e}/{:.1e}", t.linear_momentum_drift, t.angular_momentum_drift)).collect()));
+    let w0 = rows.iter().map(|r| r.0.len()).max().unwrap_or(0);
+    let mut s = format!("{:w0$}", "");
+    for (name, _) in &twins {
+        s.push_str(&format!("  {name:>16}"));
+    }
+    s.push('\n');
+    for (label, vals) in rows {
+        s.push_str(&format!("{label:w0$}"));
+        for v in vals {
+            s.push_str(&format!("  {v:>16}"));
+        }
+        s.push('\n');
+    }
+    s
+}

@@ -1,0 +1,585 @@
+//! The runner: builds a scene twice in one Rapier world, an ideal twin (every hinge a Rapier
+//! revolute joint) and a clearance twin (hinges with clearance become [`ClearanceJoint`]s), steps
+//! both together, and records both.
+
+use crate::angle::{UnwrappedAngle, twist_angle};
+use crate::drive::{DriveSet, TorsionSpring};
+use crate::error::{Error, Result};
+use crate::joint::{ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet};
+use crate::output::Table;
+use crate::scene::Scene;
+use rapier3d_f64::math::{Rotation, Vector};
+use rapier3d_f64::prelude::*;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// Which hinges a twin models with clearance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TwinKind {
+    /// Every hinge is Rapier's ideal revolute joint.
+    Ideal,
+    /// Hinges with a clearance spec are clearance joints.
+    Clearance,
+}
+
+impl TwinKind {
+    /// `"ideal"` or `"clearance"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            TwinKind::Ideal => "ideal",
+            TwinKind::Clearance => "clearance",
+        }
+    }
+}
+
+/// Which twins to build.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Twins {
+    /// Both, side by side in one world (the default).
+    #[default]
+    Both,
+    /// Only the ideal twin (for cost measurements).
+    IdealOnly,
+    /// Only the clearance twin (for cost measurements).
+    ClearanceOnly,
+}
+
+/// Run options beyond the scene.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RunOptions {
+    /// Which twins to build.
+    pub twins: Twins,
+    /// Keep output rows (off for benchmarks: metrics are still computed every step).
+    pub skip_rows: bool,
+}
+
+#[derive(Clone, Debug)]
+struct BodyTrack {
+    name: String,
+    handle: RigidBodyHandle,
+    mass: f64,
+    initial_rotation: Rotation,
+    angle: UnwrappedAngle,
+    linvel_before: Vector,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum HingeJoint {
+    Ideal(#[allow(dead_code)] ImpulseJointHandle),
+    Clearance(ClearanceJointHandle),
+}
+
+#[derive(Clone, Debug)]
+struct HingeTrack {
+    name: String,
+    joint: HingeJoint,
+    bearing: usize,
+    journal: usize,
+    local_axis1: Vector,
+    local_u1: Vector,
+    local_v1: Vector,
+    reference: Rotation,
+    angle: UnwrappedAngle,
+    /// Force magnitude acting over the current step, N.
+    force: f64,
+    metrics: HingeMetrics,
+}
+
+/// Per-hinge metrics over every internal step.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct HingeMetrics {
+    /// Largest joint force, N.
+    pub peak_force_n: f64,
+    /// Number of contact onsets.
+    pub impacts: u64,
+    /// Time of the first contact onset, s.
+    pub first_impact_t_s: Option<f64>,
+    /// Largest force during the first contact, N.
+    pub first_impact_peak_n: Option<f64>,
+    /// Largest penetration, um.
+    pub max_penetration_um: f64,
+    /// Steps spent in contact.
+    pub contact_steps: u64,
+    /// Final relative angle, deg.
+    pub final_angle_deg: f64,
+    #[serde(skip)]
+    in_first_contact: bool,
+}
+
+/// One twin: its bodies, joints, drives and records.
+#[derive(Debug)]
+pub struct Twin {
+    /// Ideal or clearance.
+    pub kind: TwinKind,
+    bodies: Vec<BodyTrack>,
+    hinges: Vec<HingeTrack>,
+    /// The clearance joints of this twin.
+    pub clearance: ClearanceJointSet,
+    /// The drives of this twin.
+    pub drives: DriveSet,
+    reaction_order: Vec<(usize, usize, f64)>,
+    reference_axis: Vector,
+    /// Output rows.
+    pub table: Table,
+    /// Invariants and energy over every step.
+    pub invariants: Invariants,
+}
+
+/// Conservation checks over every step (free-floating scenes).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Invariants {
+    /// Largest `|P(t) - P(0)|` over the largest single-body linear momentum seen.
+    pub linear_momentum_drift: f64,
+    /// Largest `|L(t) - L(0)|` (about the origin) over the largest single-body angular momentum seen.
+    pub angular_momentum_drift: f64,
+    /// Largest growth of total energy (kinetic + spring + contact elastic) above its initial
+    /// value, over the peak kinetic energy (with gravity, its potential is included).
+    pub energy_growth: f64,
+    /// Largest `|E(t) - E(0)|` over the peak kinetic energy.
+    pub energy_error: f64,
+    /// Peak kinetic energy, J.
+    pub peak_kinetic_energy_j: f64,
+    #[serde(skip)]
+    p0: Option<(Vector, Vector, f64)>,
+    #[serde(skip)]
+    max_p: f64,
+    #[serde(skip)]
+    max_l: f64,
+    #[serde(skip)]
+    max_dp: f64,
+    #[serde(skip)]
+    max_dl: f64,
+    #[serde(skip)]
+    max_de: f64,
+    #[serde(skip)]
+    max_abs_de: f64,
+}
+
+/// A scene built in a Rapier world, ready to step.
+pub struct Simulation {
+    /// The Rapier world holding both twins.
+    pub world: PhysicsWorld,
+    /// The twins, ideal first.
+    pub twins: Vec<Twin>,
+    scene: Scene,
+    steps_done: u64,
+    n_steps: u64,
+    stride: u64,
+    skip_rows: bool,
+}
+
+/// The result of a whole run.
+#[derive(Debug)]
+pub struct RunResult {
+    /// The scene that ran (after overrides).
+    pub scene: Scene,
+    /// Twins with their tables and invariants.
+    pub twins: Vec<Twin>,
+    /// Internal steps taken.
+    pub steps: u64,
+    /// Wall time of the whole run (both twins share one world), s.
+    pub wall_s: f64,
+}
+
+impl Simulation {
+    /// Builds the world for `scene`.
+    pub fn new(scene: &Scene, options: RunOptions) -> Result<Simulation> {
+        scene.validate()?;
+        let mut world = PhysicsWorld::new();
+        world.gravity = Vector::from(scene.gravity);
+        world.integration_parameters.dt = scene.run.dt_s;
+        // One substep: the hook's force is constant over the step (RAPIER_NOTES: substeps gain energy).
+        world.integration_parameters.num_solver_iterations = 1;
+        let kinds: &[TwinKind] = match options.twins {
+            Twins::Both => &[TwinKind::Ideal, TwinKind::Clearance],
+            Twins::IdealOnly => &[TwinKind::Ideal],
+            Twins::ClearanceOnly => &[TwinKind::Clearance],
+        };
+        let mut twins = Vec::new();
+        for &kind in kinds {
+            twins.push(Twin::build(scene, kind, &mut world)?);
+        }
+        let n_steps = (scene.run.end_s / scene.run.dt_s).round().max(1.0) as u64;
+        let stride = (scene.run.output_interval_s / scene.run.dt_s).round().max(1.0) as u64;
+        Ok(Simulation { world, twins, scene: scene.clone(), steps_done: 0, n_steps, stride, skip_rows: options.skip_rows })
+    }
+
+    /// Simulated time, s.
+    pub fn time(&self) -> f64 {
+        self.steps_done as f64 * self.world.integration_parameters.dt
+    }
+
+    /// Runs to `run.end_s`.
+    pub fn run(mut self) -> Result<RunResult> {
+        let start = Instant::now();
+        while self.steps_done < self.n_steps {
+            self.step()?;
+        }
+        self.finish()?;
+        Ok(RunResult { scene: self.scene, twins: self.twins, steps: self.steps_done, wall_s: start.elapsed().as_secs_f64() })
+    }
+
+    /// Advances one internal step: forces from the hooks, Rapier's step, then records.
+    pub fn step(&mut self) -> Result<()> {
+        let record = !self.skip_rows && self.steps_done % self.stride == 0;
+        self.before_step(record)?;
+        self.world.step();
+        let dt = self.world.integration_parameters.dt;
+        let gravity = self.world.gravity;
+        for twin in &mut self.twins {
+            twin.solve_ideal_reactions(&self.world.bodies, dt, gravity);
+            twin.update_force_metrics(self.steps_done as f64 * dt);
+            if record {
+                twin.fill_forces_of_last_row();
+            }
+        }
+        self.steps_done += 1;
+        self.check_health()
+    }
+
+    /// Evaluates hooks at the current state and records invariants (and a row).
+    fn before_step(&mut self, record: bool) -> Result<()> {
+        let t = self.time();
+        let params = self.world.integration_parameters;
+        for twin in &mut self.twins {
+            twin.drives.apply(&mut self.world.bodies);
+            if let Err(e) = twin.clearance.apply(&mut self.world.bodies, &params) {
+                return Err(match e {
+                    Error::StepTooLarge { hinge, dt, dt_max, penetration_um, omega, zeta, .. } => {
+                        Error::StepTooLarge { field: "run.dt_s".into(), hinge, dt, dt_max, t, penetration_um, omega, zeta }
+                    }
+                    other => other,
+                });
+            }
+            for b in &mut twin.bodies {
+                b.linvel_before = self.world.bodies[b.handle].linvel();
+            }
+            twin.update_invariants(&self.world.bodies, self.world.gravity);
+            if record {
+                twin.push_row(t, &self.world.bodies);
+            }
+        }
+        Ok(())
+    }
+
+    /// Records the final state (a last row at `end_s`) and final angles.
+    fn finish(&mut self) -> Result<()> {
+        let record = !self.skip_rows;
+        self.before_step(record)?;
+        for twin in &mut self.twins {
+            if record {
+                twin.fill_forces_of_last_row();
+            }
+            for h in &mut twin.hinges {
+                h.metrics.final_angle_deg = h.angle.value().to_degrees();
+            }
+        }
+        Ok(())
+    }
+
+    fn check_health(&self) -> Result<()> {
+        let vmax = 0.5 * self.world.integration_parameters.max_linear_velocity();
+        for twin in &self.twins {
+            for b in &twin.bodies {
+                let rb = &self.world.bodies[b.handle];
+                let (v, w) = (rb.linvel(), rb.angvel());
+                if !rb.is_enabled() || !rb.translation().is_finite() || !v.is_finite() || !w.is_finite() || v.length() > vmax {
+                    return Err(Error::Diverged {
+                        t: self.time(),
+                        reason: format!("body `{}` of the {} twin left the physical range (speed {:.3e} m/s)", b.name, twin.kind.name(), v.length()),
+                    });
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Twin {
+    fn build(scene: &Scene, kind: TwinKind, world: &mut PhysicsWorld) -> Result<Twin> {
+        let mut bodies = Vec::new();
+        for b in &scene.bodies {
+            let com = Vector::from(b.center_of_mass_m);
+            let rb = RigidBodyBuilder::dynamic()
+                .translation(com)
+                .additional_mass_properties(MassProperties::new(Vector::ZERO, b.mass_kg, Vector::from(b.inertia_kg_m2)))
+                .can_sleep(false)
+                .build();
+            let handle = world.bodies.insert(rb);
+            bodies.push(BodyTrack {
+                name: b.name.clone(),
+                handle,
+                mass: b.mass_kg,
+                initial_rotation: Rotation::IDENTITY,
+                angle: UnwrappedAngle::default(),
+                linvel_before: Vector::ZERO,
+            });
+        }
+        let mut clearance = ClearanceJointSet::new();
+        let mut hinges = Vec::new();
+        for h in &scene.hinges {
+            let (ib, ij) = (scene.body_index(&h.bearing).unwrap(), scene.body_index(&h.journal).unwrap());
+            let point = Vector::from(h.point_m);
+            let axis = Vector::from(h.axis).normalize();
+            // Bodies start unrotated with their frame at the centre of mass.
+            let a1 = point - Vector::from(scene.bodies[ib].center_of_mass_m);
+            let a2 = point - Vector::from(scene.bodies[ij].center_of_mass_m);
+            let (b1, b2) = (bodies[ib].handle, bodies[ij].handle);
+            let joint = match (&h.clearance, kind) {
+                (Some(spec), TwinKind::Clearance) => {
+                    let p = spec.build().map_err(|e| e.within(&format!("hinges[{}].clearance", h.name)))?;
+                    let j = ClearanceJointBuilder::new(axis, p.geometry, p.normal)
+                        .local_anchor1(a1)
+                        .local_anchor2(a2)
+                        .friction(p.friction)
+                        .min_impact_speed(p.min_impact_speed)
+                        .lock(spec.lock)
+                        .name(h.name.clone())
+                        .build()?;
+                    HingeJoint::Clearance(clearance.insert(b1, b2, j, &mut world.impulse_joints))
+                }
+                _ => {
+                    let j = RevoluteJointBuilder::new(axis).local_anchor1(a1).local_anchor2(a2).contacts_enabled(false);
+                    HingeJoint::Ideal(world.impulse_joints.insert(b1, b2, j, true))
+                }
+            };
+            let u = in_plane_u(axis);
+            hinges.push(HingeTrack {
+                name: h.name.clone(),
+                joint,
+                bearing: ib,
+                journal: ij,
+                local_axis1: axis,
+                local_u1: u,
+                local_v1: axis.cross(u),
+                reference: Rotation::IDENTITY,
+                angle: UnwrappedAngle::default(),
+                force: 0.0,
+                metrics: HingeMetrics::default(),
+            });
+        }
+        let mut drives = DriveSet::new();
+        for d in &scene.drives {
+            let hi = scene.hinge_index(&d.hinge).unwrap();
+            let h = &hinges[hi];
+            let per_rad = d.stiffness_nm_per_deg.to_degrees();
+            let spring = TorsionSpring::new(bodies[h.bearing].handle, bodies[h.journal].handle, h.local_axis1, d.torque_scale * d.torque0_nm, d.torque_scale * per_rad)
+                .map_err(|e| e.within(&format!("drives[{}]", d.name)))?;
+            drives.insert(spring);
+        }
+        let reaction_order = reaction_order(&hinges);
+        let mut columns = vec!["t_s".to_string()];
+        for b in &bodies {
+            columns.push(format!("{}_angle_deg", b.name));
+            columns.push(format!("{}_rate_deg_s", b.name));
+        }
+        for h in &hinges {
+            for c in ["angle_deg", "rate_deg_s", "force_n", "ecc_u_mm", "ecc_v_mm", "penetration_um", "contact"] {
+                columns.push(format!("{}_{c}", h.name));
+            }
+        }
+        Ok(Twin { kind, bodies, hinges, clearance, drives, reaction_order, reference_axis: Vector::from(scene.reference_axis).normalize(), table: Table::new(columns), invariants: Invariants::default() })
+    }
+
+    /// Exact ideal-joint reactions from the momentum balance of the bodies over the last step:
+    /// `F_joint = m (v+ - v-)/dt - F_user - m g`, eliminated from the leaves of the joint tree.
+    fn solve_ideal_reactions(&mut self, bodies: &RigidBodySet, dt: f64, gravity: Vector) {
+        if self.reaction_order.is_empty() {
+            for h in &mut self.hinges {
+                if let HingeJoint::Clearance(c) = h.joint {
+                    h.force = self.clearance.get(c).map_or(0.0, |j| j.report().force.on_journal.length());
+                }
+            }
+            return;
+        }
+        let mut residual: Vec<Vector> = self
+            .bodies
+            .iter()
+            .map(|b| {
+                let rb = &bodies[b.handle];
+                b.mass * (rb.linvel() - b.linvel_before) / dt - rb.user_force() - b.mass * gravity
+            })
+            .collect();
+        for &(hi, body, sign) in &self.reaction_order {
+            let h = &mut self.hinges[hi];
+            // Force on the journal body.
+            let f = sign * residual[body];
+            residual[h.journal] -= f;
+            residual[h.bearing] += f;
+            h.force = f.length();
+        }
+        for h in &mut self.hinges {
+            if let HingeJoint::Clearance(c) = h.joint {
+                h.force = self.clearance.get(c).map_or(0.0, |j| j.report().force.on_journal.length());
+            }
+        }
+    }
+
+    fn update_force_metrics(&mut self, t: f64) {
+        for h in &mut self.hinges {
+            let m = &mut h.metrics;
+            m.peak_force_n = m.peak_force_n.max(h.force);
+            if let HingeJoint::Clearance(c) = h.joint {
+                let r = self.clearance.get(c).expect("handle of this twin").report();
+                let in_contact = r.state.penetration > 0.0;
+                if r.onset {
+                    m.impacts += 1;
+                    if m.first_impact_t_s.is_none() {
+                        m.first_impact_t_s = Some(t);
+                        m.first_impact_peak_n = Some(0.0);
+                        m.in_first_contact = true;
+                    }
+                }
+                if m.in_first_contact {
+                    if in_contact {
+                        m.first_impact_peak_n = Some(m.first_impact_peak_n.unwrap_or(0.0).max(h.force));
+                    } else {
+                        m.in_first_contact = false;
+                    }
+                }
+                if in_contact {
+                    m.contact_steps += 1;
+                    m.max_penetration_um = m.max_penetration_um.max(r.state.penetration * 1e6);
+                }
+            }
+        }
+    }
+
+    fn update_invariants(&mut self, bodies: &RigidBodySet, gravity: Vector) {
+        let (mut p, mut l, mut ke, mut pe) = (Vector::ZERO, Vector::ZERO, 0.0, 0.0);
+        let inv = &mut self.invariants;
+        for b in &self.bodies {
+            let rb = &bodies[b.handle];
+            let com = crate::ledger::world_center_of_mass(rb);
+            let (v, w) = (rb.linvel(), rb.angvel());
+            let mp = &rb.mass_properties().local_mprops;
+            // I w in world: R I_principal R^T w (principal frame = body frame here).
+            let rot = *rb.rotation() * mp.principal_inertia_local_frame;
+            let iw = rot * (mp.principal_inertia() * (rot.inverse() * w));
+            let pb = b.mass * v;
+            let lb = com.cross(pb) + iw;
+            p += pb;
+            l += lb;
+            ke += 0.5 * b.mass * v.length_squared() + 0.5 * w.dot(iw);
+            pe -= b.mass * gravity.dot(com);
+            inv.max_p = inv.max_p.max(pb.length());
+            inv.max_l = inv.max_l.max(lb.length());
+        }
+        pe += self.drives.potential_energy();
+        pe += self.clearance.iter().map(|(_, j)| j.elastic_energy()).sum::<f64>();
+        let e = ke + pe;
+        let (p0, l0, e0) = *inv.p0.get_or_insert((p, l, e));
+        inv.max_dp = inv.max_dp.max((p - p0).length());
+        inv.max_dl = inv.max_dl.max((l - l0).length());
+        inv.max_de = inv.max_de.max(e - e0);
+        inv.max_abs_de = inv.max_abs_de.max((e - e0).abs());
+        inv.peak_kinetic_energy_j = inv.peak_kinetic_energy_j.max(ke);
+        let rel = |d: f64, scale: f64| if scale > 0.0 { d / scale } else { 0.0 };
+        inv.linear_momentum_drift = rel(inv.max_dp, inv.max_p);
+        inv.angular_momentum_drift = rel(inv.max_dl, inv.max_l);
+        inv.energy_growth = rel(inv.max_de, inv.peak_kinetic_energy_j);
+        inv.energy_error = rel(inv.max_abs_de, inv.peak_kinetic_energy_j);
+    }
+
+    fn push_row(&mut self, t: f64, bodies: &RigidBodySet) {
+        let axis_ref = self.reference_axis;
+        let v = &mut self.table.values;
+        v.push(t);
+        for b in &mut self.bodies {
+            let rb = &bodies[b.handle];
+            let q = *rb.rotation() * b.initial_rotation.inverse();
+            v.push(b.angle.update(twist_angle(&q, axis_ref)).to_degrees());
+            v.push(rb.angvel().dot(axis_ref).to_degrees());
+        }
+        for h in &mut self.hinges {
+            let (r1, r2) = (&bodies[self.bodies[h.bearing].handle], &bodies[self.bodies[h.journal].handle]);
+            let rel = h.reference.inverse() * (r1.rotation().inverse() * *r2.rotation());
+            let angle = h.angle.update(twist_angle(&rel, h.local_axis1));
+            let axis = *r1.rotation() * h.local_axis1;
+            v.push(angle.to_degrees());
+            v.push((r2.angvel() - r1.angvel()).dot(axis).to_degrees());
+            v.push(f64::NAN); // force over the step, filled after it
+            match h.joint {
+                HingeJoint::Clearance(c) => {
+                    let r = self.clearance.get(c).expect("handle of this twin").report();
+                    let e = r.state.eccentricity;
+                    v.push(e.dot(*r1.rotation() * h.local_u1) * 1e3);
+                    v.push(e.dot(*r1.rotation() * h.local_v1) * 1e3);
+                    v.push(r.state.penetration.max(0.0) * 1e6);
+                    v.push(if r.state.penetration > 0.0 { 1.0 } else { 0.0 });
+                }
+                HingeJoint::Ideal(_) => v.extend_from_slice(&[0.0, 0.0, 0.0, 0.0]),
+            }
+        }
+    }
+
+    fn fill_forces_of_last_row(&mut self) {
+        let n = self.table.columns.len();
+        let start = self.table.values.len() - n;
+        let first_hinge_col = 1 + 2 * self.bodies.len();
+        for (k, h) in self.hinges.iter().enumerate() {
+            self.table.values[start + first_hinge_col + 7 * k + 2] = h.force;
+        }
+    }
+
+    /// Per-hinge metrics by hinge name.
+    pub fn hinge_metrics(&self) -> BTreeMap<String, HingeMetrics> {
+        self.hinges.iter().map(|h| (h.name.clone(), h.metrics.clone())).collect()
+    }
+
+    /// Final angles (deg) of every body and hinge, by name.
+    pub fn final_angles_deg(&self) -> BTreeMap<String, f64> {
+        let mut m = BTreeMap::new();
+        for b in &self.bodies {
+            m.insert(b.name.clone(), b.angle.value().to_degrees());
+        }
+        for h in &self.hinges {
+            m.insert(h.name.clone(), h.angle.value().to_degrees());
+        }
+        m
+    }
+}
+
+/// The in-plane `u` direction of a hinge: the world axis least aligned with `axis`, made
+/// orthogonal to it (world x for the paper's hinge; then `v = axis x u` is world z).
+fn in_plane_u(axis: Vector) -> Vector {
+    let candidates = [Vector::X, Vector::Y, Vector::Z];
+    let mut best = candidates[0];
+    for c in candidates {
+        if c.dot(axis).abs() < best.dot(axis).abs() - 1e-12 {
+            best = c;
+        }
+    }
+    (best - best.dot(axis) * axis).normalize()
+}
+
+/// Elimination order for the ideal-joint reactions: repeatedly take a body with exactly one
+/// unsolved ideal joint; its residual momentum change is that joint's force. Returns
+/// `(hinge, body, sign)` with force on the journal `= sign * residual[body]`.
+fn reaction_order(hinges: &[HingeTrack]) -> Vec<(usize, usize, f64)> {
+    let mut unsolved: Vec<usize> = hinges.iter().enumerate().filter(|(_, h)| matches!(h.joint, HingeJoint::Ideal(_))).map(|(i, _)| i).collect();
+    let mut order = Vec::new();
+    while !unsolved.is_empty() {
+        let count = |b: usize, u: &[usize]| u.iter().filter(|&&i| hinges[i].bearing == b || hinges[i].journal == b).count();
+        let pick = unsolved.iter().enumerate().find_map(|(k, &i)| {
+            let h = &hinges[i];
+            if count(h.journal, &unsolved) == 1 {
+                Some((k, i, h.journal, 1.0))
+            } else if count(h.bearing, &unsolved) == 1 {
+                Some((k, i, h.bearing, -1.0))
+            } else {
+                None
+            }
+        });
+        match pick {
+            Some((k, i, b, s)) => {
+                order.push((i, b, s));
+                unsolved.remove(k);
+            }
+            None => break, // a closed loop: its reactions are not determined by momentum alone
+        }
+    }
+    order
+}

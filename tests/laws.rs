@@ -646,7 +646,7 @@ fn body(pos: f64, lin: f64, ang: f64) -> impl Strategy<Value = BodyMotion> {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig::with_cases(400))]
+    #![proptest_config(ProptestConfig { cases: 400, failure_persistence: None, ..ProptestConfig::default() })]
 
     #[test]
     fn normal_force_is_never_negative(

@@ -6,7 +6,9 @@ use std::f64::consts::{PI, TAU};
 /// Twist angle of `rotation` about the unit `axis`, in (-2 pi, 2 pi]: the swing-twist
 /// decomposition's twist, `2 atan2(q_v . axis, q_w)`.
 pub fn twist_angle(rotation: &Rotation, axis: Vector) -> f64 {
-    2.0 * Vector::new(rotation.x, rotation.y, rotation.z).dot(axis).atan2(rotation.w)
+    2.0 * Vector::new(rotation.x, rotation.y, rotation.z)
+        .dot(axis)
+        .atan2(rotation.w)
 }
 
 /// Tracks an angle across steps and removes the 2 pi jumps of [`twist_angle`].

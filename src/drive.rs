@@ -23,7 +23,13 @@ pub struct TorsionSpring {
 
 impl TorsionSpring {
     /// Preload `torque0` (N m) and stiffness (N m/rad), about `local_axis1` (body 1's frame).
-    pub fn new(body1: RigidBodyHandle, body2: RigidBodyHandle, local_axis1: Vector, torque0: f64, stiffness: f64) -> Result<Self> {
+    pub fn new(
+        body1: RigidBodyHandle,
+        body2: RigidBodyHandle,
+        local_axis1: Vector,
+        torque0: f64,
+        stiffness: f64,
+    ) -> Result<Self> {
         finite("torque0_nm", torque0)?;
         non_negative("stiffness_nm_per_deg", stiffness)?;
         let n = local_axis1.length();
@@ -68,13 +74,24 @@ impl TorsionSpring {
         let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
         let relative = rb1.rotation().inverse() * *rb2.rotation();
         let reference = *self.reference.get_or_insert(relative);
-        let theta = self.angle.update(twist_angle(&(reference.inverse() * relative), self.local_axis1));
+        let theta = self.angle.update(twist_angle(
+            &(reference.inverse() * relative),
+            self.local_axis1,
+        ));
         let torque = self.torque_at(theta);
         self.last_torque = torque;
         let t = torque * (*rb1.rotation() * self.local_axis1);
         Some((
-            Wrench { body: self.body1, force: Vector::ZERO, torque: -t },
-            Wrench { body: self.body2, force: Vector::ZERO, torque: t },
+            Wrench {
+                body: self.body1,
+                force: Vector::ZERO,
+                torque: -t,
+            },
+            Wrench {
+                body: self.body2,
+                force: Vector::ZERO,
+                torque: t,
+            },
         ))
     }
 }
@@ -114,6 +131,9 @@ impl DriveSet {
     }
     /// Total potential energy of the springs at their last measured angles, J.
     pub fn potential_energy(&self) -> f64 {
-        self.drives.iter().map(|d| d.potential_energy(d.angle())).sum()
+        self.drives
+            .iter()
+            .map(|d| d.potential_energy(d.angle()))
+            .sum()
     }
 }

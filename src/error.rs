@@ -74,14 +74,20 @@ pub type Result<T, E = Error> = std::result::Result<T, E>;
 impl Error {
     /// An [`Error::Invalid`] for `field` with `reason`.
     pub fn invalid(field: impl Into<String>, reason: impl Into<String>) -> Self {
-        Error::Invalid { field: field.into(), reason: reason.into() }
+        Error::Invalid {
+            field: field.into(),
+            reason: reason.into(),
+        }
     }
 
     /// Prefixes the field path of an [`Error::Invalid`] with `prefix` (`prefix.field`);
     /// other variants pass through. Used when a nested value is validated in context.
     pub fn within(self, prefix: &str) -> Self {
         match self {
-            Error::Invalid { field, reason } => Error::Invalid { field: format!("{prefix}.{field}"), reason },
+            Error::Invalid { field, reason } => Error::Invalid {
+                field: format!("{prefix}.{field}"),
+                reason,
+            },
             other => other,
         }
     }
@@ -92,7 +98,10 @@ pub fn positive(field: &str, value: f64) -> Result<f64> {
     if value.is_nan() {
         Err(Error::invalid(field, "is NaN"))
     } else if !value.is_finite() {
-        Err(Error::invalid(field, format!("must be finite (got {value})")))
+        Err(Error::invalid(
+            field,
+            format!("must be finite (got {value})"),
+        ))
     } else if value <= 0.0 {
         Err(Error::invalid(field, format!("must be > 0 (got {value})")))
     } else {
@@ -105,7 +114,10 @@ pub fn non_negative(field: &str, value: f64) -> Result<f64> {
     if value.is_nan() {
         Err(Error::invalid(field, "is NaN"))
     } else if !value.is_finite() {
-        Err(Error::invalid(field, format!("must be finite (got {value})")))
+        Err(Error::invalid(
+            field,
+            format!("must be finite (got {value})"),
+        ))
     } else if value < 0.0 {
         Err(Error::invalid(field, format!("must be >= 0 (got {value})")))
     } else {
@@ -118,7 +130,10 @@ pub fn finite(field: &str, value: f64) -> Result<f64> {
     if value.is_nan() {
         Err(Error::invalid(field, "is NaN"))
     } else if !value.is_finite() {
-        Err(Error::invalid(field, format!("must be finite (got {value})")))
+        Err(Error::invalid(
+            field,
+            format!("must be finite (got {value})"),
+        ))
     } else {
         Ok(value)
     }
@@ -128,7 +143,10 @@ pub fn finite(field: &str, value: f64) -> Result<f64> {
 pub fn in_range_open_closed(field: &str, value: f64, lo: f64, hi: f64) -> Result<f64> {
     finite(field, value)?;
     if value <= lo || value > hi {
-        Err(Error::invalid(field, format!("must be in ({lo}, {hi}] (got {value})")))
+        Err(Error::invalid(
+            field,
+            format!("must be in ({lo}, {hi}] (got {value})"),
+        ))
     } else {
         Ok(value)
     }

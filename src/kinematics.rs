@@ -67,7 +67,11 @@ pub fn journal_state(
     let d = p_j - p_i;
     let eccentricity = d - d.dot(axis) * axis;
     let e = eccentricity.length();
-    let normal = if e > 0.0 { eccentricity / e } else { axis.any_orthonormal_vector() };
+    let normal = if e > 0.0 {
+        eccentricity / e
+    } else {
+        axis.any_orthonormal_vector()
+    };
     let q_i = p_i + geometry.bearing_radius * normal;
     let q_j = p_j + geometry.journal_radius * normal;
     let v_rel = journal.velocity_at(q_j) - bearing.velocity_at(q_i);
@@ -98,14 +102,22 @@ pub struct ForcePair {
 
 /// Evaluates the laws at `state`: `F = -F_N n - mu(|v_t|) F_N v_t/|v_t|` on the journal (MODEL.md §1).
 /// `impact_rate` is `delta_dot0` of the current contact (already floored positive).
-pub fn contact_force(state: &JournalState, impact_rate: f64, normal: &impl NormalForceLaw, friction: &impl FrictionLaw) -> ForcePair {
+pub fn contact_force(
+    state: &JournalState,
+    impact_rate: f64,
+    normal: &impl NormalForceLaw,
+    friction: &impl FrictionLaw,
+) -> ForcePair {
     let normal_force = normal.normal_force(&NormalContact {
         penetration: state.penetration,
         penetration_rate: state.penetration_rate,
         impact_rate,
     });
     if normal_force <= 0.0 {
-        return ForcePair { point: state.contact_point, ..ForcePair::default() };
+        return ForcePair {
+            point: state.contact_point,
+            ..ForcePair::default()
+        };
     }
     let slip_speed = state.slip.length();
     let (friction_force, friction) = if slip_speed > 0.0 {
@@ -132,7 +144,11 @@ pub fn stable_step(stiffness: f64, damping: f64, effective_mass: f64) -> (f64, f
     }
     let omega = (stiffness / effective_mass).sqrt();
     let zeta = damping.max(0.0) / (2.0 * effective_mass * omega);
-    (2.0 * ((1.0 + zeta * zeta).sqrt() - zeta) / omega, omega, zeta)
+    (
+        2.0 * ((1.0 + zeta * zeta).sqrt() - zeta) / omega,
+        omega,
+        zeta,
+    )
 }
 
 #[cfg(test)]
@@ -151,7 +167,11 @@ mod tests {
         // journal centre 0.6 mm along +x, plus an axial offset that must be ignored
         let p_j = p_i + Vector::new(0.6e-3, 0.003, 0.0);
         let bearing = BodyMotion::default();
-        let journal = BodyMotion { center_of_mass: Vector::new(0.4, 0.0, 0.0), linvel: Vector::new(0.01, 0.0, 0.02), angvel: Vector::ZERO };
+        let journal = BodyMotion {
+            center_of_mass: Vector::new(0.4, 0.0, 0.0),
+            linvel: Vector::new(0.01, 0.0, 0.02),
+            angvel: Vector::ZERO,
+        };
         let s = journal_state(&geometry(), p_i, p_j, axis, &bearing, &journal);
         assert!((s.eccentricity - Vector::new(0.6e-3, 0.0, 0.0)).length() < 1e-15);
         assert!((s.penetration - 0.1e-3).abs() < 1e-15);
@@ -167,9 +187,20 @@ mod tests {
     fn rotation_adds_surface_velocity() {
         // Bearing spinning about the axis at w: its surface point Q_i moves at w x (Q_i - com).
         let axis = Vector::Z;
-        let bearing = BodyMotion { center_of_mass: Vector::ZERO, linvel: Vector::ZERO, angvel: Vector::new(0.0, 0.0, 2.0) };
+        let bearing = BodyMotion {
+            center_of_mass: Vector::ZERO,
+            linvel: Vector::ZERO,
+            angvel: Vector::new(0.0, 0.0, 2.0),
+        };
         let journal = BodyMotion::default();
-        let s = journal_state(&geometry(), Vector::ZERO, Vector::new(1e-3, 0.0, 0.0), axis, &bearing, &journal);
+        let s = journal_state(
+            &geometry(),
+            Vector::ZERO,
+            Vector::new(1e-3, 0.0, 0.0),
+            axis,
+            &bearing,
+            &journal,
+        );
         // Q_i = (0.010, 0, 0) moves at (0, 0.02, 0); v_rel = -(0, 0.02, 0): pure slip
         assert!(s.penetration_rate.abs() < 1e-15);
         assert!((s.slip - Vector::new(0.0, -0.02, 0.0)).length() < 1e-15);
@@ -189,7 +220,10 @@ mod tests {
         let f = contact_force(&s, 1.0, &law, &FrictionModel::Bai(Bai::DRY));
         // F_N = 1e12 * 1e-7^1.5 = 1e12 * 3.1623e-11 = 31.623 N, friction 0.25 F_N along -z
         assert!((f.normal_force - 31.622776601683793).abs() < 1e-9);
-        assert!((f.on_journal - Vector::new(-f.normal_force, 0.0, -0.25 * f.normal_force)).length() < 1e-9);
+        assert!(
+            (f.on_journal - Vector::new(-f.normal_force, 0.0, -0.25 * f.normal_force)).length()
+                < 1e-9
+        );
     }
 
     #[test]

@@ -26,7 +26,11 @@ pub struct ForceLedger {
 
 impl ForceLedger {
     /// Takes back every wrench of the previous application and adds `wrenches` instead.
-    pub fn replace(&mut self, bodies: &mut RigidBodySet, wrenches: impl IntoIterator<Item = Wrench>) {
+    pub fn replace(
+        &mut self,
+        bodies: &mut RigidBodySet,
+        wrenches: impl IntoIterator<Item = Wrench>,
+    ) {
         for w in self.applied.drain(..) {
             if let Some(rb) = bodies.get_mut(w.body) {
                 rb.add_force(-w.force, false);
@@ -52,7 +56,11 @@ pub(crate) fn world_center_of_mass(rb: &rapier3d_f64::prelude::RigidBody) -> Vec
 
 /// Ensures the local mass properties of a dynamic body are computed (Rapier fills them in at the
 /// first step; the hook needs the centre of mass before that).
-pub(crate) fn ensure_mass_properties(bodies: &mut RigidBodySet, colliders: Option<&rapier3d_f64::prelude::ColliderSet>, handle: RigidBodyHandle) {
+pub(crate) fn ensure_mass_properties(
+    bodies: &mut RigidBodySet,
+    colliders: Option<&rapier3d_f64::prelude::ColliderSet>,
+    handle: RigidBodyHandle,
+) {
     if let Some(rb) = bodies.get_mut(handle) {
         if rb.is_dynamic() && rb.mass_properties().local_mprops.inv_mass == 0.0 {
             let empty = rapier3d_f64::prelude::ColliderSet::new();

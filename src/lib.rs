@@ -1,7 +1,8 @@
-//! Revolute hinges with radial clearance for the Rapier physics engine (`rapier3d-f64`).
+#![doc = include_str!("../README.md")]
+#![warn(missing_docs)]
+
 pub mod angle;
 pub mod drive;
-pub mod scene;
 pub mod error;
 pub mod joint;
 pub mod kinematics;
@@ -9,12 +10,16 @@ pub mod laws;
 pub mod ledger;
 pub mod output;
 pub mod report;
+pub mod scene;
 pub mod sim;
 pub use error::{Error, Result};
 
 /// The types most users need.
 pub mod prelude {
-    pub use crate::joint::{ClearanceJoint, ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet, OutOfPlaneLock};
+    pub use crate::joint::{
+        ClearanceJoint, ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet,
+        OutOfPlaneLock,
+    };
     pub use crate::laws::*;
     pub use rapier3d_f64::math::Vector;
 }

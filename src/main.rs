@@ -53,7 +53,11 @@ impl RunArgs {
             None => Scene::solar_panel(),
         };
         let mut overrides = self.overrides.clone();
-        for (key, v) in [("run.dt_s", self.dt), ("run.end_s", self.end), ("run.output_interval_s", self.output_interval)] {
+        for (key, v) in [
+            ("run.dt_s", self.dt),
+            ("run.end_s", self.end),
+            ("run.output_interval_s", self.output_interval),
+        ] {
             if let Some(v) = v {
                 overrides.push(format!("{key}={v:e}"));
             }
@@ -64,12 +68,23 @@ impl RunArgs {
 
 fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     let scene = args.scene()?;
-    let out = args.out.clone().unwrap_or_else(|| PathBuf::from("out").join(&scene.name));
-    eprintln!("running `{}`: dt = {:e} s, {} s simulated, ideal and clearance twins", scene.name, scene.run.dt_s, scene.run.end_s);
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out").join(&scene.name));
+    eprintln!(
+        "running `{}`: dt = {:e} s, {} s simulated, ideal and clearance twins",
+        scene.name, scene.run.dt_s, scene.run.end_s
+    );
     let result = Simulation::new(&scene, RunOptions::default())?.run()?;
     let summary = result.write(&out)?;
     println!("{}", comparison_table(&summary));
-    println!("{} steps in {:.2} s wall; wrote {}/{{ideal.csv, clearance.csv, summary.json}}", result.steps, result.wall_s, out.display());
+    println!(
+        "{} steps in {:.2} s wall; wrote {}/{{ideal.csv, clearance.csv, summary.json}}",
+        result.steps,
+        result.wall_s,
+        out.display()
+    );
     Ok(())
 }
 

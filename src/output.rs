@@ -6,11 +6,18 @@ use std::path::Path;
 
 /// Writes `bytes` to `path` atomically (temporary file + rename), creating the folder.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let io = |action, source| Error::Io { action, path: path.to_path_buf(), source };
+    let io = |action, source| Error::Io {
+        action,
+        path: path.to_path_buf(),
+        source,
+    };
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).map_err(|e| io("cannot create the folder of", e))?;
     }
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned()).unwrap_or_default();
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
     let result = (|| {
         let mut f = std::fs::File::create(&tmp)?;
@@ -38,12 +45,19 @@ pub struct Table {
 impl Table {
     /// An empty table with these columns.
     pub fn new(columns: Vec<String>) -> Self {
-        Table { columns, values: Vec::new() }
+        Table {
+            columns,
+            values: Vec::new(),
+        }
     }
 
     /// Number of rows.
     pub fn rows(&self) -> usize {
-        if self.columns.is_empty() { 0 } else { self.values.len() / self.columns.len() }
+        if self.columns.is_empty() {
+            0
+        } else {
+            self.values.len() / self.columns.len()
+        }
     }
 
     /// Row `i`.
@@ -71,7 +85,10 @@ impl Table {
         for i in 0..self.rows() {
             for (j, v) in self.row(i).iter().enumerate() {
                 if !v.is_finite() {
-                    return Err(Error::Diverged { t: self.row(i)[0], reason: format!("non-finite `{}` in output row {i}", self.columns[j]) });
+                    return Err(Error::Diverged {
+                        t: self.row(i)[0],
+                        reason: format!("non-finite `{}` in output row {i}", self.columns[j]),
+                    });
                 }
                 if j > 0 {
                     s.push(',');

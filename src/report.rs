@@ -53,7 +53,10 @@ impl TwinSummary {
     /// Summarises `twin`.
     pub fn of(twin: &Twin, steps: u64, wall_s: f64) -> TwinSummary {
         let hinges = twin.hinge_metrics();
-        let first = hinges.values().filter_map(|m| Some((m.first_impact_t_s?, m.first_impact_peak_n?))).min_by(|a, b| a.0.total_cmp(&b.0));
+        let first = hinges
+            .values()
+            .filter_map(|m| Some((m.first_impact_t_s?, m.first_impact_peak_n?)))
+            .min_by(|a, b| a.0.total_cmp(&b.0));
         TwinSummary {
             steps,
             wall_s,
@@ -62,7 +65,10 @@ impl TwinSummary {
             impacts: hinges.values().map(|m| m.impacts).sum(),
             first_impact_t_s: first.map(|f| f.0),
             first_impact_peak_n: first.map(|f| f.1),
-            max_penetration_um: hinges.values().map(|m| m.max_penetration_um).fold(0.0, f64::max),
+            max_penetration_um: hinges
+                .values()
+                .map(|m| m.max_penetration_um)
+                .fold(0.0, f64::max),
             linear_momentum_drift: twin.invariants.linear_momentum_drift,
             angular_momentum_drift: twin.invariants.angular_momentum_drift,
             invariants: twin.invariants.clone(),
@@ -78,7 +84,16 @@ impl RunResult {
             scene: self.scene.name.clone(),
             dt_s: self.scene.run.dt_s,
             end_s: self.scene.run.end_s,
-            twins: self.twins.iter().map(|t| (t.kind.name().to_string(), TwinSummary::of(t, self.steps, self.wall_s))).collect(),
+            twins: self
+                .twins
+                .iter()
+                .map(|t| {
+                    (
+                        t.kind.name().to_string(),
+                        TwinSummary::of(t, self.steps, self.wall_s),
+                    )
+                })
+                .collect(),
         }
     }
 
@@ -90,7 +105,11 @@ impl RunResult {
     /// Writes `<twin>.csv` for each twin and `summary.json` into `dir`, each file whole or not
     /// at all. All CSVs are rendered (and checked finite) before anything is written.
     pub fn write(&self, dir: &Path) -> Result<Summary> {
-        let csvs: Vec<(String, String)> = self.twins.iter().map(|t| Ok((format!("{}.csv", t.kind.name()), t.table.to_csv()?))).collect::<Result<_>>()?;
+        let csvs: Vec<(String, String)> = self
+            .twins
+            .iter()
+            .map(|t| Ok((format!("{}.csv", t.kind.name()), t.table.to_csv()?)))
+            .collect::<Result<_>>()?;
         let summary = self.summary();
         let json = summary_json(&summary)?;
         for (name, text) in &csvs {
@@ -103,20 +122,39 @@ impl RunResult {
 
 /// Pretty JSON of a summary; refuses non-finite numbers (JSON has none).
 pub fn summary_json(summary: &Summary) -> Result<String> {
-    let value = serde_json::to_value(summary).map_err(|e| Error::invalid("summary", e.to_string()))?;
+    let value =
+        serde_json::to_value(summary).map_err(|e| Error::invalid("summary", e.to_string()))?;
     fn check(v: &serde_json::Value, path: &str) -> Result<()> {
         match v {
             // serde_json writes non-finite floats as null; a metric that should be a number must not be.
-            serde_json::Value::Object(o) => o.iter().try_for_each(|(k, c)| check(c, &format!("{path}.{k}"))),
-            serde_json::Value::Array(a) => a.iter().enumerate().try_for_each(|(i, c)| check(c, &format!("{path}[{i}]"))),
+            serde_json::Value::Object(o) => o
+                .iter()
+                .try_for_each(|(k, c)| check(c, &format!("{path}.{k}"))),
+            serde_json::Value::Array(a) => a
+                .iter()
+                .enumerate()
+                .try_for_each(|(i, c)| check(c, &format!("{path}[{i}]"))),
             _ => Ok(()),
         }
     }
     check(&value, "summary")?;
     for twin in summary.twins.values() {
-        let nums = [twin.peak_joint_force_n, twin.max_penetration_um, twin.linear_momentum_drift, twin.angular_momentum_drift, twin.invariants.energy_growth];
-        if nums.iter().chain(twin.final_angles_deg.values()).any(|x| !x.is_finite()) {
-            return Err(Error::Diverged { t: summary.end_s, reason: "non-finite metric in the summary".into() });
+        let nums = [
+            twin.peak_joint_force_n,
+            twin.max_penetration_um,
+            twin.linear_momentum_drift,
+            twin.angular_momentum_drift,
+            twin.invariants.energy_growth,
+        ];
+        if nums
+            .iter()
+            .chain(twin.final_angles_deg.values())
+            .any(|x| !x.is_finite())
+        {
+            return Err(Error::Diverged {
+                t: summary.end_s,
+                reason: "non-finite metric in the summary".into(),
+            });
         }
     }
     serde_json::to_string_pretty(&value).map_err(|e| Error::invalid("summary", e.to_string()))
@@ -128,16 +166,60 @@ pub fn comparison_table(summary: &Summary) -> String {
     let mut rows: Vec<(String, Vec<String>)> = Vec::new();
     if let Some((_, first)) = twins.first() {
         for name in first.final_angles_deg.keys() {
-            rows.push((format!("final {name} angle (deg)"), twins.iter().map(|(_, t)| format!("{:.4}", t.final_angles_deg[name])).collect()));
+            rows.push((
+                format!("final {name} angle (deg)"),
+                twins
+                    .iter()
+                    .map(|(_, t)| format!("{:.4}", t.final_angles_deg[name]))
+                    .collect(),
+            ));
         }
     }
     let opt = |x: Option<f64>, p: usize| x.map_or("-".to_string(), |v| format!("{v:.p$}"));
-    rows.push(("peak joint force (N)".into(), twins.iter().map(|(_, t)| format!("{:.4}", t.peak_joint_force_n)).collect()));
-    rows.push(("impacts".into(), twins.iter().map(|(_, t)| t.impacts.to_string()).collect()));
-    rows.push(("first impact (s)".into(), twins.iter().map(|(_, t)| opt(t.first_impact_t_s, 4)).collect()));
-    rows.push(("first impact peak (N)".into(), twins.iter().map(|(_, t)| opt(t.first_impact_peak_n, 3)).collect()));
-    rows.push(("max penetration (um)".into(), twins.iter().map(|(_, t)| format!("{:.3}", t.max_penetration_um)).collect()));
-    rows.push(("momentum drift lin/ang".into(), twins.iter().map(|(_, t)| format!("{:.1e}/{:.1e}", t.linear_momentum_drift, t.angular_momentum_drift)).collect()));
+    rows.push((
+        "peak joint force (N)".into(),
+        twins
+            .iter()
+            .map(|(_, t)| format!("{:.4}", t.peak_joint_force_n))
+            .collect(),
+    ));
+    rows.push((
+        "impacts".into(),
+        twins.iter().map(|(_, t)| t.impacts.to_string()).collect(),
+    ));
+    rows.push((
+        "first impact (s)".into(),
+        twins
+            .iter()
+            .map(|(_, t)| opt(t.first_impact_t_s, 4))
+            .collect(),
+    ));
+    rows.push((
+        "first impact peak (N)".into(),
+        twins
+            .iter()
+            .map(|(_, t)| opt(t.first_impact_peak_n, 3))
+            .collect(),
+    ));
+    rows.push((
+        "max penetration (um)".into(),
+        twins
+            .iter()
+            .map(|(_, t)| format!("{:.3}", t.max_penetration_um))
+            .collect(),
+    ));
+    rows.push((
+        "momentum drift lin/ang".into(),
+        twins
+            .iter()
+            .map(|(_, t)| {
+                format!(
+                    "{:.1e}/{:.1e}",
+                    t.linear_momentum_drift, t.angular_momentum_drift
+                )
+            })
+            .collect(),
+    ));
     let w0 = rows.iter().map(|r| r.0.len()).max().unwrap_or(0);
     let mut s = format!("{:w0$}", "");
     for (name, _) in &twins {

@@ -4,8 +4,9 @@
 use crate::error::{Error, Result, finite, non_negative, positive};
 use crate::joint::OutOfPlaneLock;
 use crate::laws::{
-    Ambrosio, Bai, BearingGeometry, Coulomb, FloresEtAl, FrictionModel, GonthierEtAl, Hertz, HuntCrossley, ImprovedLiu,
-    KelvinVoigt, LankaraniNikravesh, LiuEtAl, Material, MaxDamping, NormalModel, Threlfall, effective_modulus,
+    Ambrosio, Bai, BearingGeometry, Coulomb, FloresEtAl, FrictionModel, GonthierEtAl, Hertz,
+    HuntCrossley, ImprovedLiu, KelvinVoigt, LankaraniNikravesh, LiuEtAl, Material, MaxDamping,
+    NormalModel, Threlfall, effective_modulus,
 };
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -282,27 +283,39 @@ fn default_end() -> f64 {
 
 impl Default for RunSettings {
     fn default() -> Self {
-        RunSettings { dt_s: default_dt(), end_s: default_end(), output_interval_s: default_dt() }
+        RunSettings {
+            dt_s: default_dt(),
+            end_s: default_end(),
+            output_interval_s: default_dt(),
+        }
     }
 }
 
 impl Scene {
     /// Parses a scene from RON text; `origin` names the source in errors.
     pub fn from_ron(text: &str, origin: &str) -> Result<Scene> {
-        let scene: Scene = ron::from_str(text).map_err(|e| Error::Parse { what: origin.to_string(), reason: e.to_string() })?;
+        let scene: Scene = ron::from_str(text).map_err(|e| Error::Parse {
+            what: origin.to_string(),
+            reason: e.to_string(),
+        })?;
         scene.validate()?;
         Ok(scene)
     }
 
     /// Reads and parses a scene file.
     pub fn load(path: &Path) -> Result<Scene> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io { action: "cannot read scene", path: path.into(), source })?;
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            action: "cannot read scene",
+            path: path.into(),
+            source,
+        })?;
         Self::from_ron(&text, &path.display().to_string())
     }
 
     /// The paper's scene (MODEL.md §4).
     pub fn solar_panel() -> Scene {
-        Self::from_ron(SOLAR_PANEL_RON, "assets/solar_panel.ron").expect("the embedded scene is valid")
+        Self::from_ron(SOLAR_PANEL_RON, "assets/solar_panel.ron")
+            .expect("the embedded scene is valid")
     }
 
     /// The scene as RON text.
@@ -319,18 +332,26 @@ impl Scene {
         if overrides.is_empty() {
             return Ok(self.clone());
         }
-        let mut value = serde_json::to_value(self).map_err(|e| Error::invalid("scene", e.to_string()))?;
+        let mut value =
+            serde_json::to_value(self).map_err(|e| Error::invalid("scene", e.to_string()))?;
         for o in overrides {
             let o = o.as_ref();
-            let (path, raw) = o
-                .split_once('=')
-                .ok_or_else(|| Error::Parse { what: format!("override `{o}`"), reason: "expected `path=value`".into() })?;
-            let new: serde_json::Value = serde_json::from_str(raw.trim()).unwrap_or_else(|_| serde_json::Value::String(raw.trim().to_string()));
+            let (path, raw) = o.split_once('=').ok_or_else(|| Error::Parse {
+                what: format!("override `{o}`"),
+                reason: "expected `path=value`".into(),
+            })?;
+            let new: serde_json::Value = serde_json::from_str(raw.trim())
+                .unwrap_or_else(|_| serde_json::Value::String(raw.trim().to_string()));
             let slot = locate(&mut value, path.trim())?;
             *slot = new;
         }
-        let scene: Scene =
-            serde_json::from_value(value).map_err(|e| Error::Parse { what: format!("overrides {:?}", overrides.iter().map(|s| s.as_ref()).collect::<Vec<_>>()), reason: e.to_string() })?;
+        let scene: Scene = serde_json::from_value(value).map_err(|e| Error::Parse {
+            what: format!(
+                "overrides {:?}",
+                overrides.iter().map(|s| s.as_ref()).collect::<Vec<_>>()
+            ),
+            reason: e.to_string(),
+        })?;
         scene.validate()?;
         Ok(scene)
     }
@@ -348,7 +369,10 @@ impl Scene {
     /// Checks every field; the error names the first invalid one.
     pub fn validate(&self) -> Result<()> {
         if self.name.is_empty() || self.name.contains(['/', '\\']) {
-            return Err(Error::invalid("name", "must be a non-empty name without path separators"));
+            return Err(Error::invalid(
+                "name",
+                "must be a non-empty name without path separators",
+            ));
         }
         for (i, g) in self.gravity.iter().enumerate() {
             finite(&format!("gravity[{i}]"), *g)?;
@@ -369,7 +393,10 @@ impl Scene {
             }
             let [a, bb, c] = b.inertia_kg_m2;
             if a + bb < c || bb + c < a || a + c < bb {
-                return Err(Error::invalid(format!("{p}.inertia_kg_m2"), "violates the triangle inequality of principal moments"));
+                return Err(Error::invalid(
+                    format!("{p}.inertia_kg_m2"),
+                    "violates the triangle inequality of principal moments",
+                ));
             }
             for (i, x) in b.center_of_mass_m.iter().enumerate() {
                 finite(&format!("{p}.center_of_mass_m[{i}]"), *x)?;
@@ -378,15 +405,24 @@ impl Scene {
         for h in &self.hinges {
             let p = format!("hinges[{}]", h.name);
             if !names.insert(h.name.as_str()) {
-                return Err(Error::invalid(p, "duplicate name (bodies, hinges and drives share one namespace)"));
+                return Err(Error::invalid(
+                    p,
+                    "duplicate name (bodies, hinges and drives share one namespace)",
+                ));
             }
             for (field, body) in [("bearing", &h.bearing), ("journal", &h.journal)] {
                 if self.body_index(body).is_none() {
-                    return Err(Error::invalid(format!("{p}.{field}"), format!("no body named `{body}`")));
+                    return Err(Error::invalid(
+                        format!("{p}.{field}"),
+                        format!("no body named `{body}`"),
+                    ));
                 }
             }
             if h.bearing == h.journal {
-                return Err(Error::invalid(format!("{p}.journal"), "must differ from the bearing body"));
+                return Err(Error::invalid(
+                    format!("{p}.journal"),
+                    "must differ from the bearing body",
+                ));
             }
             for (i, x) in h.point_m.iter().enumerate() {
                 finite(&format!("{p}.point_m[{i}]"), *x)?;
@@ -402,7 +438,10 @@ impl Scene {
                 return Err(Error::invalid(p, "duplicate name"));
             }
             if self.hinge_index(&d.hinge).is_none() {
-                return Err(Error::invalid(format!("{p}.hinge"), format!("no hinge named `{}`", d.hinge)));
+                return Err(Error::invalid(
+                    format!("{p}.hinge"),
+                    format!("no hinge named `{}`", d.hinge),
+                ));
             }
             finite(&format!("{p}.torque0_nm"), d.torque0_nm)?;
             non_negative(&format!("{p}.stiffness_nm_per_deg"), d.stiffness_nm_per_deg)?;
@@ -413,7 +452,14 @@ impl Scene {
         positive("run.end_s", r.end_s)?;
         positive("run.output_interval_s", r.output_interval_s)?;
         if r.end_s / r.dt_s > 1e9 {
-            return Err(Error::invalid("run.dt_s", format!("{} steps to reach run.end_s = {}: too many", r.end_s / r.dt_s, r.end_s)));
+            return Err(Error::invalid(
+                "run.dt_s",
+                format!(
+                    "{} steps to reach run.end_s = {}: too many",
+                    r.end_s / r.dt_s,
+                    r.end_s
+                ),
+            ));
         }
         Ok(())
     }
@@ -425,7 +471,10 @@ fn unit(v: &[f64; 3], field: &str) -> Result<()> {
     }
     let n = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
     if (n - 1.0).abs() > 1e-6 {
-        return Err(Error::invalid(field, format!("must be a unit vector (length {n})")));
+        return Err(Error::invalid(
+            field,
+            format!("must be a unit vector (length {n})"),
+        ));
     }
     Ok(())
 }
@@ -452,53 +501,125 @@ impl ClearanceSpec {
         if c >= rb {
             return Err(Error::invalid(
                 "clearance_mm",
-                format!("the journal would be larger than nothing: clearance {} mm >= bearing radius {} mm", self.clearance_mm, rb * 1e3),
+                format!(
+                    "the journal would be larger than nothing: clearance {} mm >= bearing radius {} mm",
+                    self.clearance_mm,
+                    rb * 1e3
+                ),
             ));
         }
         let geometry = BearingGeometry::from_clearance(rb, c, len)?;
-        self.bearing_material.validate().map_err(|e| e.within("bearing_material"))?;
-        self.journal_material.validate().map_err(|e| e.within("journal_material"))?;
+        self.bearing_material
+            .validate()
+            .map_err(|e| e.within("bearing_material"))?;
+        self.journal_material
+            .validate()
+            .map_err(|e| e.within("journal_material"))?;
         let e_star = effective_modulus(&self.bearing_material, &self.journal_material);
-        let geometric = LankaraniNikravesh::stiffness_from_geometry(&geometry, &self.bearing_material, &self.journal_material);
+        let geometric = LankaraniNikravesh::stiffness_from_geometry(
+            &geometry,
+            &self.bearing_material,
+            &self.journal_material,
+        );
         let k = |s: &Option<f64>| s.unwrap_or(geometric);
-        let normal = (|| -> Result<NormalModel> { Ok(match &self.contact {
-            ContactSpec::Hertz { stiffness, exponent } => NormalModel::Hertz(Hertz::new(k(stiffness), *exponent)?),
-            ContactSpec::KelvinVoigt { stiffness, damping } => NormalModel::KelvinVoigt(KelvinVoigt::new(*stiffness, *damping)?),
-            ContactSpec::HuntCrossley { stiffness, exponent, restitution } => {
-                NormalModel::HuntCrossley(HuntCrossley::new(k(stiffness), *exponent, *restitution)?)
-            }
-            ContactSpec::LankaraniNikravesh { stiffness, restitution } => {
-                NormalModel::LankaraniNikravesh(LankaraniNikravesh::new(k(stiffness), LankaraniNikravesh::EXPONENT, *restitution)?)
-            }
-            ContactSpec::FloresEtAl { stiffness, exponent, restitution } => {
-                NormalModel::FloresEtAl(FloresEtAl::new(k(stiffness), *exponent, *restitution)?)
-            }
-            ContactSpec::GonthierEtAl { stiffness, exponent, restitution } => {
-                NormalModel::GonthierEtAl(GonthierEtAl::new(k(stiffness), *exponent, *restitution)?)
-            }
-            ContactSpec::LiuEtAl => NormalModel::LiuEtAl(LiuEtAl::new(e_star, len, c)?),
-            ContactSpec::ImprovedLiu { exponent, delta_max_mm, eta_s, d_max_n_s_per_m } => {
-                let damping = match d_max_n_s_per_m {
-                    Some(d) => MaxDamping::Explicit(*d),
-                    None => MaxDamping::Eta(*eta_s),
-                };
-                NormalModel::ImprovedLiu(ImprovedLiu::new(e_star, len, c, *exponent, positive("delta_max_mm", *delta_max_mm)? * 1e-3, damping)?)
-            }
-        }) })()
+        let normal = (|| -> Result<NormalModel> {
+            Ok(match &self.contact {
+                ContactSpec::Hertz {
+                    stiffness,
+                    exponent,
+                } => NormalModel::Hertz(Hertz::new(k(stiffness), *exponent)?),
+                ContactSpec::KelvinVoigt { stiffness, damping } => {
+                    NormalModel::KelvinVoigt(KelvinVoigt::new(*stiffness, *damping)?)
+                }
+                ContactSpec::HuntCrossley {
+                    stiffness,
+                    exponent,
+                    restitution,
+                } => NormalModel::HuntCrossley(HuntCrossley::new(
+                    k(stiffness),
+                    *exponent,
+                    *restitution,
+                )?),
+                ContactSpec::LankaraniNikravesh {
+                    stiffness,
+                    restitution,
+                } => NormalModel::LankaraniNikravesh(LankaraniNikravesh::new(
+                    k(stiffness),
+                    LankaraniNikravesh::EXPONENT,
+                    *restitution,
+                )?),
+                ContactSpec::FloresEtAl {
+                    stiffness,
+                    exponent,
+                    restitution,
+                } => {
+                    NormalModel::FloresEtAl(FloresEtAl::new(k(stiffness), *exponent, *restitution)?)
+                }
+                ContactSpec::GonthierEtAl {
+                    stiffness,
+                    exponent,
+                    restitution,
+                } => NormalModel::GonthierEtAl(GonthierEtAl::new(
+                    k(stiffness),
+                    *exponent,
+                    *restitution,
+                )?),
+                ContactSpec::LiuEtAl => NormalModel::LiuEtAl(LiuEtAl::new(e_star, len, c)?),
+                ContactSpec::ImprovedLiu {
+                    exponent,
+                    delta_max_mm,
+                    eta_s,
+                    d_max_n_s_per_m,
+                } => {
+                    let damping = match d_max_n_s_per_m {
+                        Some(d) => MaxDamping::Explicit(*d),
+                        None => MaxDamping::Eta(*eta_s),
+                    };
+                    NormalModel::ImprovedLiu(ImprovedLiu::new(
+                        e_star,
+                        len,
+                        c,
+                        *exponent,
+                        positive("delta_max_mm", *delta_max_mm)? * 1e-3,
+                        damping,
+                    )?)
+                }
+            })
+        })()
         .map_err_within("contact")?;
         let mm = 1e-3;
-        let friction = (|| -> Result<FrictionModel> { Ok(match &self.friction {
-            FrictionSpec::None => FrictionModel::None,
-            FrictionSpec::Coulomb { mu_d, v_eps_mm_s } => FrictionModel::Coulomb(Coulomb::new(*mu_d, v_eps_mm_s * mm)?),
-            FrictionSpec::Threlfall { mu_d, v0_mm_s } => FrictionModel::Threlfall(Threlfall::new(*mu_d, v0_mm_s * mm)?),
-            FrictionSpec::Ambrosio { mu_d, v0_mm_s, v1_mm_s } => FrictionModel::Ambrosio(Ambrosio::new(*mu_d, v0_mm_s * mm, v1_mm_s * mm)?),
-            FrictionSpec::Bai { mu_s, mu_d, v_s_mm_s, v_d_mm_s } => FrictionModel::Bai(Bai::new(*mu_s, *mu_d, v_s_mm_s * mm, v_d_mm_s * mm)?),
-            FrictionSpec::Dry => FrictionModel::Bai(Bai::DRY),
-            FrictionSpec::Lubricated => FrictionModel::Bai(Bai::LUBRICATED),
-        }) })()
+        let friction = (|| -> Result<FrictionModel> {
+            Ok(match &self.friction {
+                FrictionSpec::None => FrictionModel::None,
+                FrictionSpec::Coulomb { mu_d, v_eps_mm_s } => {
+                    FrictionModel::Coulomb(Coulomb::new(*mu_d, v_eps_mm_s * mm)?)
+                }
+                FrictionSpec::Threlfall { mu_d, v0_mm_s } => {
+                    FrictionModel::Threlfall(Threlfall::new(*mu_d, v0_mm_s * mm)?)
+                }
+                FrictionSpec::Ambrosio {
+                    mu_d,
+                    v0_mm_s,
+                    v1_mm_s,
+                } => FrictionModel::Ambrosio(Ambrosio::new(*mu_d, v0_mm_s * mm, v1_mm_s * mm)?),
+                FrictionSpec::Bai {
+                    mu_s,
+                    mu_d,
+                    v_s_mm_s,
+                    v_d_mm_s,
+                } => FrictionModel::Bai(Bai::new(*mu_s, *mu_d, v_s_mm_s * mm, v_d_mm_s * mm)?),
+                FrictionSpec::Dry => FrictionModel::Bai(Bai::DRY),
+                FrictionSpec::Lubricated => FrictionModel::Bai(Bai::LUBRICATED),
+            })
+        })()
         .map_err_within("friction")?;
         let min_impact_speed = positive("min_impact_speed_mm_s", self.min_impact_speed_mm_s)? * mm;
-        Ok(ClearanceParams { geometry, normal, friction, min_impact_speed })
+        Ok(ClearanceParams {
+            geometry,
+            normal,
+            friction,
+            min_impact_speed,
+        })
     }
 }
 
@@ -515,17 +636,33 @@ impl<T> WithinExt<T> for Result<T> {
 fn locate<'a>(root: &'a mut serde_json::Value, path: &str) -> Result<&'a mut serde_json::Value> {
     let unknown = |reason: String| Error::invalid(path, reason);
     let mut segments = path.split('.');
-    let first = segments.next().filter(|s| !s.is_empty()).ok_or_else(|| unknown("empty parameter path".into()))?;
-    let obj = root.as_object_mut().ok_or_else(|| unknown("scene is not an object".into()))?;
+    let first = segments
+        .next()
+        .filter(|s| !s.is_empty())
+        .ok_or_else(|| unknown("empty parameter path".into()))?;
+    let obj = root
+        .as_object_mut()
+        .ok_or_else(|| unknown("scene is not an object".into()))?;
     let mut cur: &mut serde_json::Value = if obj.contains_key(first) {
         obj.get_mut(first).unwrap()
     } else {
         let named = |it: &serde_json::Value| it.get("name").and_then(|n| n.as_str()) == Some(first);
-        let list = ["bodies", "hinges", "drives"]
-            .into_iter()
-            .find(|l| obj.get(*l).and_then(|v| v.as_array()).is_some_and(|items| items.iter().any(named)));
-        list.and_then(|l| obj.get_mut(l)?.as_array_mut()?.iter_mut().find(|it| named(it)))
-            .ok_or_else(|| unknown(format!("`{first}` is neither a top-level field nor the name of a body, hinge or drive")))?
+        let list = ["bodies", "hinges", "drives"].into_iter().find(|l| {
+            obj.get(*l)
+                .and_then(|v| v.as_array())
+                .is_some_and(|items| items.iter().any(named))
+        });
+        list.and_then(|l| {
+            obj.get_mut(l)?
+                .as_array_mut()?
+                .iter_mut()
+                .find(|it| named(it))
+        })
+        .ok_or_else(|| {
+            unknown(format!(
+                "`{first}` is neither a top-level field nor the name of a body, hinge or drive"
+            ))
+        })?
     };
     for seg in segments {
         cur = descend(cur, seg).map_err(unknown)?;
@@ -534,8 +671,16 @@ fn locate<'a>(root: &'a mut serde_json::Value, path: &str) -> Result<&'a mut ser
 }
 
 /// The child `key` of `v`, or the unique field called `key` at any depth below it.
-fn descend<'a>(v: &'a mut serde_json::Value, key: &str) -> std::result::Result<&'a mut serde_json::Value, String> {
-    fn paths(v: &serde_json::Value, key: &str, prefix: &mut Vec<String>, out: &mut Vec<Vec<String>>) {
+fn descend<'a>(
+    v: &'a mut serde_json::Value,
+    key: &str,
+) -> std::result::Result<&'a mut serde_json::Value, String> {
+    fn paths(
+        v: &serde_json::Value,
+        key: &str,
+        prefix: &mut Vec<String>,
+        out: &mut Vec<Vec<String>>,
+    ) {
         if let Some(o) = v.as_object() {
             for (k, child) in o {
                 prefix.push(k.clone());
@@ -550,7 +695,9 @@ fn descend<'a>(v: &'a mut serde_json::Value, key: &str) -> std::result::Result<&
     let mut found = Vec::new();
     paths(v, key, &mut Vec::new(), &mut found);
     match found.len() {
-        0 => Err(format!("no field `{key}` here (is the hinge ideal, or the name misspelt?)")),
+        0 => Err(format!(
+            "no field `{key}` here (is the hinge ideal, or the name misspelt?)"
+        )),
         1 => {
             let mut cur = v;
             for k in &found[0] {
@@ -558,6 +705,13 @@ fn descend<'a>(v: &'a mut serde_json::Value, key: &str) -> std::result::Result<&
             }
             Ok(cur)
         }
-        _ => Err(format!("`{key}` is ambiguous: {}", found.iter().map(|p| p.join(".")).collect::<Vec<_>>().join(", "))),
+        _ => Err(format!(
+            "`{key}` is ambiguous: {}",
+            found
+                .iter()
+                .map(|p| p.join("."))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )),
     }
 }

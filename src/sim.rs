@@ -202,8 +202,18 @@ impl Simulation {
             twins.push(Twin::build(scene, kind, &mut world)?);
         }
         let n_steps = (scene.run.end_s / scene.run.dt_s).round().max(1.0) as u64;
-        let stride = (scene.run.output_interval_s / scene.run.dt_s).round().max(1.0) as u64;
-        Ok(Simulation { world, twins, scene: scene.clone(), steps_done: 0, n_steps, stride, skip_rows: options.skip_rows })
+        let stride = (scene.run.output_interval_s / scene.run.dt_s)
+            .round()
+            .max(1.0) as u64;
+        Ok(Simulation {
+            world,
+            twins,
+            scene: scene.clone(),
+            steps_done: 0,
+            n_steps,
+            stride,
+            skip_rows: options.skip_rows,
+        })
     }
 
     /// Simulated time, s.
@@ -218,7 +228,12 @@ impl Simulation {
             self.step()?;
         }
         self.finish()?;
-        Ok(RunResult { scene: self.scene, twins: self.twins, steps: self.steps_done, wall_s: start.elapsed().as_secs_f64() })
+        Ok(RunResult {
+            scene: self.scene,
+            twins: self.twins,
+            steps: self.steps_done,
+            wall_s: start.elapsed().as_secs_f64(),
+        })
     }
 
     /// Advances one internal step: forces from the hooks, Rapier's step, then records.
@@ -247,9 +262,24 @@ impl Simulation {
             twin.drives.apply(&mut self.world.bodies);
             if let Err(e) = twin.clearance.apply(&mut self.world.bodies, &params) {
                 return Err(match e {
-                    Error::StepTooLarge { hinge, dt, dt_max, penetration_um, omega, zeta, .. } => {
-                        Error::StepTooLarge { field: "run.dt_s".into(), hinge, dt, dt_max, t, penetration_um, omega, zeta }
-                    }
+                    Error::StepTooLarge {
+                        hinge,
+                        dt,
+                        dt_max,
+                        penetration_um,
+                        omega,
+                        zeta,
+                        ..
+                    } => Error::StepTooLarge {
+                        field: "run.dt_s".into(),
+                        hinge,
+                        dt,
+                        dt_max,
+                        t,
+                        penetration_um,
+                        omega,
+                        zeta,
+                    },
                     other => other,
                 });
             }
@@ -285,10 +315,20 @@ impl Simulation {
             for b in &twin.bodies {
                 let rb = &self.world.bodies[b.handle];
                 let (v, w) = (rb.linvel(), rb.angvel());
-                if !rb.is_enabled() || !rb.translation().is_finite() || !v.is_finite() || !w.is_finite() || v.length() > vmax {
+                if !rb.is_enabled()
+                    || !rb.translation().is_finite()
+                    || !v.is_finite()
+                    || !w.is_finite()
+                    || v.length() > vmax
+                {
                     return Err(Error::Diverged {
                         t: self.time(),
-                        reason: format!("body `{}` of the {} twin left the physical range (speed {:.3e} m/s)", b.name, twin.kind.name(), v.length()),
+                        reason: format!(
+                            "body `{}` of the {} twin left the physical range (speed {:.3e} m/s)",
+                            b.name,
+                            twin.kind.name(),
+                            v.length()
+                        ),
                     });
                 }
             }
@@ -304,7 +344,11 @@ impl Twin {
             let com = Vector::from(b.center_of_mass_m);
             let rb = RigidBodyBuilder::dynamic()
                 .translation(com)
-                .additional_mass_properties(MassProperties::new(Vector::ZERO, b.mass_kg, Vector::from(b.inertia_kg_m2)))
+                .additional_mass_properties(MassProperties::new(
+                    Vector::ZERO,
+                    b.mass_kg,
+                    Vector::from(b.inertia_kg_m2),
+                ))
                 .can_sleep(false)
                 .build();
             let handle = world.bodies.insert(rb);
@@ -320,7 +364,10 @@ impl Twin {
         let mut clearance = ClearanceJointSet::new();
         let mut hinges = Vec::new();
         for h in &scene.hinges {
-            let (ib, ij) = (scene.body_index(&h.bearing).unwrap(), scene.body_index(&h.journal).unwrap());
+            let (ib, ij) = (
+                scene.body_index(&h.bearing).unwrap(),
+                scene.body_index(&h.journal).unwrap(),
+            );
             let point = Vector::from(h.point_m);
             let axis = Vector::from(h.axis).normalize();
             // Bodies start unrotated with their frame at the centre of mass.
@@ -329,7 +376,9 @@ impl Twin {
             let (b1, b2) = (bodies[ib].handle, bodies[ij].handle);
             let joint = match (&h.clearance, kind) {
                 (Some(spec), TwinKind::Clearance) => {
-                    let p = spec.build().map_err(|e| e.within(&format!("hinges[{}].clearance", h.name)))?;
+                    let p = spec
+                        .build()
+                        .map_err(|e| e.within(&format!("hinges[{}].clearance", h.name)))?;
                     let j = ClearanceJointBuilder::new(axis, p.geometry, p.normal)
                         .local_anchor1(a1)
                         .local_anchor2(a2)
@@ -341,7 +390,10 @@ impl Twin {
                     HingeJoint::Clearance(clearance.insert(b1, b2, j, &mut world.impulse_joints))
                 }
                 _ => {
-                    let j = RevoluteJointBuilder::new(axis).local_anchor1(a1).local_anchor2(a2).contacts_enabled(false);
+                    let j = RevoluteJointBuilder::new(axis)
+                        .local_anchor1(a1)
+                        .local_anchor2(a2)
+                        .contacts_enabled(false);
                     HingeJoint::Ideal(world.impulse_joints.insert(b1, b2, j, true))
                 }
             };
@@ -365,8 +417,14 @@ impl Twin {
             let hi = scene.hinge_index(&d.hinge).unwrap();
             let h = &hinges[hi];
             let per_rad = d.stiffness_nm_per_deg.to_degrees();
-            let spring = TorsionSpring::new(bodies[h.bearing].handle, bodies[h.journal].handle, h.local_axis1, d.torque_scale * d.torque0_nm, d.torque_scale * per_rad)
-                .map_err(|e| e.within(&format!("drives[{}]", d.name)))?;
+            let spring = TorsionSpring::new(
+                bodies[h.bearing].handle,
+                bodies[h.journal].handle,
+                h.local_axis1,
+                d.torque_scale * d.torque0_nm,
+                d.torque_scale * per_rad,
+            )
+            .map_err(|e| e.within(&format!("drives[{}]", d.name)))?;
             drives.insert(spring);
         }
         let reaction_order = reaction_order(&hinges);
@@ -376,11 +434,29 @@ impl Twin {
             columns.push(format!("{}_rate_deg_s", b.name));
         }
         for h in &hinges {
-            for c in ["angle_deg", "rate_deg_s", "force_n", "ecc_u_mm", "ecc_v_mm", "penetration_um", "contact"] {
+            for c in [
+                "angle_deg",
+                "rate_deg_s",
+                "force_n",
+                "ecc_u_mm",
+                "ecc_v_mm",
+                "penetration_um",
+                "contact",
+            ] {
                 columns.push(format!("{}_{c}", h.name));
             }
         }
-        Ok(Twin { kind, bodies, hinges, clearance, drives, reaction_order, reference_axis: Vector::from(scene.reference_axis).normalize(), table: Table::new(columns), invariants: Invariants::default() })
+        Ok(Twin {
+            kind,
+            bodies,
+            hinges,
+            clearance,
+            drives,
+            reaction_order,
+            reference_axis: Vector::from(scene.reference_axis).normalize(),
+            table: Table::new(columns),
+            invariants: Invariants::default(),
+        })
     }
 
     /// Exact ideal-joint reactions from the momentum balance of the bodies over the last step:
@@ -389,7 +465,10 @@ impl Twin {
         if self.reaction_order.is_empty() {
             for h in &mut self.hinges {
                 if let HingeJoint::Clearance(c) = h.joint {
-                    h.force = self.clearance.get(c).map_or(0.0, |j| j.report().force.on_journal.length());
+                    h.force = self
+                        .clearance
+                        .get(c)
+                        .map_or(0.0, |j| j.report().force.on_journal.length());
                 }
             }
             return;
@@ -412,7 +491,10 @@ impl Twin {
         }
         for h in &mut self.hinges {
             if let HingeJoint::Clearance(c) = h.joint {
-                h.force = self.clearance.get(c).map_or(0.0, |j| j.report().force.on_journal.length());
+                h.force = self
+                    .clearance
+                    .get(c)
+                    .map_or(0.0, |j| j.report().force.on_journal.length());
             }
         }
     }
@@ -434,7 +516,8 @@ impl Twin {
                 }
                 if m.in_first_contact {
                     if in_contact {
-                        m.first_impact_peak_n = Some(m.first_impact_peak_n.unwrap_or(0.0).max(h.force));
+                        m.first_impact_peak_n =
+                            Some(m.first_impact_peak_n.unwrap_or(0.0).max(h.force));
                     } else {
                         m.in_first_contact = false;
                     }
@@ -468,7 +551,11 @@ impl Twin {
             inv.max_l = inv.max_l.max(lb.length());
         }
         pe += self.drives.potential_energy();
-        pe += self.clearance.iter().map(|(_, j)| j.elastic_energy()).sum::<f64>();
+        pe += self
+            .clearance
+            .iter()
+            .map(|(_, j)| j.elastic_energy())
+            .sum::<f64>();
         let e = ke + pe;
         let (p0, l0, e0) = *inv.p0.get_or_insert((p, l, e));
         inv.max_dp = inv.max_dp.max((p - p0).length());
@@ -494,7 +581,10 @@ impl Twin {
             v.push(rb.angvel().dot(axis_ref).to_degrees());
         }
         for h in &mut self.hinges {
-            let (r1, r2) = (&bodies[self.bodies[h.bearing].handle], &bodies[self.bodies[h.journal].handle]);
+            let (r1, r2) = (
+                &bodies[self.bodies[h.bearing].handle],
+                &bodies[self.bodies[h.journal].handle],
+            );
             let rel = h.reference.inverse() * (r1.rotation().inverse() * *r2.rotation());
             let angle = h.angle.update(twist_angle(&rel, h.local_axis1));
             let axis = *r1.rotation() * h.local_axis1;
@@ -526,7 +616,10 @@ impl Twin {
 
     /// Per-hinge metrics by hinge name.
     pub fn hinge_metrics(&self) -> BTreeMap<String, HingeMetrics> {
-        self.hinges.iter().map(|h| (h.name.clone(), h.metrics.clone())).collect()
+        self.hinges
+            .iter()
+            .map(|h| (h.name.clone(), h.metrics.clone()))
+            .collect()
     }
 
     /// Final angles (deg) of every body and hinge, by name.
@@ -559,10 +652,19 @@ fn in_plane_u(axis: Vector) -> Vector {
 /// unsolved ideal joint; its residual momentum change is that joint's force. Returns
 /// `(hinge, body, sign)` with force on the journal `= sign * residual[body]`.
 fn reaction_order(hinges: &[HingeTrack]) -> Vec<(usize, usize, f64)> {
-    let mut unsolved: Vec<usize> = hinges.iter().enumerate().filter(|(_, h)| matches!(h.joint, HingeJoint::Ideal(_))).map(|(i, _)| i).collect();
+    let mut unsolved: Vec<usize> = hinges
+        .iter()
+        .enumerate()
+        .filter(|(_, h)| matches!(h.joint, HingeJoint::Ideal(_)))
+        .map(|(i, _)| i)
+        .collect();
     let mut order = Vec::new();
     while !unsolved.is_empty() {
-        let count = |b: usize, u: &[usize]| u.iter().filter(|&&i| hinges[i].bearing == b || hinges[i].journal == b).count();
+        let count = |b: usize, u: &[usize]| {
+            u.iter()
+                .filter(|&&i| hinges[i].bearing == b || hinges[i].journal == b)
+                .count()
+        };
         let pick = unsolved.iter().enumerate().find_map(|(k, &i)| {
             let h = &hinges[i];
             if count(h.journal, &unsolved) == 1 {

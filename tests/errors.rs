@@ -7,35 +7,50 @@ use clearance_joint::sim::{RunOptions, Simulation};
 use std::process::Command;
 
 fn override_err(set: &[&str]) -> String {
-    Scene::solar_panel().with_overrides(set).expect_err("must be refused").to_string()
+    Scene::solar_panel()
+        .with_overrides(set)
+        .expect_err("must be refused")
+        .to_string()
 }
 
 #[test]
 fn non_positive_clearance() {
     for c in ["0", "-0.1"] {
         let e = override_err(&[&format!("hinge.clearance_mm={c}")]);
-        assert!(e.contains("hinges[hinge].clearance.clearance_mm") && e.contains("> 0"), "{e}");
+        assert!(
+            e.contains("hinges[hinge].clearance.clearance_mm") && e.contains("> 0"),
+            "{e}"
+        );
     }
 }
 
 #[test]
 fn journal_larger_than_bearing() {
     let e = override_err(&["hinge.clearance_mm=12"]);
-    assert!(e.contains("clearance_mm") && e.contains("bearing radius"), "{e}");
+    assert!(
+        e.contains("clearance_mm") && e.contains("bearing radius"),
+        "{e}"
+    );
 }
 
 #[test]
 fn nan_in_a_scene_file() {
     let text = SOLAR_PANEL_RON.replace("mass_kg: 7.68", "mass_kg: NaN");
     let e = Scene::from_ron(&text, "nan.ron").unwrap_err().to_string();
-    assert!(e.contains("bodies[panel].mass_kg") && e.contains("NaN"), "{e}");
+    assert!(
+        e.contains("bodies[panel].mass_kg") && e.contains("NaN"),
+        "{e}"
+    );
 }
 
 #[test]
 fn unknown_model_name() {
     let text = SOLAR_PANEL_RON.replace("contact: ImprovedLiu(", "contact: Improved(");
     let e = Scene::from_ron(&text, "bad.ron").unwrap_err().to_string();
-    assert!(e.contains("bad.ron") && e.contains("Improved") && e.contains("ImprovedLiu"), "{e}");
+    assert!(
+        e.contains("bad.ron") && e.contains("Improved") && e.contains("ImprovedLiu"),
+        "{e}"
+    );
     let e = override_err(&["hinge.friction=Sticky"]);
     assert!(e.contains("Sticky") && e.contains("Lubricated"), "{e}");
 }
@@ -46,7 +61,10 @@ fn malformed_scene_file_names_the_position() {
     let e = Scene::from_ron(&text, "broken.ron").unwrap_err();
     assert!(matches!(e, Error::Parse { .. }));
     let e = e.to_string();
-    assert!(e.contains("broken.ron") && e.chars().any(|c| c.is_ascii_digit()), "{e}");
+    assert!(
+        e.contains("broken.ron") && e.chars().any(|c| c.is_ascii_digit()),
+        "{e}"
+    );
 }
 
 #[test]
@@ -60,8 +78,13 @@ fn unknown_override_path() {
 #[test]
 fn bad_laws_parameters_are_named() {
     let e = override_err(&[r#"hinge.contact={"HuntCrossley":{"restitution":1.5}}"#]);
-    assert!(e.contains("hinges[hinge].clearance.contact.restitution"), "{e}");
-    let e = override_err(&[r#"hinge.friction={"Bai":{"mu_s":0.3,"mu_d":0.25,"v_s_mm_s":10,"v_d_mm_s":0.1}}"#]);
+    assert!(
+        e.contains("hinges[hinge].clearance.contact.restitution"),
+        "{e}"
+    );
+    let e = override_err(&[
+        r#"hinge.friction={"Bai":{"mu_s":0.3,"mu_d":0.25,"v_s_mm_s":10,"v_d_mm_s":0.1}}"#,
+    ]);
     assert!(e.contains("hinges[hinge].clearance.friction.v_d"), "{e}");
     let e = override_err(&["run.dt_s=-1e-4"]);
     assert!(e.contains("run.dt_s"), "{e}");
@@ -69,8 +92,13 @@ fn bad_laws_parameters_are_named() {
 
 #[test]
 fn step_too_large_for_the_contact_stiffness() {
-    let scene = Scene::solar_panel().with_overrides(&["run.dt_s=5e-4"]).unwrap();
-    let e = Simulation::new(&scene, RunOptions::default()).unwrap().run().unwrap_err();
+    let scene = Scene::solar_panel()
+        .with_overrides(&["run.dt_s=5e-4"])
+        .unwrap();
+    let e = Simulation::new(&scene, RunOptions::default())
+        .unwrap()
+        .run()
+        .unwrap_err();
     match &e {
         Error::StepTooLarge { field, dt_max, .. } => {
             assert_eq!(field, "run.dt_s");
@@ -87,19 +115,38 @@ fn bin() -> Command {
 #[test]
 fn cli_refuses_without_writing_anything() {
     let dir = std::env::temp_dir().join(format!("cj-refused-{}", std::process::id()));
-    let out = bin().args(["--dt", "1e-3", "--out"]).arg(&dir).output().unwrap();
+    let out = bin()
+        .args(["--dt", "1e-3", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
     assert!(!out.status.success());
     let err = String::from_utf8_lossy(&out.stderr);
-    assert!(err.contains("run.dt_s") && err.contains("too large"), "{err}");
+    assert!(
+        err.contains("run.dt_s") && err.contains("too large"),
+        "{err}"
+    );
     assert!(!err.contains("panicked"), "{err}");
-    assert!(!dir.exists() || std::fs::read_dir(&dir).unwrap().next().is_none(), "files left in {}", dir.display());
+    assert!(
+        !dir.exists() || std::fs::read_dir(&dir).unwrap().next().is_none(),
+        "files left in {}",
+        dir.display()
+    );
 }
 
 #[test]
 fn cli_writes_the_specified_files() {
     let dir = std::env::temp_dir().join(format!("cj-ok-{}", std::process::id()));
-    let out = bin().args(["--end", "0.2", "--out"]).arg(&dir).output().unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = bin()
+        .args(["--end", "0.2", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let header = "t_s,satellite_angle_deg,satellite_rate_deg_s,panel_angle_deg,panel_rate_deg_s,hinge_angle_deg,\
                   hinge_rate_deg_s,hinge_force_n,hinge_ecc_u_mm,hinge_ecc_v_mm,hinge_penetration_um,hinge_contact";
     for twin in ["ideal", "clearance"] {
@@ -110,11 +157,32 @@ fn cli_writes_the_specified_files() {
         assert_eq!(rows.len(), 2001, "one row per 0.1 ms from 0 to 0.2 s");
         assert!(!csv.contains("NaN") && !csv.contains("inf"));
     }
-    let summary: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
-    for key in ["steps", "wall_s", "final_angles_deg", "peak_joint_force_n", "impacts", "first_impact_t_s", "first_impact_peak_n", "max_penetration_um", "linear_momentum_drift", "angular_momentum_drift"] {
-        assert!(summary["twins"]["clearance"].get(key).is_some(), "missing {key}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    for key in [
+        "steps",
+        "wall_s",
+        "final_angles_deg",
+        "peak_joint_force_n",
+        "impacts",
+        "first_impact_t_s",
+        "first_impact_peak_n",
+        "max_penetration_um",
+        "linear_momentum_drift",
+        "angular_momentum_drift",
+    ] {
+        assert!(
+            summary["twins"]["clearance"].get(key).is_some(),
+            "missing {key}"
+        );
     }
     // No temporary files left behind.
-    assert!(std::fs::read_dir(&dir).unwrap().all(|e| !e.unwrap().file_name().to_string_lossy().starts_with('.')));
+    assert!(
+        std::fs::read_dir(&dir).unwrap().all(|e| !e
+            .unwrap()
+            .file_name()
+            .to_string_lossy()
+            .starts_with('.'))
+    );
     std::fs::remove_dir_all(&dir).ok();
 }

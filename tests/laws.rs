@@ -26,7 +26,11 @@ fn close(actual: f64, expected: f64, rel: f64) {
 }
 
 fn contact(delta: f64, rate: f64, rate0: f64) -> NormalContact {
-    NormalContact { penetration: delta, penetration_rate: rate, impact_rate: rate0 }
+    NormalContact {
+        penetration: delta,
+        penetration_rate: rate,
+        impact_rate: rate0,
+    }
 }
 
 /// MSC Adams STEP as written in MODEL.md §2 (own copy, not the crate's).
@@ -66,8 +70,13 @@ fn improved_tangent(e_star: f64, l: f64, c: f64, n: f64, delta: f64) -> f64 {
 
 #[track_caller]
 fn err_names<T: std::fmt::Debug>(r: clearance_joint::Result<T>, field: &str) {
-    let msg = r.expect_err(&format!("expected an error naming `{field}`")).to_string();
-    assert!(msg.contains(field), "error message does not name `{field}`: {msg}");
+    let msg = r
+        .expect_err(&format!("expected an error naming `{field}`"))
+        .to_string();
+    assert!(
+        msg.contains(field),
+        "error message does not name `{field}`: {msg}"
+    );
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -87,7 +96,13 @@ fn hertz_hand_values() {
     // tangent stiffness K n delta^(n-1) = 2e9 * 1.5 * 2e-3 = 6e6 N/m
     close(h.tangent_stiffness(4e-6), 6e6, 1e-12);
     // linear Hertz (n = 1): K = 5e6 N/m, delta = 3e-5 -> 150 N
-    close(Hertz::new(5e6, 1.0).unwrap().normal_force(&contact(3e-5, 1.0, 1.0)), 150.0, 1e-12);
+    close(
+        Hertz::new(5e6, 1.0)
+            .unwrap()
+            .normal_force(&contact(3e-5, 1.0, 1.0)),
+        150.0,
+        1e-12,
+    );
     // no contact
     assert_eq!(h.normal_force(&contact(0.0, 1.0, 1.0)), 0.0);
     assert_eq!(h.normal_force(&contact(-1e-6, 1.0, 1.0)), 0.0);
@@ -97,7 +112,11 @@ fn hertz_hand_values() {
 fn kelvin_voigt_hand_values() {
     // K = 1e7 N/m, D = 2e3 N s/m, delta = 1e-5 m, delta_dot = 0.01 m/s: 1e7*1e-5 + 2e3*0.01 = 100 + 20 = 120 N
     let kv = KelvinVoigt::new(1e7, 2e3).unwrap();
-    close(kv.normal_force(&contact(1e-5, 0.01, 1.0)), 1e7 * 1e-5 + 2e3 * 0.01, 1e-12);
+    close(
+        kv.normal_force(&contact(1e-5, 0.01, 1.0)),
+        1e7 * 1e-5 + 2e3 * 0.01,
+        1e-12,
+    );
     close(kv.normal_force(&contact(1e-5, 0.01, 1.0)), 120.0, 1e-12);
     // separating at 0.02 m/s: 100 - 40 = 60 N
     close(kv.normal_force(&contact(1e-5, -0.02, 1.0)), 60.0, 1e-12);
@@ -122,12 +141,22 @@ fn hunt_crossley_hand_values() {
     let law = HuntCrossley::new(1e10, 1.5, 0.8).unwrap();
     let chi = 3.0 * (1.0 - 0.8) / 2.0;
     let f = law.normal_force(&contact(1e-6, 0.5, 2.0));
-    close(f, hysteresis_expected(1e10, 1.5, chi, 1e-6, 0.5, 2.0), 1e-12);
+    close(
+        f,
+        hysteresis_expected(1e10, 1.5, chi, 1e-6, 0.5, 2.0),
+        1e-12,
+    );
     close(f, 10.75, 1e-12);
     // restitution: delta_dot/delta_dot0 = -1 -> 10 (1 - 0.3) = 7 N
     close(law.normal_force(&contact(1e-6, -2.0, 2.0)), 7.0, 1e-12);
     // cr = 1 is elastic: chi = 0 -> 10 N whatever the rate
-    close(HuntCrossley::new(1e10, 1.5, 1.0).unwrap().normal_force(&contact(1e-6, 3.0, 1.0)), 10.0, 1e-12);
+    close(
+        HuntCrossley::new(1e10, 1.5, 1.0)
+            .unwrap()
+            .normal_force(&contact(1e-6, 3.0, 1.0)),
+        10.0,
+        1e-12,
+    );
     assert!(law.uses_impact_rate());
 }
 
@@ -142,7 +171,8 @@ fn lankarani_nikravesh_stiffness_from_geometry_paper_steel() {
     close(g.journal_radius, 0.0095, 1e-12);
     close(g.clearance(), 0.0005, 1e-9);
     let k = LankaraniNikravesh::stiffness_from_geometry(&g, &Material::STEEL, &Material::STEEL);
-    let expected = 4.0 / (3.0 * (SIGMA_STEEL + SIGMA_STEEL)) * (0.010f64 * 0.0095 / (0.010 - 0.0095)).sqrt();
+    let expected =
+        4.0 / (3.0 * (SIGMA_STEEL + SIGMA_STEEL)) * (0.010f64 * 0.0095 / (0.010 - 0.0095)).sqrt();
     close(k, expected, 1e-12);
     close(k, 6.610198397896845e10, 1e-9);
 
@@ -153,7 +183,11 @@ fn lankarani_nikravesh_stiffness_from_geometry_paper_steel() {
     assert_eq!(LankaraniNikravesh::EXPONENT, 1.5);
     let chi = 3.0 * (1.0 - 0.9 * 0.9) / 4.0;
     let f = ln.normal_force(&contact(1e-5, 0.1, 0.2));
-    close(f, hysteresis_expected(expected, 1.5, chi, 1e-5, 0.1, 0.2), 1e-12);
+    close(
+        f,
+        hysteresis_expected(expected, 1.5, chi, 1e-5, 0.1, 0.2),
+        1e-12,
+    );
     close(f, 2239.2641616960195, 1e-9);
     // elastic part alone
     close(ln.elastic_force(1e-5), 2090.3282722950007, 1e-9);
@@ -165,12 +199,22 @@ fn flores_hand_values() {
     // ratio 0.5: F = 10 (1 + 0.8) = 18 N; ratio -0.5: F = 10 (1 - 0.8) = 2 N; ratio -1: 10 (1-1.6) < 0 -> 0.
     let law = FloresEtAl::new(1e10, 1.5, 0.5).unwrap();
     let chi = 8.0 * (1.0 - 0.5) / (5.0 * 0.5);
-    close(law.normal_force(&contact(1e-6, 0.5, 1.0)), hysteresis_expected(1e10, 1.5, chi, 1e-6, 0.5, 1.0), 1e-12);
+    close(
+        law.normal_force(&contact(1e-6, 0.5, 1.0)),
+        hysteresis_expected(1e10, 1.5, chi, 1e-6, 0.5, 1.0),
+        1e-12,
+    );
     close(law.normal_force(&contact(1e-6, 0.5, 1.0)), 18.0, 1e-12);
     close(law.normal_force(&contact(1e-6, -0.5, 1.0)), 2.0, 1e-12);
     assert_eq!(law.normal_force(&contact(1e-6, -1.0, 1.0)), 0.0);
     // cr = 0.8: chi = 8*0.2/4 = 0.4; ratio 1 -> 10 * 1.4 = 14 N
-    close(FloresEtAl::new(1e10, 1.5, 0.8).unwrap().normal_force(&contact(1e-6, 3.0, 3.0)), 14.0, 1e-12);
+    close(
+        FloresEtAl::new(1e10, 1.5, 0.8)
+            .unwrap()
+            .normal_force(&contact(1e-6, 3.0, 3.0)),
+        14.0,
+        1e-12,
+    );
 }
 
 #[test]
@@ -179,12 +223,22 @@ fn gonthier_hand_values() {
     // ratio 0.5: F = 10 (1 + 0.75) = 17.5 N; ratio -0.5: 10 (1 - 0.75) = 2.5 N; ratio -1: -5 -> 0.
     let law = GonthierEtAl::new(1e10, 1.5, 0.5).unwrap();
     let chi = (1.0 - 0.5 * 0.5) / 0.5;
-    close(law.normal_force(&contact(1e-6, 1.0, 2.0)), hysteresis_expected(1e10, 1.5, chi, 1e-6, 1.0, 2.0), 1e-12);
+    close(
+        law.normal_force(&contact(1e-6, 1.0, 2.0)),
+        hysteresis_expected(1e10, 1.5, chi, 1e-6, 1.0, 2.0),
+        1e-12,
+    );
     close(law.normal_force(&contact(1e-6, 1.0, 2.0)), 17.5, 1e-12);
     close(law.normal_force(&contact(1e-6, -1.0, 2.0)), 2.5, 1e-12);
     assert_eq!(law.normal_force(&contact(1e-6, -2.0, 2.0)), 0.0);
     // cr = 0.8: chi = 0.36/0.8 = 0.45; ratio 1 -> 14.5 N
-    close(GonthierEtAl::new(1e10, 1.5, 0.8).unwrap().normal_force(&contact(1e-6, 1.0, 1.0)), 14.5, 1e-12);
+    close(
+        GonthierEtAl::new(1e10, 1.5, 0.8)
+            .unwrap()
+            .normal_force(&contact(1e-6, 1.0, 1.0)),
+        14.5,
+        1e-12,
+    );
 }
 
 #[test]
@@ -193,15 +247,32 @@ fn liu_hand_values_paper_joint() {
     // (pi/2) E* L = 1.5707963267948966 * 1.1373626373626373e11 * 0.016 = 2.858504084804779e9 N/m
     // delta = 10 um: sqrt(1e-5/(2 * 5.1e-4)) = sqrt(9.803921568627451e-3) = 0.09901475429766743
     // F = 2.858504084804779e9 * 1e-5 * 0.09901475429766743 = 2830.3407961582393 N
-    close(effective_modulus(&Material::STEEL, &Material::STEEL), E_STAR_STEEL, 1e-12);
+    close(
+        effective_modulus(&Material::STEEL, &Material::STEEL),
+        E_STAR_STEEL,
+        1e-12,
+    );
     let liu = LiuEtAl::new(E_STAR_STEEL, 0.016, 5e-4).unwrap();
-    let expected = 0.5 * PI * E_STAR_STEEL * 0.016 * 1e-5 * (1e-5f64 / (2.0 * (5e-4 + 1e-5))).sqrt();
+    let expected =
+        0.5 * PI * E_STAR_STEEL * 0.016 * 1e-5 * (1e-5f64 / (2.0 * (5e-4 + 1e-5))).sqrt();
     close(liu.normal_force(&contact(1e-5, 0.0, 1.0)), expected, 1e-12);
-    close(liu.normal_force(&contact(1e-5, 0.0, 1.0)), 2830.3407961582393, 1e-9);
+    close(
+        liu.normal_force(&contact(1e-5, 0.0, 1.0)),
+        2830.3407961582393,
+        1e-9,
+    );
     // elastic only: the rate does nothing
-    close(liu.normal_force(&contact(1e-5, -100.0, 1.0)), 2830.3407961582393, 1e-9);
+    close(
+        liu.normal_force(&contact(1e-5, -100.0, 1.0)),
+        2830.3407961582393,
+        1e-9,
+    );
     // delta = c = 0.5 mm: sqrt(c/(4c)) = 0.5; F = 2.858504e9 * 5e-4 * 0.5 = 714626.0212011948 N
-    close(liu.elastic_force(5e-4), 2.858504084804779e9 * 5e-4 * 0.5, 1e-9);
+    close(
+        liu.elastic_force(5e-4),
+        2.858504084804779e9 * 5e-4 * 0.5,
+        1e-9,
+    );
     assert_eq!(liu.normal_force(&contact(-1e-6, 1.0, 1.0)), 0.0);
 }
 
@@ -215,8 +286,16 @@ fn improved_liu_elastic_and_tangent_stiffness_by_hand() {
     // n = 1.5, delta = 100 um: sqrt(1e-4/(2*6e-4)) = sqrt(1/12) = 0.28867513459481287,
     // delta^1.5 = 1e-6: F_K = 2.858504e9 * 0.288675 * 1e-6 = 825.179051420842 N
     let n15 = ImprovedLiu::new(E_STAR_STEEL, l, c, 1.5, 1e-4, MaxDamping::Eta(0.0)).unwrap();
-    close(n15.elastic_force(1e-4), improved_elastic(E_STAR_STEEL, l, c, 1.5, 1e-4), 1e-12);
-    close(n15.elastic_force(1e-4), s * (1.0f64 / 12.0).sqrt() * 1e-6, 1e-9);
+    close(
+        n15.elastic_force(1e-4),
+        improved_elastic(E_STAR_STEEL, l, c, 1.5, 1e-4),
+        1e-12,
+    );
+    close(
+        n15.elastic_force(1e-4),
+        s * (1.0f64 / 12.0).sqrt() * 1e-6,
+        1e-9,
+    );
     close(n15.elastic_force(1e-4), 825.179051420842, 1e-9);
 
     // K_N = s delta^(n-1/2) (2(c+delta))^(-1/2) (n + c/(2(c+delta))) (derivation at improved_tangent).
@@ -233,11 +312,21 @@ fn improved_liu_elastic_and_tangent_stiffness_by_hand() {
     for n in [1.0, 1.2, 1.5, 2.0, 3.0] {
         let law = ImprovedLiu::new(E_STAR_STEEL, l, c, n, 1e-4, MaxDamping::Eta(0.0)).unwrap();
         for d in [1e-9, 1e-7, 3e-6, 1e-5, 1e-4, 5e-4, 2e-3] {
-            close(law.tangent_stiffness(d), improved_tangent(E_STAR_STEEL, l, c, n, d), 1e-12);
-            close(law.elastic_force(d), improved_elastic(E_STAR_STEEL, l, c, n, d), 1e-12);
+            close(
+                law.tangent_stiffness(d),
+                improved_tangent(E_STAR_STEEL, l, c, n, d),
+                1e-12,
+            );
+            close(
+                law.elastic_force(d),
+                improved_elastic(E_STAR_STEEL, l, c, n, d),
+                1e-12,
+            );
             // and the hand derivative against a central difference of the hand force
             let h = d * 1e-5;
-            let fd = (improved_elastic(E_STAR_STEEL, l, c, n, d + h) - improved_elastic(E_STAR_STEEL, l, c, n, d - h)) / (2.0 * h);
+            let fd = (improved_elastic(E_STAR_STEEL, l, c, n, d + h)
+                - improved_elastic(E_STAR_STEEL, l, c, n, d - h))
+                / (2.0 * h);
             close(improved_tangent(E_STAR_STEEL, l, c, n, d), fd, 1e-7);
         }
     }
@@ -263,19 +352,47 @@ fn improved_liu_max_damping_and_step_ramp() {
     let d = 0.25e-4;
     let expected = improved_elastic(E_STAR_STEEL, l, c, 1.0, d) + 0.15625 * d_max * rate;
     close(law.normal_force(&contact(d, rate, 1.0)), expected, 1e-12);
-    close(law.damping_coefficient(&contact(d, rate, 1.0)), 0.15625 * d_max, 1e-12);
+    close(
+        law.damping_coefficient(&contact(d, rate, 1.0)),
+        0.15625 * d_max,
+        1e-12,
+    );
     close(adams_step(d, 0.0, 0.0, dmax, d_max), 0.15625 * d_max, 1e-12);
     // F_K(25 um) = 11026.918904142527 N; + 0.15625 * 1.169003656e7 * 0.01 = 18265.6821 N -> 29292.6010 N
-    close(law.normal_force(&contact(d, rate, 1.0)), 11026.918904142527 + 0.15625 * 1.169003656179526e5, 1e-9);
+    close(
+        law.normal_force(&contact(d, rate, 1.0)),
+        11026.918904142527 + 0.15625 * 1.169003656179526e5,
+        1e-9,
+    );
     // delta = delta_max/2: s = 0.5 -> 0.25 * 2 = 0.5
-    close(law.damping_coefficient(&contact(0.5e-4, rate, 1.0)), 0.5 * d_max, 1e-12);
+    close(
+        law.damping_coefficient(&contact(0.5e-4, rate, 1.0)),
+        0.5 * d_max,
+        1e-12,
+    );
     // delta = 3/4 delta_max: s = 0.75 -> 0.5625 * 1.5 = 0.84375
-    close(law.damping_coefficient(&contact(0.75e-4, rate, 1.0)), 0.84375 * d_max, 1e-12);
+    close(
+        law.damping_coefficient(&contact(0.75e-4, rate, 1.0)),
+        0.84375 * d_max,
+        1e-12,
+    );
     // at and beyond delta_max: D_max
-    close(law.damping_coefficient(&contact(1e-4, rate, 1.0)), d_max, 1e-12);
-    close(law.damping_coefficient(&contact(3e-4, rate, 1.0)), d_max, 1e-12);
+    close(
+        law.damping_coefficient(&contact(1e-4, rate, 1.0)),
+        d_max,
+        1e-12,
+    );
+    close(
+        law.damping_coefficient(&contact(3e-4, rate, 1.0)),
+        d_max,
+        1e-12,
+    );
     let expected = improved_elastic(E_STAR_STEEL, l, c, 1.0, 3e-4) + d_max * (-0.002);
-    close(law.normal_force(&contact(3e-4, -0.002, 1.0)), expected, 1e-12);
+    close(
+        law.normal_force(&contact(3e-4, -0.002, 1.0)),
+        expected,
+        1e-12,
+    );
     // the damping term never pulls: delta = 10 um, separating at 1 m/s:
     // F_K = 2830.34 N, D_imp = 1e7-ish * s^2(3-2s) with s = 0.1 -> 0.028 * 1.169e7 = 327328 N s/m
     // -> 2830 - 327328 < 0 -> 0
@@ -300,28 +417,55 @@ fn improved_liu_max_damping_and_step_ramp() {
     let lw = ImprovedLiu::new(E_STAR_STEEL, l, c, 1.0, 5e-5, MaxDamping::Eta(0.02)).unwrap();
     let d_max = 0.02 * improved_tangent(E_STAR_STEEL, l, c, 1.0, 5e-5);
     close(lw.max_damping(), d_max, 1e-12);
-    close(lw.damping_coefficient(&contact(2.5e-5, 0.0, 1.0)), 0.5 * d_max, 1e-12);
+    close(
+        lw.damping_coefficient(&contact(2.5e-5, 0.0, 1.0)),
+        0.5 * d_max,
+        1e-12,
+    );
 }
 
 #[test]
 fn normal_model_dispatch_matches_laws() {
     let models = [
-        (NormalModel::Hertz(Hertz::new(1e10, 1.5).unwrap()), 10.0 * (1.0 + 0.0)),
+        (
+            NormalModel::Hertz(Hertz::new(1e10, 1.5).unwrap()),
+            10.0 * (1.0 + 0.0),
+        ),
         // KV K = 1e7, D = 1e3: 1e7 * 1e-6 + 1e3 * 0.5 = 10 + 500 = 510 N
-        (NormalModel::KelvinVoigt(KelvinVoigt::new(1e7, 1e3).unwrap()), 510.0),
+        (
+            NormalModel::KelvinVoigt(KelvinVoigt::new(1e7, 1e3).unwrap()),
+            510.0,
+        ),
         // HC cr 0.8 chi 0.3, ratio 0.5: 10 * 1.15 = 11.5
-        (NormalModel::HuntCrossley(HuntCrossley::new(1e10, 1.5, 0.8).unwrap()), 11.5),
+        (
+            NormalModel::HuntCrossley(HuntCrossley::new(1e10, 1.5, 0.8).unwrap()),
+            11.5,
+        ),
         // LN cr 0.8 chi 0.27, ratio 0.5: 10 * 1.135 = 11.35
-        (NormalModel::LankaraniNikravesh(LankaraniNikravesh::new(1e10, 1.5, 0.8).unwrap()), 11.35),
+        (
+            NormalModel::LankaraniNikravesh(LankaraniNikravesh::new(1e10, 1.5, 0.8).unwrap()),
+            11.35,
+        ),
         // Flores cr 0.8 chi 0.4: 10 * 1.2 = 12
-        (NormalModel::FloresEtAl(FloresEtAl::new(1e10, 1.5, 0.8).unwrap()), 12.0),
+        (
+            NormalModel::FloresEtAl(FloresEtAl::new(1e10, 1.5, 0.8).unwrap()),
+            12.0,
+        ),
         // Gonthier cr 0.8 chi 0.45: 10 * 1.225 = 12.25
-        (NormalModel::GonthierEtAl(GonthierEtAl::new(1e10, 1.5, 0.8).unwrap()), 12.25),
+        (
+            NormalModel::GonthierEtAl(GonthierEtAl::new(1e10, 1.5, 0.8).unwrap()),
+            12.25,
+        ),
         // Liu E* = 1e11, L = 0.01, c = 1e-6: sqrt(1e-6/(4e-6)) = 0.5, (pi/2)*1e9*1e-6*0.5 = 250 pi
-        (NormalModel::LiuEtAl(LiuEtAl::new(1e11, 0.01, 1e-6).unwrap()), 250.0 * PI),
+        (
+            NormalModel::LiuEtAl(LiuEtAl::new(1e11, 0.01, 1e-6).unwrap()),
+            250.0 * PI,
+        ),
         // Improved n = 1, same as Liu, explicit D_max = 1e3, delta = delta_max -> + 1e3 * 0.5 = 500
         (
-            NormalModel::ImprovedLiu(ImprovedLiu::new(1e11, 0.01, 1e-6, 1.0, 1e-6, MaxDamping::Explicit(1e3)).unwrap()),
+            NormalModel::ImprovedLiu(
+                ImprovedLiu::new(1e11, 0.01, 1e-6, 1.0, 1e-6, MaxDamping::Explicit(1e3)).unwrap(),
+            ),
             250.0 * PI + 500.0,
         ),
     ];
@@ -376,7 +520,11 @@ fn ambrosio_hand_values() {
     assert_eq!(f.coefficient(5e-3), 0.2);
     assert_eq!(f.max_coefficient(), 0.2);
     // v0 = 0 allowed: linear from rest
-    close(Ambrosio::new(0.4, 0.0, 2e-3).unwrap().coefficient(0.5e-3), 0.1, 1e-12);
+    close(
+        Ambrosio::new(0.4, 0.0, 2e-3).unwrap().coefficient(0.5e-3),
+        0.1,
+        1e-12,
+    );
 }
 
 /// MODEL.md §3, Bai / Adams stiction, written from the spec with the local STEP.
@@ -405,9 +553,15 @@ fn bai_table_3_hand_values() {
         close(law.coefficient(1e-4), mu_s, 1e-12);
         close(law.coefficient(1e-2), mu_d, 1e-12);
         assert_eq!(law.coefficient(1.0), mu_d);
-        for v in [0.0, 1e-6, 3e-5, 0.5e-4, 0.99e-4, 1e-4, 2e-4, 2.575e-3, 5e-3, 9.99e-3, 1e-2, 0.5] {
+        for v in [
+            0.0, 1e-6, 3e-5, 0.5e-4, 0.99e-4, 1e-4, 2e-4, 2.575e-3, 5e-3, 9.99e-3, 1e-2, 0.5,
+        ] {
             let e = bai_expected(mu_s, mu_d, 1e-4, 1e-2, v);
-            assert!((law.coefficient(v) - e).abs() <= 1e-14, "v = {v}: {} vs {e}", law.coefficient(v));
+            assert!(
+                (law.coefficient(v) - e).abs() <= 1e-14,
+                "v = {v}: {} vs {e}",
+                law.coefficient(v)
+            );
         }
     }
     // v = v_s/2: s = (0.5e-4 + 1e-4)/2e-4 = 0.75, s^2 (3-2s) = 0.5625 * 1.5 = 0.84375,
@@ -421,7 +575,11 @@ fn bai_table_3_hand_values() {
     close(Bai::LUBRICATED.coefficient(2.575e-3), 0.0753125, 1e-12);
     // v = 5 mm/s, lubricated: s = 4.9e-3/9.9e-3 = 0.494949..., s^2(3-2s) = 0.4924242...,
     //   mu = 0.08 - 0.03 * 0.4924242 = 0.06522726499769659
-    close(Bai::LUBRICATED.coefficient(5e-3), 0.06522726499769659, 1e-12);
+    close(
+        Bai::LUBRICATED.coefficient(5e-3),
+        0.06522726499769659,
+        1e-12,
+    );
 }
 
 #[test]
@@ -443,7 +601,10 @@ fn friction_model_dispatch_matches_laws() {
         assert_eq!(FrictionModel::Coulomb(c).coefficient(v), c.coefficient(v));
         assert_eq!(FrictionModel::Threlfall(t).coefficient(v), t.coefficient(v));
         assert_eq!(FrictionModel::Ambrosio(a).coefficient(v), a.coefficient(v));
-        assert_eq!(FrictionModel::Bai(Bai::DRY).coefficient(v), Bai::DRY.coefficient(v));
+        assert_eq!(
+            FrictionModel::Bai(Bai::DRY).coefficient(v),
+            Bai::DRY.coefficient(v)
+        );
     }
 }
 
@@ -458,8 +619,19 @@ fn contact_force_hand_value_paper_joint() {
     let g = BearingGeometry::from_clearance(0.010, 0.0005, 0.016).unwrap();
     let bearing = BodyMotion::default();
     // journal translating at (0, 1, 0.3) m/s: v_rel = (0, 1, 0.3); delta_dot = 0; slip = (0, 1, 0)
-    let journal = BodyMotion { center_of_mass: Vector::new(0.0, 0.0, 0.002), linvel: Vector::new(0.0, 1.0, 0.3), angvel: Vector::ZERO };
-    let st = journal_state(&g, Vector::ZERO, Vector::new(0.51e-3, 0.0, 0.002), Vector::Z, &bearing, &journal);
+    let journal = BodyMotion {
+        center_of_mass: Vector::new(0.0, 0.0, 0.002),
+        linvel: Vector::new(0.0, 1.0, 0.3),
+        angvel: Vector::ZERO,
+    };
+    let st = journal_state(
+        &g,
+        Vector::ZERO,
+        Vector::new(0.51e-3, 0.0, 0.002),
+        Vector::Z,
+        &bearing,
+        &journal,
+    );
     assert!((st.penetration - 1e-5).abs() < 1e-15, "{}", st.penetration);
     assert!((st.normal - Vector::X).length() < 1e-12);
     assert!(st.penetration_rate.abs() < 1e-15);
@@ -469,16 +641,28 @@ fn contact_force_hand_value_paper_joint() {
 
     // ImprovedLiu, n = 1, eta = 0.01: F_N = F_K(10 um) = 2830.3407961582393 N (delta_dot = 0)
     // lubricated Bai at v = 1 m/s >= v_d: mu = 0.05 -> friction 141.51703980791197 N along -y
-    let law = ImprovedLiu::new(E_STAR_STEEL, 0.016, 5e-4, 1.0, 1e-4, MaxDamping::Eta(0.01)).unwrap();
+    let law =
+        ImprovedLiu::new(E_STAR_STEEL, 0.016, 5e-4, 1.0, 1e-4, MaxDamping::Eta(0.01)).unwrap();
     let f = contact_force(&st, 1.0, &law, &Bai::LUBRICATED);
     close(f.normal_force, 2830.3407961582393, 1e-9);
     close(f.friction_force, 141.51703980791197, 1e-9);
     let expected = Vector::new(-2830.3407961582393, -141.51703980791197, 0.0);
-    assert!((f.on_journal - expected).length() < 1e-9 * expected.length(), "{:?}", f.on_journal);
+    assert!(
+        (f.on_journal - expected).length() < 1e-9 * expected.length(),
+        "{:?}",
+        f.on_journal
+    );
     assert!((f.point - st.contact_point).length() == 0.0);
 
     // free flight: no force at all
-    let st_free = journal_state(&g, Vector::ZERO, Vector::new(0.4e-3, 0.0, 0.0), Vector::Z, &bearing, &journal);
+    let st_free = journal_state(
+        &g,
+        Vector::ZERO,
+        Vector::new(0.4e-3, 0.0, 0.0),
+        Vector::Z,
+        &bearing,
+        &journal,
+    );
     assert!(st_free.penetration < 0.0);
     let f = contact_force(&st_free, 1.0, &law, &Bai::DRY);
     assert_eq!(f.on_journal, Vector::ZERO);
@@ -520,15 +704,42 @@ fn invalid_normal_parameters_are_named() {
     err_names(LiuEtAl::new(1e11, 0.016, 0.0), "clearance");
     err_names(LiuEtAl::new(1e11, 0.016, f64::NAN), "clearance");
     let eta = MaxDamping::Eta(0.01);
-    err_names(ImprovedLiu::new(f64::NAN, 0.016, 5e-4, 1.0, 1e-4, eta), "effective_modulus");
-    err_names(ImprovedLiu::new(1e11, -0.016, 5e-4, 1.0, 1e-4, eta), "length");
-    err_names(ImprovedLiu::new(1e11, 0.016, -5e-4, 1.0, 1e-4, eta), "clearance");
-    err_names(ImprovedLiu::new(1e11, 0.016, 5e-4, 0.5, 1e-4, eta), "exponent");
-    err_names(ImprovedLiu::new(1e11, 0.016, 5e-4, f64::NAN, 1e-4, eta), "exponent");
-    err_names(ImprovedLiu::new(1e11, 0.016, 5e-4, 1.0, 0.0, eta), "delta_max");
-    err_names(ImprovedLiu::new(1e11, 0.016, 5e-4, 1.0, 1e-4, MaxDamping::Eta(-0.01)), "eta");
-    err_names(ImprovedLiu::new(1e11, 0.016, 5e-4, 1.0, 1e-4, MaxDamping::Eta(f64::NAN)), "eta");
-    err_names(ImprovedLiu::new(1e11, 0.016, 5e-4, 1.0, 1e-4, MaxDamping::Explicit(-1.0)), "d_max");
+    err_names(
+        ImprovedLiu::new(f64::NAN, 0.016, 5e-4, 1.0, 1e-4, eta),
+        "effective_modulus",
+    );
+    err_names(
+        ImprovedLiu::new(1e11, -0.016, 5e-4, 1.0, 1e-4, eta),
+        "length",
+    );
+    err_names(
+        ImprovedLiu::new(1e11, 0.016, -5e-4, 1.0, 1e-4, eta),
+        "clearance",
+    );
+    err_names(
+        ImprovedLiu::new(1e11, 0.016, 5e-4, 0.5, 1e-4, eta),
+        "exponent",
+    );
+    err_names(
+        ImprovedLiu::new(1e11, 0.016, 5e-4, f64::NAN, 1e-4, eta),
+        "exponent",
+    );
+    err_names(
+        ImprovedLiu::new(1e11, 0.016, 5e-4, 1.0, 0.0, eta),
+        "delta_max",
+    );
+    err_names(
+        ImprovedLiu::new(1e11, 0.016, 5e-4, 1.0, 1e-4, MaxDamping::Eta(-0.01)),
+        "eta",
+    );
+    err_names(
+        ImprovedLiu::new(1e11, 0.016, 5e-4, 1.0, 1e-4, MaxDamping::Eta(f64::NAN)),
+        "eta",
+    );
+    err_names(
+        ImprovedLiu::new(1e11, 0.016, 5e-4, 1.0, 1e-4, MaxDamping::Explicit(-1.0)),
+        "d_max",
+    );
     // NaN is reported as such
     let msg = Hertz::new(f64::NAN, 1.5).unwrap_err().to_string();
     assert!(msg.contains("NaN"), "{msg}");
@@ -561,14 +772,29 @@ fn invalid_geometry_and_material_are_named() {
     err_names(BearingGeometry::new(0.010, 0.010, 0.016), "journal_radius");
     err_names(BearingGeometry::new(0.010, 0.011, 0.016), "journal_radius");
     err_names(BearingGeometry::new(0.0, 0.0095, 0.016), "bearing_radius");
-    err_names(BearingGeometry::new(0.010, -0.0095, 0.016), "journal_radius");
+    err_names(
+        BearingGeometry::new(0.010, -0.0095, 0.016),
+        "journal_radius",
+    );
     err_names(BearingGeometry::new(0.010, 0.0095, 0.0), "length");
     err_names(BearingGeometry::new(0.010, 0.0095, f64::NAN), "length");
     // clearance <= 0
-    err_names(BearingGeometry::from_clearance(0.010, 0.0, 0.016), "clearance");
-    err_names(BearingGeometry::from_clearance(0.010, -1e-4, 0.016), "clearance");
-    err_names(BearingGeometry::from_clearance(0.010, f64::NAN, 0.016), "clearance");
-    err_names(BearingGeometry::from_clearance(0.010, 0.010, 0.016), "clearance");
+    err_names(
+        BearingGeometry::from_clearance(0.010, 0.0, 0.016),
+        "clearance",
+    );
+    err_names(
+        BearingGeometry::from_clearance(0.010, -1e-4, 0.016),
+        "clearance",
+    );
+    err_names(
+        BearingGeometry::from_clearance(0.010, f64::NAN, 0.016),
+        "clearance",
+    );
+    err_names(
+        BearingGeometry::from_clearance(0.010, 0.010, 0.016),
+        "clearance",
+    );
     err_names(Material::new(-207e9, 0.3), "youngs_modulus_pa");
     err_names(Material::new(207e9, 0.6), "poisson_ratio");
     err_names(Material::new(207e9, -1.0), "poisson_ratio");
@@ -594,18 +820,30 @@ fn normal_model() -> impl Strategy<Value = NormalModel> {
     let len = log_uniform(-3.0, 0.0);
     let c = log_uniform(-6.0, -2.0);
     let dmax = log_uniform(-6.0, -3.0);
-    let damping = prop_oneof![(0.0..0.1f64).prop_map(MaxDamping::Eta), (0.0..1e9f64).prop_map(MaxDamping::Explicit)];
+    let damping = prop_oneof![
+        (0.0..0.1f64).prop_map(MaxDamping::Eta),
+        (0.0..1e9f64).prop_map(MaxDamping::Explicit)
+    ];
     prop_oneof![
         (k.clone(), n.clone()).prop_map(|(k, n)| NormalModel::Hertz(Hertz::new(k, n).unwrap())),
-        (k.clone(), 0.0..1e6f64).prop_map(|(k, d)| NormalModel::KelvinVoigt(KelvinVoigt::new(k, d).unwrap())),
-        (k.clone(), n.clone(), cr.clone()).prop_map(|(k, n, cr)| NormalModel::HuntCrossley(HuntCrossley::new(k, n, cr).unwrap())),
+        (k.clone(), 0.0..1e6f64)
+            .prop_map(|(k, d)| NormalModel::KelvinVoigt(KelvinVoigt::new(k, d).unwrap())),
         (k.clone(), n.clone(), cr.clone())
-            .prop_map(|(k, n, cr)| NormalModel::LankaraniNikravesh(LankaraniNikravesh::new(k, n, cr).unwrap())),
-        (k.clone(), n.clone(), cr.clone()).prop_map(|(k, n, cr)| NormalModel::FloresEtAl(FloresEtAl::new(k, n, cr).unwrap())),
-        (k, n.clone(), cr).prop_map(|(k, n, cr)| NormalModel::GonthierEtAl(GonthierEtAl::new(k, n, cr).unwrap())),
-        (e_star.clone(), len.clone(), c.clone()).prop_map(|(e, l, c)| NormalModel::LiuEtAl(LiuEtAl::new(e, l, c).unwrap())),
-        (e_star, len, c, n, dmax, damping)
-            .prop_map(|(e, l, c, n, dm, d)| NormalModel::ImprovedLiu(ImprovedLiu::new(e, l, c, n, dm, d).unwrap())),
+            .prop_map(|(k, n, cr)| NormalModel::HuntCrossley(HuntCrossley::new(k, n, cr).unwrap())),
+        (k.clone(), n.clone(), cr.clone()).prop_map(|(k, n, cr)| NormalModel::LankaraniNikravesh(
+            LankaraniNikravesh::new(k, n, cr).unwrap()
+        )),
+        (k.clone(), n.clone(), cr.clone())
+            .prop_map(|(k, n, cr)| NormalModel::FloresEtAl(FloresEtAl::new(k, n, cr).unwrap())),
+        (k, n.clone(), cr)
+            .prop_map(|(k, n, cr)| NormalModel::GonthierEtAl(GonthierEtAl::new(k, n, cr).unwrap())),
+        (e_star.clone(), len.clone(), c.clone())
+            .prop_map(|(e, l, c)| NormalModel::LiuEtAl(LiuEtAl::new(e, l, c).unwrap())),
+        (e_star, len, c, n, dmax, damping).prop_map(
+            |(e, l, c, n, dm, d)| NormalModel::ImprovedLiu(
+                ImprovedLiu::new(e, l, c, n, dm, d).unwrap()
+            )
+        ),
     ]
 }
 
@@ -614,12 +852,25 @@ fn friction_model() -> impl Strategy<Value = FrictionModel> {
     let mu = 0.0..1.0f64;
     prop_oneof![
         Just(FrictionModel::None),
-        (mu.clone(), log_uniform(-6.0, 0.0)).prop_map(|(m, v)| FrictionModel::Coulomb(Coulomb::new(m, v).unwrap())),
-        (mu.clone(), log_uniform(-6.0, 0.0)).prop_map(|(m, v)| FrictionModel::Threlfall(Threlfall::new(m, v).unwrap())),
-        (mu.clone(), prop_oneof![Just(0.0), log_uniform(-6.0, -1.0)], log_uniform(-6.0, -1.0))
+        (mu.clone(), log_uniform(-6.0, 0.0))
+            .prop_map(|(m, v)| FrictionModel::Coulomb(Coulomb::new(m, v).unwrap())),
+        (mu.clone(), log_uniform(-6.0, 0.0))
+            .prop_map(|(m, v)| FrictionModel::Threlfall(Threlfall::new(m, v).unwrap())),
+        (
+            mu.clone(),
+            prop_oneof![Just(0.0), log_uniform(-6.0, -1.0)],
+            log_uniform(-6.0, -1.0)
+        )
             .prop_map(|(m, v0, w)| FrictionModel::Ambrosio(Ambrosio::new(m, v0, v0 + w).unwrap())),
-        (mu.clone(), mu, log_uniform(-6.0, -2.0), log_uniform(-3.0, 2.0))
-            .prop_map(|(ms, md, vs, r)| FrictionModel::Bai(Bai::new(ms, md, vs, vs * (1.0 + r)).unwrap())),
+        (
+            mu.clone(),
+            mu,
+            log_uniform(-6.0, -2.0),
+            log_uniform(-3.0, 2.0)
+        )
+            .prop_map(|(ms, md, vs, r)| FrictionModel::Bai(
+                Bai::new(ms, md, vs, vs * (1.0 + r)).unwrap()
+            )),
         Just(FrictionModel::Bai(Bai::DRY)),
         Just(FrictionModel::Bai(Bai::LUBRICATED)),
     ]
@@ -642,7 +893,11 @@ fn vec3(scale: f64) -> impl Strategy<Value = Vector> {
 }
 
 fn body(pos: f64, lin: f64, ang: f64) -> impl Strategy<Value = BodyMotion> {
-    (vec3(pos), vec3(lin), vec3(ang)).prop_map(|(c, v, w)| BodyMotion { center_of_mass: c, linvel: v, angvel: w })
+    (vec3(pos), vec3(lin), vec3(ang)).prop_map(|(c, v, w)| BodyMotion {
+        center_of_mass: c,
+        linvel: v,
+        angvel: w,
+    })
 }
 
 proptest! {

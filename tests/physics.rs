@@ -7,8 +7,19 @@ use clearance_joint::sim::{RunOptions, RunResult, Simulation, TwinKind, Twins};
 use rapier3d_f64::prelude::*;
 
 fn run(overrides: &[&str], twins: Twins) -> RunResult {
-    let scene = Scene::solar_panel().with_overrides(overrides).expect("valid overrides");
-    Simulation::new(&scene, RunOptions { twins, skip_rows: false }).unwrap().run().unwrap()
+    let scene = Scene::solar_panel()
+        .with_overrides(overrides)
+        .expect("valid overrides");
+    Simulation::new(
+        &scene,
+        RunOptions {
+            twins,
+            skip_rows: false,
+        },
+    )
+    .unwrap()
+    .run()
+    .unwrap()
 }
 
 fn clearance_summary(r: &RunResult) -> clearance_joint::report::TwinSummary {
@@ -20,17 +31,36 @@ fn free_floating_momentum_is_conserved() {
     // Dry friction and damping on: every contact force is an equal-and-opposite pair at one point.
     let r = run(&[], Twins::ClearanceOnly);
     let s = clearance_summary(&r);
-    assert!(s.impacts > 100, "the default scene rattles: {} impacts", s.impacts);
-    assert!(s.linear_momentum_drift < 1e-9, "linear drift {:e}", s.linear_momentum_drift);
-    assert!(s.angular_momentum_drift < 1e-9, "angular drift {:e}", s.angular_momentum_drift);
+    assert!(
+        s.impacts > 100,
+        "the default scene rattles: {} impacts",
+        s.impacts
+    );
+    assert!(
+        s.linear_momentum_drift < 1e-9,
+        "linear drift {:e}",
+        s.linear_momentum_drift
+    );
+    assert!(
+        s.angular_momentum_drift < 1e-9,
+        "angular drift {:e}",
+        s.angular_momentum_drift
+    );
 }
 
 #[test]
 fn energy_is_conserved_without_damping_and_friction() {
-    let r = run(&["hinge.eta_s=0", "hinge.friction=None"], Twins::ClearanceOnly);
+    let r = run(
+        &["hinge.eta_s=0", "hinge.friction=None"],
+        Twins::ClearanceOnly,
+    );
     let s = clearance_summary(&r);
     assert!(s.impacts > 5, "{} impacts", s.impacts);
-    assert!(s.invariants.energy_error < 1e-3, "energy error {:e} of peak kinetic energy", s.invariants.energy_error);
+    assert!(
+        s.invariants.energy_error < 1e-3,
+        "energy error {:e} of peak kinetic energy",
+        s.invariants.energy_error
+    );
 }
 
 #[test]
@@ -38,7 +68,11 @@ fn dissipation_never_creates_energy() {
     // With damping and friction the total energy may only fall (tolerance: the integrator's own
     // error measured in the conservative test above).
     let s = clearance_summary(&run(&[], Twins::ClearanceOnly));
-    assert!(s.invariants.energy_growth < 1e-3, "energy grew by {:e} of peak kinetic energy", s.invariants.energy_growth);
+    assert!(
+        s.invariants.energy_growth < 1e-3,
+        "energy grew by {:e} of peak kinetic energy",
+        s.invariants.energy_growth
+    );
 }
 
 #[test]
@@ -47,12 +81,28 @@ fn clearance_twin_approaches_ideal_as_clearance_shrinks() {
     let mut gaps = Vec::new();
     for c in ["0.5", "0.1", "0.02"] {
         let clearance = format!("hinge.clearance_mm={c}");
-        let r = run(&[&clearance, "hinge.friction=None", "run.dt_s=5e-5", "run.output_interval_s=1e-3"], Twins::Both);
+        let r = run(
+            &[
+                &clearance,
+                "hinge.friction=None",
+                "run.dt_s=5e-5",
+                "run.output_interval_s=1e-3",
+            ],
+            Twins::Both,
+        );
         let s = r.summary();
-        gaps.push((s.twins["ideal"].final_angles_deg["hinge"] - s.twins["clearance"].final_angles_deg["hinge"]).abs());
+        gaps.push(
+            (s.twins["ideal"].final_angles_deg["hinge"]
+                - s.twins["clearance"].final_angles_deg["hinge"])
+                .abs(),
+        );
     }
     assert!(gaps[0] > gaps[1] && gaps[1] > gaps[2], "{gaps:?}");
-    assert!(gaps[2] < 0.01, "at c = 0.02 mm the twins differ by {} deg", gaps[2]);
+    assert!(
+        gaps[2] < 0.01,
+        "at c = 0.02 mm the twins differ by {} deg",
+        gaps[2]
+    );
 }
 
 #[test]
@@ -61,16 +111,38 @@ fn default_run_matches_paper_conclusion_one() {
     let s = r.summary();
     let (ideal, clear) = (&s.twins["ideal"], &s.twins["clearance"]);
     // MODEL.md §4 cross-check: the ideal deployment reaches about 53 deg at 5 s.
-    assert!((ideal.final_angles_deg["hinge"] - 53.0).abs() < 1.0, "{}", ideal.final_angles_deg["hinge"]);
+    assert!(
+        (ideal.final_angles_deg["hinge"] - 53.0).abs() < 1.0,
+        "{}",
+        ideal.final_angles_deg["hinge"]
+    );
     // Angles barely change (friction torque mu F_N R costs about 0.5 %), forces are impulsive.
     let gap = (ideal.final_angles_deg["hinge"] - clear.final_angles_deg["hinge"]).abs();
-    assert!(gap < 0.01 * ideal.final_angles_deg["hinge"], "angle gap {gap} deg");
-    assert!(clear.peak_joint_force_n > 100.0 * ideal.peak_joint_force_n, "{} vs {}", clear.peak_joint_force_n, ideal.peak_joint_force_n);
+    assert!(
+        gap < 0.01 * ideal.final_angles_deg["hinge"],
+        "angle gap {gap} deg"
+    );
+    assert!(
+        clear.peak_joint_force_n > 100.0 * ideal.peak_joint_force_n,
+        "{} vs {}",
+        clear.peak_joint_force_n,
+        ideal.peak_joint_force_n
+    );
     // The ideal reaction from the momentum balance is the load a rigid hinge carries: order 0.3 N.
-    assert!(ideal.peak_joint_force_n > 0.1 && ideal.peak_joint_force_n < 1.0, "{}", ideal.peak_joint_force_n);
+    assert!(
+        ideal.peak_joint_force_n > 0.1 && ideal.peak_joint_force_n < 1.0,
+        "{}",
+        ideal.peak_joint_force_n
+    );
     // Ideal twin rows carry no eccentricity and no contact.
     let t = r.twin(TwinKind::Ideal).unwrap();
-    assert!(t.table.column("hinge_contact").unwrap().iter().all(|&c| c == 0.0));
+    assert!(
+        t.table
+            .column("hinge_contact")
+            .unwrap()
+            .iter()
+            .all(|&c| c == 0.0)
+    );
 }
 
 #[test]
@@ -80,16 +152,34 @@ fn first_impact_peak_converges_at_first_order() {
     let peaks: Vec<f64> = dts
         .iter()
         .map(|dt| {
-            let set = [format!("run.dt_s={dt:e}"), "run.end_s=0.1".into(), "run.output_interval_s=1e-3".into()];
+            let set = [
+                format!("run.dt_s={dt:e}"),
+                "run.end_s=0.1".into(),
+                "run.output_interval_s=1e-3".into(),
+            ];
             let scene = Scene::solar_panel().with_overrides(&set).unwrap();
-            let r = Simulation::new(&scene, RunOptions { twins: Twins::ClearanceOnly, skip_rows: true }).unwrap().run().unwrap();
-            clearance_summary(&r).first_impact_peak_n.expect("an impact in the first 0.1 s")
+            let r = Simulation::new(
+                &scene,
+                RunOptions {
+                    twins: Twins::ClearanceOnly,
+                    skip_rows: true,
+                },
+            )
+            .unwrap()
+            .run()
+            .unwrap();
+            clearance_summary(&r)
+                .first_impact_peak_n
+                .expect("an impact in the first 0.1 s")
         })
         .collect();
     let d: Vec<f64> = peaks.windows(2).map(|w| w[0] - w[1]).collect();
     for w in d.windows(2) {
         let order = (w[0] / w[1]).log2();
-        assert!((0.8..1.25).contains(&order), "observed order {order} from peaks {peaks:?}");
+        assert!(
+            (0.8..1.25).contains(&order),
+            "observed order {order} from peaks {peaks:?}"
+        );
     }
 }
 
@@ -107,14 +197,19 @@ fn lankarani_nikravesh_impact_restitution() {
             .can_sleep(false),
     );
     let geometry = BearingGeometry::from_clearance(0.010, 0.1e-3, 0.016).unwrap();
-    let k = LankaraniNikravesh::stiffness_from_geometry(&geometry, &Material::STEEL, &Material::STEEL);
+    let k =
+        LankaraniNikravesh::stiffness_from_geometry(&geometry, &Material::STEEL, &Material::STEEL);
     let law = NormalModel::LankaraniNikravesh(LankaraniNikravesh::new(k, 1.5, 0.9).unwrap());
-    let joint = ClearanceJointBuilder::new(Vector::Z, geometry, law).lock(OutOfPlaneLock::None).build().unwrap();
+    let joint = ClearanceJointBuilder::new(Vector::Z, geometry, law)
+        .lock(OutOfPlaneLock::None)
+        .build()
+        .unwrap();
     let mut set = ClearanceJointSet::new();
     set.insert(bearing, journal, joint, &mut world.impulse_joints);
     let (mut v_in, mut v_out, mut touched) = (None, None, false);
     for _ in 0..5000 {
-        set.apply(&mut world.bodies, &world.integration_parameters).unwrap();
+        set.apply(&mut world.bodies, &world.integration_parameters)
+            .unwrap();
         let r = *set.get(ClearanceJointHandle(0)).unwrap().report();
         if r.onset {
             v_in = Some(r.impact_rate);

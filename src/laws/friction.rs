@@ -22,7 +22,10 @@ pub struct Coulomb {
 impl Coulomb {
     /// Dynamic coefficient `mu_d >= 0`, regularisation speed `v_eps > 0` (m/s).
     pub fn new(mu_d: f64, v_eps: f64) -> Result<Self> {
-        Ok(Coulomb { mu_d: non_negative("mu_d", mu_d)?, v_eps: positive("v_eps", v_eps)? })
+        Ok(Coulomb {
+            mu_d: non_negative("mu_d", mu_d)?,
+            v_eps: positive("v_eps", v_eps)?,
+        })
     }
 }
 
@@ -45,7 +48,10 @@ pub struct Threlfall {
 impl Threlfall {
     /// Dynamic coefficient `mu_d >= 0`, characteristic speed `v_0 > 0` (m/s).
     pub fn new(mu_d: f64, v0: f64) -> Result<Self> {
-        Ok(Threlfall { mu_d: non_negative("mu_d", mu_d)?, v0: positive("v0", v0)? })
+        Ok(Threlfall {
+            mu_d: non_negative("mu_d", mu_d)?,
+            v0: positive("v0", v0)?,
+        })
     }
 }
 
@@ -73,7 +79,10 @@ impl Ambrosio {
         non_negative("v0", v0)?;
         positive("v1", v1)?;
         if v1 <= v0 {
-            return Err(Error::invalid("v1", format!("must be greater than v0 = {v0} (got {v1})")));
+            return Err(Error::invalid(
+                "v1",
+                format!("must be greater than v0 = {v0} (got {v1})"),
+            ));
         }
         Ok(Ambrosio { mu_d, v0, v1 })
     }
@@ -107,9 +116,19 @@ pub struct Bai {
 
 impl Bai {
     /// The paper's table 3, dry (no lubrication): `mu_s = 0.3, mu_d = 0.25, v_s = 0.1 mm/s, v_d = 10 mm/s`.
-    pub const DRY: Bai = Bai { mu_s: 0.3, mu_d: 0.25, v_s: 1e-4, v_d: 1e-2 };
+    pub const DRY: Bai = Bai {
+        mu_s: 0.3,
+        mu_d: 0.25,
+        v_s: 1e-4,
+        v_d: 1e-2,
+    };
     /// The paper's table 3, lubricated: `mu_s = 0.08, mu_d = 0.05`, same transition speeds.
-    pub const LUBRICATED: Bai = Bai { mu_s: 0.08, mu_d: 0.05, v_s: 1e-4, v_d: 1e-2 };
+    pub const LUBRICATED: Bai = Bai {
+        mu_s: 0.08,
+        mu_d: 0.05,
+        v_s: 1e-4,
+        v_d: 1e-2,
+    };
 
     /// Static `mu_s` and dynamic `mu_d` coefficients (`>= 0`), transition speeds `0 < v_s < v_d` (m/s).
     pub fn new(mu_s: f64, mu_d: f64, v_s: f64, v_d: f64) -> Result<Self> {
@@ -118,9 +137,17 @@ impl Bai {
         positive("v_s", v_s)?;
         positive("v_d", v_d)?;
         if v_d <= v_s {
-            return Err(Error::invalid("v_d", format!("must be greater than v_s = {v_s} (got {v_d})")));
+            return Err(Error::invalid(
+                "v_d",
+                format!("must be greater than v_s = {v_s} (got {v_d})"),
+            ));
         }
-        Ok(Bai { mu_s, mu_d, v_s, v_d })
+        Ok(Bai {
+            mu_s,
+            mu_d,
+            v_s,
+            v_d,
+        })
     }
 }
 

@@ -1,7 +1,7 @@
 //! Elastic materials of the journal and bearing (MODEL.md §2).
 
-use crate::error::{Result, positive};
 use crate::error::{Error, in_range_open_closed};
+use crate::error::{Result, positive};
 use serde::{Deserialize, Serialize};
 
 /// An isotropic linear-elastic material.
@@ -16,11 +16,17 @@ pub struct Material {
 
 impl Material {
     /// Structural steel of the paper's table 2: E = 207 GPa, nu = 0.3.
-    pub const STEEL: Material = Material { youngs_modulus_pa: 207e9, poisson_ratio: 0.3 };
+    pub const STEEL: Material = Material {
+        youngs_modulus_pa: 207e9,
+        poisson_ratio: 0.3,
+    };
 
     /// A validated material.
     pub fn new(youngs_modulus_pa: f64, poisson_ratio: f64) -> Result<Self> {
-        let m = Material { youngs_modulus_pa, poisson_ratio };
+        let m = Material {
+            youngs_modulus_pa,
+            poisson_ratio,
+        };
         m.validate()?;
         Ok(m)
     }
@@ -69,7 +75,11 @@ impl BearingGeometry {
                 ),
             ));
         }
-        Ok(BearingGeometry { bearing_radius, journal_radius, length })
+        Ok(BearingGeometry {
+            bearing_radius,
+            journal_radius,
+            length,
+        })
     }
 
     /// From the bearing radius and the radial clearance `c = R_b - R_j`.
@@ -79,7 +89,9 @@ impl BearingGeometry {
         if clearance >= bearing_radius {
             return Err(Error::invalid(
                 "clearance",
-                format!("the clearance ({clearance} m) must be smaller than the bearing radius ({bearing_radius} m)"),
+                format!(
+                    "the clearance ({clearance} m) must be smaller than the bearing radius ({bearing_radius} m)"
+                ),
             ));
         }
         Self::new(bearing_radius, bearing_radius - clearance, length)

@@ -24,7 +24,8 @@ pub trait NormalForceLaw {
         if c.penetration <= 0.0 {
             return 0.0;
         }
-        (self.elastic_force(c.penetration) + self.damping_coefficient(c) * c.penetration_rate).max(0.0)
+        (self.elastic_force(c.penetration) + self.damping_coefficient(c) * c.penetration_rate)
+            .max(0.0)
     }
 
     /// The elastic (conservative) part of the force at `penetration`, N (0 for `penetration <= 0`).
@@ -55,12 +56,24 @@ pub trait NormalForceLaw {
 /// `integral_0^1 f(s) ds` by 16-point Gauss-Legendre.
 fn gauss_legendre_16(f: impl Fn(f64) -> f64) -> f64 {
     const X: [f64; 8] = [
-        0.0950125098376374, 0.2816035507792589, 0.4580167776572274, 0.6178762444026438,
-        0.7554044083550030, 0.8656312023878318, 0.9445750230732326, 0.9894009349916499,
+        0.0950125098376374,
+        0.2816035507792589,
+        0.4580167776572274,
+        0.6178762444026438,
+        0.7554044083550030,
+        0.8656312023878318,
+        0.9445750230732326,
+        0.9894009349916499,
     ];
     const W: [f64; 8] = [
-        0.1894506104550685, 0.1826034150449236, 0.1691565193950025, 0.1495959888165767,
-        0.1246289712555339, 0.0951585116824928, 0.0622535239386479, 0.0271524594117541,
+        0.1894506104550685,
+        0.1826034150449236,
+        0.1691565193950025,
+        0.1495959888165767,
+        0.1246289712555339,
+        0.0951585116824928,
+        0.0622535239386479,
+        0.0271524594117541,
     ];
     let mut sum = 0.0;
     for (x, w) in X.iter().zip(W) {
@@ -77,7 +90,10 @@ fn check_stiffness_exponent(k: f64, n: f64) -> Result<()> {
     positive("stiffness", k)?;
     positive("exponent", n)?;
     if n < 1.0 {
-        return Err(Error::invalid("exponent", format!("must be >= 1 for a force with finite stiffness at contact (got {n})")));
+        return Err(Error::invalid(
+            "exponent",
+            format!("must be >= 1 for a force with finite stiffness at contact (got {n})"),
+        ));
     }
     Ok(())
 }
@@ -93,7 +109,10 @@ impl Hertz {
     /// `K` in N/m^n, `n >= 1`.
     pub fn new(stiffness: f64, exponent: f64) -> Result<Self> {
         check_stiffness_exponent(stiffness, exponent)?;
-        Ok(Hertz { stiffness, exponent })
+        Ok(Hertz {
+            stiffness,
+            exponent,
+        })
     }
 }
 
@@ -102,7 +121,11 @@ impl NormalForceLaw for Hertz {
         self.stiffness * penetration_power(delta, self.exponent)
     }
     fn tangent_stiffness(&self, delta: f64) -> f64 {
-        if delta <= 0.0 { 0.0 } else { self.stiffness * self.exponent * delta.powf(self.exponent - 1.0) }
+        if delta <= 0.0 {
+            0.0
+        } else {
+            self.stiffness * self.exponent * delta.powf(self.exponent - 1.0)
+        }
     }
     fn damping_coefficient(&self, _: &NormalContact) -> f64 {
         0.0
@@ -153,16 +176,30 @@ struct Hysteresis {
 }
 
 impl Hysteresis {
-    fn new(stiffness: f64, exponent: f64, restitution: f64, chi: impl Fn(f64) -> f64) -> Result<Self> {
+    fn new(
+        stiffness: f64,
+        exponent: f64,
+        restitution: f64,
+        chi: impl Fn(f64) -> f64,
+    ) -> Result<Self> {
         check_stiffness_exponent(stiffness, exponent)?;
         in_range_open_closed("restitution", restitution, 0.0, 1.0)?;
-        Ok(Hysteresis { stiffness, exponent, restitution, chi: chi(restitution) })
+        Ok(Hysteresis {
+            stiffness,
+            exponent,
+            restitution,
+            chi: chi(restitution),
+        })
     }
     fn elastic_force(&self, delta: f64) -> f64 {
         self.stiffness * penetration_power(delta, self.exponent)
     }
     fn tangent_stiffness(&self, delta: f64) -> f64 {
-        if delta <= 0.0 { 0.0 } else { self.stiffness * self.exponent * delta.powf(self.exponent - 1.0) }
+        if delta <= 0.0 {
+            0.0
+        } else {
+            self.stiffness * self.exponent * delta.powf(self.exponent - 1.0)
+        }
     }
     fn damping_coefficient(&self, c: &NormalContact) -> f64 {
         if c.penetration <= 0.0 || c.impact_rate <= 0.0 {
@@ -243,7 +280,11 @@ impl LankaraniNikravesh {
     pub const EXPONENT: f64 = 1.5;
 
     /// `K = 4/(3(sigma_i + sigma_j)) * sqrt(R_b R_j/(R_b - R_j))` (MODEL.md §2), N/m^1.5.
-    pub fn stiffness_from_geometry(geometry: &super::BearingGeometry, bearing: &super::Material, journal: &super::Material) -> f64 {
+    pub fn stiffness_from_geometry(
+        geometry: &super::BearingGeometry,
+        bearing: &super::Material,
+        journal: &super::Material,
+    ) -> f64 {
         let (rb, rj) = (geometry.bearing_radius, geometry.journal_radius);
         4.0 / (3.0 * (bearing.sigma() + journal.sigma())) * (rb * rj / (rb - rj)).sqrt()
     }
@@ -252,7 +293,11 @@ impl LankaraniNikravesh {
 /// `sqrt(delta/(2(c+delta)))` and its derivative in `delta`.
 fn liu_factor(delta: f64, clearance: f64) -> (f64, f64) {
     let g = (delta / (2.0 * (clearance + delta))).sqrt();
-    let slope = if g > 0.0 { clearance / (4.0 * (clearance + delta).powi(2) * g) } else { f64::INFINITY };
+    let slope = if g > 0.0 {
+        clearance / (4.0 * (clearance + delta).powi(2) * g)
+    } else {
+        f64::INFINITY
+    };
     (g, slope)
 }
 
@@ -269,7 +314,10 @@ impl LiuEtAl {
         positive("effective_modulus", effective_modulus)?;
         positive("length", length)?;
         positive("clearance", clearance)?;
-        Ok(LiuEtAl { scale: 0.5 * PI * effective_modulus * length, clearance })
+        Ok(LiuEtAl {
+            scale: 0.5 * PI * effective_modulus * length,
+            clearance,
+        })
     }
 }
 
@@ -321,16 +369,32 @@ impl ImprovedLiu {
 
     /// Composite modulus `E*` (Pa), length `L` (m), clearance `c` (m), exponent `n >= 1`,
     /// damping saturation depth `delta_max` (m) and the maximum damping.
-    pub fn new(effective_modulus: f64, length: f64, clearance: f64, exponent: f64, delta_max: f64, damping: MaxDamping) -> Result<Self> {
+    pub fn new(
+        effective_modulus: f64,
+        length: f64,
+        clearance: f64,
+        exponent: f64,
+        delta_max: f64,
+        damping: MaxDamping,
+    ) -> Result<Self> {
         positive("effective_modulus", effective_modulus)?;
         positive("length", length)?;
         positive("clearance", clearance)?;
         positive("exponent", exponent)?;
         if exponent < 1.0 {
-            return Err(Error::invalid("exponent", format!("must be >= 1 (got {exponent})")));
+            return Err(Error::invalid(
+                "exponent",
+                format!("must be >= 1 (got {exponent})"),
+            ));
         }
         positive("delta_max", delta_max)?;
-        let mut law = ImprovedLiu { scale: 0.5 * PI * effective_modulus * length, clearance, exponent, delta_max, d_max: 0.0 };
+        let mut law = ImprovedLiu {
+            scale: 0.5 * PI * effective_modulus * length,
+            clearance,
+            exponent,
+            delta_max,
+            d_max: 0.0,
+        };
         law.d_max = match damping {
             MaxDamping::Eta(eta) => non_negative("eta_s", eta)? * law.tangent_stiffness(delta_max),
             MaxDamping::Explicit(d) => non_negative("d_max", d)?,
@@ -450,7 +514,11 @@ mod tests {
     use super::*;
 
     fn contact(delta: f64, rate: f64, rate0: f64) -> NormalContact {
-        NormalContact { penetration: delta, penetration_rate: rate, impact_rate: rate0 }
+        NormalContact {
+            penetration: delta,
+            penetration_rate: rate,
+            impact_rate: rate0,
+        }
     }
 
     #[test]
@@ -467,9 +535,18 @@ mod tests {
     fn hysteresis_factors_hand_values() {
         let cr = 0.8;
         assert!((HuntCrossley::new(1.0, 1.5, cr).unwrap().hysteresis_factor() - 0.3).abs() < 1e-15);
-        assert!((LankaraniNikravesh::new(1.0, 1.5, cr).unwrap().hysteresis_factor() - 0.27).abs() < 1e-15);
+        assert!(
+            (LankaraniNikravesh::new(1.0, 1.5, cr)
+                .unwrap()
+                .hysteresis_factor()
+                - 0.27)
+                .abs()
+                < 1e-15
+        );
         assert!((FloresEtAl::new(1.0, 1.5, cr).unwrap().hysteresis_factor() - 0.4).abs() < 1e-15);
-        assert!((GonthierEtAl::new(1.0, 1.5, cr).unwrap().hysteresis_factor() - 0.45).abs() < 1e-15);
+        assert!(
+            (GonthierEtAl::new(1.0, 1.5, cr).unwrap().hysteresis_factor() - 0.45).abs() < 1e-15
+        );
         // LN at delta = 1e-6, K = 1e10: elastic 10 N; delta_dot/delta_dot0 = 0.5 -> 10 (1 + 0.135)
         let ln = LankaraniNikravesh::new(1e10, 1.5, cr).unwrap();
         assert!((ln.normal_force(&contact(1e-6, 0.5, 1.0)) - 11.35).abs() < 1e-9);
@@ -514,7 +591,9 @@ mod tests {
     #[test]
     fn tangent_stiffness_matches_finite_difference() {
         let laws = [
-            NormalModel::ImprovedLiu(ImprovedLiu::new(1.1e11, 0.016, 5e-4, 1.5, 1e-4, MaxDamping::Eta(0.01)).unwrap()),
+            NormalModel::ImprovedLiu(
+                ImprovedLiu::new(1.1e11, 0.016, 5e-4, 1.5, 1e-4, MaxDamping::Eta(0.01)).unwrap(),
+            ),
             NormalModel::LiuEtAl(LiuEtAl::new(1.1e11, 0.016, 5e-4).unwrap()),
             NormalModel::Hertz(Hertz::new(1e10, 1.5).unwrap()),
         ];
@@ -522,7 +601,11 @@ mod tests {
             for d in [1e-7, 2e-6, 5e-5] {
                 let h = d * 1e-6;
                 let fd = (law.elastic_force(d + h) - law.elastic_force(d - h)) / (2.0 * h);
-                assert!((fd - law.tangent_stiffness(d)).abs() < 1e-6 * fd.abs(), "{} at {d}", law.name());
+                assert!(
+                    (fd - law.tangent_stiffness(d)).abs() < 1e-6 * fd.abs(),
+                    "{} at {d}",
+                    law.name()
+                );
             }
         }
     }
@@ -550,7 +633,9 @@ mod tests {
         assert!(err.contains("stiffness") && err.contains("> 0"), "{err}");
         let err = HuntCrossley::new(1.0, 1.5, 1.5).unwrap_err().to_string();
         assert!(err.contains("restitution"), "{err}");
-        let err = ImprovedLiu::new(1e11, 0.01, f64::NAN, 1.0, 1e-4, MaxDamping::Eta(0.01)).unwrap_err().to_string();
+        let err = ImprovedLiu::new(1e11, 0.01, f64::NAN, 1.0, 1e-4, MaxDamping::Eta(0.01))
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("clearance") && err.contains("NaN"), "{err}");
     }
 }

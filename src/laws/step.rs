@@ -49,7 +49,8 @@ mod tests {
     fn slope_matches_finite_difference() {
         let h = 1e-7;
         for x in [0.1, 0.37, 0.8] {
-            let fd = (step(x + h, 0.0, -2.0, 1.0, 5.0) - step(x - h, 0.0, -2.0, 1.0, 5.0)) / (2.0 * h);
+            let fd =
+                (step(x + h, 0.0, -2.0, 1.0, 5.0) - step(x - h, 0.0, -2.0, 1.0, 5.0)) / (2.0 * h);
             assert!((fd - step_slope(x, 0.0, -2.0, 1.0, 5.0)).abs() < 1e-6);
         }
     }

@@ -1,7 +1,7 @@
 //! Torsion-spring drive between two bodies (MODEL.md §4, eq. 20): `T = T0 - k theta`.
 
 use crate::angle::{UnwrappedAngle, twist_angle};
-use crate::error::{Error, Result, finite, non_negative};
+use crate::error::{Result, finite, non_negative, unit_vector};
 use crate::ledger::{ForceLedger, Wrench};
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
@@ -32,14 +32,10 @@ impl TorsionSpring {
     ) -> Result<Self> {
         finite("torque0_nm", torque0)?;
         non_negative("stiffness_nm_per_deg", stiffness)?;
-        let n = local_axis1.length();
-        if !(n.is_finite() && n > 1e-12) {
-            return Err(Error::invalid("axis", "must be a finite, non-zero vector"));
-        }
         Ok(TorsionSpring {
             body1,
             body2,
-            local_axis1: local_axis1 / n,
+            local_axis1: unit_vector("axis", local_axis1)?,
             torque0,
             stiffness,
             reference: None,

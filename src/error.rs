@@ -151,3 +151,18 @@ pub fn in_range_open_closed(field: &str, value: f64, lo: f64, hi: f64) -> Result
         Ok(value)
     }
 }
+
+/// Checks that `v` is finite and non-zero; returns it normalised.
+pub fn unit_vector(
+    field: &str,
+    v: rapier3d_f64::math::Vector,
+) -> Result<rapier3d_f64::math::Vector> {
+    let n = v.length();
+    if !n.is_finite() || n < 1e-12 {
+        return Err(Error::invalid(
+            field,
+            format!("must be a finite, non-zero vector (got {v:?})"),
+        ));
+    }
+    Ok(v / n)
+}

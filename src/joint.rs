@@ -111,8 +111,8 @@ impl ClearanceJointBuilder {
     /// Validates and returns the joint.
     pub fn build(mut self) -> Result<ClearanceJoint> {
         let j = &mut self.joint;
-        j.local_axis1 = unit_axis("local_axis1", j.local_axis1)?;
-        j.local_axis2 = unit_axis("local_axis2", j.local_axis2)?;
+        j.local_axis1 = crate::error::unit_vector("local_axis1", j.local_axis1)?;
+        j.local_axis2 = crate::error::unit_vector("local_axis2", j.local_axis2)?;
         for (field, v) in [
             ("local_anchor1", j.local_anchor1),
             ("local_anchor2", j.local_anchor2),
@@ -124,17 +124,6 @@ impl ClearanceJointBuilder {
         crate::error::positive("min_impact_speed", j.min_impact_speed)?;
         Ok(self.joint)
     }
-}
-
-fn unit_axis(field: &str, axis: Vector) -> Result<Vector> {
-    let n = axis.length();
-    if !n.is_finite() || n < 1e-12 {
-        return Err(Error::invalid(
-            field,
-            format!("must be a finite, non-zero vector (got {axis:?})"),
-        ));
-    }
-    Ok(axis / n)
 }
 
 /// State carried between steps: whether a contact is on, and its impact velocity.

@@ -260,28 +260,13 @@ impl Simulation {
         let params = self.world.integration_parameters;
         for twin in &mut self.twins {
             twin.drives.apply(&mut self.world.bodies);
-            if let Err(e) = twin.clearance.apply(&mut self.world.bodies, &params) {
-                return Err(match e {
-                    Error::StepTooLarge {
-                        hinge,
-                        dt,
-                        dt_max,
-                        penetration_um,
-                        omega,
-                        zeta,
-                        ..
-                    } => Error::StepTooLarge {
-                        field: "run.dt_s".into(),
-                        hinge,
-                        dt,
-                        dt_max,
-                        t,
-                        penetration_um,
-                        omega,
-                        zeta,
-                    },
-                    other => other,
-                });
+            if let Err(mut e) = twin.clearance.apply(&mut self.world.bodies, &params) {
+                // Name the scene's field and the time: the set knows neither.
+                if let Error::StepTooLarge { field, t: at, .. } = &mut e {
+                    *field = "run.dt_s".into();
+                    *at = t;
+                }
+                return Err(e);
             }
             for b in &mut twin.bodies {
                 b.linvel_before = self.world.bodies[b.handle].linvel();

@@ -2,7 +2,10 @@
 #![warn(missing_docs)]
 
 pub mod angle;
+pub mod convert;
 pub mod drive;
+#[cfg(feature = "ecs")]
+pub mod ecs;
 pub mod error;
 pub mod joint;
 pub mod kinematics;
@@ -12,6 +15,7 @@ pub mod output;
 pub mod report;
 pub mod scene;
 pub mod sim;
+pub mod study;
 pub use error::{Error, Result};
 
 /// The types most users need.

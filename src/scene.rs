@@ -8,6 +8,7 @@ use crate::laws::{
     HuntCrossley, ImprovedLiu, KelvinVoigt, LankaraniNikravesh, LiuEtAl, Material, MaxDamping,
     NormalModel, Threlfall, effective_modulus,
 };
+use rapier3d_f64::math::Vector;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -49,6 +50,9 @@ pub struct BodySpec {
     pub inertia_kg_m2: [f64; 3],
     /// World position of the centre of mass at t = 0, m.
     pub center_of_mass_m: [f64; 3],
+    /// A fixed body (ground): it does not move; mass and inertia are then ignored.
+    #[serde(default)]
+    pub fixed: bool,
 }
 
 /// A hinge: ideal (Rapier revolute joint) unless `clearance` is given.
@@ -432,6 +436,7 @@ impl Scene {
                 c.build().map_err(|e| e.within(&format!("{p}.clearance")))?;
             }
         }
+        self.validate_planar()?;
         for d in &self.drives {
             let p = format!("drives[{}]", d.name);
             if !names.insert(d.name.as_str()) {
@@ -460,6 +465,40 @@ impl Scene {
                     r.end_s
                 ),
             ));
+        }
+        Ok(())
+    }
+}
+
+impl Scene {
+    /// The clearance model is planar (MODEL.md §4): contact and friction act in the plane normal
+    /// to each clearance hinge's axis, and the out-of-plane degrees of freedom are held rigidly.
+    /// A scene whose loads would act out of that plane is refused, naming what cannot be represented.
+    fn validate_planar(&self) -> Result<()> {
+        let a_ref = Vector::from(self.reference_axis);
+        let g = Vector::from(self.gravity);
+        for h in self.hinges.iter().filter(|h| h.clearance.is_some()) {
+            let p = format!("hinges[{}]", h.name);
+            let a = Vector::from(h.axis).normalize();
+            if a.cross(a_ref).length() > 1e-9 {
+                return Err(Error::invalid(
+                    format!("{p}.axis"),
+                    "a clearance hinge must be parallel to the scene's reference_axis: the planar clearance \
+                     model has no axial or tilting contact, so non-parallel hinges (out-of-plane motion) \
+                     cannot be represented; make this hinge ideal or align it",
+                ));
+            }
+            if g.dot(a).abs() > 1e-9 * g.length().max(1e-300) && g.length() > 0.0 {
+                return Err(Error::invalid(
+                    "gravity",
+                    format!(
+                        "has a component along the axis of clearance hinge `{}`: an axial (out-of-plane) load, \
+                         which the planar clearance model cannot carry through contact; put gravity in the \
+                         hinge plane or make the hinge ideal",
+                        h.name
+                    ),
+                ));
+            }
         }
         Ok(())
     }

@@ -60,6 +60,7 @@ struct BodyTrack {
     name: String,
     handle: RigidBodyHandle,
     mass: f64,
+    fixed: bool,
     initial_rotation: Rotation,
     angle: UnwrappedAngle,
     linvel_before: Vector,
@@ -327,7 +328,12 @@ impl Twin {
         let mut bodies = Vec::new();
         for b in &scene.bodies {
             let com = Vector::from(b.center_of_mass_m);
-            let rb = RigidBodyBuilder::dynamic()
+            let builder = if b.fixed {
+                RigidBodyBuilder::fixed()
+            } else {
+                RigidBodyBuilder::dynamic()
+            };
+            let rb = builder
                 .translation(com)
                 .additional_mass_properties(MassProperties::new(
                     Vector::ZERO,
@@ -341,6 +347,7 @@ impl Twin {
                 name: b.name.clone(),
                 handle,
                 mass: b.mass_kg,
+                fixed: b.fixed,
                 initial_rotation: Rotation::IDENTITY,
                 angle: UnwrappedAngle::default(),
                 linvel_before: Vector::ZERO,
@@ -412,7 +419,8 @@ impl Twin {
             .map_err(|e| e.within(&format!("drives[{}]", d.name)))?;
             drives.insert(spring);
         }
-        let reaction_order = reaction_order(&hinges);
+        let fixed: Vec<bool> = bodies.iter().map(|b| b.fixed).collect();
+        let reaction_order = reaction_order(&hinges, &fixed);
         let mut columns = vec!["t_s".to_string()];
         for b in &bodies {
             columns.push(format!("{}_angle_deg", b.name));
@@ -635,8 +643,9 @@ fn in_plane_u(axis: Vector) -> Vector {
 
 /// Elimination order for the ideal-joint reactions: repeatedly take a body with exactly one
 /// unsolved ideal joint; its residual momentum change is that joint's force. Returns
-/// `(hinge, body, sign)` with force on the journal `= sign * residual[body]`.
-fn reaction_order(hinges: &[HingeTrack]) -> Vec<(usize, usize, f64)> {
+/// `(hinge, body, sign)` with force on the journal `= sign * residual[body]`. A fixed body's
+/// balance is unknown (the ground supplies any force), so it is never used.
+fn reaction_order(hinges: &[HingeTrack], fixed: &[bool]) -> Vec<(usize, usize, f64)> {
     let mut unsolved: Vec<usize> = hinges
         .iter()
         .enumerate()
@@ -652,9 +661,9 @@ fn reaction_order(hinges: &[HingeTrack]) -> Vec<(usize, usize, f64)> {
         };
         let pick = unsolved.iter().enumerate().find_map(|(k, &i)| {
             let h = &hinges[i];
-            if count(h.journal, &unsolved) == 1 {
+            if !fixed[h.journal] && count(h.journal, &unsolved) == 1 {
                 Some((k, i, h.journal, 1.0))
-            } else if count(h.bearing, &unsolved) == 1 {
+            } else if !fixed[h.bearing] && count(h.bearing, &unsolved) == 1 {
                 Some((k, i, h.bearing, -1.0))
             } else {
                 None

@@ -1,0 +1,1 @@
+//! Conversions between Rapier revolute joints and clearance joints (issue 5). Placeholder until built.

@@ -1,0 +1,1 @@
+//! The bevy_ecs layer (issue 5). Placeholder until built.

@@ -1,0 +1,1 @@
+//! Parameter sweeps, the paper's studies, metrics and plots (issue 3). Placeholder until built.

@@ -18,6 +18,8 @@ pub struct Summary {
     pub end_s: f64,
     /// Per twin (`ideal`, `clearance`).
     pub twins: BTreeMap<String, TwinSummary>,
+    /// Clearance twin against ideal twin (null unless both ran).
+    pub comparison: Option<crate::sim::Comparison>,
 }
 
 /// Metrics of one twin.
@@ -94,6 +96,7 @@ impl RunResult {
                     )
                 })
                 .collect(),
+            comparison: self.comparison.clone(),
         }
     }
 

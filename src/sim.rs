@@ -103,6 +103,14 @@ pub struct HingeMetrics {
     pub max_penetration_um: f64,
     /// Steps spent in contact.
     pub contact_steps: u64,
+    /// Fraction of simulated time in contact.
+    pub contact_fraction: f64,
+    /// Root-mean-square joint force over the run (time-weighted), N.
+    pub rms_force_n: f64,
+    #[serde(skip)]
+    force_sq_time: f64,
+    #[serde(skip)]
+    contact_time: f64,
     /// Final relative angle, deg.
     pub final_angle_deg: f64,
     #[serde(skip)]
@@ -169,6 +177,105 @@ pub struct Simulation {
     n_steps: u64,
     stride: u64,
     skip_rows: bool,
+    comparison: ComparisonSums,
+}
+
+/// The clearance twin against the ideal twin, from every internal step (both twins built).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Comparison {
+    /// Per body: deviation of its angular rate (about the reference axis) from the ideal twin's.
+    pub bodies: BTreeMap<String, RateDeviation>,
+    /// Per hinge: settling of the joint force.
+    pub hinges: BTreeMap<String, Settling>,
+}
+
+/// Rate deviation of one body, clearance twin minus ideal twin.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct RateDeviation {
+    /// Root-mean-square over the run (time-weighted), deg/s.
+    pub rms_deg_s: f64,
+    /// Largest absolute deviation, deg/s.
+    pub max_deg_s: f64,
+}
+
+/// When the joint force of a hinge settles.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Settling {
+    /// The last time at which the clearance joint force exceeded the ideal joint force by more
+    /// than `band_n`: after it the force stays within one ideal peak of the rigid hinge's load.
+    /// 0 when it never did.
+    pub settling_time_s: f64,
+    /// The band: the ideal twin's peak joint force on this hinge, N.
+    pub band_n: f64,
+}
+
+/// Running sums behind [`Comparison`].
+#[derive(Clone, Debug, Default)]
+struct ComparisonSums {
+    rate_sq_time: Vec<f64>,
+    rate_max: Vec<f64>,
+    /// Per hinge, a stack of `(t, excess)` with decreasing excess and increasing time: for any band
+    /// `b`, the last time the excess exceeded `b` is the latest entry above `b`.
+    excess: Vec<Vec<(f64, f64)>>,
+}
+
+impl ComparisonSums {
+    fn record(&mut self, ideal: &Twin, clear: &Twin, bodies: &RigidBodySet, t: f64, dt: f64) {
+        let n = ideal.bodies.len();
+        self.rate_sq_time.resize(n, 0.0);
+        self.rate_max.resize(n, 0.0);
+        self.excess.resize(ideal.hinges.len(), Vec::new());
+        let axis = ideal.reference_axis;
+        for (i, (bi, bc)) in ideal.bodies.iter().zip(&clear.bodies).enumerate() {
+            let d = (bodies[bc.handle].angvel() - bodies[bi.handle].angvel())
+                .dot(axis)
+                .to_degrees();
+            self.rate_sq_time[i] += d * d * dt;
+            self.rate_max[i] = self.rate_max[i].max(d.abs());
+        }
+        for (k, (hi, hc)) in ideal.hinges.iter().zip(&clear.hinges).enumerate() {
+            let excess = hc.force - hi.force;
+            let stack = &mut self.excess[k];
+            while stack.last().is_some_and(|&(_, e)| e <= excess) {
+                stack.pop();
+            }
+            stack.push((t, excess));
+        }
+    }
+
+    fn finish(&self, ideal: &Twin, duration: f64) -> Comparison {
+        let mut c = Comparison::default();
+        for (i, b) in ideal.bodies.iter().enumerate() {
+            let rms = if duration > 0.0 {
+                (self.rate_sq_time.get(i).copied().unwrap_or(0.0) / duration).sqrt()
+            } else {
+                0.0
+            };
+            c.bodies.insert(
+                b.name.clone(),
+                RateDeviation {
+                    rms_deg_s: rms,
+                    max_deg_s: self.rate_max.get(i).copied().unwrap_or(0.0),
+                },
+            );
+        }
+        for (k, h) in ideal.hinges.iter().enumerate() {
+            let band = h.metrics.peak_force_n;
+            let last = self
+                .excess
+                .get(k)
+                .and_then(|s| s.iter().rev().find(|&&(_, e)| e > band))
+                .map_or(0.0, |&(t, _)| t);
+            c.hinges.insert(
+                h.name.clone(),
+                Settling {
+                    settling_time_s: last,
+                    band_n: band,
+                },
+            );
+        }
+        c
+    }
 }
 
 /// The result of a whole run.
@@ -182,6 +289,8 @@ pub struct RunResult {
     pub steps: u64,
     /// Wall time of the whole run (both twins share one world), s.
     pub wall_s: f64,
+    /// Clearance twin against ideal twin (when both were built).
+    pub comparison: Option<Comparison>,
 }
 
 impl Simulation {
@@ -214,6 +323,7 @@ impl Simulation {
             n_steps,
             stride,
             skip_rows: options.skip_rows,
+            comparison: ComparisonSums::default(),
         })
     }
 
@@ -229,7 +339,12 @@ impl Simulation {
             self.step()?;
         }
         self.finish()?;
+        let comparison = match self.twins.as_slice() {
+            [ideal, _] => Some(self.comparison.finish(ideal, self.time())),
+            _ => None,
+        };
         Ok(RunResult {
+            comparison,
             scene: self.scene,
             twins: self.twins,
             steps: self.steps_done,
@@ -240,16 +355,21 @@ impl Simulation {
     /// Advances one internal step: forces from the hooks, Rapier's step, then records.
     pub fn step(&mut self) -> Result<()> {
         let record = !self.skip_rows && self.steps_done % self.stride == 0;
+        let t = self.time();
         self.before_step(record)?;
         self.world.step();
         let dt = self.world.integration_parameters.dt;
         let gravity = self.world.gravity;
         for twin in &mut self.twins {
             twin.solve_ideal_reactions(&self.world.bodies, dt, gravity);
-            twin.update_force_metrics(self.steps_done as f64 * dt);
+            twin.update_force_metrics(t, dt);
             if record {
                 twin.fill_forces_of_last_row();
             }
+        }
+        if let [ideal, clear] = self.twins.as_slice() {
+            self.comparison
+                .record(ideal, clear, &self.world.bodies, t, dt);
         }
         self.steps_done += 1;
         self.check_health()
@@ -284,12 +404,18 @@ impl Simulation {
     fn finish(&mut self) -> Result<()> {
         let record = !self.skip_rows;
         self.before_step(record)?;
+        let duration = self.time();
         for twin in &mut self.twins {
             if record {
                 twin.fill_forces_of_last_row();
             }
             for h in &mut twin.hinges {
-                h.metrics.final_angle_deg = h.angle.value().to_degrees();
+                let m = &mut h.metrics;
+                m.final_angle_deg = h.angle.value().to_degrees();
+                if duration > 0.0 {
+                    m.rms_force_n = (m.force_sq_time / duration).sqrt();
+                    m.contact_fraction = m.contact_time / duration;
+                }
             }
         }
         Ok(())
@@ -492,10 +618,11 @@ impl Twin {
         }
     }
 
-    fn update_force_metrics(&mut self, t: f64) {
+    fn update_force_metrics(&mut self, t: f64, dt: f64) {
         for h in &mut self.hinges {
             let m = &mut h.metrics;
             m.peak_force_n = m.peak_force_n.max(h.force);
+            m.force_sq_time += h.force * h.force * dt;
             if let HingeJoint::Clearance(c) = h.joint {
                 let r = self.clearance.get(c).expect("handle of this twin").report();
                 let in_contact = r.state.penetration > 0.0;
@@ -517,6 +644,7 @@ impl Twin {
                 }
                 if in_contact {
                     m.contact_steps += 1;
+                    m.contact_time += dt;
                     m.max_penetration_um = m.max_penetration_um.max(r.state.penetration * 1e6);
                 }
             }

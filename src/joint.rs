@@ -68,6 +68,7 @@ impl ClearanceJointBuilder {
                 lock_handle: None,
                 contact: ContactHistory::default(),
                 report: ClearanceReport::default(),
+                previous_rate: None,
                 prepared: false,
             },
         }
@@ -175,8 +176,15 @@ pub struct ClearanceJoint {
     lock_handle: Option<ImpulseJointHandle>,
     contact: ContactHistory,
     report: ClearanceReport,
+    previous_rate: Option<f64>,
     prepared: bool,
 }
+
+/// Fraction of the predicted time to contact that one free-flight step may cover, so that a
+/// contact is approached in shrinking steps and starts near a step boundary.
+const APPROACH_FRACTION: f64 = 0.5;
+/// Margin on the damped stability limit used by the adaptive step.
+const STABILITY_SAFETY: f64 = 0.8;
 
 impl ClearanceJoint {
     /// The joint's name.
@@ -231,6 +239,76 @@ impl ClearanceJoint {
     pub fn elastic_energy(&self) -> f64 {
         self.normal_law
             .elastic_energy(self.report.state.penetration)
+    }
+
+    /// The largest step that resolves this joint's contact dynamics to `tolerance`, the fraction of
+    /// a contact's natural period `2 pi/omega` one step may cover, from the state of the last
+    /// application. `last_dt` is the step taken before it (to estimate the gap's acceleration).
+    ///
+    /// - In contact: `omega` at the deepest point the contact can reach (its elastic energy plus
+    ///   the kinetic energy of the approach), and within the damped stability limit there.
+    /// - In free flight: the contact ahead is predicted from the gap, closing speed and
+    ///   acceleration; a step covers at most half the time to it, and no less than the step that
+    ///   contact will need. Separating without acceleration towards the wall: unbounded.
+    pub fn adaptive_step(&self, tolerance: f64, last_dt: f64) -> f64 {
+        let r = &self.report;
+        let m = r.effective_mass;
+        if !(m > 0.0 && m.is_finite()) {
+            return f64::INFINITY;
+        }
+        let delta = r.state.penetration;
+        let rate = r.state.penetration_rate;
+        let contact_step = |approach_speed: f64, depth: f64| {
+            let energy =
+                0.5 * m * approach_speed * approach_speed + self.normal_law.elastic_energy(depth);
+            let peak =
+                crate::laws::penetration_for_energy(&self.normal_law, energy, 1e-6).max(depth);
+            let stiffness = self.normal_law.tangent_stiffness(peak);
+            if !(stiffness > 0.0) {
+                return f64::INFINITY;
+            }
+            let impact_rate = if self.contact.in_contact {
+                self.contact.impact_rate
+            } else {
+                approach_speed.max(self.min_impact_speed)
+            };
+            let c = NormalContact {
+                penetration: peak,
+                penetration_rate: approach_speed,
+                impact_rate,
+            };
+            let (stable, omega, _) =
+                stable_step(stiffness, self.normal_law.damping_coefficient(&c), m);
+            (tolerance * std::f64::consts::TAU / omega).min(STABILITY_SAFETY * stable)
+        };
+        if delta > 0.0 {
+            return contact_step(rate.max(0.0), delta).min(STABILITY_SAFETY * r.max_stable_dt);
+        }
+        let gap = -delta;
+        let accel = match self.previous_rate {
+            Some(prev) if last_dt > 0.0 => (rate - prev) / last_dt,
+            _ => 0.0,
+        };
+        // Smallest positive t with gap = rate t + accel t^2/2.
+        let time_to_contact = if accel.abs() < 1e-300 {
+            if rate > 0.0 {
+                gap / rate
+            } else {
+                f64::INFINITY
+            }
+        } else {
+            let disc = rate * rate + 2.0 * accel * gap;
+            if disc < 0.0 {
+                f64::INFINITY
+            } else {
+                (-rate + disc.sqrt()) / accel
+            }
+        };
+        if !(time_to_contact > 0.0 && time_to_contact.is_finite()) {
+            return f64::INFINITY;
+        }
+        let speed_at_contact = (rate + accel * time_to_contact).max(0.0);
+        (APPROACH_FRACTION * time_to_contact).max(contact_step(speed_at_contact, 0.0))
     }
 
     fn evaluate(&mut self, bodies: &RigidBodySet) -> Option<(Wrench, Wrench)> {
@@ -291,6 +369,9 @@ impl ClearanceJoint {
         } else {
             (f64::INFINITY, 0.0, 0.0)
         };
+        if self.prepared_report() {
+            self.previous_rate = Some(self.report.state.penetration_rate);
+        }
         self.report = ClearanceReport {
             state,
             mode,
@@ -314,6 +395,13 @@ impl ClearanceJoint {
             torque: (force.point - m1.center_of_mass).cross(-f),
         };
         Some((w1, w2))
+    }
+}
+
+impl ClearanceJoint {
+    /// Whether a report from an earlier application exists.
+    fn prepared_report(&self) -> bool {
+        self.report.effective_mass > 0.0
     }
 }
 
@@ -440,6 +528,15 @@ impl ClearanceJointSet {
         bodies: &mut RigidBodySet,
         params: &IntegrationParameters,
     ) -> Result<()> {
+        self.apply_forces(bodies);
+        self.check_substeps(params)?;
+        self.check_step(params.dt)
+    }
+
+    /// The force evaluation of [`apply`](Self::apply) without its checks, for callers that choose
+    /// the step after seeing the contact state (adaptive stepping) and then call
+    /// [`check_step`](Self::check_step) themselves.
+    pub fn apply_forces(&mut self, bodies: &mut RigidBodySet) {
         self.wrenches.clear();
         for joint in &mut self.joints {
             if !joint.prepared {
@@ -453,6 +550,10 @@ impl ClearanceJointSet {
             }
         }
         self.ledger.replace(bodies, self.wrenches.iter().copied());
+    }
+
+    /// Refuses Rapier substeps (`num_solver_iterations != 1`) when the set holds joints.
+    pub fn check_substeps(&self, params: &IntegrationParameters) -> Result<()> {
         if params.num_solver_iterations != 1 && !self.joints.is_empty() {
             return Err(Error::invalid(
                 "num_solver_iterations",
@@ -463,7 +564,7 @@ impl ClearanceJointSet {
                 ),
             ));
         }
-        self.check_step(params.dt)
+        Ok(())
     }
 
     /// Checks `dt` against every joint's current stability limit.
@@ -484,6 +585,14 @@ impl ClearanceJointSet {
             }
         }
         Ok(())
+    }
+
+    /// Smallest [`ClearanceJoint::adaptive_step`] over all joints (infinite without joints).
+    pub fn adaptive_step(&self, tolerance: f64, last_dt: f64) -> f64 {
+        self.joints
+            .iter()
+            .map(|j| j.adaptive_step(tolerance, last_dt))
+            .fold(f64::INFINITY, f64::min)
     }
 
     /// Smallest stability limit over all joints at the last application (infinite when no

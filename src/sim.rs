@@ -7,7 +7,7 @@ use crate::drive::{DriveSet, TorsionSpring};
 use crate::error::{Error, Result};
 use crate::joint::{ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet};
 use crate::output::Table;
-use crate::scene::Scene;
+use crate::scene::{Scene, StepMode};
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::*;
 use serde::Serialize;
@@ -174,11 +174,22 @@ pub struct Simulation {
     pub twins: Vec<Twin>,
     scene: Scene,
     steps_done: u64,
+    /// Simulated time: `steps_done * dt` with fixed steps, the sum of the steps otherwise.
+    t: f64,
+    /// The step before the current one (0 before the first).
+    last_dt: f64,
+    /// Fixed steps: the number of steps to `end_s`.
     n_steps: u64,
+    /// Fixed steps: steps between rows.
     stride: u64,
+    /// Index of the next output row.
+    next_row: u64,
     skip_rows: bool,
     comparison: ComparisonSums,
 }
+
+/// Smallest adaptive step: below it a contact cannot be resolved in f64 time arithmetic.
+const MIN_ADAPTIVE_DT: f64 = 1e-10;
 
 /// The clearance twin against the ideal twin, from every internal step (both twins built).
 #[derive(Clone, Debug, Default, Serialize)]
@@ -320,8 +331,11 @@ impl Simulation {
             twins,
             scene: scene.clone(),
             steps_done: 0,
+            t: 0.0,
+            last_dt: 0.0,
             n_steps,
             stride,
+            next_row: 0,
             skip_rows: options.skip_rows,
             comparison: ComparisonSums::default(),
         })
@@ -329,13 +343,77 @@ impl Simulation {
 
     /// Simulated time, s.
     pub fn time(&self) -> f64 {
-        self.steps_done as f64 * self.world.integration_parameters.dt
+        self.t
+    }
+
+    fn adaptive(&self) -> bool {
+        self.scene.run.step == StepMode::Adaptive
+    }
+
+    fn done(&self) -> bool {
+        if self.adaptive() {
+            self.t >= self.scene.run.end_s
+        } else {
+            self.steps_done >= self.n_steps
+        }
+    }
+
+    /// Whether the state at the current time is an output row.
+    fn row_due(&self) -> bool {
+        if self.skip_rows {
+            false
+        } else if self.adaptive() {
+            self.t >= self.next_row as f64 * self.scene.run.output_interval_s
+        } else {
+            self.steps_done % self.stride == 0
+        }
+    }
+
+    /// The next step: fixed, or the adaptive choice landing exactly on row times and the end.
+    fn choose_dt(&self) -> f64 {
+        let run = &self.scene.run;
+        if !self.adaptive() {
+            return run.dt_s;
+        }
+        let mut dt = run.dt_s;
+        for twin in &self.twins {
+            dt = dt.min(twin.clearance.adaptive_step(run.tolerance, self.last_dt));
+        }
+        dt = dt.max(MIN_ADAPTIVE_DT);
+        let mut targets = vec![run.end_s];
+        if !self.skip_rows {
+            targets.push(self.next_row as f64 * run.output_interval_s);
+        }
+        for target in targets {
+            if target > self.t {
+                dt = dt.min(target - self.t);
+            }
+        }
+        dt
+    }
+
+    /// Time after a step of `dt`: exact multiples with fixed steps, exact landing on row times and
+    /// the end with adaptive ones.
+    fn advance_time(&self, dt: f64) -> f64 {
+        let run = &self.scene.run;
+        if !self.adaptive() {
+            return (self.steps_done + 1) as f64 * run.dt_s;
+        }
+        let row = self.next_row as f64 * run.output_interval_s;
+        let t = self.t + dt;
+        if !self.skip_rows && row > self.t && t >= row {
+            row
+        } else if t >= run.end_s {
+            run.end_s
+        } else {
+            t
+        }
     }
 
     /// Runs to `run.end_s`.
     pub fn run(mut self) -> Result<RunResult> {
         let start = Instant::now();
-        while self.steps_done < self.n_steps {
+        while !self.done() {
             self.step()?;
         }
         self.finish()?;
@@ -354,11 +432,22 @@ impl Simulation {
 
     /// Advances one internal step: forces from the hooks, Rapier's step, then records.
     pub fn step(&mut self) -> Result<()> {
-        let record = !self.skip_rows && self.steps_done % self.stride == 0;
+        let record = self.row_due();
         let t = self.time();
         self.before_step(record)?;
+        let dt = self.choose_dt();
+        for twin in &self.twins {
+            if let Err(mut e) = twin.clearance.check_step(dt) {
+                // Name the scene's field and the time: the set knows neither.
+                if let Error::StepTooLarge { field, t: at, .. } = &mut e {
+                    *field = "run.dt_s".into();
+                    *at = t;
+                }
+                return Err(e);
+            }
+        }
+        self.world.integration_parameters.dt = dt;
         self.world.step();
-        let dt = self.world.integration_parameters.dt;
         let gravity = self.world.gravity;
         for twin in &mut self.twins {
             twin.solve_ideal_reactions(&self.world.bodies, dt, gravity);
@@ -371,7 +460,9 @@ impl Simulation {
             self.comparison
                 .record(ideal, clear, &self.world.bodies, t, dt);
         }
+        self.t = self.advance_time(dt);
         self.steps_done += 1;
+        self.last_dt = dt;
         self.check_health()
     }
 
@@ -381,14 +472,8 @@ impl Simulation {
         let params = self.world.integration_parameters;
         for twin in &mut self.twins {
             twin.drives.apply(&mut self.world.bodies);
-            if let Err(mut e) = twin.clearance.apply(&mut self.world.bodies, &params) {
-                // Name the scene's field and the time: the set knows neither.
-                if let Error::StepTooLarge { field, t: at, .. } = &mut e {
-                    *field = "run.dt_s".into();
-                    *at = t;
-                }
-                return Err(e);
-            }
+            twin.clearance.apply_forces(&mut self.world.bodies);
+            twin.clearance.check_substeps(&params)?;
             for b in &mut twin.bodies {
                 b.linvel_before = self.world.bodies[b.handle].linvel();
             }
@@ -396,6 +481,9 @@ impl Simulation {
             if record {
                 twin.push_row(t, &self.world.bodies);
             }
+        }
+        if record {
+            self.next_row += 1;
         }
         Ok(())
     }

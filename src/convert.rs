@@ -1,1 +1,601 @@
-//! Conversions between Rapier revolute joints and clearance joints (issue 5). Placeholder until built.
+//! One-call conversions between Rapier revolute joints and clearance joints.
+//!
+//! A scene built with Rapier's `RevoluteJoint`s gets radial play in one hinge with one call,
+//! which takes the anchors and axes from the revolute joint itself, removes it from the
+//! `ImpulseJointSet`, and adds the equivalent [`ClearanceJoint`] to a [`ClearanceJointSet`]:
+//!
+//! ```
+//! use clearance_joint::convert::{Clearance, ConvertRevolute};
+//! use clearance_joint::prelude::*;
+//! use rapier3d_f64::prelude::*;
+//!
+//! let mut world = PhysicsWorld::new();
+//! world.integration_parameters.num_solver_iterations = 1; // the hook's force is constant over a step
+//! let base = world.bodies.insert(RigidBodyBuilder::fixed());
+//! let arm = world.bodies.insert(
+//!     RigidBodyBuilder::dynamic()
+//!         .translation(Vector::new(0.0, -0.3, 0.0))
+//!         .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02))),
+//! );
+//! let revolute = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0));
+//! let hinge = world.impulse_joints.insert(base, arm, revolute, true);
+//! let mut clearance = ClearanceJointSet::new();
+//!
+//! // The one line: 0.2 mm of radial play in a 20 mm steel bearing, 16 mm wide, dry friction.
+//! let hinge = clearance.convert_revolute(hinge, Clearance::steel(0.010, 0.2e-3, 0.016)?.friction(FrictionModel::Bai(Bai::DRY)), &mut world.impulse_joints)?;
+//!
+//! assert_eq!(clearance.get(hinge).unwrap().local_anchor2(), Vector::new(0.0, 0.3, 0.0));
+//! // The revolute is gone; the only Rapier joint left is the lock of the out-of-plane motion.
+//! assert_eq!(world.impulse_joints.len(), 1);
+//!
+//! // And back, with the same anchors and axes.
+//! let revolute = clearance.revert_to_revolute(hinge, &mut world.bodies, &mut world.impulse_joints)?;
+//! assert!(world.impulse_joints.get(revolute).unwrap().data.as_revolute().is_some());
+//! assert!(clearance.is_empty());
+//! # Ok::<(), clearance_joint::Error>(())
+//! ```
+//!
+//! What a clearance joint cannot carry is refused with an error before anything changes: a joint
+//! that is not a revolute, a revolute with a motor or limits (use a
+//! [`TorsionSpring`](crate::drive::TorsionSpring) for a drive), or a disabled joint.
+
+use crate::error::{Error, Result};
+use crate::joint::{
+    ClearanceJoint, ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet, OutOfPlaneLock,
+};
+use crate::laws::{
+    BearingGeometry, FrictionModel, ImprovedLiu, Material, MaxDamping, NormalModel,
+    effective_modulus,
+};
+use crate::scene::{ClearanceParams, ClearanceSpec};
+use rapier3d_f64::math::Vector;
+use rapier3d_f64::prelude::{
+    GenericJoint, GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, JointAxesMask,
+    RevoluteJoint, RigidBodySet,
+};
+
+/// Everything a clearance joint needs beyond the revolute joint it replaces: the radial
+/// geometry, the normal and friction laws, and options. Built with chained setters.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Clearance {
+    /// Radial geometry of the bearing and journal.
+    pub geometry: BearingGeometry,
+    /// Normal contact law.
+    pub normal: NormalModel,
+    /// Friction law (default none).
+    pub friction: FrictionModel,
+    /// Floor on the impact velocity of the hysteresis laws, m/s (default 1e-4).
+    pub min_impact_speed: f64,
+    /// What holds the out-of-plane degrees of freedom (default [`OutOfPlaneLock::Joint`]).
+    pub lock: OutOfPlaneLock,
+    /// Name used in errors and reports (default: the builder's default name).
+    pub name: Option<String>,
+}
+
+impl Clearance {
+    /// A frictionless clearance with the given geometry and normal law.
+    pub fn new(geometry: BearingGeometry, normal: NormalModel) -> Self {
+        Clearance {
+            geometry,
+            normal,
+            friction: FrictionModel::None,
+            min_impact_speed: 1e-4,
+            lock: OutOfPlaneLock::Joint,
+            name: None,
+        }
+    }
+
+    /// The paper's improved law (MODEL.md §2) with its defaults (`n = 1`, `delta_max = 0.1 mm`,
+    /// `eta = 0.01 s`) for a bearing of radius `bearing_radius`, radial clearance `clearance` and
+    /// width `length` (all in m) between two materials; frictionless.
+    pub fn improved_liu(
+        bearing_radius: f64,
+        clearance: f64,
+        length: f64,
+        bearing: Material,
+        journal: Material,
+    ) -> Result<Self> {
+        let geometry = BearingGeometry::from_clearance(bearing_radius, clearance, length)?;
+        bearing.validate().map_err(|e| e.within("bearing"))?;
+        journal.validate().map_err(|e| e.within("journal"))?;
+        let law = ImprovedLiu::new(
+            effective_modulus(&bearing, &journal),
+            length,
+            clearance,
+            1.0,
+            ImprovedLiu::DEFAULT_DELTA_MAX,
+            MaxDamping::Eta(ImprovedLiu::DEFAULT_ETA),
+        )?;
+        Ok(Self::new(geometry, NormalModel::ImprovedLiu(law)))
+    }
+
+    /// [`improved_liu`](Self::improved_liu) with structural steel on both sides (the paper's
+    /// table 2: E = 207 GPa, nu = 0.3). Lengths in m.
+    pub fn steel(bearing_radius: f64, clearance: f64, length: f64) -> Result<Self> {
+        Self::improved_liu(
+            bearing_radius,
+            clearance,
+            length,
+            Material::STEEL,
+            Material::STEEL,
+        )
+    }
+
+    /// From a scene file's clearance spec (millimetres, materials, laws by name).
+    pub fn from_spec(spec: &ClearanceSpec) -> Result<Self> {
+        let params = spec.build()?;
+        let mut c = Self::from(params);
+        c.lock = spec.lock;
+        Ok(c)
+    }
+
+    /// Sets the friction law.
+    pub fn friction(mut self, friction: FrictionModel) -> Self {
+        self.friction = friction;
+        self
+    }
+
+    /// Sets the floor on the impact velocity of the hysteresis laws, m/s.
+    pub fn min_impact_speed(mut self, speed: f64) -> Self {
+        self.min_impact_speed = speed;
+        self
+    }
+
+    /// Sets what holds the out-of-plane degrees of freedom.
+    pub fn lock(mut self, lock: OutOfPlaneLock) -> Self {
+        self.lock = lock;
+        self
+    }
+
+    /// Sets the name used in errors and reports.
+    pub fn name(mut self, name: impl Into<String>) -> Self {
+        self.name = Some(name.into());
+        self
+    }
+
+    /// A validated clearance joint with these laws, about `local_axis1` / `local_axis2` through
+    /// `local_anchor1` / `local_anchor2` (body frames; body 1 carries the bearing).
+    pub fn joint(
+        &self,
+        local_anchor1: Vector,
+        local_anchor2: Vector,
+        local_axis1: Vector,
+        local_axis2: Vector,
+    ) -> Result<ClearanceJoint> {
+        let mut b = ClearanceJointBuilder::new(local_axis1, self.geometry, self.normal)
+            .local_axis2(local_axis2)
+            .local_anchor1(local_anchor1)
+            .local_anchor2(local_anchor2)
+            .friction(self.friction)
+            .min_impact_speed(self.min_impact_speed)
+            .lock(self.lock);
+        if let Some(name) = &self.name {
+            b = b.name(name.clone());
+        }
+        b.build()
+    }
+}
+
+impl From<ClearanceParams> for Clearance {
+    fn from(p: ClearanceParams) -> Self {
+        Clearance {
+            min_impact_speed: p.min_impact_speed,
+            ..Clearance::new(p.geometry, p.normal).friction(p.friction)
+        }
+    }
+}
+
+/// The clearance joint equivalent to the revolute `joint`: same anchors, same axes (the X axis
+/// of each joint frame), with the laws of `clearance`. Refuses what a clearance joint cannot
+/// represent: a joint that does not lock exactly the revolute axes, motors, limits, and a disabled
+/// joint.
+pub fn clearance_joint_from_revolute(
+    joint: &GenericJoint,
+    clearance: &Clearance,
+) -> Result<ClearanceJoint> {
+    if joint.locked_axes != JointAxesMask::LOCKED_REVOLUTE_AXES {
+        return Err(Error::invalid(
+            "revolute",
+            format!(
+                "is not a revolute joint (locked axes {:?}, a revolute locks {:?}): only a revolute \
+                 hinge can be given radial clearance",
+                joint.locked_axes,
+                JointAxesMask::LOCKED_REVOLUTE_AXES
+            ),
+        ));
+    }
+    if !joint.motor_axes.is_empty() {
+        return Err(Error::invalid(
+            "revolute",
+            "has a motor, which a clearance joint cannot carry (its rotation is free, play and \
+             contact are the contact law's): remove the motor, or drive the hinge with a \
+             `drive::TorsionSpring`",
+        ));
+    }
+    if !joint.limit_axes.is_empty() {
+        return Err(Error::invalid(
+            "revolute",
+            "has limits, which a clearance joint cannot carry (its rotation is free): remove them \
+             before converting",
+        ));
+    }
+    if !joint.is_enabled() {
+        return Err(Error::invalid(
+            "revolute",
+            "is disabled: enable it (or leave it out) rather than converting it into an active \
+             clearance joint",
+        ));
+    }
+    // The X axis of each joint frame. Not `GenericJoint::local_axis1()`: in Rapier 0.36 it
+    // transforms X as a point by the whole frame, so it adds the anchor to the axis.
+    clearance.joint(
+        joint.local_anchor1(),
+        joint.local_anchor2(),
+        joint.local_frame1.rotation * Vector::X,
+        joint.local_frame2.rotation * Vector::X,
+    )
+}
+
+/// The ideal revolute joint with the anchors and axes of `joint`. Contacts between the two
+/// bodies are disabled, as by the clearance joint's own out-of-plane lock (re-enable them with
+/// `GenericJoint::set_contacts_enabled` if your colliders need them).
+pub fn revolute_from_clearance(joint: &ClearanceJoint) -> RevoluteJoint {
+    let data = GenericJointBuilder::new(JointAxesMask::LOCKED_REVOLUTE_AXES)
+        .local_axis1(joint.local_axis1())
+        .local_axis2(joint.local_axis2())
+        .local_anchor1(joint.local_anchor1())
+        .local_anchor2(joint.local_anchor2())
+        .contacts_enabled(false)
+        .build();
+    RevoluteJoint { data }
+}
+
+/// Replaces the revolute joint `revolute` of `impulse_joints` by a clearance joint in `set`
+/// between the same bodies (body 1 carries the bearing), with the same anchors and axes and the
+/// laws of `clearance`. Nothing changes when it fails (unknown handle, not a convertible
+/// revolute, invalid clearance).
+pub fn revolute_to_clearance(
+    set: &mut ClearanceJointSet,
+    revolute: ImpulseJointHandle,
+    clearance: Clearance,
+    impulse_joints: &mut ImpulseJointSet,
+) -> Result<ClearanceJointHandle> {
+    let ij = impulse_joints.get(revolute).ok_or_else(|| {
+        Error::invalid(
+            "revolute",
+            format!("no joint with handle {revolute:?} in the ImpulseJointSet"),
+        )
+    })?;
+    let (body1, body2) = (ij.body1(), ij.body2());
+    let joint = clearance_joint_from_revolute(&ij.data, &clearance)?;
+    impulse_joints.remove(revolute, true);
+    Ok(set.insert(body1, body2, joint, impulse_joints))
+}
+
+/// Replaces the clearance joint `handle` of `set` by an ideal revolute joint in
+/// `impulse_joints` with the same bodies, anchors and axes (see [`revolute_from_clearance`]);
+/// the clearance joint's forces are taken back from the bodies and its out-of-plane lock is
+/// removed. As with [`ClearanceJointSet::remove`], the handles of the clearance joints inserted
+/// after it shift down by one.
+pub fn clearance_to_revolute(
+    set: &mut ClearanceJointSet,
+    handle: ClearanceJointHandle,
+    bodies: &mut RigidBodySet,
+    impulse_joints: &mut ImpulseJointSet,
+) -> Result<ImpulseJointHandle> {
+    let joint = set.remove(handle, bodies, impulse_joints).ok_or_else(|| {
+        Error::invalid(
+            "clearance joint",
+            format!(
+                "no joint with handle {handle:?} in the ClearanceJointSet ({} joints)",
+                set.len()
+            ),
+        )
+    })?;
+    Ok(impulse_joints.insert(
+        joint.body1(),
+        joint.body2(),
+        revolute_from_clearance(&joint),
+        true,
+    ))
+}
+
+/// The conversions as methods of [`ClearanceJointSet`].
+pub trait ConvertRevolute {
+    /// See [`revolute_to_clearance`].
+    fn convert_revolute(
+        &mut self,
+        revolute: ImpulseJointHandle,
+        clearance: Clearance,
+        impulse_joints: &mut ImpulseJointSet,
+    ) -> Result<ClearanceJointHandle>;
+
+    /// See [`clearance_to_revolute`].
+    fn revert_to_revolute(
+        &mut self,
+        handle: ClearanceJointHandle,
+        bodies: &mut RigidBodySet,
+        impulse_joints: &mut ImpulseJointSet,
+    ) -> Result<ImpulseJointHandle>;
+}
+
+impl ConvertRevolute for ClearanceJointSet {
+    fn convert_revolute(
+        &mut self,
+        revolute: ImpulseJointHandle,
+        clearance: Clearance,
+        impulse_joints: &mut ImpulseJointSet,
+    ) -> Result<ClearanceJointHandle> {
+        revolute_to_clearance(self, revolute, clearance, impulse_joints)
+    }
+
+    fn revert_to_revolute(
+        &mut self,
+        handle: ClearanceJointHandle,
+        bodies: &mut RigidBodySet,
+        impulse_joints: &mut ImpulseJointSet,
+    ) -> Result<ImpulseJointHandle> {
+        clearance_to_revolute(self, handle, bodies, impulse_joints)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::laws::{Bai, FrictionModel};
+    use rapier3d_f64::prelude::*;
+
+    struct Rig {
+        world: PhysicsWorld,
+        base: RigidBodyHandle,
+        arm: RigidBodyHandle,
+    }
+
+    fn rig() -> Rig {
+        let mut world = PhysicsWorld::new();
+        world.gravity = Vector::new(0.0, -9.81, 0.0);
+        // Stiff steel contact under a 20 N load: the hook refuses steps above about 3e-5 s.
+        world.integration_parameters.dt = 1e-5;
+        world.integration_parameters.num_solver_iterations = 1;
+        let base = world.bodies.insert(RigidBodyBuilder::fixed());
+        let arm = world.bodies.insert(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(0.0, -0.3, 0.0))
+                .can_sleep(false)
+                .additional_mass_properties(MassProperties::new(
+                    Vector::ZERO,
+                    2.0,
+                    Vector::splat(0.02),
+                )),
+        );
+        Rig { world, base, arm }
+    }
+
+    fn revolute() -> RevoluteJointBuilder {
+        RevoluteJointBuilder::new(Vector::Z)
+            .local_anchor1(Vector::new(0.01, 0.0, 0.0))
+            .local_anchor2(Vector::new(0.01, 0.3, 0.0))
+    }
+
+    fn clearance() -> Clearance {
+        Clearance::steel(0.010, 0.2e-3, 0.016)
+            .unwrap()
+            .friction(FrictionModel::Bai(Bai::DRY))
+            .name("pivot")
+    }
+
+    #[test]
+    fn converts_with_the_revolute_anchors_and_axes() {
+        let mut r = rig();
+        let h = r
+            .world
+            .impulse_joints
+            .insert(r.base, r.arm, revolute(), true);
+        let mut set = ClearanceJointSet::new();
+        let c = set
+            .convert_revolute(h, clearance(), &mut r.world.impulse_joints)
+            .unwrap();
+        assert!(r.world.impulse_joints.get(h).is_none(), "revolute removed");
+        let j = set.get(c).unwrap();
+        assert_eq!(j.name(), "pivot");
+        assert_eq!((j.body1(), j.body2()), (r.base, r.arm));
+        assert_eq!(j.local_anchor1(), Vector::new(0.01, 0.0, 0.0));
+        assert_eq!(j.local_anchor2(), Vector::new(0.01, 0.3, 0.0));
+        assert!((j.local_axis1() - Vector::Z).length() < 1e-15);
+        assert!((j.local_axis2() - Vector::Z).length() < 1e-15);
+        assert!(matches!(j.friction_law(), FrictionModel::Bai(_)));
+        // Only the lock of the out-of-plane motion remains, and it is not a revolute.
+        assert_eq!(r.world.impulse_joints.len(), 1);
+        let lock = r
+            .world
+            .impulse_joints
+            .get(j.lock_handle().unwrap())
+            .unwrap();
+        assert!(lock.data.as_revolute().is_none());
+    }
+
+    #[test]
+    fn converts_a_rotated_frame_pair() {
+        // Different axes on the two bodies (body 2 built rotated by 90 deg about z).
+        let mut r = rig();
+        let data = GenericJointBuilder::new(JointAxesMask::LOCKED_REVOLUTE_AXES)
+            .local_axis1(Vector::Y)
+            .local_axis2(Vector::X)
+            .local_anchor1(Vector::new(0.0, 0.0, 0.2))
+            .local_anchor2(Vector::new(0.1, 0.0, 0.0))
+            .build();
+        let h = r.world.impulse_joints.insert(r.base, r.arm, data, true);
+        let mut set = ClearanceJointSet::new();
+        let c =
+            revolute_to_clearance(&mut set, h, clearance(), &mut r.world.impulse_joints).unwrap();
+        let j = set.get(c).unwrap();
+        assert!((j.local_axis1() - Vector::Y).length() < 1e-15);
+        assert!((j.local_axis2() - Vector::X).length() < 1e-15);
+        // And back: the revolute has the same frames' axes and anchors.
+        let back = clearance_to_revolute(
+            &mut set,
+            c,
+            &mut r.world.bodies,
+            &mut r.world.impulse_joints,
+        )
+        .unwrap();
+        let d = &r.world.impulse_joints.get(back).unwrap().data;
+        assert!(d.as_revolute().is_some());
+        assert!((d.local_frame1.rotation * Vector::X - Vector::Y).length() < 1e-15);
+        assert!((d.local_frame2.rotation * Vector::X - Vector::X).length() < 1e-15);
+        assert_eq!(d.local_anchor1(), Vector::new(0.0, 0.0, 0.2));
+        assert_eq!(d.local_anchor2(), Vector::new(0.1, 0.0, 0.0));
+    }
+
+    #[test]
+    fn round_trip_restores_an_equivalent_revolute() {
+        let mut r = rig();
+        let original: GenericJoint = revolute().contacts_enabled(false).into();
+        let h = r.world.impulse_joints.insert(r.base, r.arm, original, true);
+        let mut set = ClearanceJointSet::new();
+        let c = set
+            .convert_revolute(h, clearance(), &mut r.world.impulse_joints)
+            .unwrap();
+        let back = set
+            .revert_to_revolute(c, &mut r.world.bodies, &mut r.world.impulse_joints)
+            .unwrap();
+        assert!(set.is_empty());
+        assert_eq!(
+            r.world.impulse_joints.len(),
+            1,
+            "lock removed, revolute back"
+        );
+        let ij = r.world.impulse_joints.get(back).unwrap();
+        assert_eq!((ij.body1(), ij.body2()), (r.base, r.arm));
+        assert_eq!(ij.data.local_frame1, original.local_frame1);
+        assert_eq!(ij.data.local_frame2, original.local_frame2);
+        assert_eq!(ij.data.locked_axes, original.locked_axes);
+    }
+
+    #[test]
+    fn converted_mid_run_the_hinge_keeps_the_arm_and_carries_its_weight() {
+        let mut r = rig();
+        let h = r.world.impulse_joints.insert(
+            r.base,
+            r.arm,
+            RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0)),
+            true,
+        );
+        let mut set = ClearanceJointSet::new();
+        for _ in 0..100 {
+            set.apply(&mut r.world.bodies, &r.world.integration_parameters)
+                .unwrap();
+            r.world.step();
+        }
+        let c = set
+            .convert_revolute(h, clearance(), &mut r.world.impulse_joints)
+            .unwrap();
+        for _ in 0..20_000 {
+            set.apply(&mut r.world.bodies, &r.world.integration_parameters)
+                .unwrap();
+            r.world.step();
+        }
+        let report = set.get(c).unwrap().report();
+        assert!(report.state.penetration > 0.0, "resting on the journal");
+        let f = report.force.on_journal.length();
+        assert!((f - 2.0 * 9.81).abs() < 0.02, "carries the weight: {f} N");
+        // The arm fell by the clearance plus a fraction of a micrometre of contact deflection.
+        let y = r.world.bodies[r.arm].translation().y;
+        assert!((y + 0.3 + 0.2e-3).abs() < 1e-6, "arm at {y}");
+    }
+
+    #[test]
+    fn refusals_leave_everything_unchanged() {
+        let mut r = rig();
+        let mut set = ClearanceJointSet::new();
+        let check = |e: Error, needle: &str| {
+            let msg = e.to_string();
+            assert!(msg.contains(needle), "{msg}");
+        };
+        let cases: Vec<(GenericJoint, &str)> = vec![
+            (
+                PrismaticJointBuilder::new(Vector::X).into(),
+                "not a revolute",
+            ),
+            (FixedJointBuilder::new().into(), "not a revolute"),
+            (revolute().motor_velocity(1.0, 0.5).into(), "motor"),
+            (revolute().limits([-1.0, 1.0]).into(), "limits"),
+            (
+                {
+                    let mut j: GenericJoint = revolute().into();
+                    j.set_enabled(false);
+                    j
+                },
+                "disabled",
+            ),
+        ];
+        for (joint, needle) in cases {
+            let h = r.world.impulse_joints.insert(r.base, r.arm, joint, true);
+            let n = r.world.impulse_joints.len();
+            check(
+                set.convert_revolute(h, clearance(), &mut r.world.impulse_joints)
+                    .unwrap_err(),
+                needle,
+            );
+            assert_eq!(r.world.impulse_joints.len(), n, "nothing removed");
+            assert!(set.is_empty());
+            r.world.impulse_joints.remove(h, false);
+        }
+        // An unknown handle, in both directions.
+        let h = r
+            .world
+            .impulse_joints
+            .insert(r.base, r.arm, revolute(), true);
+        r.world.impulse_joints.remove(h, false);
+        check(
+            set.convert_revolute(h, clearance(), &mut r.world.impulse_joints)
+                .unwrap_err(),
+            "no joint with handle",
+        );
+        check(
+            set.revert_to_revolute(
+                ClearanceJointHandle(3),
+                &mut r.world.bodies,
+                &mut r.world.impulse_joints,
+            )
+            .unwrap_err(),
+            "no joint with handle",
+        );
+        // An invalid clearance is refused by the laws, naming the field.
+        check(
+            Clearance::steel(0.010, 0.02, 0.016).unwrap_err(),
+            "clearance",
+        );
+        check(
+            Clearance::steel(0.010, 0.2e-3, -0.016).unwrap_err(),
+            "length",
+        );
+        let h = r
+            .world
+            .impulse_joints
+            .insert(r.base, r.arm, revolute(), true);
+        check(
+            set.convert_revolute(
+                h,
+                clearance().min_impact_speed(-1.0),
+                &mut r.world.impulse_joints,
+            )
+            .unwrap_err(),
+            "min_impact_speed",
+        );
+        assert!(r.world.impulse_joints.get(h).is_some(), "revolute kept");
+    }
+
+    #[test]
+    fn from_a_scene_spec() {
+        let scene = crate::scene::Scene::solar_panel();
+        let spec = scene.hinges[0].clearance.as_ref().unwrap();
+        let c = Clearance::from_spec(spec).unwrap();
+        assert!((c.geometry.clearance() - 0.5e-3).abs() < 1e-15);
+        assert_eq!(c.friction, FrictionModel::Bai(Bai::DRY));
+        assert_eq!(
+            c.normal,
+            Clearance::steel(0.010, 0.5e-3, 0.016).unwrap().normal
+        );
+    }
+}

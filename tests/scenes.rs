@@ -1,0 +1,330 @@
+//! Scenes beyond the paper's (assets/): a pendulum resting on its journal under gravity, a
+//! deployable array of four rattling clearance hinges, and what the planar model handles or
+//! refuses (gravity, several joints, out-of-plane loads).
+
+use clearance_joint::Error;
+use clearance_joint::joint::ClearanceJoint;
+use clearance_joint::kinematics::ContactMode;
+use clearance_joint::laws::NormalForceLaw;
+use clearance_joint::scene::{BodySpec, HingeSpec, Scene};
+use clearance_joint::sim::{RunOptions, Simulation, TwinKind, Twins};
+use rapier3d_f64::math::Vector;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn asset_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("assets")
+        .join(name)
+}
+
+fn asset(name: &str) -> Scene {
+    Scene::load(&asset_path(name)).expect("the asset is a valid scene")
+}
+
+fn options(twins: Twins) -> RunOptions {
+    RunOptions {
+        twins,
+        skip_rows: true,
+    }
+}
+
+/// Builds `scene` with only the clearance twin and steps it to `run.end_s` by hand, so that the
+/// world (bodies, joints) can be inspected at the end.
+fn settle(scene: &Scene) -> Simulation {
+    let mut sim = Simulation::new(scene, options(Twins::ClearanceOnly)).unwrap();
+    let n = (scene.run.end_s / scene.run.dt_s).round() as u64;
+    for _ in 0..n {
+        sim.step().unwrap();
+    }
+    sim
+}
+
+/// The clearance joint called `name` in the (only) twin of `sim`.
+fn joint<'a>(sim: &'a Simulation, name: &str) -> &'a ClearanceJoint {
+    sim.twins[0]
+        .clearance
+        .iter()
+        .map(|(_, j)| j)
+        .find(|j| j.name() == name)
+        .unwrap_or_else(|| panic!("no clearance joint `{name}`"))
+}
+
+/// Penetration at which the elastic part of hinge `hinge`'s law carries `load`, by bisection.
+fn static_penetration(scene: &Scene, hinge: &str, load: f64) -> f64 {
+    let spec = scene.hinges[scene.hinge_index(hinge).unwrap()]
+        .clearance
+        .as_ref()
+        .unwrap();
+    let p = spec.build().unwrap();
+    let (mut lo, mut hi) = (0.0, p.geometry.clearance());
+    assert!(p.normal.elastic_force(hi) > load);
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if p.normal.elastic_force(mid) < load {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    0.5 * (lo + hi)
+}
+
+fn mass(scene: &Scene, body: &str) -> f64 {
+    scene.bodies[scene.body_index(body).unwrap()].mass_kg
+}
+
+fn weight(scene: &Scene, bodies: &[&str]) -> f64 {
+    let g = Vector::from(scene.gravity).length();
+    bodies.iter().map(|b| mass(scene, b) * g).sum()
+}
+
+/// Checks that `j` rests in continuous contact at the bottom of its bearing carrying `load`:
+/// force within 0.1 %, penetration within 0.1 % of the law's static penetration.
+fn assert_resting(scene: &Scene, j: &ClearanceJoint, load: f64) {
+    let r = j.report();
+    let force = r.force.on_journal.length();
+    assert!(
+        ((force - load) / load).abs() < 1e-3,
+        "`{}`: resting force {force} N, static load {load} N",
+        j.name()
+    );
+    let delta_s = static_penetration(scene, j.name(), load);
+    let delta = r.state.penetration;
+    assert!(
+        ((delta - delta_s) / delta_s).abs() < 1e-3,
+        "`{}`: rest penetration {delta:e} m, static penetration of the law {delta_s:e} m",
+        j.name()
+    );
+    assert_eq!(r.mode, ContactMode::Continuous, "`{}`", j.name());
+    // At the bottom: the journal sits below the bearing centre, along gravity.
+    let down = Vector::from(scene.gravity).normalize();
+    assert!(
+        r.state.normal.dot(down) > 1.0 - 1e-6,
+        "`{}`: contact normal {:?}",
+        j.name(),
+        r.state.normal
+    );
+    assert!(r.state.slip.length() < 1e-6, "`{}`: slipping", j.name());
+}
+
+#[test]
+fn pendulum_settles_onto_its_journal_carrying_the_static_load() {
+    let scene = asset("pendulum.ron");
+    let sim = settle(&scene);
+    let j = joint(&sim, "pivot");
+    let load = weight(&scene, &["arm"]);
+    assert_resting(&scene, j, load);
+    // It got there by bouncing: the drop through the clearance is an impact, not a touch-down.
+    let r = j.report();
+    assert!(r.state.penetration > 0.0);
+    let metrics = &sim.twins[0].hinge_metrics()["pivot"];
+    assert!(metrics.impacts > 1, "{} impacts", metrics.impacts);
+    assert!(
+        metrics.peak_force_n > 10.0 * load,
+        "first impact {} N",
+        metrics.peak_force_n
+    );
+}
+
+#[test]
+fn pendulum_ideal_twin_carries_the_static_load_exactly() {
+    let scene = asset("pendulum.ron")
+        .with_overrides(&["run.end_s=0.05"])
+        .unwrap();
+    let r = Simulation::new(&scene, options(Twins::IdealOnly))
+        .unwrap()
+        .run()
+        .unwrap();
+    let ideal = r.twin(TwinKind::Ideal).unwrap();
+    let m = &ideal.hinge_metrics()["pivot"];
+    let load = weight(&scene, &["arm"]);
+    assert!(
+        ((m.peak_force_n - load) / load).abs() < 1e-3,
+        "ideal reaction {} N, load {load} N",
+        m.peak_force_n
+    );
+    assert_eq!(m.impacts, 0);
+}
+
+/// The pendulum with a second link hanging from the first: two clearance hinges in series
+/// under gravity.
+fn double_pendulum() -> Scene {
+    let mut scene = asset("pendulum.ron");
+    scene.name = "double_pendulum".into();
+    scene.bodies.push(BodySpec {
+        name: "lower".into(),
+        mass_kg: 1.0,
+        inertia_kg_m2: [0.0133, 0.001, 0.0133],
+        center_of_mass_m: [0.0, -0.8, 0.0],
+        fixed: false,
+    });
+    let pivot = scene.hinges[0].clone();
+    scene.hinges.push(HingeSpec {
+        name: "knee".into(),
+        bearing: "arm".into(),
+        journal: "lower".into(),
+        point_m: [0.0, -0.6, 0.0],
+        ..pivot
+    });
+    scene.validate().unwrap();
+    scene
+}
+
+#[test]
+fn double_pendulum_hinges_each_carry_the_weight_below_them() {
+    let scene = double_pendulum();
+    let sim = settle(&scene);
+    assert_resting(
+        &scene,
+        joint(&sim, "pivot"),
+        weight(&scene, &["arm", "lower"]),
+    );
+    assert_resting(&scene, joint(&sim, "knee"), weight(&scene, &["lower"]));
+}
+
+#[test]
+fn out_of_plane_moment_is_carried_by_the_lock() {
+    // The arm's centre of mass 50 mm along the hinge axis from the bearing: its weight tilts the
+    // arm about a horizontal axis normal to the hinge. The planar contact cannot carry that moment;
+    // the out-of-plane lock (a Rapier joint on the axial translation and the tilts) does, and the
+    // contact still carries exactly the weight.
+    let mut scene = asset("pendulum.ron");
+    scene.bodies[1].center_of_mass_m = [0.0, -0.3, 0.05];
+    let sim = settle(&scene);
+    let j = joint(&sim, "pivot");
+    assert_resting(&scene, j, weight(&scene, &["arm"]));
+    let arm = &sim.world.bodies[j.body2()];
+    let tilt = (*arm.rotation() * Vector::Z).angle_between(Vector::Z);
+    assert!(tilt < 1e-6, "the arm tilted by {tilt} rad");
+}
+
+#[test]
+fn deployable_array_rattles_in_all_four_hinges_and_conserves_momentum() {
+    let scene = asset("deployable_array.ron")
+        .with_overrides(&["run.end_s=0.5"])
+        .unwrap();
+    assert_eq!(scene.hinges.len(), 4);
+    assert_eq!(scene.drives.len(), 4);
+    assert!(scene.hinges.iter().all(|h| h.clearance.is_some()));
+    // Rows on (one per ms): the hinge angles are measured at rows.
+    let with_rows = RunOptions {
+        twins: Twins::ClearanceOnly,
+        skip_rows: false,
+    };
+    let r = Simulation::new(&scene, with_rows).unwrap().run().unwrap();
+    let s = r.summary().twins["clearance"].clone();
+    for (name, m) in &s.hinges {
+        assert!(m.impacts > 0, "hinge `{name}` never impacted");
+        assert!(
+            m.peak_force_n > 10.0,
+            "hinge `{name}`: {} N",
+            m.peak_force_n
+        );
+    }
+    assert!(
+        s.linear_momentum_drift < 1e-9,
+        "linear momentum drift {:e}",
+        s.linear_momentum_drift
+    );
+    assert!(
+        s.angular_momentum_drift < 1e-9,
+        "angular momentum drift {:e}",
+        s.angular_momentum_drift
+    );
+    // Every hinge moved (the chain's inertia makes some relative angles go negative first).
+    for (name, m) in &s.hinges {
+        assert!(m.final_angle_deg.abs() > 0.1, "`{name}` did not move");
+    }
+}
+
+fn refusal(scene: Result<Scene, Error>) -> String {
+    let e = scene
+        .and_then(|s| Simulation::new(&s, RunOptions::default()).map(|_| ()))
+        .expect_err("the scene must be refused");
+    let msg = e.to_string();
+    assert!(matches!(e, Error::Invalid { .. }), "{msg}");
+    msg
+}
+
+#[test]
+fn a_door_on_a_vertical_clearance_hinge_is_refused() {
+    // Gravity along the hinge axis is an axial load: the planar contact cannot carry it.
+    let door = asset("pendulum.ron").with_overrides(&[
+        "pivot.axis=[0,1,0]",
+        "reference_axis=[0,1,0]",
+        "arm.center_of_mass_m=[0.4,0,0]",
+    ]);
+    let msg = refusal(door);
+    assert!(msg.contains("`gravity`"), "{msg}");
+    assert!(
+        msg.contains("along the axis of clearance hinge `pivot`"),
+        "{msg}"
+    );
+    assert!(msg.contains("axial"), "{msg}");
+    // Tilted gravity is refused too: any axial component.
+    let msg = refusal(asset("pendulum.ron").with_overrides(&["gravity=[0,-9.81,0.1]"]));
+    assert!(msg.contains("axial"), "{msg}");
+}
+
+#[test]
+fn a_door_on_an_ideal_vertical_hinge_is_handled() {
+    // The same door with an ideal hinge: Rapier's revolute joint carries the axial load.
+    let scene = asset("pendulum.ron")
+        .with_overrides(&[
+            "pivot.axis=[0,1,0]",
+            "reference_axis=[0,1,0]",
+            "arm.center_of_mass_m=[0.4,0,0]",
+            "pivot.clearance=null",
+            "run.end_s=0.01",
+        ])
+        .unwrap();
+    let r = Simulation::new(&scene, options(Twins::Both))
+        .unwrap()
+        .run()
+        .unwrap();
+    assert_eq!(r.summary().twins["clearance"].impacts, 0);
+}
+
+#[test]
+fn an_array_hinge_out_of_the_deployment_plane_is_refused() {
+    let msg =
+        refusal(asset("deployable_array.ron").with_overrides(&["panel1_panel2.axis=[0,0,1]"]));
+    assert!(msg.contains("hinges[panel1_panel2].axis"), "{msg}");
+    assert!(
+        msg.contains("parallel to the scene's reference_axis"),
+        "{msg}"
+    );
+    assert!(msg.contains("out-of-plane"), "{msg}");
+    // Hinges alternately along +y and -y are parallel: the asset itself is accepted.
+    asset("deployable_array.ron").validate().unwrap();
+}
+
+#[test]
+fn cli_runs_the_new_scenes() {
+    for (name, end) in [("pendulum.ron", "0.02"), ("deployable_array.ron", "0.02")] {
+        let dir = std::env::temp_dir().join(format!(
+            "cj-scenes-{}-{}",
+            name.trim_end_matches(".ron"),
+            std::process::id()
+        ));
+        let out = Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
+            .arg("--scene")
+            .arg(asset_path(name))
+            .args(["--end", end, "--out"])
+            .arg(&dir)
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(stdout.contains("impacts"), "{stdout}");
+        for file in ["ideal.csv", "clearance.csv", "summary.json"] {
+            assert!(dir.join(file).is_file(), "{name}: no {file}");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

@@ -4,8 +4,11 @@ use clap::{Args, Parser, Subcommand};
 use clearance_joint::report::comparison_table;
 use clearance_joint::scene::Scene;
 use clearance_joint::sim::{RunOptions, Simulation};
-use std::path::PathBuf;
+use clearance_joint::study::sweep::{self, ExecOptions, MetricsTable, Progress, Sweep};
+use clearance_joint::study::{Axis, Grid, Shard, StudyKind, StudyOptions, run_studies};
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
+use std::time::Instant;
 
 /// Revolute hinges with clearance in Rapier: runs a scene with an ideal and a clearance twin.
 #[derive(Parser, Debug)]
@@ -21,6 +24,104 @@ struct Cli {
 enum Command {
     /// Run a scene (the default command): ideal vs clearance, CSV + summary.json.
     Run(RunArgs),
+    /// Run a grid of scenes, one ideal-vs-clearance run per point, plus a metrics table.
+    Sweep(SweepArgs),
+    /// Run the paper's studies with figures and reports: clearance, torque, friction or all.
+    Study(StudyArgs),
+    /// Gather the metrics tables of a sharded sweep into one.
+    Merge(MergeArgs),
+}
+
+/// Parallelism and progress, shared by `sweep` and `study`.
+#[derive(Args, Debug, Clone, Default)]
+struct ExecArgs {
+    /// Worker threads; default one per core (or RAYON_NUM_THREADS).
+    #[arg(long)]
+    jobs: Option<usize>,
+    /// Recompute every point, even those finished by an earlier run.
+    #[arg(long)]
+    rerun: bool,
+    /// Progress: auto (a bar on a terminal, lines otherwise), bar, lines or quiet.
+    #[arg(long, default_value = "auto", value_parser = ["auto", "bar", "lines", "quiet"])]
+    progress: String,
+}
+
+impl ExecArgs {
+    fn options(&self) -> ExecOptions {
+        ExecOptions {
+            progress: match self.progress.as_str() {
+                "bar" => Progress::Bar,
+                "lines" => Progress::Lines,
+                "quiet" => Progress::Quiet,
+                _ => Progress::Auto,
+            },
+            threads: self.jobs,
+            rerun: self.rerun,
+        }
+    }
+}
+
+/// `sweep`: every `--set` is an axis of the grid.
+#[derive(Args, Debug, Clone)]
+struct SweepArgs {
+    /// Scene file (RON); default: the paper's solar-panel scene.
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    /// A swept parameter and its values: `--set hinge.clearance_mm=0.1,0.25,0.5` (repeatable;
+    /// the grid is the product, the first `--set` varying slowest). One value fixes a parameter.
+    #[arg(long = "set", value_name = "PATH=V1,V2,...")]
+    axes: Vec<String>,
+    /// Step size, s, for every point (same as `--set run.dt_s=...`).
+    #[arg(long)]
+    dt: Option<f64>,
+    /// Simulated time, s, for every point.
+    #[arg(long)]
+    end: Option<f64>,
+    /// Interval between CSV rows, s, for every point.
+    #[arg(long)]
+    output_interval: Option<f64>,
+    /// Output folder; default `out/sweep`.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Run only the points with index % N == K (K from 0): `--shard 0/4` ... `--shard 3/4`.
+    #[arg(long, value_name = "K/N")]
+    shard: Option<String>,
+    #[command(flatten)]
+    exec: ExecArgs,
+}
+
+/// `study NAME`.
+#[derive(Args, Debug, Clone)]
+struct StudyArgs {
+    /// clearance, torque, friction or all.
+    #[arg(value_parser = ["clearance", "torque", "friction", "all"])]
+    name: String,
+    /// Scene file (RON); default: the paper's solar-panel scene.
+    #[arg(long)]
+    scene: Option<PathBuf>,
+    /// Override a parameter in every case, after the study's own settings (repeatable),
+    /// e.g. `--set run.end_s=1` for a quick look.
+    #[arg(long = "set", value_name = "PATH=VALUE")]
+    overrides: Vec<String>,
+    /// Root folder; each study writes into `<out>/<name>/`. Default `out/studies`.
+    #[arg(long)]
+    out: Option<PathBuf>,
+    /// Skip the figures.
+    #[arg(long)]
+    no_figures: bool,
+    #[command(flatten)]
+    exec: ExecArgs,
+}
+
+/// `merge`: shard tables in, one table out.
+#[derive(Args, Debug, Clone)]
+struct MergeArgs {
+    /// Sweep folders (their `metrics.shard-*.json` are read) or shard table files.
+    #[arg(required = true)]
+    inputs: Vec<PathBuf>,
+    /// Folder for the merged `metrics.csv` and `metrics.json`; default: the first input folder.
+    #[arg(long)]
+    out: Option<PathBuf>,
 }
 
 /// Scene selection and overrides shared by the commands.
@@ -88,10 +189,188 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     Ok(())
 }
 
+fn base_scene(path: &Option<PathBuf>) -> clearance_joint::Result<Scene> {
+    match path {
+        Some(p) => Scene::load(p),
+        None => Ok(Scene::solar_panel()),
+    }
+}
+
+fn sweep(args: &SweepArgs) -> clearance_joint::Result<()> {
+    let base = base_scene(&args.scene)?;
+    let axes = args
+        .axes
+        .iter()
+        .map(|a| Axis::parse(a))
+        .collect::<clearance_joint::Result<Vec<_>>>()?;
+    let mut fixed = Vec::new();
+    for (key, v) in [
+        ("run.dt_s", args.dt),
+        ("run.end_s", args.end),
+        ("run.output_interval_s", args.output_interval),
+    ] {
+        if let Some(v) = v {
+            fixed.push(format!("{key}={v:e}"));
+        }
+    }
+    let shard = match &args.shard {
+        Some(s) => Shard::parse(s)?,
+        None => Shard::ALL,
+    };
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out/sweep"));
+    let sweep = Sweep::new("sweep", base, fixed, Grid::new(axes)?);
+    let n = shard.points(&sweep.grid).len();
+    eprintln!(
+        "sweep of {} points{}: {n} to run or reuse, into {}",
+        sweep.grid.len(),
+        if shard.is_all() {
+            String::new()
+        } else {
+            format!(" (shard {shard})")
+        },
+        out.display()
+    );
+    let start = Instant::now();
+    let outcome = sweep.run(&out, shard, args.exec.options())?;
+    let reused = outcome.points.iter().filter(|p| p.reused).count();
+    println!(
+        "{} points finished ({} run, {reused} reused), {} failed, in {:.2} s; table {}",
+        outcome.points.len(),
+        outcome.points.len() - reused,
+        outcome.table.failures.len(),
+        start.elapsed().as_secs_f64(),
+        out.join(format!("{}.csv", outcome.table.stem())).display()
+    );
+    fail_on_failures(&outcome.table)
+}
+
+fn fail_on_failures(table: &MetricsTable) -> clearance_joint::Result<()> {
+    for f in &table.failures {
+        eprintln!("point `{}` failed: {}", f.point.dir, f.error);
+    }
+    match table.failures.len() {
+        0 => Ok(()),
+        n => Err(clearance_joint::Error::invalid(
+            "sweep",
+            format!(
+                "{n} point(s) failed (listed above and in the table's `failures`); fix the cause and run again: finished points are reused"
+            ),
+        )),
+    }
+}
+
+fn study(args: &StudyArgs) -> clearance_joint::Result<()> {
+    let base = base_scene(&args.scene)?;
+    let kinds: Vec<StudyKind> = if args.name == "all" {
+        StudyKind::ALL.to_vec()
+    } else {
+        vec![StudyKind::parse(&args.name)?]
+    };
+    let root = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("out/studies"));
+    let options = StudyOptions {
+        exec: args.exec.options(),
+        extra_overrides: args.overrides.clone(),
+        no_figures: args.no_figures,
+    };
+    let start = Instant::now();
+    let outcomes = run_studies(&kinds, &base, &root, &options)?;
+    for o in &outcomes {
+        println!("{} study -> {}", o.kind.name(), o.report.display());
+        for c in &o.cases {
+            let h = c.metrics.hinges.values().find(|h| h.clearance_mm > 0.0);
+            if let Some(h) = h {
+                println!(
+                    "  {:<22} impacts {:>5}  peak force {:>9.3} N  RMS force {:>7.3} N  final hinge angle {:>8.3} deg (ideal {:>8.3}){}",
+                    c.label,
+                    h.impacts,
+                    h.peak_force_n,
+                    h.rms_force_n,
+                    h.final_angle_deg,
+                    h.final_angle_ideal_deg,
+                    if c.reused { "  [reused]" } else { "" }
+                );
+            }
+        }
+        for c in &o.conclusions {
+            if c.verdict != clearance_joint::study::report::Verdict::NotTested {
+                println!("  paper conclusion {}: {}", c.number, c.verdict.text());
+            }
+        }
+    }
+    if outcomes.len() > 1 {
+        println!("summary -> {}", root.join("report.md").display());
+    }
+    println!("done in {:.2} s", start.elapsed().as_secs_f64());
+    Ok(())
+}
+
+fn merge(args: &MergeArgs) -> clearance_joint::Result<()> {
+    let mut files = Vec::new();
+    for input in &args.inputs {
+        if input.is_dir() {
+            let found = sweep::shard_tables_in(input)?;
+            if found.is_empty() {
+                return Err(clearance_joint::Error::invalid(
+                    format!("merge input `{}`", input.display()),
+                    "holds no shard table (metrics.shard-K-of-N.json)",
+                ));
+            }
+            files.extend(found);
+        } else {
+            files.push(input.clone());
+        }
+    }
+    let tables = files
+        .iter()
+        .map(|f| MetricsTable::load(f))
+        .collect::<clearance_joint::Result<Vec<_>>>()?;
+    let merged = sweep::merge(&tables)?;
+    let out = match &args.out {
+        Some(o) => o.clone(),
+        None => {
+            let first = &args.inputs[0];
+            if first.is_dir() {
+                first.clone()
+            } else {
+                first.parent().unwrap_or(Path::new(".")).to_path_buf()
+            }
+        }
+    };
+    merged.write(&out)?;
+    println!(
+        "merged {} table(s): {} of {} points, {} failed, {} missing -> {}",
+        tables.len(),
+        merged.rows.len(),
+        merged.sweep.points,
+        merged.failures.len(),
+        merged.missing.len(),
+        out.join("metrics.csv").display()
+    );
+    if !merged.missing.is_empty() {
+        return Err(clearance_joint::Error::invalid(
+            "merge",
+            format!(
+                "points {:?} are in no table: run their shards (a point i belongs to shard i % N)",
+                merged.missing
+            ),
+        ));
+    }
+    fail_on_failures(&merged)
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let outcome = match &cli.command {
         Some(Command::Run(a)) => run(a),
+        Some(Command::Sweep(a)) => sweep(a),
+        Some(Command::Study(a)) => study(a),
+        Some(Command::Merge(a)) => merge(a),
         None => run(&cli.run),
     };
     match outcome {

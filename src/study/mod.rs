@@ -1,1 +1,24 @@
-//! Parameter sweeps, the paper's studies, metrics and plots (issue 3). Placeholder until built.
+//! Parameter sweeps, the paper's three studies, their metrics, figures and reports (issue 3).
+//!
+//! - [`grid`]: sweep axes (`--set path=v1,v2,...`), their Cartesian product in a fixed order,
+//!   deterministic folder names, and shards (`--shard K/N`).
+//! - [`sweep`]: runs the points in parallel (rayon), each an ideal-vs-clearance run in its own
+//!   folder with a manifest written last (resume reuses finished points and redoes half-written
+//!   ones), writes the metrics table (CSV and JSON), and merges shard tables.
+//! - [`metrics`]: per-run metrics, from the runner's every-step values and from the output rows.
+//! - [`series`], [`plot`]: the time series of a case and the paper's three kinds of figure (PNG and SVG).
+//! - [`preset`]: the paper's studies (clearance, torque, friction) as named sweeps, run end to end.
+//! - [`report`]: each study's `report.md`, with the verdict of our numbers on every conclusion of the paper.
+
+pub mod grid;
+pub mod metrics;
+pub mod plot;
+pub mod preset;
+pub mod report;
+pub mod series;
+pub mod sweep;
+
+pub use grid::{Axis, Grid, Point, Shard};
+pub use metrics::RunMetrics;
+pub use preset::{StudyKind, StudyOptions, StudyOutcome, run_studies};
+pub use sweep::{ExecOptions, MetricsTable, Progress, Sweep, merge};

@@ -237,6 +237,39 @@ pub fn decimate_path(u: &[f64], v: &[f64], min_step: f64) -> Vec<(f64, f64)> {
     out
 }
 
+/// The corner of the plotting area (`x` and `y` ranges) where a legend box of `(fw, fh)`
+/// (fractions of width and height) covers the fewest of `points`; upper corners win ties.
+fn emptiest_corner(
+    points: impl Iterator<Item = (f64, f64)>,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+    (fw, fh): (f64, f64),
+) -> SeriesLabelPosition {
+    let mut counts = [0usize; 4]; // upper left, upper right, lower left, lower right
+    let (w, h) = ((x1 - x0).max(1e-300), (y1 - y0).max(1e-300));
+    for (x, y) in points {
+        let (fx, fy) = ((x - x0) / w, (y - y0) / h);
+        let left = fx <= fw;
+        let right = fx >= 1.0 - fw;
+        let upper = fy >= 1.0 - fh;
+        let lower = fy <= fh;
+        for (k, hit) in [upper && left, upper && right, lower && left, lower && right]
+            .into_iter()
+            .enumerate()
+        {
+            if hit {
+                counts[k] += 1;
+            }
+        }
+    }
+    match (0..4).min_by_key(|&k| (counts[k], k)) {
+        Some(1) => SeriesLabelPosition::UpperRight,
+        Some(2) => SeriesLabelPosition::LowerLeft,
+        Some(3) => SeriesLabelPosition::LowerRight,
+        _ => SeriesLabelPosition::UpperLeft,
+    }
+}
+
 /// `[lo, hi]` of the values with 5 % padding (a unit span around a constant).
 fn range_of<'a>(values: impl IntoIterator<Item = &'a f64>) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -283,6 +316,9 @@ fn distinct_ideals(cases: &[CaseSeries]) -> Vec<bool> {
         .collect()
 }
 
+/// A line to draw: label, colour, dashed (ideal) or solid, points.
+type Curve = (String, RGBColor, bool, Vec<(f64, f64)>);
+
 fn case_color(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
 }
@@ -314,7 +350,7 @@ where
                     (true, true) => b.rate_ideal_deg_s.clone(),
                 }
             };
-            let mut curves: Vec<(String, RGBColor, bool, Vec<(f64, f64)>)> = Vec::new();
+            let mut curves: Vec<Curve> = Vec::new();
             for (i, case) in cases.iter().enumerate() {
                 let Some(b) = case.bodies.iter().find(|b| b.name == body.name) else {
                     continue;
@@ -345,6 +381,12 @@ where
                 }
             }
             let (y0, y1) = range_of(curves.iter().flat_map(|c| c.3.iter().map(|p| &p.1)));
+            let corner = emptiest_corner(
+                curves.iter().flat_map(|c| c.3.iter().copied()),
+                (t0, t1),
+                (y0, y1),
+                (0.3, 0.1 + 0.07 * curves.len() as f64),
+            );
             let what = if is_rate { "angular rate" } else { "angle" };
             let unit = if is_rate { "deg/s" } else { "deg" };
             let mut chart = ChartBuilder::on(panel)
@@ -381,7 +423,7 @@ where
             }
             chart
                 .configure_series_labels()
-                .position(SeriesLabelPosition::UpperLeft)
+                .position(corner)
                 .label_font((FAMILY, 16))
                 .background_style(WHITE.mix(0.85))
                 .border_style(RGBColor(160, 160, 160))
@@ -433,13 +475,14 @@ where
                 .draw()?;
             let points = minmax_decimate(&case.t_s, series, t0, t1, DECIMATE_BINS);
             let peak = series.iter().copied().fold(0.0, f64::max);
+            let corner = emptiest_corner(points.iter().copied(), (t0, t1), (0.0, y1), (0.45, 0.2));
             chart
                 .draw_series(LineSeries::new(points, color.stroke_width(1)))?
                 .label(format!("{name}, highest row {peak:.4} N"))
                 .legend(legend_line(color));
             chart
                 .configure_series_labels()
-                .position(SeriesLabelPosition::UpperRight)
+                .position(corner)
                 .label_font((FAMILY, 15))
                 .background_style(WHITE.mix(0.85))
                 .border_style(RGBColor(160, 160, 160))

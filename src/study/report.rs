@@ -497,11 +497,20 @@ pub fn conclusions(
                     );
                 }
                 Some(k) if k + 1 < ordered.len() => {
+                    let from = if k + 2 == ordered.len() {
+                        format!("only at the end of the run (t = {} s)", num(end))
+                    } else {
+                        format!("from t = {} s on", num((k + 2) as f64 * tl.window_s))
+                    };
                     let _ = write!(
                         more,
                         ": a smaller clearance has shorter free flights and strikes more often at first; the cumulative count \
-                         increases with c only from t = {} s on, because the larger clearances then impact more often per second.",
-                        num((k + 2) as f64 * tl.window_s)
+                         increases with c {from}, because the larger clearances impact more often per second later in the run \
+                         (per-second counts in the last window: {}).",
+                        (0..cases.len())
+                            .map(|i| tl.counts[i].last().copied().unwrap_or(0).to_string())
+                            .collect::<Vec<_>>()
+                            .join(", ")
                     );
                 }
                 Some(_) => {

@@ -259,6 +259,17 @@ pub fn run_studies(
         };
         table.write(&dir)?;
         if !table.failures.is_empty() {
+            // No report for an incomplete study; an older one must not pass for this run's.
+            let stale = dir.join("report.md");
+            if let Err(e) = std::fs::remove_file(&stale)
+                && e.kind() != std::io::ErrorKind::NotFound
+            {
+                return Err(Error::Io {
+                    action: "cannot remove",
+                    path: stale,
+                    source: e,
+                });
+            }
             continue;
         }
         outcomes.push(finish_study(kind, dir, &sweep, cases, table, options)?);

@@ -839,7 +839,7 @@ pub fn study_report(
     let _ = writeln!(s, "## The paper's conclusions against our numbers\n");
     let _ = writeln!(
         s,
-        "Criteria, fixed before looking at the results: values within {} % of each other count as equal; \"angles barely change\" \
+        "Criteria (ours: the paper states none): values within {} % of each other count as equal; \"angles barely change\" \
          means a largest angle deviation below {} % of the ideal deployment; \"rates visibly change\" a largest rate deviation \
          above {} % of the mean ideal rate; \"force strongly changes\" a clearance peak above {}x the ideal peak; a trend \
          \"increases\" only if every step up the list increases.\n",

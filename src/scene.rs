@@ -289,11 +289,12 @@ pub struct RunSettings {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub enum StepMode {
     /// A constant step `run.dt_s` (the paper's way).
-    #[default]
     Fixed,
     /// The step changes between Rapier steps: at most `run.dt_s` (the smooth dynamics), shorter
     /// as a contact approaches and inside it (`run.tolerance` of the contact's natural period,
-    /// and within its damped stability limit).
+    /// and within its damped stability limit). The default: at the cost of the paper's fixed
+    /// 1e-4 s it resolves impacts (first-impact peak error 1.3 % against 26 %; README, work-precision).
+    #[default]
     Adaptive,
 }
 

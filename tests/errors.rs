@@ -93,7 +93,7 @@ fn bad_laws_parameters_are_named() {
 #[test]
 fn step_too_large_for_the_contact_stiffness() {
     let scene = Scene::solar_panel()
-        .with_overrides(&["run.dt_s=5e-4"])
+        .with_overrides(&["run.step=Fixed", "run.dt_s=5e-4"])
         .unwrap();
     let e = Simulation::new(&scene, RunOptions::default())
         .unwrap()
@@ -116,7 +116,7 @@ fn bin() -> Command {
 fn cli_refuses_without_writing_anything() {
     let dir = std::env::temp_dir().join(format!("cj-refused-{}", std::process::id()));
     let out = bin()
-        .args(["--dt", "1e-3", "--out"])
+        .args(["--set", "run.step=Fixed", "--dt", "1e-3", "--out"])
         .arg(&dir)
         .output()
         .unwrap();

@@ -21,7 +21,10 @@ fn median_us_per_step(mut make: impl FnMut() -> Simulation) -> f64 {
 }
 
 fn main() {
-    let scene = Scene::solar_panel();
+    // Fixed steps: the cost of one step, not of a step count that varies.
+    let scene = Scene::solar_panel()
+        .with_overrides(&["run.step=Fixed"])
+        .unwrap();
     let opts = |twins| RunOptions {
         twins,
         skip_rows: true,

@@ -724,11 +724,12 @@ impl Twin {
         if self.window_time < window * (1.0 - 1e-9) {
             return; // the hinges keep the last window's reaction
         }
-        let mut residual: Vec<Vector> = self
-            .window_impulse
-            .iter()
-            .map(|i| *i / self.window_time)
-            .collect();
+        // Eliminate in place on the window's impulses (no allocation per step).
+        let window_time = self.window_time;
+        let residual = &mut self.window_impulse;
+        for r in residual.iter_mut() {
+            *r /= window_time;
+        }
         for &(hi, body, sign) in &self.reaction_order {
             let h = &mut self.hinges[hi];
             // Force on the journal body.

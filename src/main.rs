@@ -174,8 +174,10 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&scene.name));
     eprintln!(
-        "running `{}`: dt = {:e} s, {} s simulated, ideal and clearance twins",
-        scene.name, scene.run.dt_s, scene.run.end_s
+        "running `{}`: {}, {} s simulated, ideal and clearance twins",
+        scene.name,
+        scene.run.stepping(),
+        scene.run.end_s
     );
     let result = Simulation::new(&scene, RunOptions::default())?.run()?;
     let summary = result.write(&out)?;

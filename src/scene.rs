@@ -309,6 +309,20 @@ fn default_end() -> f64 {
     5.0
 }
 
+impl RunSettings {
+    /// The step control in words, e.g. "adaptive steps of at most 1e-4 s (tolerance 0.02 of a
+    /// contact period)".
+    pub fn stepping(&self) -> String {
+        match self.step {
+            StepMode::Fixed => format!("fixed step {:e} s", self.dt_s),
+            StepMode::Adaptive => format!(
+                "adaptive steps of at most {:e} s (tolerance {} of a contact period)",
+                self.dt_s, self.tolerance
+            ),
+        }
+    }
+}
+
 impl Default for RunSettings {
     fn default() -> Self {
         RunSettings {

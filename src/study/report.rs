@@ -114,13 +114,7 @@ impl Setup {
         if let Some(h) = hinge {
             bodies.sort_by_key(|b| *b != h.journal);
         }
-        let stepping = match scene.run.step {
-            crate::scene::StepMode::Fixed => format!("fixed step {:e} s", scene.run.dt_s),
-            crate::scene::StepMode::Adaptive => format!(
-                "adaptive steps of at most {:e} s (tolerance {} of a contact period)",
-                scene.run.dt_s, scene.run.tolerance
-            ),
-        };
+        let stepping = scene.run.stepping();
         Setup {
             stepping,
             dt_s: scene.run.dt_s,

@@ -242,3 +242,47 @@ fn identical_runs_are_bit_identical() {
     };
     assert_eq!(strip(&a), strip(&b));
 }
+
+#[test]
+fn adaptive_steps_resolve_contact_onset() {
+    // Fixed 1e-4 s steps over the first contact: it starts wherever the step lands. Adaptive steps
+    // shrink on approach so the contact begins at a small fraction of its peak penetration.
+    let onset_and_peak = |step: &str| {
+        let set = [step, "run.end_s=0.1", "run.output_interval_s=1e-3"];
+        let scene = Scene::solar_panel().with_overrides(&set).unwrap();
+        let mut sim = Simulation::new(
+            &scene,
+            RunOptions {
+                twins: Twins::ClearanceOnly,
+                skip_rows: true,
+            },
+        )
+        .unwrap();
+        let (mut onset, mut peak) = (None, 0.0f64);
+        while sim.time() < 0.1 {
+            sim.step().unwrap();
+            let (_, joint) = sim.twins[0].clearance.iter().next().unwrap();
+            let r = joint.report();
+            if r.onset && onset.is_none() {
+                onset = Some(r.state.penetration);
+            }
+            if onset.is_some() {
+                peak = peak.max(r.state.penetration);
+                if r.state.penetration <= 0.0 {
+                    break;
+                }
+            }
+        }
+        (onset.expect("a contact in 0.1 s"), peak)
+    };
+    let (onset, peak) = onset_and_peak("run.step=Adaptive");
+    assert!(
+        onset < 0.1 * peak,
+        "adaptive: contact began {onset:e} m deep, peak {peak:e} m"
+    );
+    let (fixed_onset, fixed_peak) = onset_and_peak("run.step=Fixed");
+    assert!(
+        onset < fixed_onset,
+        "adaptive onset {onset:e} m vs fixed {fixed_onset:e} m (peak {fixed_peak:e} m)"
+    );
+}

@@ -1,1 +1,1241 @@
-//! The bevy_ecs layer (issue 5). Placeholder until built.
+//! The bevy_ecs layer (cargo feature `ecs`, on by default): the Rapier world as a resource, rigid
+//! bodies, hinges and drives as components, and the per-step systems in a fixed order.
+//!
+//! A thin layer: the physics is the core's ([`ClearanceJointSet`], [`DriveSet`], the conversions of
+//! [`convert`](crate::convert)). The systems reconcile the Rapier world with the components
+//! every step: spawning, changing or removing a component is all a user does.
+//!
+//! - [`Physics`] (resource): the Rapier `PhysicsWorld`, the clearance joints and the drives.
+//! - [`Body`]: a rigid body, from a Rapier description (`RigidBodyBuilder`) or an existing handle.
+//! - [`Hinge`]: which two bodies a hinge joins, its anchors and axes; with a mode component:
+//!   [`IdealHinge`] (Rapier's revolute joint) or [`ClearanceHinge`] (radial clearance, contact and
+//!   friction laws). A hinge with neither joins nothing. When both are present, the clearance wins.
+//! - [`Drive`]: a torsion spring `T = T0 - k theta` on a hinge (on the hinge's entity).
+//! - [`HingeState`] and [`BodyState`] (added automatically): what the last step did.
+//!
+//! Swapping an entity's `IdealHinge` for a `ClearanceHinge` is the whole change, at spawn or
+//! while running: the sync system converts the Rapier revolute joint into a clearance joint with
+//! [`revolute_to_clearance`](crate::convert::revolute_to_clearance) (and back with
+//! [`clearance_to_revolute`](crate::convert::clearance_to_revolute) when the `ClearanceHinge`
+//! is removed again).
+//!
+//! ```
+//! use bevy_ecs::prelude::*;
+//! use clearance_joint::convert::Clearance;
+//! use clearance_joint::ecs::*;
+//! use rapier3d_f64::math::Vector;
+//! use rapier3d_f64::prelude::{MassProperties, RigidBodyBuilder};
+//!
+//! let mut world = World::new();
+//! world.insert_resource(Physics::new(1e-5, Vector::new(0.0, -9.81, 0.0)));
+//! let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
+//! let arm = world
+//!     .spawn(Body::new(
+//!         RigidBodyBuilder::dynamic()
+//!             .translation(Vector::new(0.0, -0.3, 0.0))
+//!             .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02)))
+//!             .can_sleep(false),
+//!     ))
+//!     .id();
+//! let pivot = world
+//!     .spawn((
+//!         Hinge::new(base, arm, Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0)),
+//!         // Was: IdealHinge,
+//!         ClearanceHinge(Clearance::steel(0.010, 0.2e-3, 0.016)?),
+//!     ))
+//!     .id();
+//! let mut schedule = physics_schedule();
+//! for _ in 0..20_000 {
+//!     run_step(&mut world, &mut schedule)?;
+//! }
+//! let state = world.get::<HingeState>(pivot).unwrap();
+//! assert_eq!(state.mode, HingeMode::Clearance);
+//! assert!((state.force - 19.62).abs() < 0.05, "the journal carries the arm: {} N", state.force);
+//! # Ok::<(), clearance_joint::Error>(())
+//! ```
+
+use crate::angle::{UnwrappedAngle, twist_angle};
+use crate::convert::{Clearance, ConvertRevolute};
+use crate::drive::{DriveSet, TorsionSpring};
+use crate::error::{Error, Result, unit_vector};
+use crate::joint::{ClearanceJoint, ClearanceJointHandle, ClearanceJointSet};
+use crate::kinematics::ContactMode;
+use bevy_ecs::prelude::*;
+use rapier3d_f64::math::{Rotation, Vector};
+use rapier3d_f64::prelude::{
+    GenericJointBuilder, ImpulseJointHandle, JointAxesMask, PhysicsWorld, RevoluteJoint, RigidBody,
+    RigidBodyHandle,
+};
+use std::collections::{BTreeMap, BTreeSet};
+
+/// The Rapier joint behind a hinge entity.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HingeJoint {
+    /// Rapier's revolute joint.
+    Ideal(ImpulseJointHandle),
+    /// A clearance joint of [`Physics::clearance`].
+    Clearance(ClearanceJointHandle),
+}
+
+/// What a hinge entity is realised as.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum HingeMode {
+    /// No joint (not yet synchronised, or neither [`IdealHinge`] nor [`ClearanceHinge`]).
+    #[default]
+    None,
+    /// A Rapier revolute joint.
+    Ideal,
+    /// A clearance joint.
+    Clearance,
+}
+
+#[derive(Clone, Debug)]
+struct RealizedHinge {
+    joint: HingeJoint,
+    bodies: (RigidBodyHandle, RigidBodyHandle),
+    frame: Hinge,
+    clearance: Option<Clearance>,
+}
+
+#[derive(Clone, Debug)]
+struct RealizedDrive {
+    set: DriveSet,
+    drive: Drive,
+    bodies: (RigidBodyHandle, RigidBodyHandle),
+    axis: Vector,
+    /// The torque (world) added to body 2 at the last application; body 1 got its negative.
+    last_torque: Vector,
+}
+
+/// The physics of an ECS world: the Rapier world, the clearance joints and the drives, and the
+/// map from entities to what they are in Rapier.
+#[derive(Resource)]
+pub struct Physics {
+    /// The Rapier world. Set gravity, the step (`integration_parameters.dt`) and colliders here;
+    /// bodies and joints are managed through the components.
+    pub world: PhysicsWorld,
+    clearance: ClearanceJointSet,
+    bodies: BTreeMap<Entity, RigidBodyHandle>,
+    hinges: BTreeMap<Entity, RealizedHinge>,
+    drives: BTreeMap<Entity, RealizedDrive>,
+    error: Option<Error>,
+    steps: u64,
+    time: f64,
+}
+
+impl Physics {
+    /// An empty world stepping by `dt` (s) under `gravity` (m/s^2), with one solver iteration
+    /// (the clearance hook's force is constant over a step; RAPIER_NOTES).
+    pub fn new(dt: f64, gravity: Vector) -> Self {
+        let mut world = PhysicsWorld::new();
+        world.integration_parameters.dt = dt;
+        world.integration_parameters.num_solver_iterations = 1;
+        world.gravity = gravity;
+        Self::from_world(world)
+    }
+
+    /// Wraps an existing Rapier world (its bodies and joints stay; entities refer to bodies with
+    /// [`Body::from_handle`]).
+    pub fn from_world(world: PhysicsWorld) -> Self {
+        Physics {
+            world,
+            clearance: ClearanceJointSet::new(),
+            bodies: BTreeMap::new(),
+            hinges: BTreeMap::new(),
+            drives: BTreeMap::new(),
+            error: None,
+            steps: 0,
+            time: 0.0,
+        }
+    }
+
+    /// The clearance joints (read-only: they follow the [`ClearanceHinge`] components).
+    pub fn clearance(&self) -> &ClearanceJointSet {
+        &self.clearance
+    }
+
+    /// Simulated time, s.
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// The first error of the systems, if any. While it is set the systems do nothing: the
+    /// simulation stops where it failed instead of running on a destroyed state.
+    pub fn error(&self) -> Option<&Error> {
+        self.error.as_ref()
+    }
+
+    /// Takes the error out, letting the systems run again.
+    pub fn take_error(&mut self) -> Option<Error> {
+        self.error.take()
+    }
+
+    /// The Rapier body of a [`Body`] entity.
+    pub fn body(&self, entity: Entity) -> Option<RigidBodyHandle> {
+        self.bodies.get(&entity).copied()
+    }
+
+    /// The Rapier joint of a [`Hinge`] entity.
+    pub fn joint(&self, entity: Entity) -> Option<HingeJoint> {
+        self.hinges.get(&entity).map(|h| h.joint)
+    }
+
+    /// The clearance joint of a [`ClearanceHinge`] entity.
+    pub fn clearance_joint(&self, entity: Entity) -> Option<&ClearanceJoint> {
+        match self.joint(entity)? {
+            HingeJoint::Clearance(h) => self.clearance.get(h),
+            HingeJoint::Ideal(_) => None,
+        }
+    }
+
+    /// The drive of a [`Drive`] entity.
+    pub fn drive(&self, entity: Entity) -> Option<&TorsionSpring> {
+        self.drives.get(&entity)?.set.drives().first()
+    }
+
+    fn fail(&mut self, error: Error) {
+        if self.error.is_none() {
+            self.error = Some(error);
+        }
+    }
+
+    /// Removes the Rapier joint of hinge `entity` (if realised).
+    fn unrealize_hinge(&mut self, entity: Entity) {
+        if let Some(h) = self.hinges.remove(&entity) {
+            match h.joint {
+                HingeJoint::Ideal(j) => {
+                    self.world.impulse_joints.remove(j, true);
+                }
+                HingeJoint::Clearance(c) => {
+                    self.clearance.remove(
+                        c,
+                        &mut self.world.bodies,
+                        &mut self.world.impulse_joints,
+                    );
+                    self.clearance_removed(c);
+                }
+            }
+        }
+    }
+
+    /// Renumbers the clearance handles after the set removed `removed` (later handles shift down).
+    fn clearance_removed(&mut self, removed: ClearanceJointHandle) {
+        for h in self.hinges.values_mut() {
+            if let HingeJoint::Clearance(c) = &mut h.joint {
+                if c.0 > removed.0 {
+                    c.0 -= 1;
+                }
+            }
+        }
+    }
+
+    /// Takes back the last torques of drive `entity` and forgets it.
+    fn unrealize_drive(&mut self, entity: Entity) {
+        if let Some(d) = self.drives.remove(&entity) {
+            if let Some(rb) = self.world.bodies.get_mut(d.bodies.0) {
+                rb.add_torque(d.last_torque, false);
+            }
+            if let Some(rb) = self.world.bodies.get_mut(d.bodies.1) {
+                rb.add_torque(-d.last_torque, false);
+            }
+        }
+    }
+
+    /// Removes the Rapier body of `entity` with every hinge and drive attached to it.
+    fn remove_body(&mut self, entity: Entity) {
+        let Some(handle) = self.bodies.remove(&entity) else {
+            return;
+        };
+        let attached: Vec<Entity> = self
+            .hinges
+            .iter()
+            .filter(|(_, h)| h.bodies.0 == handle || h.bodies.1 == handle)
+            .map(|(e, _)| *e)
+            .collect();
+        for e in attached {
+            self.unrealize_hinge(e);
+        }
+        let driven: Vec<Entity> = self
+            .drives
+            .iter()
+            .filter(|(_, d)| d.bodies.0 == handle || d.bodies.1 == handle)
+            .map(|(e, _)| *e)
+            .collect();
+        for e in driven {
+            self.unrealize_drive(e);
+        }
+        let w = &mut self.world;
+        w.bodies.remove(
+            handle,
+            &mut w.islands,
+            &mut w.colliders,
+            &mut w.impulse_joints,
+            &mut w.multibody_joints,
+            &mut w.soft_bodies,
+            true,
+        );
+    }
+
+    /// Brings hinge `entity` to the `desired` mode between `bodies`.
+    fn reconcile_hinge(
+        &mut self,
+        entity: Entity,
+        frame: &Hinge,
+        desired: Option<Option<&Clearance>>,
+        bodies: (RigidBodyHandle, RigidBodyHandle),
+    ) -> Result<()> {
+        let context = |e: Error| e.within(&format!("hinge {entity}"));
+        frame.validate().map_err(context)?;
+        if let Some(r) = self.hinges.get(&entity) {
+            let same_place = r.bodies == bodies && r.frame == *frame;
+            match (r.joint, desired) {
+                (HingeJoint::Ideal(_), Some(None)) if same_place => return Ok(()),
+                (HingeJoint::Clearance(_), Some(Some(c)))
+                    if same_place && r.clearance.as_ref() == Some(c) =>
+                {
+                    return Ok(());
+                }
+                // The swap, in place: the plain API's conversions.
+                (HingeJoint::Ideal(j), Some(Some(c))) if same_place => {
+                    let c = named(c, entity);
+                    let h = self
+                        .clearance
+                        .convert_revolute(j, c.clone(), &mut self.world.impulse_joints)
+                        .map_err(context)?;
+                    let r = self.hinges.get_mut(&entity).expect("realised");
+                    r.joint = HingeJoint::Clearance(h);
+                    r.clearance = Some(c);
+                    return Ok(());
+                }
+                (HingeJoint::Clearance(k), Some(None)) if same_place => {
+                    let j = self
+                        .clearance
+                        .revert_to_revolute(
+                            k,
+                            &mut self.world.bodies,
+                            &mut self.world.impulse_joints,
+                        )
+                        .map_err(context)?;
+                    let r = self.hinges.get_mut(&entity).expect("realised");
+                    r.joint = HingeJoint::Ideal(j);
+                    r.clearance = None;
+                    self.clearance_removed(k);
+                    return Ok(());
+                }
+                _ => self.unrealize_hinge(entity),
+            }
+        }
+        let Some(clearance) = desired else {
+            return Ok(());
+        };
+        let (joint, clearance) = match clearance {
+            None => {
+                let j =
+                    self.world
+                        .impulse_joints
+                        .insert(bodies.0, bodies.1, frame.revolute(), true);
+                (HingeJoint::Ideal(j), None)
+            }
+            Some(c) => {
+                let c = named(c, entity);
+                let joint = c
+                    .joint(
+                        frame.local_anchor1,
+                        frame.local_anchor2,
+                        frame.local_axis1,
+                        frame.local_axis2,
+                    )
+                    .map_err(context)?;
+                let h = self.clearance.insert(
+                    bodies.0,
+                    bodies.1,
+                    joint,
+                    &mut self.world.impulse_joints,
+                );
+                (HingeJoint::Clearance(h), Some(c))
+            }
+        };
+        self.hinges.insert(
+            entity,
+            RealizedHinge {
+                joint,
+                bodies,
+                frame: frame.clone(),
+                clearance,
+            },
+        );
+        Ok(())
+    }
+
+    /// Brings the drive of hinge `entity` to `desired`.
+    fn reconcile_drive(
+        &mut self,
+        entity: Entity,
+        frame: &Hinge,
+        desired: Option<&Drive>,
+        bodies: (RigidBodyHandle, RigidBodyHandle),
+    ) -> Result<()> {
+        if let Some(d) = self.drives.get(&entity) {
+            if Some(&d.drive) == desired && d.bodies == bodies && d.axis == frame.local_axis1 {
+                return Ok(());
+            }
+            self.unrealize_drive(entity);
+        }
+        let Some(drive) = desired else {
+            return Ok(());
+        };
+        let spring = TorsionSpring::new(
+            bodies.0,
+            bodies.1,
+            frame.local_axis1,
+            drive.torque0,
+            drive.stiffness,
+        )
+        .map_err(|e| e.within(&format!("drive {entity}")))?;
+        let mut set = DriveSet::new();
+        set.insert(spring);
+        self.drives.insert(
+            entity,
+            RealizedDrive {
+                set,
+                drive: *drive,
+                bodies,
+                axis: frame.local_axis1,
+                last_torque: Vector::ZERO,
+            },
+        );
+        Ok(())
+    }
+}
+
+/// `c` with the entity as its name unless it has one.
+fn named(c: &Clearance, entity: Entity) -> Clearance {
+    let mut c = c.clone();
+    if c.name.is_none() {
+        c.name = Some(format!("hinge {entity}"));
+    }
+    c
+}
+
+/// A rigid body. Spawn it with a Rapier description ([`Body::new`]); the sync system inserts it
+/// into [`Physics::world`] and records its handle. Removing the component (or despawning the
+/// entity) removes the body, with the hinges and drives attached to it.
+#[derive(Component, Debug)]
+#[require(BodyState)]
+pub struct Body {
+    pending: Option<Box<RigidBody>>,
+    handle: Option<RigidBodyHandle>,
+}
+
+impl Body {
+    /// A body to insert, e.g. from `RigidBodyBuilder::dynamic()...`. Use `can_sleep(false)` for
+    /// slow mechanisms: Rapier's sleep thresholds freeze them (RAPIER_NOTES).
+    pub fn new(body: impl Into<RigidBody>) -> Self {
+        Body {
+            pending: Some(Box::new(body.into())),
+            handle: None,
+        }
+    }
+
+    /// A body already in [`Physics::world`].
+    pub fn from_handle(handle: RigidBodyHandle) -> Self {
+        Body {
+            pending: None,
+            handle: Some(handle),
+        }
+    }
+
+    /// The Rapier handle, once inserted.
+    pub fn handle(&self) -> Option<RigidBodyHandle> {
+        self.handle
+    }
+}
+
+/// Where a body is and how it moves, after the last step.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct BodyState {
+    /// Position of the body frame's origin, m.
+    pub translation: Vector,
+    /// Orientation.
+    pub rotation: Rotation,
+    /// Linear velocity of the centre of mass, m/s.
+    pub linvel: Vector,
+    /// Angular velocity, rad/s.
+    pub angvel: Vector,
+}
+
+/// A hinge between two [`Body`] entities: `body1` carries the bearing, `body2` the journal.
+/// Anchors and axes are in each body's frame (as Rapier's `RevoluteJointBuilder`). What it is
+/// made of is a second component: [`IdealHinge`] or [`ClearanceHinge`].
+#[derive(Component, Clone, Debug, PartialEq)]
+#[require(HingeState)]
+pub struct Hinge {
+    /// The bearing's body entity.
+    pub body1: Entity,
+    /// The journal's body entity.
+    pub body2: Entity,
+    /// Bearing centre in body 1's frame, m.
+    pub local_anchor1: Vector,
+    /// Journal centre in body 2's frame, m.
+    pub local_anchor2: Vector,
+    /// Hinge axis in body 1's frame.
+    pub local_axis1: Vector,
+    /// Hinge axis in body 2's frame.
+    pub local_axis2: Vector,
+}
+
+impl Hinge {
+    /// A hinge about `axis` (both bodies' frames), anchors at both bodies' origins.
+    pub fn new(body1: Entity, body2: Entity, axis: Vector) -> Self {
+        Hinge {
+            body1,
+            body2,
+            local_anchor1: Vector::ZERO,
+            local_anchor2: Vector::ZERO,
+            local_axis1: axis,
+            local_axis2: axis,
+        }
+    }
+    /// Sets the bearing centre in body 1's frame.
+    pub fn local_anchor1(mut self, anchor: Vector) -> Self {
+        self.local_anchor1 = anchor;
+        self
+    }
+    /// Sets the journal centre in body 2's frame.
+    pub fn local_anchor2(mut self, anchor: Vector) -> Self {
+        self.local_anchor2 = anchor;
+        self
+    }
+    /// Sets the axis in body 2's frame.
+    pub fn local_axis2(mut self, axis: Vector) -> Self {
+        self.local_axis2 = axis;
+        self
+    }
+    /// Checks that the anchors are finite and the axes finite and non-zero.
+    pub fn validate(&self) -> Result<()> {
+        unit_vector("local_axis1", self.local_axis1)?;
+        unit_vector("local_axis2", self.local_axis2)?;
+        for (field, v) in [
+            ("local_anchor1", self.local_anchor1),
+            ("local_anchor2", self.local_anchor2),
+        ] {
+            if !v.is_finite() {
+                return Err(Error::invalid(field, format!("must be finite (got {v:?})")));
+            }
+        }
+        Ok(())
+    }
+
+    /// The ideal Rapier revolute joint of this hinge (axes normalised, contacts between the
+    /// bodies disabled).
+    pub fn revolute(&self) -> RevoluteJoint {
+        RevoluteJoint {
+            data: GenericJointBuilder::new(JointAxesMask::LOCKED_REVOLUTE_AXES)
+                .local_axis1(self.local_axis1.normalize_or_zero())
+                .local_axis2(self.local_axis2.normalize_or_zero())
+                .local_anchor1(self.local_anchor1)
+                .local_anchor2(self.local_anchor2)
+                .contacts_enabled(false)
+                .build(),
+        }
+    }
+}
+
+/// Makes a [`Hinge`] an ideal Rapier revolute joint.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct IdealHinge;
+
+/// Makes a [`Hinge`] a clearance joint with these laws (takes precedence over [`IdealHinge`]).
+#[derive(Component, Clone, Debug, PartialEq)]
+pub struct ClearanceHinge(pub Clearance);
+
+/// A torsion spring `T = T0 - k theta` on the [`Hinge`] of the same entity: `+T` on body 2 and
+/// `-T` on body 1 about the hinge axis; `theta` is zero where the drive starts.
+#[derive(Component, Clone, Copy, Debug, PartialEq)]
+pub struct Drive {
+    /// Preload `T0`, N m.
+    pub torque0: f64,
+    /// Stiffness `k`, N m/rad.
+    pub stiffness: f64,
+}
+
+impl Drive {
+    /// Preload `torque0` (N m) and stiffness (N m/rad).
+    pub fn torsion_spring(torque0: f64, stiffness: f64) -> Self {
+        Drive { torque0, stiffness }
+    }
+    /// Preload `torque0` (N m) and stiffness in N m/deg (the paper's unit).
+    pub fn per_degree(torque0: f64, stiffness_nm_per_deg: f64) -> Self {
+        Drive {
+            torque0,
+            stiffness: stiffness_nm_per_deg.to_degrees(),
+        }
+    }
+}
+
+/// What a hinge did over the last step.
+#[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
+pub struct HingeState {
+    /// What the hinge is realised as.
+    pub mode: HingeMode,
+    /// Relative rotation of body 2 about the axis since the hinge was first realised, rad.
+    pub angle: f64,
+    /// Relative angular rate about the axis, rad/s.
+    pub rate: f64,
+    /// Joint force magnitude over the last step, N. Clearance: the contact force (exact). Ideal:
+    /// Rapier's joint impulse divided by the step (approximate: the last substep's impulse).
+    pub force: f64,
+    /// Largest `force` so far, N.
+    pub peak_force: f64,
+    /// Contact onsets so far (clearance).
+    pub impacts: u64,
+    /// Penetration (clearance; negative: free gap), m.
+    pub penetration: f64,
+    /// Eccentricity of the journal in the bearing (clearance; world), m.
+    pub eccentricity: Vector,
+    /// Motion mode (clearance).
+    pub contact: ContactMode,
+    reference: Option<Rotation>,
+    unwrapped: UnwrappedAngle,
+}
+
+/// The stages of a physics step, in this order.
+#[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum PhysicsSet {
+    /// Components to Rapier: bodies, hinges (with conversions), drives.
+    Sync,
+    /// Torsion-spring torques.
+    Drives,
+    /// Clearance contact and friction forces (the force hook).
+    ClearanceForces,
+    /// Rapier's step.
+    Step,
+    /// Rapier to [`HingeState`] and [`BodyState`].
+    Record,
+}
+
+/// Inserts new [`Body`] components into Rapier and removes the bodies of removed ones.
+pub fn sync_bodies(mut physics: ResMut<Physics>, mut query: Query<(Entity, &mut Body)>) {
+    if physics.error.is_some() {
+        return;
+    }
+    let mut items: Vec<(Entity, Mut<Body>)> = query.iter_mut().collect();
+    items.sort_by_key(|(e, _)| *e);
+    let mut seen = BTreeSet::new();
+    for (entity, mut body) in items {
+        seen.insert(entity);
+        if let Some(rb) = body.pending.take() {
+            physics.remove_body(entity);
+            let h = physics.world.bodies.insert(*rb);
+            physics.bodies.insert(entity, h);
+            body.handle = Some(h);
+        } else if let Some(h) = body.handle {
+            if physics.bodies.get(&entity) != Some(&h) {
+                if !physics.world.bodies.contains(h) {
+                    physics.fail(Error::invalid(
+                        format!("body {entity}"),
+                        format!("no rigid body with handle {h:?} in the Rapier world"),
+                    ));
+                    return;
+                }
+                physics.bodies.insert(entity, h);
+            }
+        }
+    }
+    let gone: Vec<Entity> = physics
+        .bodies
+        .keys()
+        .filter(|e| !seen.contains(*e))
+        .copied()
+        .collect();
+    for e in gone {
+        physics.remove_body(e);
+    }
+}
+
+/// Realises each [`Hinge`] as its mode component says (converting in place when only the mode
+/// changed), its [`Drive`], and removes the joints and drives of removed components.
+#[allow(clippy::type_complexity)]
+pub fn sync_hinges(
+    mut physics: ResMut<Physics>,
+    mut query: Query<(
+        Entity,
+        &Hinge,
+        Has<IdealHinge>,
+        Option<&ClearanceHinge>,
+        Option<&Drive>,
+        &mut HingeState,
+    )>,
+) {
+    if physics.error.is_some() {
+        return;
+    }
+    let mut items: Vec<_> = query.iter_mut().collect();
+    items.sort_by_key(|item| item.0);
+    let mut seen = BTreeSet::new();
+    for (entity, frame, ideal, clearance, drive, mut state) in items {
+        seen.insert(entity);
+        let body = |e: Entity, field: &str| {
+            physics.body(e).ok_or_else(|| {
+                Error::invalid(
+                    format!("hinge {entity}.{field}"),
+                    format!(
+                        "entity {e} has no Body (spawn a hinge's bodies with or before it, and \
+                         despawn the hinge with them)"
+                    ),
+                )
+            })
+        };
+        let bodies = match (body(frame.body1, "body1"), body(frame.body2, "body2")) {
+            (Ok(b1), Ok(b2)) => (b1, b2),
+            (Err(e), _) | (_, Err(e)) => {
+                physics.fail(e);
+                return;
+            }
+        };
+        let desired = match (clearance, ideal) {
+            (Some(c), _) => Some(Some(&c.0)),
+            (None, true) => Some(None),
+            (None, false) => None,
+        };
+        if let Err(e) = physics.reconcile_hinge(entity, frame, desired, bodies) {
+            physics.fail(e);
+            return;
+        }
+        if let Err(e) = physics.reconcile_drive(entity, frame, drive, bodies) {
+            physics.fail(e);
+            return;
+        }
+        state.mode = match physics.joint(entity) {
+            None => HingeMode::None,
+            Some(HingeJoint::Ideal(_)) => HingeMode::Ideal,
+            Some(HingeJoint::Clearance(_)) => HingeMode::Clearance,
+        };
+        if state.reference.is_none() {
+            let w = &physics.world.bodies;
+            if let (Some(r1), Some(r2)) = (w.get(bodies.0), w.get(bodies.1)) {
+                state.reference = Some(r1.rotation().inverse() * *r2.rotation());
+            }
+        }
+    }
+    let gone: Vec<Entity> = physics
+        .hinges
+        .keys()
+        .chain(physics.drives.keys())
+        .filter(|e| !seen.contains(*e))
+        .copied()
+        .collect();
+    for e in gone {
+        physics.unrealize_hinge(e);
+        physics.unrealize_drive(e);
+    }
+}
+
+/// Applies the torsion-spring torques (each replaces its own previous torque).
+pub fn apply_drives(mut physics: ResMut<Physics>) {
+    if physics.error.is_some() {
+        return;
+    }
+    let Physics { world, drives, .. } = &mut *physics;
+    for d in drives.values_mut() {
+        d.set.apply(&mut world.bodies);
+        // The same expression as the spring's own, so that taking it back is exact.
+        if let (Some(rb1), Some(spring)) = (world.bodies.get(d.bodies.0), d.set.drives().first()) {
+            let axis = unit_vector("axis", d.axis).unwrap_or(Vector::ZERO);
+            d.last_torque = spring.torque() * (*rb1.rotation() * axis);
+        }
+    }
+}
+
+/// The clearance force hook ([`ClearanceJointSet::apply`]).
+pub fn apply_clearance_forces(mut physics: ResMut<Physics>) {
+    if physics.error.is_some() {
+        return;
+    }
+    let Physics {
+        world, clearance, ..
+    } = &mut *physics;
+    if let Err(mut e) = clearance.apply(&mut world.bodies, &world.integration_parameters) {
+        if let Error::StepTooLarge { field, t, .. } = &mut e {
+            *field = "Physics::world.integration_parameters.dt".into();
+            *t = physics.time;
+        }
+        physics.fail(e);
+    }
+}
+
+/// Rapier's step; refuses to go on from a non-physical state.
+pub fn step_physics(mut physics: ResMut<Physics>) {
+    if physics.error.is_some() {
+        return;
+    }
+    physics.world.step();
+    physics.steps += 1;
+    physics.time += physics.world.integration_parameters.dt;
+    let vmax = 0.5 * physics.world.integration_parameters.max_linear_velocity();
+    let bad = physics.bodies.iter().find_map(|(e, h)| {
+        let rb = physics.world.bodies.get(*h)?;
+        let v = rb.linvel();
+        let bad = !rb.is_enabled() || !rb.translation().is_finite() || !v.is_finite();
+        (bad || v.length() > vmax).then(|| (*e, v.length()))
+    });
+    if let Some((e, speed)) = bad {
+        let t = physics.time;
+        physics.fail(Error::Diverged {
+            t,
+            reason: format!("body {e} left the physical range (speed {speed:.3e} m/s)"),
+        });
+    }
+}
+
+/// Copies the state of the step into [`HingeState`] and [`BodyState`].
+pub fn record(
+    physics: Res<Physics>,
+    mut hinges: Query<(Entity, &Hinge, &mut HingeState)>,
+    mut bodies: Query<(&Body, &mut BodyState)>,
+) {
+    if physics.error.is_some() {
+        return;
+    }
+    let w = &physics.world;
+    let dt = w.integration_parameters.dt;
+    for (body, mut state) in bodies.iter_mut() {
+        if let Some(rb) = body.handle.and_then(|h| w.bodies.get(h)) {
+            *state = BodyState {
+                translation: rb.translation(),
+                rotation: *rb.rotation(),
+                linvel: rb.linvel(),
+                angvel: rb.angvel(),
+            };
+        }
+    }
+    for (entity, frame, mut state) in hinges.iter_mut() {
+        let Some(r) = physics.hinges.get(&entity) else {
+            continue;
+        };
+        let (Some(rb1), Some(rb2)) = (w.bodies.get(r.bodies.0), w.bodies.get(r.bodies.1)) else {
+            continue;
+        };
+        let axis1 = unit_vector("axis", frame.local_axis1).unwrap_or(Vector::X);
+        let relative = rb1.rotation().inverse() * *rb2.rotation();
+        let reference = *state.reference.get_or_insert(relative);
+        state.angle = state
+            .unwrapped
+            .update(twist_angle(&(reference.inverse() * relative), axis1));
+        state.rate = (rb2.angvel() - rb1.angvel()).dot(*rb1.rotation() * axis1);
+        match r.joint {
+            HingeJoint::Ideal(j) => {
+                let i = w.impulse_joints.get(j).map_or([0.0; 6], |j| j.impulses);
+                state.force = Vector::new(i[0], i[1], i[2]).length() / dt;
+                state.penetration = 0.0;
+                state.eccentricity = Vector::ZERO;
+                state.contact = ContactMode::FreeFlight;
+            }
+            HingeJoint::Clearance(c) => {
+                if let Some(j) = physics.clearance.get(c) {
+                    let rep = j.report();
+                    state.force = rep.force.on_journal.length();
+                    state.penetration = rep.state.penetration;
+                    state.eccentricity = rep.state.eccentricity;
+                    state.contact = rep.mode;
+                    if rep.onset {
+                        state.impacts += 1;
+                    }
+                }
+            }
+        }
+        state.peak_force = state.peak_force.max(state.force);
+    }
+}
+
+/// Adds the physics systems to `schedule`, in [`PhysicsSet`] order.
+pub fn add_physics_systems(schedule: &mut Schedule) {
+    schedule.configure_sets(
+        (
+            PhysicsSet::Sync,
+            PhysicsSet::Drives,
+            PhysicsSet::ClearanceForces,
+            PhysicsSet::Step,
+            PhysicsSet::Record,
+        )
+            .chain(),
+    );
+    schedule.add_systems((
+        (sync_bodies, sync_hinges).chain().in_set(PhysicsSet::Sync),
+        apply_drives.in_set(PhysicsSet::Drives),
+        apply_clearance_forces.in_set(PhysicsSet::ClearanceForces),
+        step_physics.in_set(PhysicsSet::Step),
+        record.in_set(PhysicsSet::Record),
+    ));
+}
+
+/// A schedule with the physics systems: one run is one physics step.
+pub fn physics_schedule() -> Schedule {
+    let mut schedule = Schedule::default();
+    add_physics_systems(&mut schedule);
+    schedule
+}
+
+/// Runs `schedule` (one physics step) and returns the error it met, if any (taken out of
+/// [`Physics`]).
+pub fn run_step(world: &mut World, schedule: &mut Schedule) -> Result<()> {
+    if !world.contains_resource::<Physics>() {
+        return Err(Error::invalid(
+            "Physics",
+            "no such resource in the world: insert one with `world.insert_resource(Physics::new(dt, gravity))`",
+        ));
+    }
+    schedule.run(world);
+    world.clear_trackers();
+    match world.resource_mut::<Physics>().take_error() {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::laws::{Bai, FrictionModel};
+    use crate::scene::{Scene, StepMode};
+    use crate::sim::{RunOptions, Simulation, Twins};
+    use rapier3d_f64::prelude::{MassProperties, RigidBodyBuilder};
+
+    fn clearance() -> Clearance {
+        Clearance::steel(0.010, 0.2e-3, 0.016)
+            .unwrap()
+            .friction(FrictionModel::Bai(Bai::DRY))
+    }
+
+    /// A 2 kg arm hanging 0.3 m below a fixed base on an ideal hinge about z.
+    fn pendulum(dt: f64) -> (World, Schedule, Entity, Entity) {
+        let mut world = World::new();
+        world.insert_resource(Physics::new(dt, Vector::new(0.0, -9.81, 0.0)));
+        let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
+        let arm = world
+            .spawn(Body::new(
+                RigidBodyBuilder::dynamic()
+                    .translation(Vector::new(0.0, -0.3, 0.0))
+                    .additional_mass_properties(MassProperties::new(
+                        Vector::ZERO,
+                        2.0,
+                        Vector::splat(0.02),
+                    ))
+                    .can_sleep(false),
+            ))
+            .id();
+        let hinge = world
+            .spawn((
+                Hinge::new(base, arm, Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0)),
+                IdealHinge,
+            ))
+            .id();
+        (world, physics_schedule(), arm, hinge)
+    }
+
+    fn steps(world: &mut World, schedule: &mut Schedule, n: usize) -> Result<()> {
+        for _ in 0..n {
+            run_step(world, schedule)?;
+        }
+        Ok(())
+    }
+
+    #[test]
+    fn swapping_the_mode_converts_the_rapier_joint_both_ways() {
+        let (mut world, mut schedule, arm, hinge) = pendulum(1e-5);
+        steps(&mut world, &mut schedule, 10).unwrap();
+        let p = world.resource::<Physics>();
+        assert!(matches!(p.joint(hinge), Some(HingeJoint::Ideal(_))));
+        assert_eq!(p.world.impulse_joints.len(), 1);
+        assert_eq!(
+            world.get::<HingeState>(hinge).unwrap().mode,
+            HingeMode::Ideal
+        );
+
+        // Swap in place: the revolute becomes a clearance joint (plus its out-of-plane lock).
+        world
+            .entity_mut(hinge)
+            .remove::<IdealHinge>()
+            .insert(ClearanceHinge(clearance()));
+        steps(&mut world, &mut schedule, 20_000).unwrap();
+        let p = world.resource::<Physics>();
+        let j = p.clearance_joint(hinge).expect("converted");
+        assert_eq!(j.local_anchor2(), Vector::new(0.0, 0.3, 0.0));
+        assert_eq!(p.clearance().len(), 1);
+        assert_eq!(p.world.impulse_joints.len(), 1, "only the lock");
+        let s = world.get::<HingeState>(hinge).unwrap();
+        assert_eq!(s.mode, HingeMode::Clearance);
+        assert!(s.impacts > 0);
+        assert!((s.force - 19.62).abs() < 0.02, "{}", s.force);
+        assert!(s.penetration > 0.0);
+
+        // And back: ideal again, and the contact force taken off the arm.
+        world
+            .entity_mut(hinge)
+            .remove::<ClearanceHinge>()
+            .insert(IdealHinge);
+        steps(&mut world, &mut schedule, 1).unwrap();
+        let p = world.resource::<Physics>();
+        assert!(p.clearance().is_empty());
+        assert!(matches!(p.joint(hinge), Some(HingeJoint::Ideal(_))));
+        let rb = &p.world.bodies[p.body(arm).unwrap()];
+        assert_eq!(rb.user_force(), Vector::ZERO);
+        assert_eq!(rb.user_torque(), Vector::ZERO);
+
+        // Neither mode: no joint at all; the arm falls.
+        world.entity_mut(hinge).remove::<IdealHinge>();
+        steps(&mut world, &mut schedule, 100).unwrap();
+        let p = world.resource::<Physics>();
+        assert_eq!(p.joint(hinge), None);
+        assert_eq!(p.world.impulse_joints.len(), 0);
+        assert_eq!(
+            world.get::<HingeState>(hinge).unwrap().mode,
+            HingeMode::None
+        );
+        assert!(world.get::<BodyState>(arm).unwrap().linvel.y < -0.005);
+    }
+
+    #[test]
+    fn clearance_takes_precedence_and_handles_follow_removals() {
+        // Two pendulums; removing the first clearance joint renumbers the second's handle.
+        let (mut world, mut schedule, _, first) = pendulum(1e-5);
+        let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
+        let arm = world
+            .spawn(Body::new(
+                RigidBodyBuilder::dynamic()
+                    .translation(Vector::new(1.0, -0.3, 0.0))
+                    .additional_mass_properties(MassProperties::new(
+                        Vector::ZERO,
+                        2.0,
+                        Vector::splat(0.02),
+                    ))
+                    .can_sleep(false),
+            ))
+            .id();
+        let second = world
+            .spawn((
+                Hinge::new(base, arm, Vector::Z)
+                    .local_anchor1(Vector::new(1.0, 0.0, 0.0))
+                    .local_anchor2(Vector::new(0.0, 0.3, 0.0)),
+                ClearanceHinge(clearance().name("second")),
+            ))
+            .id();
+        // Both components: the clearance wins.
+        world
+            .entity_mut(first)
+            .insert(ClearanceHinge(clearance().name("first")));
+        steps(&mut world, &mut schedule, 2).unwrap();
+        assert_eq!(world.resource::<Physics>().clearance().len(), 2);
+        world.entity_mut(first).remove::<ClearanceHinge>();
+        steps(&mut world, &mut schedule, 2).unwrap();
+        let p = world.resource::<Physics>();
+        assert_eq!(p.clearance().len(), 1);
+        assert!(matches!(p.joint(first), Some(HingeJoint::Ideal(_))));
+        assert_eq!(p.clearance_joint(second).unwrap().name(), "second");
+    }
+
+    #[test]
+    fn despawning_a_hinge_with_its_body_removes_them_from_rapier() {
+        let (mut world, mut schedule, arm, hinge) = pendulum(1e-5);
+        world
+            .entity_mut(hinge)
+            .insert((ClearanceHinge(clearance()), Drive::torsion_spring(0.1, 0.0)));
+        steps(&mut world, &mut schedule, 10).unwrap();
+        world.despawn(hinge);
+        world.despawn(arm);
+        steps(&mut world, &mut schedule, 10).unwrap();
+        let p = world.resource::<Physics>();
+        assert_eq!(p.world.bodies.len(), 1, "the base is left");
+        assert_eq!(p.world.impulse_joints.len(), 0);
+        assert!(p.clearance().is_empty());
+        assert!(p.drive(hinge).is_none());
+    }
+
+    #[test]
+    fn removing_a_drive_takes_back_its_torque_exactly() {
+        let mut world = World::new();
+        world.insert_resource(Physics::new(1e-3, Vector::ZERO));
+        let body = |x: f64| {
+            Body::new(
+                RigidBodyBuilder::dynamic()
+                    .translation(Vector::new(x, 0.0, 0.0))
+                    .additional_mass_properties(MassProperties::new(
+                        Vector::ZERO,
+                        1.0,
+                        Vector::new(0.1, 0.2, 0.3),
+                    ))
+                    .can_sleep(false),
+            )
+        };
+        let (a, b) = (world.spawn(body(0.0)).id(), world.spawn(body(1.0)).id());
+        let axis = Vector::new(0.3, -1.0, 0.2);
+        let hinge = world
+            .spawn((
+                Hinge::new(a, b, axis).local_anchor1(Vector::new(0.5, 0.0, 0.0)),
+                Drive::per_degree(0.5, 0.01),
+            ))
+            .id();
+        let mut schedule = physics_schedule();
+        steps(&mut world, &mut schedule, 50).unwrap();
+        let p = world.resource::<Physics>();
+        assert!(
+            p.drive(hinge).unwrap().angle() > 0.0,
+            "the spring turned body b"
+        );
+        assert!(p.joint(hinge).is_none(), "no mode component: no joint");
+        world.entity_mut(hinge).remove::<Drive>();
+        steps(&mut world, &mut schedule, 1).unwrap();
+        let p = world.resource::<Physics>();
+        for e in [a, b] {
+            let rb = &p.world.bodies[p.body(e).unwrap()];
+            assert_eq!(rb.user_torque(), Vector::ZERO, "torque left on {e}");
+        }
+    }
+
+    #[test]
+    fn errors_are_values_and_stop_the_systems() {
+        // No resource.
+        let mut empty = World::new();
+        let e = run_step(&mut empty, &mut physics_schedule()).unwrap_err();
+        assert!(e.to_string().contains("Physics"), "{e}");
+
+        // A hinge to an entity without a body.
+        let (mut world, mut schedule, _, _) = pendulum(1e-5);
+        let ghost = world.spawn_empty().id();
+        let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
+        let bad = world
+            .spawn((Hinge::new(base, ghost, Vector::Z), IdealHinge))
+            .id();
+        let e = run_step(&mut world, &mut schedule).unwrap_err();
+        let msg = e.to_string();
+        assert!(
+            msg.contains(&format!("hinge {bad}.body2")) && msg.contains("has no Body"),
+            "{msg}"
+        );
+        world.despawn(bad);
+        run_step(&mut world, &mut schedule).unwrap();
+
+        // A step too large for the contact: refused when the journal hits the bearing, and the
+        // world does not move on until the error is taken.
+        let (mut world, mut schedule, _, hinge) = pendulum(1e-4);
+        world.entity_mut(hinge).insert(ClearanceHinge(clearance()));
+        let e = steps(&mut world, &mut schedule, 2_000).unwrap_err();
+        match &e {
+            Error::StepTooLarge { field, t, .. } => {
+                assert_eq!(field, "Physics::world.integration_parameters.dt");
+                assert!(t.is_finite() && *t > 0.0);
+            }
+            other => panic!("expected StepTooLarge, got {other}"),
+        }
+        let t = world.resource::<Physics>().time();
+        world
+            .resource_mut::<Physics>()
+            .fail(Error::invalid("x", "y"));
+        schedule.run(&mut world);
+        assert_eq!(
+            world.resource::<Physics>().time(),
+            t,
+            "halted while an error is set"
+        );
+
+        // An invalid frame is named, for ideal hinges too.
+        let (mut world, mut schedule, _, hinge) = pendulum(1e-5);
+        world.get_mut::<Hinge>(hinge).unwrap().local_axis2 = Vector::ZERO;
+        let msg = run_step(&mut world, &mut schedule).unwrap_err().to_string();
+        assert!(msg.contains(&format!("hinge {hinge}.local_axis2")), "{msg}");
+        world.get_mut::<Hinge>(hinge).unwrap().local_anchor1 = Vector::new(f64::NAN, 0.0, 0.0);
+        world.get_mut::<Hinge>(hinge).unwrap().local_axis2 = Vector::Z;
+        let msg = run_step(&mut world, &mut schedule).unwrap_err().to_string();
+        assert!(
+            msg.contains(&format!("hinge {hinge}.local_anchor1")),
+            "{msg}"
+        );
+
+        // An invalid clearance is named.
+        let (mut world, mut schedule, _, hinge) = pendulum(1e-5);
+        let mut c = clearance();
+        c.min_impact_speed = -1.0;
+        world.entity_mut(hinge).insert(ClearanceHinge(c));
+        let msg = run_step(&mut world, &mut schedule).unwrap_err().to_string();
+        assert!(
+            msg.contains(&format!("hinge {hinge}.min_impact_speed")),
+            "{msg}"
+        );
+    }
+
+    #[test]
+    fn the_papers_scene_through_the_ecs_is_the_runners() {
+        // Both twins of the paper's scene as entities, 1 s at the paper's fixed step: the ECS
+        // layer makes the same Rapier calls in the same order as the runner, to the last bit.
+        let mut scene = Scene::solar_panel();
+        scene.run.step = StepMode::Fixed;
+        scene.run.dt_s = 1e-4;
+        scene.run.end_s = 1.0;
+        let r = Simulation::new(
+            &scene,
+            RunOptions {
+                twins: Twins::Both,
+                skip_rows: false,
+            },
+        )
+        .unwrap()
+        .run()
+        .unwrap();
+
+        let mut world = World::new();
+        world.insert_resource(Physics::new(1e-4, Vector::ZERO));
+        let h = &scene.hinges[0];
+        let spec = h.clearance.as_ref().unwrap();
+        let d = &scene.drives[0];
+        let mut hinges = Vec::new();
+        for with_clearance in [false, true] {
+            let bodies: Vec<Entity> = scene
+                .bodies
+                .iter()
+                .map(|b| {
+                    world
+                        .spawn(Body::new(
+                            RigidBodyBuilder::dynamic()
+                                .translation(Vector::from(b.center_of_mass_m))
+                                .additional_mass_properties(MassProperties::new(
+                                    Vector::ZERO,
+                                    b.mass_kg,
+                                    Vector::from(b.inertia_kg_m2),
+                                ))
+                                .can_sleep(false),
+                        ))
+                        .id()
+                })
+                .collect();
+            let point = Vector::from(h.point_m);
+            let hinge = Hinge::new(bodies[0], bodies[1], Vector::from(h.axis))
+                .local_anchor1(point - Vector::from(scene.bodies[0].center_of_mass_m))
+                .local_anchor2(point - Vector::from(scene.bodies[1].center_of_mass_m));
+            let drive = Drive::per_degree(d.torque0_nm, d.stiffness_nm_per_deg);
+            let e = if with_clearance {
+                let c = Clearance::from_spec(spec).unwrap().name("hinge");
+                world.spawn((hinge, ClearanceHinge(c), drive))
+            } else {
+                world.spawn((hinge, IdealHinge, drive))
+            };
+            hinges.push(e.id());
+        }
+        let mut schedule = physics_schedule();
+        steps(&mut world, &mut schedule, 10_000).unwrap();
+        for (twin, e) in r.twins.iter().zip(hinges) {
+            let s = world.get::<HingeState>(e).unwrap();
+            let angle = twin.final_angles_deg()["hinge"];
+            assert_eq!(s.angle.to_degrees(), angle, "{:?}", twin.kind);
+            let m = &twin.hinge_metrics()["hinge"];
+            assert_eq!(s.impacts, m.impacts, "{:?}", twin.kind);
+            if s.mode == HingeMode::Clearance {
+                assert_eq!(s.peak_force, m.peak_force_n);
+            }
+        }
+    }
+}

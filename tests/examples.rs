@@ -1,0 +1,199 @@
+//! The examples (examples/*.rs) run as tests two ways: their `run` functions are compiled into
+//! this test and their numbers checked, and their binaries are run as a user would run them.
+
+use clearance_joint::scene::Scene;
+use clearance_joint::sim::{RunOptions, Simulation, TwinKind, Twins};
+use std::path::PathBuf;
+use std::process::Command;
+
+#[allow(dead_code)]
+#[path = "../examples/drop_in.rs"]
+mod drop_in;
+#[allow(dead_code)]
+#[path = "../examples/ecs.rs"]
+mod ecs;
+#[allow(dead_code)]
+#[path = "../examples/solar_panel.rs"]
+mod solar_panel;
+
+#[test]
+fn drop_in_converts_the_elbow_and_the_arm_rattles() {
+    let runs = drop_in::run().unwrap();
+    let (ideal, clear) = &runs;
+    assert_eq!(ideal.impacts, 0);
+    assert_eq!(ideal.max_penetration_um, 0.0);
+    assert!(clear.impacts > 10, "{} impacts", clear.impacts);
+    // The swing barely changes; the joint force becomes impulsive.
+    assert!(
+        (ideal.shoulder_deg - clear.shoulder_deg).abs() < 1.0,
+        "{} vs {}",
+        ideal.shoulder_deg,
+        clear.shoulder_deg
+    );
+    assert!(
+        ideal.shoulder_deg < -20.0,
+        "the arm swung through the vertical"
+    );
+    assert!(
+        clear.peak_elbow_force_n > 10.0 * ideal.peak_elbow_force_n,
+        "{} vs {}",
+        clear.peak_elbow_force_n,
+        ideal.peak_elbow_force_n
+    );
+    // The lower link (0.5 kg) swinging: its ideal elbow load is a few times its weight.
+    assert!(ideal.peak_elbow_force_n > 4.9 && ideal.peak_elbow_force_n < 20.0);
+    // The lower link's momentum balance sees exactly the contact force the joint reports.
+    assert!(
+        (clear.peak_elbow_force_n - clear.peak_contact_force_n).abs()
+            < 1e-6 * clear.peak_contact_force_n,
+        "{} vs {}",
+        clear.peak_elbow_force_n,
+        clear.peak_contact_force_n
+    );
+    assert_eq!(ideal.peak_contact_force_n, 0.0);
+    let text = drop_in::report(&runs);
+    for needle in [
+        "ideal",
+        "clearance",
+        "peak elbow force (N)",
+        "elbow impacts",
+    ] {
+        assert!(text.contains(needle), "{text}");
+    }
+}
+
+#[test]
+fn ecs_swap_is_the_plain_api_run() {
+    // The ECS layer is thin: the arm with a ClearanceHinge steps exactly like drop_in's arm
+    // converted with the plain API (same Rapier calls in the same order).
+    let runs = ecs::run().unwrap();
+    let plain = drop_in::clearance_run().unwrap();
+    let [ideal, clear, swapped] = &runs;
+    use clearance_joint::ecs::HingeMode;
+    assert_eq!(ideal.elbow.mode, HingeMode::Ideal);
+    assert_eq!(clear.elbow.mode, HingeMode::Clearance);
+    assert_eq!(swapped.elbow.mode, HingeMode::Clearance);
+    assert_eq!(ideal.shoulder.mode, HingeMode::Ideal);
+    assert_eq!(ideal.elbow.impacts, 0);
+    assert_eq!(clear.elbow.impacts, plain.impacts);
+    assert_eq!(clear.elbow.peak_force, plain.peak_contact_force_n);
+    assert!((clear.shoulder.angle.to_degrees() - plain.shoulder_deg).abs() < 1e-9);
+    assert!((clear.elbow.angle.to_degrees() - plain.elbow_deg).abs() < 1e-9);
+    // Swapped while running: ideal until half time, then rattling.
+    assert!(swapped.elbow.impacts > 0);
+    let text = ecs::report(&runs);
+    assert!(
+        text.contains("swapped@0.5s") && text.contains("Clearance"),
+        "{text}"
+    );
+}
+
+#[test]
+fn solar_panel_in_code_is_the_scene_file() {
+    let outcomes = solar_panel::run().unwrap();
+    let (ideal, clear) = &outcomes;
+    // The same scene through the runner, at the same fixed step.
+    let scene = Scene::solar_panel()
+        .with_overrides(&["run.step=Fixed", "run.dt_s=1e-4", "run.end_s=5"])
+        .unwrap();
+    let r = Simulation::new(
+        &scene,
+        RunOptions {
+            twins: Twins::Both,
+            skip_rows: false,
+        },
+    )
+    .unwrap()
+    .run()
+    .unwrap();
+    for (kind, o) in [(TwinKind::Ideal, ideal), (TwinKind::Clearance, clear)] {
+        let twin = r.twin(kind).unwrap();
+        let angles = twin.final_angles_deg();
+        let m = &twin.hinge_metrics()["hinge"];
+        let close = |a: f64, b: f64, what: &str| {
+            assert!(
+                (a - b).abs() <= 1e-9 * b.abs().max(1.0),
+                "{kind:?} {what}: {a} vs {b}"
+            )
+        };
+        close(o.deployment_deg, angles["hinge"], "deployment");
+        close(o.panel_deg, angles["panel"], "panel angle");
+        close(o.satellite_deg, angles["satellite"], "satellite angle");
+        close(o.peak_force_n, m.peak_force_n, "peak force");
+        assert_eq!(o.impacts, m.impacts, "{kind:?} impacts");
+    }
+    // The paper's conclusion 1: angles barely change, the joint force becomes impulsive.
+    assert!((ideal.deployment_deg - clear.deployment_deg).abs() < 0.5);
+    assert!(clear.peak_force_n > 100.0 * ideal.peak_force_n);
+    assert!(clear.impacts > 100);
+    assert!(clear.linear_momentum_drift < 1e-9 && clear.angular_momentum_drift < 1e-9);
+    let text = solar_panel::report(&outcomes);
+    assert!(text.contains("final deployment angle (deg)"), "{text}");
+}
+
+/// `target/<profile>/examples`, next to this test's `deps` folder.
+fn examples_dir() -> PathBuf {
+    let exe = std::env::current_exe().unwrap();
+    exe.parent().unwrap().parent().unwrap().join("examples")
+}
+
+#[test]
+fn example_binaries_run_headless_and_print_the_comparison() {
+    // `cargo test` builds the examples; build them here too (a no-op then) for `--test examples`.
+    let dir = examples_dir();
+    let profile = dir
+        .parent()
+        .and_then(|p| p.file_name())
+        .and_then(|p| p.to_str())
+        .unwrap()
+        .to_string();
+    let mut build = Command::new(env!("CARGO"));
+    build.current_dir(env!("CARGO_MANIFEST_DIR")).arg("build");
+    match profile.as_str() {
+        "debug" => {}
+        "release" => {
+            build.arg("--release");
+        }
+        other => {
+            build.args(["--profile", other]);
+        }
+    }
+    let out = build
+        .args([
+            "--example",
+            "drop_in",
+            "--example",
+            "ecs",
+            "--example",
+            "solar_panel",
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for (name, needles) in [
+        ("drop_in", &["ideal", "clearance", "elbow impacts"][..]),
+        ("ecs", &["ideal", "clearance", "swapped@0.5s"][..]),
+        (
+            "solar_panel",
+            &["ideal", "clearance", "final deployment angle"][..],
+        ),
+    ] {
+        let exe = dir.join(format!("{name}{}", std::env::consts::EXE_SUFFIX));
+        let out = Command::new(&exe)
+            .output()
+            .unwrap_or_else(|e| panic!("{}: {e}", exe.display()));
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            out.status.success(),
+            "{name}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        for n in needles {
+            assert!(stdout.contains(n), "{name}: no `{n}` in\n{stdout}");
+        }
+    }
+}

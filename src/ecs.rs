@@ -226,10 +226,10 @@ impl Physics {
     /// Renumbers the clearance handles after the set removed `removed` (later handles shift down).
     fn clearance_removed(&mut self, removed: ClearanceJointHandle) {
         for h in self.hinges.values_mut() {
-            if let HingeJoint::Clearance(c) = &mut h.joint {
-                if c.0 > removed.0 {
-                    c.0 -= 1;
-                }
+            if let HingeJoint::Clearance(c) = &mut h.joint
+                && c.0 > removed.0
+            {
+                c.0 -= 1;
             }
         }
     }
@@ -634,17 +634,19 @@ pub fn sync_bodies(mut physics: ResMut<Physics>, mut query: Query<(Entity, &mut 
             let h = physics.world.bodies.insert(*rb);
             physics.bodies.insert(entity, h);
             body.handle = Some(h);
-        } else if let Some(h) = body.handle {
-            if physics.bodies.get(&entity) != Some(&h) {
-                if !physics.world.bodies.contains(h) {
-                    physics.fail(Error::invalid(
-                        format!("body {entity}"),
-                        format!("no rigid body with handle {h:?} in the Rapier world"),
-                    ));
-                    return;
-                }
-                physics.bodies.insert(entity, h);
+        } else if let Some(h) = body.handle
+            && physics.bodies.get(&entity) != Some(&h)
+        {
+            if !physics.world.bodies.contains(h) {
+                physics.fail(Error::invalid(
+                    format!("body {entity}"),
+                    format!("no rigid body with handle {h:?} in the Rapier world"),
+                ));
+                return;
             }
+            // A new handle for this entity: its previous body goes, as on removal.
+            physics.remove_body(entity);
+            physics.bodies.insert(entity, h);
         }
     }
     let gone: Vec<Entity> = physics
@@ -1037,6 +1039,54 @@ mod tests {
         assert_eq!(p.clearance().len(), 1);
         assert!(matches!(p.joint(first), Some(HingeJoint::Ideal(_))));
         assert_eq!(p.clearance_joint(second).unwrap().name(), "second");
+    }
+
+    #[test]
+    fn bodies_of_an_existing_rapier_world_by_handle() {
+        let mut rapier = PhysicsWorld::new();
+        rapier.integration_parameters.num_solver_iterations = 1;
+        rapier.integration_parameters.dt = 1e-5;
+        let base = rapier.bodies.insert(RigidBodyBuilder::fixed());
+        let arm = rapier.bodies.insert(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(0.0, -0.3, 0.0))
+                .additional_mass_properties(MassProperties::new(
+                    Vector::ZERO,
+                    2.0,
+                    Vector::splat(0.02),
+                ))
+                .can_sleep(false),
+        );
+        let mut world = World::new();
+        world.insert_resource(Physics::from_world(rapier));
+        let (b, a) = (
+            world.spawn(Body::from_handle(base)).id(),
+            world.spawn(Body::from_handle(arm)).id(),
+        );
+        let hinge = world
+            .spawn((
+                Hinge::new(b, a, Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0)),
+                ClearanceHinge(clearance()),
+            ))
+            .id();
+        let mut schedule = physics_schedule();
+        steps(&mut world, &mut schedule, 20_000).unwrap();
+        let p = world.resource::<Physics>();
+        assert_eq!(p.body(a), Some(arm));
+        assert_eq!(p.world.bodies.len(), 2);
+        // PhysicsWorld::new() has Rapier's default gravity, -9.81 along y.
+        let s = world.get::<HingeState>(hinge).unwrap();
+        assert!((s.force - 19.62).abs() < 0.02, "{}", s.force);
+
+        // A handle that is not in the world is refused.
+        let mut other = PhysicsWorld::new();
+        for _ in 0..5 {
+            other.bodies.insert(RigidBodyBuilder::fixed());
+        }
+        let stale = other.bodies.insert(RigidBodyBuilder::fixed());
+        world.spawn(Body::from_handle(stale));
+        let msg = run_step(&mut world, &mut schedule).unwrap_err().to_string();
+        assert!(msg.contains("no rigid body with handle"), "{msg}");
     }
 
     #[test]

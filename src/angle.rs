@@ -36,6 +36,43 @@ impl UnwrappedAngle {
     }
 }
 
+/// The angle of a hinge: body 2's rotation relative to body 1 about the hinge axis (in body 1's
+/// frame), zero at the first measurement and continuous (unwrapped) after it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct HingeAngle {
+    /// Relative orientation `q1^-1 q2` at the first measurement.
+    reference: Option<Rotation>,
+    angle: UnwrappedAngle,
+}
+
+impl HingeAngle {
+    /// Measures the angle from the bodies' rotations `q1`, `q2`; `local_axis1` is the unit hinge
+    /// axis in body 1's frame. Returns the continuous angle (rad).
+    pub fn update(&mut self, q1: &Rotation, q2: &Rotation, local_axis1: Vector) -> f64 {
+        let relative = q1.inverse() * *q2;
+        let reference = *self.reference.get_or_insert(relative);
+        // A hinge turn is a rotation in body 1's frame applied after the reference:
+        // relative = turn * reference, so turn = relative * reference^-1.
+        self.angle
+            .update(twist_angle(&(relative * reference.inverse()), local_axis1))
+    }
+
+    /// Fixes the reference orientation now (otherwise the first [`update`](Self::update) does).
+    pub fn set_reference(&mut self, q1: &Rotation, q2: &Rotation) {
+        self.reference = Some(q1.inverse() * *q2);
+    }
+
+    /// Whether the reference orientation is set.
+    pub fn has_reference(&self) -> bool {
+        self.reference.is_some()
+    }
+
+    /// The last continuous angle (rad).
+    pub fn value(&self) -> f64 {
+        self.angle.value()
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -46,6 +83,20 @@ mod tests {
         let q = Rotation::from_axis_angle(axis, 0.7);
         assert!((twist_angle(&q, axis) - 0.7).abs() < 1e-14);
         assert!((twist_angle(&q, -axis) + 0.7).abs() < 1e-14);
+    }
+
+    #[test]
+    fn hinge_angle_with_a_rotated_body() {
+        // Body 2 starts turned 90 deg about x; the hinge (body 1's z) then turns it by 0.5 rad.
+        let q1 = Rotation::IDENTITY;
+        let q2_0 = Rotation::from_axis_angle(Vector::X, std::f64::consts::FRAC_PI_2);
+        let mut h = HingeAngle::default();
+        assert_eq!(h.update(&q1, &q2_0, Vector::Z), 0.0);
+        let q2 = Rotation::from_axis_angle(Vector::Z, 0.5) * q2_0;
+        assert!((h.update(&q1, &q2, Vector::Z) - 0.5).abs() < 1e-12);
+        // Both bodies turned together by any rotation: no hinge angle.
+        let common = Rotation::from_axis_angle(Vector::new(0.3, -0.2, 0.9).normalize(), 1.1);
+        assert!((h.update(&(common * q1), &(common * q2), Vector::Z) - 0.5).abs() < 1e-12);
     }
 
     #[test]

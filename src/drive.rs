@@ -1,9 +1,9 @@
 //! Torsion-spring drive between two bodies (MODEL.md §4, eq. 20): `T = T0 - k theta`.
 
-use crate::angle::{UnwrappedAngle, twist_angle};
+use crate::angle::HingeAngle;
 use crate::error::{Result, finite, non_negative, unit_vector};
 use crate::ledger::{ForceLedger, Wrench};
-use rapier3d_f64::math::{Rotation, Vector};
+use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
 
 /// A torsion spring about a hinge axis: torque `+T a` on body 2, `-T a` on body 1 (a pure couple,
@@ -16,8 +16,7 @@ pub struct TorsionSpring {
     local_axis1: Vector,
     torque0: f64,
     stiffness: f64,
-    reference: Option<Rotation>,
-    angle: UnwrappedAngle,
+    angle: HingeAngle,
     last_torque: f64,
 }
 
@@ -38,8 +37,7 @@ impl TorsionSpring {
             local_axis1: unit_vector("axis", local_axis1)?,
             torque0,
             stiffness,
-            reference: None,
-            angle: UnwrappedAngle::default(),
+            angle: HingeAngle::default(),
             last_torque: 0.0,
         })
     }
@@ -68,12 +66,9 @@ impl TorsionSpring {
     /// Measures the relative angle and returns the couple to apply.
     fn evaluate(&mut self, bodies: &RigidBodySet) -> Option<(Wrench, Wrench)> {
         let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
-        let relative = rb1.rotation().inverse() * *rb2.rotation();
-        let reference = *self.reference.get_or_insert(relative);
-        let theta = self.angle.update(twist_angle(
-            &(reference.inverse() * relative),
-            self.local_axis1,
-        ));
+        let theta = self
+            .angle
+            .update(rb1.rotation(), rb2.rotation(), self.local_axis1);
         let torque = self.torque_at(theta);
         self.last_torque = torque;
         let t = torque * (*rb1.rotation() * self.local_axis1);

@@ -54,7 +54,7 @@
 //! # Ok::<(), clearance_joint::Error>(())
 //! ```
 
-use crate::angle::{UnwrappedAngle, twist_angle};
+use crate::angle::HingeAngle;
 use crate::convert::{Clearance, ConvertRevolute};
 use crate::drive::{DriveSet, TorsionSpring};
 use crate::error::{Error, Result, unit_vector};
@@ -600,8 +600,7 @@ pub struct HingeState {
     pub eccentricity: Vector,
     /// Motion mode (clearance).
     pub contact: ContactMode,
-    reference: Option<Rotation>,
-    unwrapped: UnwrappedAngle,
+    angle_tracker: HingeAngle,
 }
 
 /// The stages of a physics step, in this order.
@@ -718,10 +717,12 @@ pub fn sync_hinges(
             Some(HingeJoint::Ideal(_)) => HingeMode::Ideal,
             Some(HingeJoint::Clearance(_)) => HingeMode::Clearance,
         };
-        if state.reference.is_none() {
+        if !state.angle_tracker.has_reference() {
             let w = &physics.world.bodies;
             if let (Some(r1), Some(r2)) = (w.get(bodies.0), w.get(bodies.1)) {
-                state.reference = Some(r1.rotation().inverse() * *r2.rotation());
+                state
+                    .angle_tracker
+                    .set_reference(r1.rotation(), r2.rotation());
             }
         }
     }
@@ -824,11 +825,9 @@ pub fn record(
             continue;
         };
         let axis1 = unit_vector("axis", frame.local_axis1).unwrap_or(Vector::X);
-        let relative = rb1.rotation().inverse() * *rb2.rotation();
-        let reference = *state.reference.get_or_insert(relative);
         state.angle = state
-            .unwrapped
-            .update(twist_angle(&(reference.inverse() * relative), axis1));
+            .angle_tracker
+            .update(rb1.rotation(), rb2.rotation(), axis1);
         state.rate = (rb2.angvel() - rb1.angvel()).dot(*rb1.rotation() * axis1);
         match r.joint {
             HingeJoint::Ideal(j) => {

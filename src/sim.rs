@@ -2,13 +2,13 @@
 //! revolute joint) and a clearance twin (hinges with clearance become [`ClearanceJoint`]s), steps
 //! both together, and records both.
 
-use crate::angle::{UnwrappedAngle, twist_angle};
+use crate::angle::{HingeAngle, UnwrappedAngle, twist_angle};
 use crate::drive::{DriveSet, TorsionSpring};
 use crate::error::{Error, Result};
 use crate::joint::{ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet};
 use crate::output::Table;
 use crate::scene::{Scene, StepMode};
-use rapier3d_f64::math::{Rotation, Vector};
+use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -61,14 +61,13 @@ struct BodyTrack {
     handle: RigidBodyHandle,
     mass: f64,
     fixed: bool,
-    initial_rotation: Rotation,
     angle: UnwrappedAngle,
     linvel_before: Vector,
 }
 
 #[derive(Clone, Copy, Debug)]
 enum HingeJoint {
-    Ideal(#[allow(dead_code)] ImpulseJointHandle),
+    Ideal,
     Clearance(ClearanceJointHandle),
 }
 
@@ -81,8 +80,7 @@ struct HingeTrack {
     local_axis1: Vector,
     local_u1: Vector,
     local_v1: Vector,
-    reference: Rotation,
-    angle: UnwrappedAngle,
+    angle: HingeAngle,
     /// Force magnitude acting over the current step, N.
     force: f64,
     metrics: HingeMetrics,
@@ -585,7 +583,6 @@ impl Twin {
                 handle,
                 mass: b.mass_kg,
                 fixed: b.fixed,
-                initial_rotation: Rotation::IDENTITY,
                 angle: UnwrappedAngle::default(),
                 linvel_before: Vector::ZERO,
             });
@@ -623,7 +620,10 @@ impl Twin {
                         .local_anchor1(a1)
                         .local_anchor2(a2)
                         .contacts_enabled(false);
-                    HingeJoint::Ideal(world.impulse_joints.insert(b1, b2, j, true))
+                    {
+                        world.impulse_joints.insert(b1, b2, j, true);
+                        HingeJoint::Ideal
+                    }
                 }
             };
             let u = in_plane_u(axis);
@@ -635,8 +635,7 @@ impl Twin {
                 local_axis1: axis,
                 local_u1: u,
                 local_v1: axis.cross(u),
-                reference: Rotation::IDENTITY,
-                angle: UnwrappedAngle::default(),
+                angle: HingeAngle::default(),
                 force: 0.0,
                 metrics: HingeMetrics::default(),
             });
@@ -821,7 +820,8 @@ impl Twin {
         v.push(t);
         for b in &mut self.bodies {
             let rb = &bodies[b.handle];
-            let q = *rb.rotation() * b.initial_rotation.inverse();
+            // Bodies start unrotated: the body's rotation is its rotation since t = 0.
+            let q = *rb.rotation();
             v.push(b.angle.update(twist_angle(&q, axis_ref)).to_degrees());
             v.push(rb.angvel().dot(axis_ref).to_degrees());
         }
@@ -830,8 +830,7 @@ impl Twin {
                 &bodies[self.bodies[h.bearing].handle],
                 &bodies[self.bodies[h.journal].handle],
             );
-            let rel = h.reference.inverse() * (r1.rotation().inverse() * *r2.rotation());
-            let angle = h.angle.update(twist_angle(&rel, h.local_axis1));
+            let angle = h.angle.update(r1.rotation(), r2.rotation(), h.local_axis1);
             let axis = *r1.rotation() * h.local_axis1;
             v.push(angle.to_degrees());
             v.push((r2.angvel() - r1.angvel()).dot(axis).to_degrees());
@@ -845,7 +844,7 @@ impl Twin {
                     v.push(r.state.penetration.max(0.0) * 1e6);
                     v.push(if r.state.penetration > 0.0 { 1.0 } else { 0.0 });
                 }
-                HingeJoint::Ideal(_) => v.extend_from_slice(&[0.0, 0.0, 0.0, 0.0]),
+                HingeJoint::Ideal => v.extend_from_slice(&[0.0, 0.0, 0.0, 0.0]),
             }
         }
     }
@@ -901,7 +900,7 @@ fn reaction_order(hinges: &[HingeTrack], fixed: &[bool]) -> Vec<(usize, usize, f
     let mut unsolved: Vec<usize> = hinges
         .iter()
         .enumerate()
-        .filter(|(_, h)| matches!(h.joint, HingeJoint::Ideal(_)))
+        .filter(|(_, h)| matches!(h.joint, HingeJoint::Ideal))
         .map(|(i, _)| i)
         .collect();
     let mut order = Vec::new();

@@ -51,7 +51,7 @@ fn free_floating_momentum_is_conserved() {
 #[test]
 fn energy_is_conserved_without_damping_and_friction() {
     let r = run(
-        &["hinge.eta_s=0", "hinge.friction=None"],
+        &["hinge.eta_s=0", "hinge.friction=None", "run.step=Fixed"],
         Twins::ClearanceOnly,
     );
     let s = clearance_summary(&r);
@@ -85,6 +85,7 @@ fn clearance_twin_approaches_ideal_as_clearance_shrinks() {
             &[
                 &clearance,
                 "hinge.friction=None",
+                "run.step=Fixed",
                 "run.dt_s=5e-5",
                 "run.output_interval_s=1e-3",
             ],
@@ -153,6 +154,7 @@ fn first_impact_peak_converges_at_first_order() {
         .iter()
         .map(|dt| {
             let set = [
+                "run.step=Fixed".into(),
                 format!("run.dt_s={dt:e}"),
                 "run.end_s=0.1".into(),
                 "run.output_interval_s=1e-3".into(),

@@ -149,8 +149,13 @@ fn example_binaries_run_headless_and_print_the_comparison() {
         .to_string();
     let mut build = Command::new(env!("CARGO"));
     build.current_dir(env!("CARGO_MANIFEST_DIR")).arg("build");
+    // `cargo test` builds examples with the `test` profile into `target/debug`, and with
+    // `--release` with the `release` profile into `target/release`: the same profile here makes
+    // this build a no-op after `cargo test`.
     match profile.as_str() {
-        "debug" => {}
+        "debug" => {
+            build.args(["--profile", "test"]);
+        }
         "release" => {
             build.arg("--release");
         }

@@ -66,6 +66,8 @@ pub struct Clearance {
     pub friction: FrictionModel,
     /// Floor on the impact velocity of the hysteresis laws, m/s (default 1e-4).
     pub min_impact_speed: f64,
+    /// Gap a free flight must open for the next contact to count as an impact, m (default 0.1 um).
+    pub min_separation: f64,
     /// What holds the out-of-plane degrees of freedom (default [`OutOfPlaneLock::Joint`]).
     pub lock: OutOfPlaneLock,
     /// Name used in errors and reports (default: the builder's default name).
@@ -79,7 +81,8 @@ impl Clearance {
             geometry,
             normal,
             friction: FrictionModel::None,
-            min_impact_speed: 1e-4,
+            min_impact_speed: crate::joint::DEFAULT_MIN_IMPACT_SPEED,
+            min_separation: crate::joint::DEFAULT_MIN_SEPARATION,
             lock: OutOfPlaneLock::Joint,
             name: None,
         }
@@ -168,6 +171,7 @@ impl Clearance {
             .local_anchor2(local_anchor2)
             .friction(self.friction)
             .min_impact_speed(self.min_impact_speed)
+            .min_separation(self.min_separation)
             .lock(self.lock);
         if let Some(name) = &self.name {
             b = b.name(name.clone());
@@ -180,6 +184,7 @@ impl From<ClearanceParams> for Clearance {
     fn from(p: ClearanceParams) -> Self {
         Clearance {
             min_impact_speed: p.min_impact_speed,
+            min_separation: p.min_separation,
             ..Clearance::new(p.geometry, p.normal).friction(p.friction)
         }
     }

@@ -96,13 +96,19 @@ pub struct ClearanceSpec {
     /// Floor on the impact velocity of the hysteresis laws, mm/s.
     #[serde(default = "default_min_impact_speed")]
     pub min_impact_speed_mm_s: f64,
+    /// Gap a free flight must open for the next contact to count as an impact, um (default 0.1).
+    #[serde(default = "default_min_separation")]
+    pub min_separation_um: f64,
     /// What holds the out-of-plane degrees of freedom.
     #[serde(default)]
     pub lock: OutOfPlaneLock,
 }
 
 fn default_min_impact_speed() -> f64 {
-    0.1
+    crate::joint::DEFAULT_MIN_IMPACT_SPEED * 1e3
+}
+fn default_min_separation() -> f64 {
+    crate::joint::DEFAULT_MIN_SEPARATION * 1e6
 }
 
 /// Normal contact law by name (MODEL.md §2). Stiffness `None` means the Lankarani-Nikravesh
@@ -570,6 +576,8 @@ pub struct ClearanceParams {
     pub friction: FrictionModel,
     /// Floor on the impact speed, m/s.
     pub min_impact_speed: f64,
+    /// Gap that separates two impacts, m.
+    pub min_separation: f64,
 }
 
 impl ClearanceSpec {
@@ -694,11 +702,13 @@ impl ClearanceSpec {
         })()
         .map_err_within("friction")?;
         let min_impact_speed = positive("min_impact_speed_mm_s", self.min_impact_speed_mm_s)? * mm;
+        let min_separation = non_negative("min_separation_um", self.min_separation_um)? * 1e-6;
         Ok(ClearanceParams {
             geometry,
             normal,
             friction,
             min_impact_speed,
+            min_separation,
         })
     }
 }

@@ -91,8 +91,12 @@ struct HingeTrack {
 pub struct HingeMetrics {
     /// Largest joint force, N.
     pub peak_force_n: f64,
-    /// Number of contact onsets.
+    /// Number of contact onsets (issue 2's definition of impacts), chatter of a journal
+    /// following the wall included.
     pub impacts: u64,
+    /// Contact onsets after a free flight that opened at least the joint's `min_separation`
+    /// (0.1 um by default; the first contact always counts): impacts without the chatter.
+    pub separated_impacts: u64,
     /// Time of the first contact onset, s.
     pub first_impact_t_s: Option<f64>,
     /// Largest force during the first contact, N.
@@ -610,6 +614,7 @@ impl Twin {
                         .local_anchor2(a2)
                         .friction(p.friction)
                         .min_impact_speed(p.min_impact_speed)
+                        .min_separation(p.min_separation)
                         .lock(spec.lock)
                         .name(h.name.clone())
                         .build()?;
@@ -749,6 +754,9 @@ impl Twin {
             if let HingeJoint::Clearance(c) = h.joint {
                 let r = self.clearance.get(c).expect("handle of this twin").report();
                 let in_contact = r.state.penetration > 0.0;
+                if r.impact {
+                    m.separated_impacts += 1;
+                }
                 if r.onset {
                     m.impacts += 1;
                     if m.first_impact_t_s.is_none() {

@@ -58,6 +58,10 @@ pub struct HingeRunMetrics {
     pub clearance_mm: f64,
     /// Contact onsets (every step).
     pub impacts: u64,
+    /// Contact onsets after a free flight that opened at least the joint's minimum separation
+    /// (0.1 um by default): impacts without the chatter of a journal following the wall.
+    #[serde(default)]
+    pub separated_impacts: u64,
     /// Peak joint force, clearance twin (every step), N.
     pub peak_force_n: f64,
     /// Peak joint force, ideal twin (every step), N.
@@ -179,6 +183,7 @@ impl RunMetrics {
                 HingeRunMetrics {
                     clearance_mm: h.clearance.as_ref().map_or(0.0, |s| s.clearance_mm),
                     impacts: hc.impacts,
+                    separated_impacts: hc.separated_impacts,
                     peak_force_n: hc.peak_force_n,
                     peak_force_ideal_n: hi.peak_force_n,
                     rms_force_n: hc.rms_force_n,
@@ -231,6 +236,7 @@ impl RunMetrics {
             for (k, v) in [
                 ("clearance_mm", Some(h.clearance_mm)),
                 ("impacts", Some(h.impacts as f64)),
+                ("separated_impacts", Some(h.separated_impacts as f64)),
                 ("peak_force_n", Some(h.peak_force_n)),
                 ("peak_force_ideal_n", Some(h.peak_force_ideal_n)),
                 ("rms_force_n", Some(h.rms_force_n)),

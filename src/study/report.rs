@@ -668,8 +668,7 @@ pub fn conclusions(
                 "smaller joint forces",
                 smaller_force,
                 format!(
-                    "Peak {} N vs {} N ({}, {} %); RMS {} N vs {} N ({}, {} %). The peak is the first impact, at {} s in both, \
-                     before any sliding has built up.",
+                    "Peak {} N vs {} N ({}, {} %); RMS {} N vs {} N ({}, {} %).{}",
                     num(hd.peak_force_n),
                     num(hl.peak_force_n),
                     compare(hd.peak_force_n, hl.peak_force_n),
@@ -678,18 +677,30 @@ pub fn conclusions(
                     num(hl.rms_force_n),
                     compare(hd.rms_force_n, hl.rms_force_n),
                     pct(hd.rms_force_n, hl.rms_force_n),
-                    hd.first_impact_t_s.map_or("-".into(), num),
+                    if hd.first_impact_peak_n == Some(hd.peak_force_n)
+                        && hl.first_impact_peak_n == Some(hl.peak_force_n)
+                    {
+                        format!(
+                            " In both the peak is the first impact (at {} s), before any sliding has built up.",
+                            hd.first_impact_t_s.map_or("-".into(), num)
+                        )
+                    } else {
+                        String::new()
+                    },
                 ),
             ),
             part(
                 "fewer impacts",
                 fewer,
                 format!(
-                    "{} vs {}; time in contact {} % vs {} %.",
+                    "{} vs {} contact onsets; time in contact {} % vs {} %. Without the chatter of a journal \
+                     following the wall (onsets after a free flight of at least 0.1 um): {} vs {}.",
                     hd.impacts,
                     hl.impacts,
                     num(100.0 * hd.contact_fraction),
-                    num(100.0 * hl.contact_fraction)
+                    num(100.0 * hl.contact_fraction),
+                    hd.separated_impacts,
+                    hl.separated_impacts
                 ),
             ),
             part(

@@ -25,9 +25,10 @@ pub enum Error {
     /// The time step is too large for the stiffness (and damping) of a contact: the explicit
     /// integration would blow up. Raised before the state is destroyed, never silently.
     #[error(
-        "`{field}` = {dt:e} s is too large for the contact stiffness of hinge `{hinge}` at t = {t:.6} s \
+        "`{field}` = {dt:e} s is too large for the contact stiffness of hinge `{hinge}`{at} \
          (penetration {penetration_um:.3} um, natural frequency {omega:.4e} rad/s, damping ratio {zeta:.3}): \
-         the explicit step is stable only below {dt_max:e} s; use a smaller step or adaptive stepping"
+         the explicit step is stable only below {dt_max:e} s; use a smaller step or adaptive stepping",
+        at = t.map_or(String::new(), |t| format!(" at t = {t:.6} s"))
     )]
     StepTooLarge {
         /// The parameter that sets the step (`run.dt_s`).
@@ -38,8 +39,8 @@ pub enum Error {
         dt: f64,
         /// The largest stable step for this contact.
         dt_max: f64,
-        /// Simulated time when detected.
-        t: f64,
+        /// Simulated time when detected, when the caller knows it.
+        t: Option<f64>,
         /// Penetration at detection, micrometres.
         penetration_um: f64,
         /// Linearised natural frequency of the contact.

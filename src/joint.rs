@@ -70,6 +70,7 @@ impl ClearanceJointBuilder {
                 contact: ContactHistory::default(),
                 report: ClearanceReport::default(),
                 previous_rate: None,
+                last_wrenches: None,
                 prepared: false,
             },
         }
@@ -204,6 +205,8 @@ pub struct ClearanceJoint {
     contact: ContactHistory,
     report: ClearanceReport,
     previous_rate: Option<f64>,
+    /// The wrenches on body 1 and body 2 at the last application.
+    last_wrenches: Option<[Wrench; 2]>,
     prepared: bool,
 }
 
@@ -530,9 +533,11 @@ impl ClearanceJointSet {
         if let Some(lock) = joint.lock_handle.take() {
             impulse_joints.remove(lock, true);
         }
-        // Re-apply the rest so the removed joint's last forces are taken back.
+        // Take back the removed joint's last forces only: the others' stay as last applied.
         self.wrenches.clear();
-        self.ledger.replace(bodies, std::iter::empty());
+        self.wrenches
+            .extend(self.joints.iter().filter_map(|j| j.last_wrenches).flatten());
+        self.ledger.replace(bodies, self.wrenches.iter().copied());
         Some(joint)
     }
 
@@ -589,10 +594,9 @@ impl ClearanceJointSet {
                 ensure_mass_properties(bodies, None, joint.body2);
                 joint.prepared = true;
             }
-            if let Some((w1, w2)) = joint.evaluate(bodies) {
-                self.wrenches.push(w1);
-                self.wrenches.push(w2);
-            }
+            joint.last_wrenches = joint.evaluate(bodies).map(|(w1, w2)| [w1, w2]);
+            self.wrenches
+                .extend(joint.last_wrenches.into_iter().flatten());
         }
         self.ledger.replace(bodies, self.wrenches.iter().copied());
     }
@@ -622,7 +626,7 @@ impl ClearanceJointSet {
                     hinge: j.name.clone(),
                     dt,
                     dt_max: r.max_stable_dt,
-                    t: f64::NAN,
+                    t: None,
                     penetration_um: r.state.penetration * 1e6,
                     omega: r.omega,
                     zeta: r.zeta,

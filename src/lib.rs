@@ -20,6 +20,7 @@ pub use error::{Error, Result};
 
 /// The types most users need.
 pub mod prelude {
+    pub use crate::convert::{Clearance, ConvertRevolute};
     pub use crate::joint::{
         ClearanceJoint, ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet,
         OutOfPlaneLock,

@@ -6,28 +6,51 @@ use std::path::Path;
 
 /// Writes `bytes` to `path` atomically (temporary file + rename), creating the folder.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let io = |action, source| Error::Io {
+    write_all_atomic(&[(path, bytes)])
+}
+
+/// Writes several files as a set: every file goes to a temporary name in its folder first, and
+/// only when all are written are they renamed into place. A failure before the renames leaves
+/// the previous files untouched and no temporary behind.
+pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<()> {
+    let io = |action, path: &Path, source| Error::Io {
         action,
         path: path.to_path_buf(),
         source,
     };
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::create_dir_all(dir).map_err(|e| io("cannot create the folder of", e))?;
+    let temp = |path: &Path| {
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        path.with_file_name(format!(".{name}.tmp-{}", std::process::id()))
+    };
+    let mut staged = Vec::with_capacity(files.len());
+    for (path, bytes) in files {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|e| io("cannot create the folder of", path, e))?;
+        }
+        let tmp = temp(path);
+        let written = (|| {
+            let mut f = std::fs::File::create(&tmp)?;
+            f.write_all(bytes)?;
+            f.sync_all()
+        })();
+        staged.push(tmp);
+        if let Err(e) = written {
+            for t in &staged {
+                let _ = std::fs::remove_file(t);
+            }
+            return Err(io("cannot write", path, e));
+        }
     }
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        std::fs::rename(&tmp, path)
-    })();
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(io("cannot write", e));
+    for ((path, _), tmp) in files.iter().zip(&staged) {
+        if let Err(e) = std::fs::rename(tmp, path) {
+            for t in &staged {
+                let _ = std::fs::remove_file(t);
+            }
+            return Err(io("cannot write", path, e));
+        }
     }
     Ok(())
 }

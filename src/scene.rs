@@ -418,10 +418,10 @@ impl Scene {
 
     /// Checks every field; the error names the first invalid one.
     pub fn validate(&self) -> Result<()> {
-        if self.name.is_empty() || self.name.contains(['/', '\\']) {
+        if !is_plain_name(&self.name) {
             return Err(Error::invalid(
                 "name",
-                "must be a non-empty name without path separators",
+                "must be a plain name: letters, digits, `_` and `-` (it names the output folder)",
             ));
         }
         for (i, g) in self.gravity.iter().enumerate() {
@@ -434,6 +434,12 @@ impl Scene {
         let mut names = std::collections::HashSet::new();
         for b in &self.bodies {
             let p = format!("bodies[{}]", b.name);
+            if !is_plain_name(&b.name) {
+                return Err(Error::invalid(
+                    p,
+                    "name must be letters, digits, `_` and `-` (it prefixes CSV columns)",
+                ));
+            }
             if !names.insert(b.name.as_str()) {
                 return Err(Error::invalid(p, "duplicate name"));
             }
@@ -454,6 +460,12 @@ impl Scene {
         }
         for h in &self.hinges {
             let p = format!("hinges[{}]", h.name);
+            if !is_plain_name(&h.name) {
+                return Err(Error::invalid(
+                    p,
+                    "name must be letters, digits, `_` and `-` (it prefixes CSV columns)",
+                ));
+            }
             if !names.insert(h.name.as_str()) {
                 return Err(Error::invalid(
                     p,
@@ -480,11 +492,24 @@ impl Scene {
             unit(&h.axis, &format!("{p}.axis"))?;
             if let Some(c) = &h.clearance {
                 c.build().map_err(|e| e.within(&format!("{p}.clearance")))?;
+                if c.lock == OutOfPlaneLock::None {
+                    return Err(Error::invalid(
+                        format!("{p}.clearance.lock"),
+                        "`None` leaves the axial translation and the tilts free, and a scene has no locked axes to \
+                         hold them: use `Joint` (plain-API users may lock the bodies' axes themselves)",
+                    ));
+                }
             }
         }
         self.validate_planar()?;
         for d in &self.drives {
             let p = format!("drives[{}]", d.name);
+            if !is_plain_name(&d.name) {
+                return Err(Error::invalid(
+                    p,
+                    "name must be letters, digits, `_` and `-` (it prefixes CSV columns)",
+                ));
+            }
             if !names.insert(d.name.as_str()) {
                 return Err(Error::invalid(p, "duplicate name"));
             }
@@ -503,6 +528,16 @@ impl Scene {
         positive("run.end_s", r.end_s)?;
         positive("run.output_interval_s", r.output_interval_s)?;
         crate::error::in_range_open_closed("run.tolerance", r.tolerance, 0.0, 1.0)?;
+        if r.end_s / r.output_interval_s > MAX_ROWS {
+            return Err(Error::invalid(
+                "run.output_interval_s",
+                format!(
+                    "{} rows to reach run.end_s = {}: more than {MAX_ROWS:e} (memory); use a larger interval",
+                    r.end_s / r.output_interval_s,
+                    r.end_s
+                ),
+            ));
+        }
         if r.end_s / r.dt_s > 1e9 {
             return Err(Error::invalid(
                 "run.dt_s",
@@ -549,6 +584,17 @@ impl Scene {
         }
         Ok(())
     }
+}
+
+/// Most output rows a run may keep (each row is a few hundred bytes for a small scene).
+const MAX_ROWS: f64 = 1e7;
+
+/// Letters, digits, `_` and `-`: safe in CSV headers and file names.
+fn is_plain_name(name: &str) -> bool {
+    !name.is_empty()
+        && name
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
 }
 
 fn unit(v: &[f64; 3], field: &str) -> Result<()> {
@@ -609,13 +655,26 @@ impl ClearanceSpec {
             &self.bearing_material,
             &self.journal_material,
         );
-        let k = |s: &Option<f64>| s.unwrap_or(geometric);
+        // The geometric stiffness is Lankarani-Nikravesh's, in N/m^1.5: a default only for n = 1.5.
+        let k_n = |s: &Option<f64>, n: f64| -> Result<f64> {
+            match s {
+                Some(k) => Ok(*k),
+                None if n == LankaraniNikravesh::EXPONENT => Ok(geometric),
+                None => Err(Error::invalid(
+                    "stiffness",
+                    format!(
+                        "must be given for exponent {n}: the default (the Lankarani-Nikravesh geometric stiffness) \
+                         is in N/m^1.5 and holds only for exponent 1.5"
+                    ),
+                )),
+            }
+        };
         let normal = (|| -> Result<NormalModel> {
             Ok(match &self.contact {
                 ContactSpec::Hertz {
                     stiffness,
                     exponent,
-                } => NormalModel::Hertz(Hertz::new(k(stiffness), *exponent)?),
+                } => NormalModel::Hertz(Hertz::new(k_n(stiffness, *exponent)?, *exponent)?),
                 ContactSpec::KelvinVoigt { stiffness, damping } => {
                     NormalModel::KelvinVoigt(KelvinVoigt::new(*stiffness, *damping)?)
                 }
@@ -624,7 +683,7 @@ impl ClearanceSpec {
                     exponent,
                     restitution,
                 } => NormalModel::HuntCrossley(HuntCrossley::new(
-                    k(stiffness),
+                    k_n(stiffness, *exponent)?,
                     *exponent,
                     *restitution,
                 )?),
@@ -632,7 +691,7 @@ impl ClearanceSpec {
                     stiffness,
                     restitution,
                 } => NormalModel::LankaraniNikravesh(LankaraniNikravesh::new(
-                    k(stiffness),
+                    k_n(stiffness, LankaraniNikravesh::EXPONENT)?,
                     LankaraniNikravesh::EXPONENT,
                     *restitution,
                 )?),
@@ -640,15 +699,17 @@ impl ClearanceSpec {
                     stiffness,
                     exponent,
                     restitution,
-                } => {
-                    NormalModel::FloresEtAl(FloresEtAl::new(k(stiffness), *exponent, *restitution)?)
-                }
+                } => NormalModel::FloresEtAl(FloresEtAl::new(
+                    k_n(stiffness, *exponent)?,
+                    *exponent,
+                    *restitution,
+                )?),
                 ContactSpec::GonthierEtAl {
                     stiffness,
                     exponent,
                     restitution,
                 } => NormalModel::GonthierEtAl(GonthierEtAl::new(
-                    k(stiffness),
+                    k_n(stiffness, *exponent)?,
                     *exponent,
                     *restitution,
                 )?),

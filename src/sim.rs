@@ -459,7 +459,7 @@ impl Simulation {
                 // Name the scene's field and the time: the set knows neither.
                 if let Error::StepTooLarge { field, t: at, .. } = &mut e {
                     *field = "run.dt_s".into();
-                    *at = t;
+                    *at = Some(t);
                 }
                 return Err(e);
             }

@@ -186,3 +186,45 @@ fn cli_writes_the_specified_files() {
     );
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn names_that_would_break_outputs() {
+    let text = SOLAR_PANEL_RON.replace("name: \"hinge\"", "name: \"hin,ge\"");
+    let e = Scene::from_ron(&text, "names.ron").unwrap_err().to_string();
+    assert!(e.contains("hinges[hin,ge]") && e.contains("letters"), "{e}");
+    let e = override_err(&["name=\"..\""]);
+    assert!(e.contains("`name`"), "{e}");
+}
+
+#[test]
+fn too_many_rows() {
+    let e = override_err(&["run.output_interval_s=1e-12"]);
+    assert!(
+        e.contains("run.output_interval_s") && e.contains("rows"),
+        "{e}"
+    );
+}
+
+#[test]
+fn geometric_stiffness_only_for_exponent_one_and_a_half() {
+    let e = override_err(&[r#"hinge.contact={"HuntCrossley":{"restitution":0.8,"exponent":1.0}}"#]);
+    assert!(
+        e.contains("hinges[hinge].clearance.contact.stiffness") && e.contains("1.5"),
+        "{e}"
+    );
+    // With n = 1.5 the default applies; with an explicit stiffness any n is fine.
+    Scene::solar_panel()
+        .with_overrides(&[r#"hinge.contact={"HuntCrossley":{"restitution":0.8}}"#])
+        .unwrap();
+    Scene::solar_panel()
+        .with_overrides(&[
+            r#"hinge.contact={"HuntCrossley":{"restitution":0.8,"exponent":1.0,"stiffness":1e9}}"#,
+        ])
+        .unwrap();
+}
+
+#[test]
+fn unlocked_out_of_plane_motion_in_a_scene() {
+    let e = override_err(&["hinge.lock=None"]);
+    assert!(e.contains("hinges[hinge].clearance.lock"), "{e}");
+}

@@ -5,9 +5,7 @@ use crate::error::{Error, Result};
 use crate::kinematics::{
     BodyMotion, ContactMode, ForcePair, JournalState, contact_force, journal_state, stable_step,
 };
-use crate::laws::{
-    BearingGeometry, FrictionModel, ImprovedLiu, NormalContact, NormalForceLaw, NormalModel,
-};
+use crate::laws::{BearingGeometry, FrictionModel, NormalContact, NormalForceLaw, NormalModel};
 use crate::ledger::{ForceLedger, Wrench, ensure_mass_properties, world_center_of_mass};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
@@ -403,11 +401,9 @@ impl ClearanceJoint {
                 penetration_rate: state.penetration_rate,
                 impact_rate: self.contact.impact_rate,
             };
-            let mut stiffness = self.normal_law.tangent_stiffness(state.penetration);
-            if let NormalModel::ImprovedLiu(law) = &self.normal_law {
-                stiffness +=
-                    ImprovedLiu::damping_slope(law, state.penetration) * state.penetration_rate;
-            }
+            // dF/d delta = K_tangent + (dD/d delta) delta_dot (MODEL.md §2 laws, linearised).
+            let stiffness = self.normal_law.tangent_stiffness(state.penetration)
+                + self.normal_law.damping_slope(&c) * state.penetration_rate;
             stable_step(
                 stiffness,
                 self.normal_law.damping_coefficient(&c),

@@ -37,6 +37,13 @@ pub trait NormalForceLaw {
     /// The coefficient multiplying `delta_dot` in the force (`dF/d delta_dot`), N s/m.
     fn damping_coefficient(&self, c: &NormalContact) -> f64;
 
+    /// `d D/d delta`, the change of the damping coefficient with penetration (0 by default): with
+    /// [`tangent_stiffness`](Self::tangent_stiffness) it linearises the force for step limits,
+    /// `dF/d delta = K_tangent + (dD/d delta) delta_dot`.
+    fn damping_slope(&self, _c: &NormalContact) -> f64 {
+        0.0
+    }
+
     /// Work stored by the elastic part from 0 to `penetration`, J. The default integrates
     /// [`elastic_force`](Self::elastic_force) by 16-point Gauss-Legendre after the substitution
     /// `delta = penetration s^2`, which removes the `sqrt` behaviour at 0.
@@ -200,8 +207,8 @@ impl NormalForceLaw for KelvinVoigt {
 /// Shared form of the hysteresis laws: `F = K delta^n (1 + chi delta_dot/delta_dot0)`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct Hysteresis {
-    stiffness: f64,
-    exponent: f64,
+    /// The elastic part `K delta^n`.
+    elastic: Hertz,
     restitution: f64,
     chi: f64,
 }
@@ -213,24 +220,19 @@ impl Hysteresis {
         restitution: f64,
         chi: impl Fn(f64) -> f64,
     ) -> Result<Self> {
-        check_stiffness_exponent(stiffness, exponent)?;
+        let elastic = Hertz::new(stiffness, exponent)?;
         in_range_open_closed("restitution", restitution, 0.0, 1.0)?;
         Ok(Hysteresis {
-            stiffness,
-            exponent,
+            elastic,
             restitution,
             chi: chi(restitution),
         })
     }
     fn elastic_force(&self, delta: f64) -> f64 {
-        self.stiffness * penetration_power(delta, self.exponent)
+        self.elastic.elastic_force(delta)
     }
     fn tangent_stiffness(&self, delta: f64) -> f64 {
-        if delta <= 0.0 {
-            0.0
-        } else {
-            self.stiffness * self.exponent * delta.powf(self.exponent - 1.0)
-        }
+        self.elastic.tangent_stiffness(delta)
     }
     fn damping_coefficient(&self, c: &NormalContact) -> f64 {
         if c.penetration <= 0.0 || c.impact_rate <= 0.0 {
@@ -238,8 +240,15 @@ impl Hysteresis {
         }
         self.elastic_force(c.penetration) * self.chi / c.impact_rate
     }
+    /// `d D/d delta = chi K_tangent / delta_dot0`.
+    fn damping_slope(&self, c: &NormalContact) -> f64 {
+        if c.penetration <= 0.0 || c.impact_rate <= 0.0 {
+            return 0.0;
+        }
+        self.tangent_stiffness(c.penetration) * self.chi / c.impact_rate
+    }
     fn elastic_energy(&self, delta: f64) -> f64 {
-        self.stiffness * penetration_power(delta, self.exponent + 1.0) / (self.exponent + 1.0)
+        self.elastic.elastic_energy(delta)
     }
 }
 
@@ -273,6 +282,9 @@ macro_rules! hysteresis_law {
             }
             fn damping_coefficient(&self, c: &NormalContact) -> f64 {
                 self.0.damping_coefficient(c)
+            }
+            fn damping_slope(&self, c: &NormalContact) -> f64 {
+                self.0.damping_slope(c)
             }
             fn elastic_energy(&self, delta: f64) -> f64 {
                 self.0.elastic_energy(delta)
@@ -332,39 +344,33 @@ fn liu_factor(delta: f64, clearance: f64) -> (f64, f64) {
     (g, slope)
 }
 
-/// Liu et al. 2007, cylindrical contact with clearance: `F = (pi/2) E* L delta sqrt(delta/(2(c+delta)))`.
+/// Liu et al. 2007, cylindrical contact with clearance: `F = (pi/2) E* L delta sqrt(delta/(2(c+delta)))`,
+/// the paper's improved law with `n = 1` and no damping.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LiuEtAl {
-    scale: f64,
-    clearance: f64,
-}
+pub struct LiuEtAl(ImprovedLiu);
 
 impl LiuEtAl {
     /// Composite modulus `E*` (Pa), axial length `L` (m), radial clearance `c` (m).
     pub fn new(effective_modulus: f64, length: f64, clearance: f64) -> Result<Self> {
-        positive("effective_modulus", effective_modulus)?;
-        positive("length", length)?;
-        positive("clearance", clearance)?;
-        Ok(LiuEtAl {
-            scale: 0.5 * PI * effective_modulus * length,
+        let undamped = MaxDamping::Explicit(0.0);
+        ImprovedLiu::new(
+            effective_modulus,
+            length,
             clearance,
-        })
+            1.0,
+            ImprovedLiu::DEFAULT_DELTA_MAX,
+            undamped,
+        )
+        .map(LiuEtAl)
     }
 }
 
 impl NormalForceLaw for LiuEtAl {
     fn elastic_force(&self, delta: f64) -> f64 {
-        if delta <= 0.0 {
-            return 0.0;
-        }
-        self.scale * delta * liu_factor(delta, self.clearance).0
+        self.0.elastic_force(delta)
     }
     fn tangent_stiffness(&self, delta: f64) -> f64 {
-        if delta <= 0.0 {
-            return 0.0;
-        }
-        let (g, dg) = liu_factor(delta, self.clearance);
-        self.scale * (g + delta * dg)
+        self.0.tangent_stiffness(delta)
     }
     fn damping_coefficient(&self, _: &NormalContact) -> f64 {
         0.0
@@ -455,15 +461,12 @@ impl NormalForceLaw for ImprovedLiu {
         let n = self.exponent;
         self.scale * (n * delta.powf(n - 1.0) * g + delta.powf(n) * dg)
     }
+    /// `d D_imp / d delta`: the slope of the STEP ramp.
+    fn damping_slope(&self, c: &NormalContact) -> f64 {
+        step_slope(c.penetration, 0.0, 0.0, self.delta_max, self.d_max)
+    }
     fn damping_coefficient(&self, c: &NormalContact) -> f64 {
         step(c.penetration, 0.0, 0.0, self.delta_max, self.d_max)
-    }
-}
-
-impl ImprovedLiu {
-    /// `d D_imp / d delta`, used to linearise the contact for step-size limits.
-    pub fn damping_slope(&self, delta: f64) -> f64 {
-        step_slope(delta, 0.0, 0.0, self.delta_max, self.d_max)
     }
 }
 
@@ -515,6 +518,9 @@ impl NormalForceLaw for NormalModel {
     }
     fn damping_coefficient(&self, c: &NormalContact) -> f64 {
         dispatch_normal!(self, l => l.damping_coefficient(c))
+    }
+    fn damping_slope(&self, c: &NormalContact) -> f64 {
+        dispatch_normal!(self, l => l.damping_slope(c))
     }
     fn elastic_energy(&self, delta: f64) -> f64 {
         dispatch_normal!(self, l => l.elastic_energy(delta))

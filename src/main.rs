@@ -149,21 +149,9 @@ struct RunArgs {
 
 impl RunArgs {
     fn scene(&self) -> clearance_joint::Result<Scene> {
-        let base = match &self.scene {
-            Some(p) => Scene::load(p)?,
-            None => Scene::solar_panel(),
-        };
         let mut overrides = self.overrides.clone();
-        for (key, v) in [
-            ("run.dt_s", self.dt),
-            ("run.end_s", self.end),
-            ("run.output_interval_s", self.output_interval),
-        ] {
-            if let Some(v) = v {
-                overrides.push(format!("{key}={v:e}"));
-            }
-        }
-        base.with_overrides(&overrides)
+        overrides.extend(run_overrides(self.dt, self.end, self.output_interval));
+        base_scene(&self.scene)?.with_overrides(&overrides)
     }
 }
 
@@ -191,6 +179,18 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     Ok(())
 }
 
+/// The `--dt`, `--end` and `--output-interval` options as `--set` overrides.
+fn run_overrides(dt: Option<f64>, end: Option<f64>, interval: Option<f64>) -> Vec<String> {
+    [
+        ("run.dt_s", dt),
+        ("run.end_s", end),
+        ("run.output_interval_s", interval),
+    ]
+    .into_iter()
+    .filter_map(|(key, v)| v.map(|v| format!("{key}={v:e}")))
+    .collect()
+}
+
 fn base_scene(path: &Option<PathBuf>) -> clearance_joint::Result<Scene> {
     match path {
         Some(p) => Scene::load(p),
@@ -205,16 +205,7 @@ fn sweep(args: &SweepArgs) -> clearance_joint::Result<()> {
         .iter()
         .map(|a| Axis::parse(a))
         .collect::<clearance_joint::Result<Vec<_>>>()?;
-    let mut fixed = Vec::new();
-    for (key, v) in [
-        ("run.dt_s", args.dt),
-        ("run.end_s", args.end),
-        ("run.output_interval_s", args.output_interval),
-    ] {
-        if let Some(v) = v {
-            fixed.push(format!("{key}={v:e}"));
-        }
-    }
+    let fixed = run_overrides(args.dt, args.end, args.output_interval);
     let shard = match &args.shard {
         Some(s) => Shard::parse(s)?,
         None => Shard::ALL,

@@ -96,7 +96,8 @@ struct StudyArgs {
     /// clearance, torque, friction or all.
     #[arg(value_parser = ["clearance", "torque", "friction", "all"])]
     name: String,
-    /// Scene file (RON); default: the paper's solar-panel scene.
+    /// Scene file (RON); default: the paper's solar-panel scene. The presets set
+    /// `hinge.*` and `drive.*`: the scene must name its clearance hinge `hinge` and its drive `drive`.
     #[arg(long)]
     scene: Option<PathBuf>,
     /// Override a parameter in every case, after the study's own settings (repeatable),

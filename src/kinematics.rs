@@ -72,8 +72,8 @@ pub fn journal_state(
     } else {
         axis.any_orthonormal_vector()
     };
-    let q_i = p_i + geometry.bearing_radius * normal;
-    let q_j = p_j + geometry.journal_radius * normal;
+    let q_i = p_i + geometry.bearing_radius() * normal;
+    let q_j = p_j + geometry.journal_radius() * normal;
     let v_rel = journal.velocity_at(q_j) - bearing.velocity_at(q_i);
     let penetration_rate = v_rel.dot(normal);
     let slip = v_rel - penetration_rate * normal - v_rel.dot(axis) * axis;

@@ -171,11 +171,15 @@ fn cli_writes_the_specified_files() {
         "linear_momentum_drift",
         "angular_momentum_drift",
     ] {
-        assert!(
-            summary["twins"]["clearance"].get(key).is_some(),
-            "missing {key}"
-        );
+        let v = &summary["twins"]["clearance"][key];
+        assert!(v.is_number() || v.is_object(), "`{key}` is {v}");
     }
+    // The first impact of the paper's scene comes at 0.0875 s, within the 0.2 s run.
+    let t = summary["twins"]["clearance"]["first_impact_t_s"]
+        .as_f64()
+        .unwrap();
+    assert!((t - 0.0875).abs() < 1e-3, "{t}");
+    assert!(summary["twins"]["ideal"]["first_impact_t_s"].is_null());
     // No temporary files left behind.
     assert!(
         std::fs::read_dir(&dir).unwrap().all(|e| !e

@@ -168,7 +168,7 @@ fn lankarani_nikravesh_stiffness_from_geometry_paper_steel() {
     // R_b R_j/(R_b - R_j) = 0.01 * 0.0095 / 0.0005 = 0.19 m, sqrt(0.19) = 0.4358898943540674
     // K = 1.5164835164835165e11 * 0.4358898943540674 = 6.610198397896845e10 N/m^1.5
     let g = BearingGeometry::from_clearance(0.010, 0.0005, 0.016).unwrap();
-    close(g.journal_radius, 0.0095, 1e-12);
+    close(g.journal_radius(), 0.0095, 1e-12);
     close(g.clearance(), 0.0005, 1e-9);
     let k = LankaraniNikravesh::stiffness_from_geometry(&g, &Material::STEEL, &Material::STEEL);
     let expected =

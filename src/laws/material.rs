@@ -49,15 +49,13 @@ pub fn effective_modulus(bearing: &Material, journal: &Material) -> f64 {
     1.0 / (bearing.sigma() + journal.sigma())
 }
 
-/// Radial geometry of a journal bearing.
+/// Radial geometry of a journal bearing. Built only through validating constructors, so the
+/// journal is always strictly smaller than the bearing.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BearingGeometry {
-    /// Bearing (hole) radius `R_b`, m.
-    pub bearing_radius: f64,
-    /// Journal (pin) radius `R_j`, m.
-    pub journal_radius: f64,
-    /// Axial length (bearing width) `L`, m.
-    pub length: f64,
+    bearing_radius: f64,
+    journal_radius: f64,
+    length: f64,
 }
 
 impl BearingGeometry {
@@ -95,6 +93,21 @@ impl BearingGeometry {
             ));
         }
         Self::new(bearing_radius, bearing_radius - clearance, length)
+    }
+
+    /// Bearing (hole) radius `R_b`, m.
+    pub fn bearing_radius(&self) -> f64 {
+        self.bearing_radius
+    }
+
+    /// Journal (pin) radius `R_j`, m.
+    pub fn journal_radius(&self) -> f64 {
+        self.journal_radius
+    }
+
+    /// Axial length (bearing width) `L`, m.
+    pub fn length(&self) -> f64 {
+        self.length
     }
 
     /// Radial clearance `c = R_b - R_j`.

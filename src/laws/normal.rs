@@ -328,7 +328,7 @@ impl LankaraniNikravesh {
         bearing: &super::Material,
         journal: &super::Material,
     ) -> f64 {
-        let (rb, rj) = (geometry.bearing_radius, geometry.journal_radius);
+        let (rb, rj) = (geometry.bearing_radius(), geometry.journal_radius());
         4.0 / (3.0 * (bearing.sigma() + journal.sigma())) * (rb * rj / (rb - rj)).sqrt()
     }
 }

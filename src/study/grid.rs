@@ -244,10 +244,9 @@ pub(crate) fn fnv1a(bytes: &[u8]) -> u64 {
 /// `--shard K/N` on N machines (a job array with tasks 0..N-1) covers every point exactly once.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Shard {
-    /// This shard, `0 <= k < n`.
-    pub k: usize,
-    /// Number of shards.
-    pub n: usize,
+    /// This shard, `0 <= k < n` (private: built by [`Shard::new`], which refuses `n = 0`).
+    k: usize,
+    n: usize,
 }
 
 impl Default for Shard {
@@ -286,6 +285,16 @@ impl Shard {
         let k: usize = k.trim().parse().map_err(|e| err(format!("K: {e}")))?;
         let n: usize = n.trim().parse().map_err(|e| err(format!("N: {e}")))?;
         Shard::new(k, n)
+    }
+
+    /// This shard's index `K`.
+    pub fn index(&self) -> usize {
+        self.k
+    }
+
+    /// The number of shards `N`.
+    pub fn count(&self) -> usize {
+        self.n
     }
 
     /// Whether point `index` belongs to this shard.

@@ -462,7 +462,7 @@ impl MetricsTable {
     /// File stem of this table: `metrics` or `metrics.shard-K-of-N`.
     pub fn stem(&self) -> String {
         match self.shard {
-            Some(s) => format!("metrics.shard-{}-of-{}", s.k, s.n),
+            Some(s) => format!("metrics.shard-{}-of-{}", s.index(), s.count()),
             None => "metrics".into(),
         }
     }

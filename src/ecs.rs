@@ -913,23 +913,26 @@ mod tests {
             .friction(FrictionModel::Bai(Bai::DRY))
     }
 
+    /// A 2 kg arm whose centre of mass hangs 0.3 m below `(x, 0, 0)`.
+    fn arm_at(x: f64) -> Body {
+        Body::new(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(x, -0.3, 0.0))
+                .additional_mass_properties(MassProperties::new(
+                    Vector::ZERO,
+                    2.0,
+                    Vector::splat(0.02),
+                ))
+                .can_sleep(false),
+        )
+    }
+
     /// A 2 kg arm hanging 0.3 m below a fixed base on an ideal hinge about z.
     fn pendulum(dt: f64) -> (World, Schedule, Entity, Entity) {
         let mut world = World::new();
         world.insert_resource(Physics::new(dt, Vector::new(0.0, -9.81, 0.0)));
         let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
-        let arm = world
-            .spawn(Body::new(
-                RigidBodyBuilder::dynamic()
-                    .translation(Vector::new(0.0, -0.3, 0.0))
-                    .additional_mass_properties(MassProperties::new(
-                        Vector::ZERO,
-                        2.0,
-                        Vector::splat(0.02),
-                    ))
-                    .can_sleep(false),
-            ))
-            .id();
+        let arm = world.spawn(arm_at(0.0)).id();
         let hinge = world
             .spawn((
                 Hinge::new(base, arm, Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0)),
@@ -1006,18 +1009,7 @@ mod tests {
         // Two pendulums; removing the first clearance joint renumbers the second's handle.
         let (mut world, mut schedule, _, first) = pendulum(1e-5);
         let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
-        let arm = world
-            .spawn(Body::new(
-                RigidBodyBuilder::dynamic()
-                    .translation(Vector::new(1.0, -0.3, 0.0))
-                    .additional_mass_properties(MassProperties::new(
-                        Vector::ZERO,
-                        2.0,
-                        Vector::splat(0.02),
-                    ))
-                    .can_sleep(false),
-            ))
-            .id();
+        let arm = world.spawn(arm_at(1.0)).id();
         let second = world
             .spawn((
                 Hinge::new(base, arm, Vector::Z)

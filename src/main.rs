@@ -71,15 +71,8 @@ struct SweepArgs {
     /// the grid is the product, the first `--set` varying slowest). One value fixes a parameter.
     #[arg(long = "set", value_name = "PATH=V1,V2,...")]
     axes: Vec<String>,
-    /// Step size, s, for every point (same as `--set run.dt_s=...`).
-    #[arg(long)]
-    dt: Option<f64>,
-    /// Simulated time, s, for every point.
-    #[arg(long)]
-    end: Option<f64>,
-    /// Interval between CSV rows, s, for every point.
-    #[arg(long)]
-    output_interval: Option<f64>,
+    #[command(flatten)]
+    time: TimeArgs,
     /// Output folder; default `out/sweep`.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -125,6 +118,34 @@ struct MergeArgs {
     out: Option<PathBuf>,
 }
 
+/// The run-settings shortcuts shared by `run` and `sweep` (for a sweep, they hold for every point).
+#[derive(Args, Debug, Clone, Default)]
+struct TimeArgs {
+    /// Step size, s (same as `--set run.dt_s=...`; the largest step with adaptive stepping).
+    #[arg(long)]
+    dt: Option<f64>,
+    /// Simulated time, s.
+    #[arg(long)]
+    end: Option<f64>,
+    /// Interval between CSV rows, s.
+    #[arg(long)]
+    output_interval: Option<f64>,
+}
+
+impl TimeArgs {
+    /// The options as `--set` overrides.
+    fn overrides(&self) -> Vec<String> {
+        [
+            ("run.dt_s", self.dt),
+            ("run.end_s", self.end),
+            ("run.output_interval_s", self.output_interval),
+        ]
+        .into_iter()
+        .filter_map(|(key, v)| v.map(|v| format!("{key}={v:e}")))
+        .collect()
+    }
+}
+
 /// Scene selection and overrides shared by the commands.
 #[derive(Args, Debug, Clone, Default)]
 struct RunArgs {
@@ -134,15 +155,8 @@ struct RunArgs {
     /// Override a parameter: `--set hinge.clearance_mm=0.25` (repeatable).
     #[arg(long = "set", value_name = "PATH=VALUE")]
     overrides: Vec<String>,
-    /// Step size, s (same as `--set run.dt_s=...`).
-    #[arg(long)]
-    dt: Option<f64>,
-    /// Simulated time, s.
-    #[arg(long)]
-    end: Option<f64>,
-    /// Interval between CSV rows, s.
-    #[arg(long)]
-    output_interval: Option<f64>,
+    #[command(flatten)]
+    time: TimeArgs,
     /// Output folder; default `out/<scene name>`.
     #[arg(long)]
     out: Option<PathBuf>,
@@ -151,7 +165,7 @@ struct RunArgs {
 impl RunArgs {
     fn scene(&self) -> clearance_joint::Result<Scene> {
         let mut overrides = self.overrides.clone();
-        overrides.extend(run_overrides(self.dt, self.end, self.output_interval));
+        overrides.extend(self.time.overrides());
         base_scene(&self.scene)?.with_overrides(&overrides)
     }
 }
@@ -180,18 +194,6 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     Ok(())
 }
 
-/// The `--dt`, `--end` and `--output-interval` options as `--set` overrides.
-fn run_overrides(dt: Option<f64>, end: Option<f64>, interval: Option<f64>) -> Vec<String> {
-    [
-        ("run.dt_s", dt),
-        ("run.end_s", end),
-        ("run.output_interval_s", interval),
-    ]
-    .into_iter()
-    .filter_map(|(key, v)| v.map(|v| format!("{key}={v:e}")))
-    .collect()
-}
-
 fn base_scene(path: &Option<PathBuf>) -> clearance_joint::Result<Scene> {
     match path {
         Some(p) => Scene::load(p),
@@ -206,7 +208,7 @@ fn sweep(args: &SweepArgs) -> clearance_joint::Result<()> {
         .iter()
         .map(|a| Axis::parse(a))
         .collect::<clearance_joint::Result<Vec<_>>>()?;
-    let fixed = run_overrides(args.dt, args.end, args.output_interval);
+    let fixed = args.time.overrides();
     let shard = match &args.shard {
         Some(s) => Shard::parse(s)?,
         None => Shard::ALL,

@@ -120,6 +120,13 @@ impl DriveSet {
         }
         self.ledger.replace(bodies, self.wrenches.iter().copied());
     }
+    /// Takes back, exactly, every torque this set applied at its last [`apply`](Self::apply)
+    /// (for a drive removed from the world).
+    pub fn take_back(&mut self, bodies: &mut RigidBodySet) {
+        self.wrenches.clear();
+        self.ledger.replace(bodies, std::iter::empty());
+    }
+
     /// Total potential energy of the springs at their last measured angles, J.
     pub fn potential_energy(&self) -> f64 {
         self.drives

@@ -103,8 +103,6 @@ struct RealizedDrive {
     drive: Drive,
     bodies: (RigidBodyHandle, RigidBodyHandle),
     axis: Vector,
-    /// The torque (world) added to body 2 at the last application; body 1 got its negative.
-    last_torque: Vector,
 }
 
 /// The physics of an ECS world: the Rapier world, the clearance joints and the drives, and the
@@ -236,13 +234,8 @@ impl Physics {
 
     /// Takes back the last torques of drive `entity` and forgets it.
     fn unrealize_drive(&mut self, entity: Entity) {
-        if let Some(d) = self.drives.remove(&entity) {
-            if let Some(rb) = self.world.bodies.get_mut(d.bodies.0) {
-                rb.add_torque(d.last_torque, false);
-            }
-            if let Some(rb) = self.world.bodies.get_mut(d.bodies.1) {
-                rb.add_torque(-d.last_torque, false);
-            }
+        if let Some(mut d) = self.drives.remove(&entity) {
+            d.set.take_back(&mut self.world.bodies);
         }
     }
 
@@ -406,7 +399,6 @@ impl Physics {
                 drive: *drive,
                 bodies,
                 axis: frame.local_axis1,
-                last_torque: Vector::ZERO,
             },
         );
         Ok(())
@@ -747,11 +739,6 @@ pub fn apply_drives(mut physics: ResMut<Physics>) {
     let Physics { world, drives, .. } = &mut *physics;
     for d in drives.values_mut() {
         d.set.apply(&mut world.bodies);
-        // The same expression as the spring's own, so that taking it back is exact.
-        if let (Some(rb1), Some(spring)) = (world.bodies.get(d.bodies.0), d.set.drives().first()) {
-            let axis = unit_vector("axis", d.axis).unwrap_or(Vector::ZERO);
-            d.last_torque = spring.torque() * (*rb1.rotation() * axis);
-        }
     }
 }
 
@@ -780,12 +767,10 @@ pub fn step_physics(mut physics: ResMut<Physics>) {
     physics.world.step();
     physics.steps += 1;
     physics.time += physics.world.integration_parameters.dt;
-    let vmax = 0.5 * physics.world.integration_parameters.max_linear_velocity();
+    let params = physics.world.integration_parameters;
     let bad = physics.bodies.iter().find_map(|(e, h)| {
         let rb = physics.world.bodies.get(*h)?;
-        let v = rb.linvel();
-        let bad = !rb.is_enabled() || !rb.translation().is_finite() || !v.is_finite();
-        (bad || v.length() > vmax).then(|| (*e, v.length()))
+        crate::sim::left_physical_range(rb, &params).map(|speed| (*e, speed))
     });
     if let Some((e, speed)) = bad {
         let t = physics.time;

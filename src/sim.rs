@@ -204,6 +204,15 @@ const ADAPTIVE_REACTION_WINDOW: f64 = 20.0;
 /// Smallest adaptive step: below it a contact cannot be resolved in f64 time arithmetic.
 const MIN_ADAPTIVE_DT: f64 = 1e-10;
 
+/// `Some(speed)` when `rb` has left the physical range: disabled by Rapier's quarantine,
+/// non-finite, or faster than half Rapier's speed clamp (Rapier clamps a blown-up body instead of
+/// producing NaN, so a clamped speed is the sign of a silent blow-up).
+pub(crate) fn left_physical_range(rb: &RigidBody, params: &IntegrationParameters) -> Option<f64> {
+    let (v, w) = (rb.linvel(), rb.angvel());
+    let bad = !rb.is_enabled() || !rb.translation().is_finite() || !v.is_finite() || !w.is_finite();
+    (bad || v.length() > 0.5 * params.max_linear_velocity()).then(|| v.length())
+}
+
 /// The clearance twin against the ideal twin, from every internal step (both twins built).
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Comparison {
@@ -535,24 +544,16 @@ impl Simulation {
     }
 
     fn check_health(&self) -> Result<()> {
-        let vmax = 0.5 * self.world.integration_parameters.max_linear_velocity();
         for twin in &self.twins {
             for b in &twin.bodies {
                 let rb = &self.world.bodies[b.handle];
-                let (v, w) = (rb.linvel(), rb.angvel());
-                if !rb.is_enabled()
-                    || !rb.translation().is_finite()
-                    || !v.is_finite()
-                    || !w.is_finite()
-                    || v.length() > vmax
-                {
+                if let Some(speed) = left_physical_range(rb, &self.world.integration_parameters) {
                     return Err(Error::Diverged {
                         t: self.time(),
                         reason: format!(
-                            "body `{}` of the {} twin left the physical range (speed {:.3e} m/s)",
+                            "body `{}` of the {} twin left the physical range (speed {speed:.3e} m/s)",
                             b.name,
                             twin.kind.name(),
-                            v.length()
                         ),
                     });
                 }

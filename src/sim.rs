@@ -311,6 +311,17 @@ impl ComparisonSums {
     }
 }
 
+/// Where a run is, passed to the callback of [`Simulation::run_with_progress`].
+#[derive(Clone, Copy, Debug)]
+pub struct Progress {
+    /// Simulated time reached, s.
+    pub t: f64,
+    /// Simulated time at the end of the run, s.
+    pub end: f64,
+    /// Internal steps taken so far.
+    pub steps: u64,
+}
+
 /// The result of a whole run.
 #[derive(Debug)]
 pub struct RunResult {
@@ -438,10 +449,21 @@ impl Simulation {
     }
 
     /// Runs to `run.end_s`.
-    pub fn run(mut self) -> Result<RunResult> {
+    pub fn run(self) -> Result<RunResult> {
+        self.run_with_progress(|_| {})
+    }
+
+    /// Runs to `run.end_s`, calling `progress` after every internal step (e.g. to show simulated
+    /// time, steps per second and an ETA on a terminal; the call should be cheap).
+    pub fn run_with_progress(mut self, mut progress: impl FnMut(&Progress)) -> Result<RunResult> {
         let start = Instant::now();
         while !self.done() {
             self.step()?;
+            progress(&Progress {
+                t: self.time(),
+                end: self.scene.run.end_s,
+                steps: self.steps_done,
+            });
         }
         self.finish()?;
         let comparison = match self.twins.as_slice() {

@@ -1,7 +1,8 @@
 //! Drop-in, plain Rapier: a two-link arm hangs from a fixed base on two ideal revolute joints and
 //! swings down from 30 degrees under gravity. The same Rapier code runs twice; the second time,
 //! one call turns the elbow's revolute joint into a clearance joint (0.1 mm of radial play in a
-//! 10 mm steel bearing, dry friction). Everything else, including the step loop, is identical.
+//! 10 mm steel bearing, dry friction). Everything else, including the step loop (the library's
+//! stepper in place of `world.step()`), is identical.
 //!
 //! `cargo run --release --example drop_in`
 
@@ -10,6 +11,7 @@ use clearance_joint::angle::{UnwrappedAngle, twist_angle};
 use clearance_joint::convert::{Clearance, ConvertRevolute};
 use clearance_joint::joint::ClearanceJointSet;
 use clearance_joint::laws::{Bai, FrictionModel};
+use clearance_joint::stepper::{StepControl, Stepper};
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::{
     ImpulseJointHandle, MassProperties, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder,
@@ -118,27 +120,33 @@ pub struct Run {
     pub max_penetration_um: f64,
 }
 
-/// Steps `world` to [`END`]: the force hook, then Rapier's step. The same loop for both runs.
+/// Steps `world` to [`END`] with the library's stepper in place of `world.step()`: it applies the
+/// clearance forces, keeps the kicks consistent and refuses an unstable step. The same loop for
+/// both runs.
 fn simulate(mut world: PhysicsWorld, arm: &Arm, mut clearance: ClearanceJointSet) -> Result<Run> {
-    let steps = (END / DT).round() as u64;
+    let mut stepper = Stepper::new(StepControl::fixed(DT));
+    stepper.prepare(&mut world, &mut [&mut clearance])?; // the hook's forces at the start
     let mut run = Run::default();
     let (mut shoulder, mut elbow) = (UnwrappedAngle::default(), UnwrappedAngle::default());
     let start = *world.bodies[arm.upper].rotation();
-    let mut sum_sq = 0.0;
-    for _ in 0..steps {
+    let (mut sum_sq, mut steps) = (0.0, 0u64);
+    while stepper.time() < END {
         let v_before = world.bodies[arm.lower].linvel();
-        clearance.apply(&mut world.bodies, &world.integration_parameters)?; // the one addition to a Rapier loop
-        world.step();
-        let lower = &world.bodies[arm.lower];
-        let force = (LOWER.0 * (lower.linvel() - v_before) / DT - LOWER.0 * world.gravity).length();
-        run.peak_elbow_force_n = run.peak_elbow_force_n.max(force);
-        sum_sq += force * force;
+        // The hook's contact over the coming step (evaluated at its start).
         for (_, j) in clearance.iter() {
             let r = j.report();
             run.impacts += u64::from(r.onset);
             run.peak_contact_force_n = run.peak_contact_force_n.max(r.force.on_journal.length());
             run.max_penetration_um = run.max_penetration_um.max(r.state.penetration * 1e6);
         }
+        let step = stepper.step(&mut world, &mut [&mut clearance], END)?; // was: world.step()
+        // The lower link's momentum balance: applied forces act for the step's kick.
+        let lower = &world.bodies[arm.lower];
+        let force =
+            (LOWER.0 * (lower.linvel() - v_before) / step.kick - LOWER.0 * world.gravity).length();
+        run.peak_elbow_force_n = run.peak_elbow_force_n.max(force);
+        sum_sq += force * force;
+        steps += 1;
         let (q1, q2) = (*world.bodies[arm.upper].rotation(), *lower.rotation());
         shoulder.update(twist_angle(&(q1 * start.inverse()), Vector::Z));
         elbow.update(twist_angle(&(q1.inverse() * q2), Vector::Z));

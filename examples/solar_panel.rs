@@ -14,6 +14,8 @@ use clearance_joint::laws::{
     Bai, BearingGeometry, FrictionModel, ImprovedLiu, Material, MaxDamping, NormalModel,
     effective_modulus,
 };
+use clearance_joint::reaction::{IdealRevolute, ReactionSolver, prepare_mass_properties};
+use clearance_joint::stepper::{StepControl, Stepper};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     MassProperties, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder, RigidBodyHandle,
@@ -51,7 +53,8 @@ pub struct Outcome {
     pub satellite_deg: f64,
     /// Final panel angular rate about the hinge axis, deg/s.
     pub panel_rate_deg_s: f64,
-    /// Largest hinge force, N (ideal: the panel's momentum balance; clearance: the contact force).
+    /// Largest hinge force, N (ideal: the exact reaction of the ideal joint; clearance: the
+    /// contact force).
     pub peak_force_n: f64,
     /// Contact onsets.
     pub impacts: u64,
@@ -152,44 +155,52 @@ fn momentum(bodies: &RigidBodySet, twin: &Twin) -> (Vector, Vector, f64, f64) {
     (p, l, max_p, max_l)
 }
 
-/// Runs both twins in one world.
+/// Runs both twins in one world, stepped by the library's stepper (fixed steps of [`DT`]).
 pub fn run() -> Result<(Outcome, Outcome)> {
     let mut world = PhysicsWorld::new();
     world.gravity = Vector::ZERO;
     world.integration_parameters.dt = DT;
     world.integration_parameters.num_solver_iterations = 1; // the hook's force is constant over a step
     let mut set = ClearanceJointSet::new();
-    let mut twins = [
+    let [mut ideal, mut clear] = [
         add_twin(&mut world, &mut set, false)?,
         add_twin(&mut world, &mut set, true)?,
     ];
+    // The ideal hinge's exact reaction at each state (not a momentum difference over a step).
+    prepare_mass_properties(&mut world.bodies);
+    let h = Vector::from(HINGE_POINT);
+    let ideal_hinge = [IdealRevolute {
+        body1: ideal.satellite,
+        body2: ideal.panel,
+        local_anchor1: h - Vector::from(SATELLITE.2),
+        local_anchor2: h - Vector::from(PANEL.2),
+        local_axis1: AXIS,
+    }];
+    let mut reactions = ReactionSolver::default();
+    let mut stepper = Stepper::new(StepControl::fixed(DT));
+    stepper.prepare(
+        &mut world,
+        &mut [&mut ideal.drives, &mut clear.drives, &mut set],
+    )?;
     let mut out = [Outcome::default(), Outcome::default()];
     let mut angles = [[UnwrappedAngle::default(); 3]; 2];
     let mut p0 = [None; 2];
     let (mut dp, mut dl, mut sp, mut sl) = ([0.0f64; 2], [0.0f64; 2], [0.0f64; 2], [0.0f64; 2]);
-    let steps = (END / DT).round() as u64;
-    for step in 0..=steps {
-        for (k, twin) in twins.iter_mut().enumerate() {
-            twin.drives.apply(&mut world.bodies);
+    loop {
+        // The state at the stepper's time, with the forces the next step applies.
+        let t = stepper.time();
+        for (k, twin) in [&ideal, &clear].into_iter().enumerate() {
             let (p, l, mp, ml) = momentum(&world.bodies, twin);
             let (p_start, l_start) = *p0[k].get_or_insert((p, l));
             dp[k] = dp[k].max((p - p_start).length());
             dl[k] = dl[k].max((l - l_start).length());
             sp[k] = sp[k].max(mp);
             sl[k] = sl[k].max(ml);
-        }
-        set.apply(&mut world.bodies, &world.integration_parameters)?;
-        if step == steps {
-            break;
-        }
-        let v_before = twins.each_ref().map(|t| world.bodies[t.panel].linvel());
-        world.step();
-        let t = step as f64 * DT;
-        for (k, twin) in twins.iter().enumerate() {
             let o = &mut out[k];
             let force = match twin.clearance {
-                // The panel's momentum balance: only the joint applies a force to it.
-                None => (PANEL.0 * (world.bodies[twin.panel].linvel() - v_before[k]) / DT).length(),
+                None => reactions
+                    .solve(&world.bodies, &ideal_hinge, world.gravity)
+                    .map_or(0.0, |f| f[0].length()),
                 Some(c) => {
                     let r = set.get(c).expect("inserted").report();
                     if r.onset {
@@ -213,6 +224,14 @@ pub fn run() -> Result<(Outcome, Outcome)> {
                 .to_degrees();
             o.panel_rate_deg_s = world.bodies[twin.panel].angvel().dot(AXIS).to_degrees();
         }
+        if t >= END {
+            break;
+        }
+        stepper.step(
+            &mut world,
+            &mut [&mut ideal.drives, &mut clear.drives, &mut set],
+            END,
+        )?;
     }
     for k in 0..2 {
         out[k].linear_momentum_drift = dp[k] / sp[k].max(f64::MIN_POSITIVE);

@@ -93,6 +93,8 @@ pub struct DriveSet {
     drives: Vec<TorsionSpring>,
     ledger: ForceLedger,
     wrenches: Vec<Wrench>,
+    saved: Vec<(HingeAngle, f64)>,
+    saved_ledger: Vec<Wrench>,
 }
 
 impl DriveSet {
@@ -125,6 +127,24 @@ impl DriveSet {
     pub fn take_back(&mut self, bodies: &mut RigidBodySet) {
         self.wrenches.clear();
         self.ledger.replace(bodies, std::iter::empty());
+    }
+
+    /// Saves the angle trackers and applied torques (before a step that may be rejected).
+    pub fn save_state(&mut self) {
+        self.saved.clear();
+        self.saved
+            .extend(self.drives.iter().map(|d| (d.angle, d.last_torque)));
+        self.ledger.save(&mut self.saved_ledger);
+    }
+
+    /// Restores what [`save_state`](Self::save_state) saved (the bodies' forces are restored by
+    /// the caller).
+    pub fn restore_state(&mut self) {
+        for (d, &(angle, torque)) in self.drives.iter_mut().zip(&self.saved) {
+            d.angle = angle;
+            d.last_torque = torque;
+        }
+        self.ledger.restore(&self.saved_ledger);
     }
 
     /// Total potential energy of the springs at their last measured angles, J.

@@ -60,6 +60,8 @@ use crate::drive::{DriveSet, TorsionSpring};
 use crate::error::{Error, Result, unit_vector};
 use crate::joint::{ClearanceJoint, ClearanceJointHandle, ClearanceJointSet};
 use crate::kinematics::ContactMode;
+use crate::reaction::{IdealRevolute, ReactionSolver};
+use crate::stepper::{ForceSource, GuardReport, StepControl, StepMode, Stepper};
 use bevy_ecs::prelude::*;
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::{
@@ -117,8 +119,13 @@ pub struct Physics {
     hinges: BTreeMap<Entity, RealizedHinge>,
     drives: BTreeMap<Entity, RealizedDrive>,
     error: Option<Error>,
-    steps: u64,
-    time: f64,
+    /// The step control: the same public piece the scene runner uses.
+    stepper: Stepper,
+    /// Set when the sync systems changed joints, drives or bodies: the force sources are
+    /// evaluated again before the next step.
+    changed: bool,
+    reactions: ReactionSolver,
+    ideal_joints: Vec<IdealRevolute>,
 }
 
 impl Physics {
@@ -135,6 +142,7 @@ impl Physics {
     /// Wraps an existing Rapier world (its bodies and joints stay; entities refer to bodies with
     /// [`Body::from_handle`]).
     pub fn from_world(world: PhysicsWorld) -> Self {
+        let dt = world.integration_parameters.dt;
         Physics {
             world,
             clearance: ClearanceJointSet::new(),
@@ -142,9 +150,24 @@ impl Physics {
             hinges: BTreeMap::new(),
             drives: BTreeMap::new(),
             error: None,
-            steps: 0,
-            time: 0.0,
+            stepper: Stepper::new(StepControl::fixed(dt)),
+            changed: true,
+            reactions: ReactionSolver::default(),
+            ideal_joints: Vec::new(),
         }
+    }
+
+    /// The step control: fixed steps of `world.integration_parameters.dt` by default (changing
+    /// `dt` between steps is followed). With [`StepControl::adaptive`] each run of the schedule
+    /// takes one accepted step of the stepper's choice towards the frame's end, `time() + dt`.
+    pub fn set_step_control(&mut self, control: StepControl) {
+        self.stepper.set_control(control);
+    }
+
+    /// What the run-time guards recorded (rejected steps, penetrations beyond a law's validity,
+    /// steps at the floor).
+    pub fn guards(&self) -> &GuardReport {
+        self.stepper.guards()
     }
 
     /// The clearance joints (read-only: they follow the [`ClearanceHinge`] components).
@@ -154,12 +177,12 @@ impl Physics {
 
     /// Simulated time, s.
     pub fn time(&self) -> f64 {
-        self.time
+        self.stepper.time()
     }
 
     /// Steps taken.
     pub fn steps(&self) -> u64 {
-        self.steps
+        self.stepper.steps()
     }
 
     /// The first error of the systems, if any. While it is set the systems do nothing: the
@@ -205,6 +228,7 @@ impl Physics {
     /// Removes the Rapier joint of hinge `entity` (if realised).
     fn unrealize_hinge(&mut self, entity: Entity) {
         if let Some(h) = self.hinges.remove(&entity) {
+            self.changed = true;
             match h.joint {
                 HingeJoint::Ideal(j) => {
                     self.world.impulse_joints.remove(j, true);
@@ -235,6 +259,7 @@ impl Physics {
     /// Takes back the last torques of drive `entity` and forgets it.
     fn unrealize_drive(&mut self, entity: Entity) {
         if let Some(mut d) = self.drives.remove(&entity) {
+            self.changed = true;
             d.set.take_back(&mut self.world.bodies);
         }
     }
@@ -300,6 +325,7 @@ impl Physics {
                         .clearance
                         .convert_revolute(j, c.clone(), &mut self.world.impulse_joints)
                         .map_err(context)?;
+                    self.changed = true;
                     let r = self.hinges.get_mut(&entity).expect("realised");
                     r.joint = HingeJoint::Clearance(h);
                     r.clearance = Some(c);
@@ -314,6 +340,7 @@ impl Physics {
                             &mut self.world.impulse_joints,
                         )
                         .map_err(context)?;
+                    self.changed = true;
                     let r = self.hinges.get_mut(&entity).expect("realised");
                     r.joint = HingeJoint::Ideal(j);
                     r.clearance = None;
@@ -353,6 +380,7 @@ impl Physics {
                 (HingeJoint::Clearance(h), Some(c))
             }
         };
+        self.changed = true;
         self.hinges.insert(
             entity,
             RealizedHinge {
@@ -392,6 +420,7 @@ impl Physics {
         .map_err(|e| e.within(&format!("drive {entity}")))?;
         let mut set = DriveSet::new();
         set.insert(spring);
+        self.changed = true;
         self.drives.insert(
             entity,
             RealizedDrive {
@@ -600,11 +629,10 @@ pub struct HingeState {
 pub enum PhysicsSet {
     /// Components to Rapier: bodies, hinges (with conversions), drives.
     Sync,
-    /// Torsion-spring torques.
-    Drives,
-    /// Clearance contact and friction forces (the force hook).
-    ClearanceForces,
-    /// Rapier's step.
+    /// Torsion-spring torques and clearance contact and friction forces at the current state,
+    /// when the stepper has not evaluated them yet ([`apply_forces`]).
+    Forces,
+    /// One accepted step of the [`Stepper`].
     Step,
     /// Rapier to [`HingeState`] and [`BodyState`].
     Record,
@@ -622,6 +650,7 @@ pub fn sync_bodies(mut physics: ResMut<Physics>, mut query: Query<(Entity, &mut 
         seen.insert(entity);
         if let Some(rb) = body.pending.take() {
             physics.remove_body(entity);
+            physics.changed = true;
             let h = physics.world.bodies.insert(*rb);
             physics.bodies.insert(entity, h);
             body.handle = Some(h);
@@ -637,6 +666,7 @@ pub fn sync_bodies(mut physics: ResMut<Physics>, mut query: Query<(Entity, &mut 
             }
             // A new handle for this entity: its previous body goes, as on removal.
             physics.remove_body(entity);
+            physics.changed = true;
             physics.bodies.insert(entity, h);
         }
     }
@@ -731,67 +761,116 @@ pub fn sync_hinges(
     }
 }
 
-/// Applies the torsion-spring torques (each replaces its own previous torque).
-pub fn apply_drives(mut physics: ResMut<Physics>) {
-    if physics.error.is_some() {
-        return;
-    }
-    let Physics { world, drives, .. } = &mut *physics;
-    for d in drives.values_mut() {
-        d.set.apply(&mut world.bodies);
-    }
-}
-
-/// The clearance force hook ([`ClearanceJointSet::apply`]).
-pub fn apply_clearance_forces(mut physics: ResMut<Physics>) {
+/// Evaluates the force sources (torsion springs, the clearance force hook) at the current state
+/// when the stepper needs it: before the first step and after the sync systems changed
+/// something. Otherwise the stepper already evaluated them at the end of the last step.
+pub fn apply_forces(mut physics: ResMut<Physics>) {
     if physics.error.is_some() {
         return;
     }
     let Physics {
-        world, clearance, ..
+        world,
+        clearance,
+        drives,
+        stepper,
+        changed,
+        ..
     } = &mut *physics;
-    if let Err(mut e) = clearance.apply(&mut world.bodies, &world.integration_parameters) {
-        if let Error::StepTooLarge { field, t, .. } = &mut e {
+    if std::mem::take(changed) {
+        stepper.invalidate(false);
+    }
+    let mut sources = ecs_sources(clearance, drives);
+    if let Err(e) = stepper.prepare(world, &mut sources) {
+        physics.fail(e);
+    }
+}
+
+/// The force sources of the ECS world, in a fixed order (drives by entity, then the clearance
+/// joints: the runner's order, so both add forces to a body in the same order, to the bit).
+fn ecs_sources<'a>(
+    clearance: &'a mut ClearanceJointSet,
+    drives: &'a mut BTreeMap<Entity, RealizedDrive>,
+) -> Vec<&'a mut dyn ForceSource> {
+    let mut v: Vec<&mut dyn ForceSource> = Vec::with_capacity(1 + drives.len());
+    for d in drives.values_mut() {
+        v.push(&mut d.set);
+    }
+    v.push(clearance);
+    v
+}
+
+/// One accepted step of the [`Stepper`] (fixed steps of `world.integration_parameters.dt` unless
+/// [`Physics::set_step_control`] chose otherwise): variable-step consistent kicks, step
+/// acceptance, guards. An error stops the systems where the state was last valid.
+pub fn step_physics(mut physics: ResMut<Physics>) {
+    if physics.error.is_some() {
+        return;
+    }
+    let Physics {
+        world,
+        clearance,
+        drives,
+        stepper,
+        ..
+    } = &mut *physics;
+    let dt = world.integration_parameters.dt;
+    let mut control = *stepper.control();
+    if control.mode == StepMode::Fixed {
+        control.max_dt = dt;
+        stepper.set_control(control);
+    }
+    let until = stepper.time() + dt;
+    let mut sources = ecs_sources(clearance, drives);
+    let result = stepper.step(world, &mut sources, until);
+    drop(sources);
+    // Rapier's `dt` as the user set it (the stepper sets it per step).
+    physics.world.integration_parameters.dt = dt;
+    if let Err(mut e) = result {
+        if let Error::StepTooLarge { field, .. } = &mut e {
             *field = "Physics::world.integration_parameters.dt".into();
-            *t = Some(physics.time);
         }
         physics.fail(e);
     }
 }
 
-/// Rapier's step; refuses to go on from a non-physical state.
-pub fn step_physics(mut physics: ResMut<Physics>) {
-    if physics.error.is_some() {
-        return;
-    }
-    physics.world.step();
-    physics.steps += 1;
-    physics.time += physics.world.integration_parameters.dt;
-    let params = physics.world.integration_parameters;
-    let bad = physics.bodies.iter().find_map(|(e, h)| {
-        let rb = physics.world.bodies.get(*h)?;
-        crate::sim::left_physical_range(rb, &params).map(|speed| (*e, speed))
-    });
-    if let Some((e, speed)) = bad {
-        let t = physics.time;
-        physics.fail(Error::Diverged {
-            t,
-            reason: format!("body {e} left the physical range (speed {speed:.3e} m/s)"),
-        });
-    }
-}
-
 /// Copies the state of the step into [`HingeState`] and [`BodyState`].
 pub fn record(
-    physics: Res<Physics>,
+    mut physics: ResMut<Physics>,
     mut hinges: Query<(Entity, &Hinge, &mut HingeState)>,
     mut bodies: Query<(&Body, &mut BodyState)>,
 ) {
     if physics.error.is_some() {
         return;
     }
+    let physics = &mut *physics;
+    // Exact ideal reactions at this state (the runner's piece).
+    physics.ideal_joints.clear();
+    let mut ideal_entities = Vec::new();
+    for (e, r) in &physics.hinges {
+        if let HingeJoint::Ideal(_) = r.joint {
+            physics.ideal_joints.push(IdealRevolute {
+                body1: r.bodies.0,
+                body2: r.bodies.1,
+                local_anchor1: r.frame.local_anchor1,
+                local_anchor2: r.frame.local_anchor2,
+                local_axis1: unit_vector("axis", r.frame.local_axis1).unwrap_or(Vector::X),
+            });
+            ideal_entities.push(*e);
+        }
+    }
+    let gravity = physics.world.gravity;
+    let ideal_forces: BTreeMap<Entity, f64> = physics
+        .reactions
+        .solve(&physics.world.bodies, &physics.ideal_joints, gravity)
+        .map(|f| {
+            ideal_entities
+                .iter()
+                .zip(f)
+                .map(|(e, f)| (*e, f.length()))
+                .collect()
+        })
+        .unwrap_or_default();
     let w = &physics.world;
-    let dt = w.integration_parameters.dt;
     for (body, mut state) in bodies.iter_mut() {
         if let Some(rb) = body.handle.and_then(|h| w.bodies.get(h)) {
             *state = BodyState {
@@ -815,9 +894,8 @@ pub fn record(
             .update(rb1.rotation(), rb2.rotation(), axis1);
         state.rate = (rb2.angvel() - rb1.angvel()).dot(*rb1.rotation() * axis1);
         match r.joint {
-            HingeJoint::Ideal(j) => {
-                let i = w.impulse_joints.get(j).map_or([0.0; 6], |j| j.impulses);
-                state.force = Vector::new(i[0], i[1], i[2]).length() / dt;
+            HingeJoint::Ideal(_) => {
+                state.force = ideal_forces.get(&entity).copied().unwrap_or(0.0);
                 state.penetration = 0.0;
                 state.eccentricity = Vector::ZERO;
                 state.contact = ContactMode::FreeFlight;
@@ -844,8 +922,7 @@ pub fn add_physics_systems(schedule: &mut Schedule) {
     schedule.configure_sets(
         (
             PhysicsSet::Sync,
-            PhysicsSet::Drives,
-            PhysicsSet::ClearanceForces,
+            PhysicsSet::Forces,
             PhysicsSet::Step,
             PhysicsSet::Record,
         )
@@ -853,8 +930,7 @@ pub fn add_physics_systems(schedule: &mut Schedule) {
     );
     schedule.add_systems((
         (sync_bodies, sync_hinges).chain().in_set(PhysicsSet::Sync),
-        apply_drives.in_set(PhysicsSet::Drives),
-        apply_clearance_forces.in_set(PhysicsSet::ClearanceForces),
+        apply_forces.in_set(PhysicsSet::Forces),
         step_physics.in_set(PhysicsSet::Step),
         record.in_set(PhysicsSet::Record),
     ));

@@ -56,6 +56,23 @@ pub enum Error {
         /// What was detected.
         reason: String,
     },
+    /// The step control could not make progress: every step it tried was rejected, or it stayed
+    /// at its floor without advancing the simulated time.
+    #[error("the step control stalled at t = {t:.6} s: {reason}")]
+    Stalled {
+        /// Simulated time when detected.
+        t: f64,
+        /// What was seen, with the likely cause.
+        reason: String,
+    },
+    /// A run-time guard was violated and the step control is strict (`--strict`).
+    #[error("guard violated (strict) by t = {t:.6} s: {violations}")]
+    Guard {
+        /// Simulated time when detected.
+        t: f64,
+        /// The violations in words.
+        violations: String,
+    },
     /// A file could not be read or written.
     #[error("{action} `{path}`: {source}")]
     Io {
@@ -166,4 +183,23 @@ pub fn unit_vector(
         ));
     }
     Ok(v / n)
+}
+
+/// `x` with 4 significant digits, in plain or scientific notation as fits (for messages).
+pub fn sig4(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let a = x.abs();
+    if (1e-3..1e5).contains(&a) {
+        let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
+        let s = format!("{x:.decimals$}");
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
+    } else {
+        format!("{x:.3e}")
+    }
 }

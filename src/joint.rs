@@ -5,7 +5,9 @@ use crate::error::{Error, Result};
 use crate::kinematics::{
     BodyMotion, ContactMode, ForcePair, JournalState, contact_force, journal_state, stable_step,
 };
-use crate::laws::{BearingGeometry, FrictionModel, NormalContact, NormalForceLaw, NormalModel};
+use crate::laws::{
+    BearingGeometry, FrictionLaw, FrictionModel, NormalContact, NormalForceLaw, NormalModel,
+};
 use crate::ledger::{ForceLedger, Wrench, ensure_mass_properties, world_center_of_mass};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
@@ -61,6 +63,7 @@ impl ClearanceJointBuilder {
                 friction_law: FrictionModel::None,
                 min_impact_speed: DEFAULT_MIN_IMPACT_SPEED,
                 min_separation: DEFAULT_MIN_SEPARATION,
+                max_valid_penetration: None,
                 lock: OutOfPlaneLock::Joint,
                 body1: RigidBodyHandle::invalid(),
                 body2: RigidBodyHandle::invalid(),
@@ -106,6 +109,14 @@ impl ClearanceJointBuilder {
         self.joint.min_separation = gap;
         self
     }
+    /// The deepest penetration at which the contact law is still trusted, m (default: a tenth
+    /// of the radial clearance). Compliant laws assume a contact small against the bodies'
+    /// curvature: a journal pressed deeper is outside the model. The steppers report it as a
+    /// guard violation ([`crate::stepper::GuardReport`]); it is not a force limit.
+    pub fn max_valid_penetration(mut self, depth: f64) -> Self {
+        self.joint.max_valid_penetration = Some(depth);
+        self
+    }
     /// What locks the out-of-plane degrees of freedom (default [`OutOfPlaneLock::Joint`]).
     pub fn lock(mut self, lock: OutOfPlaneLock) -> Self {
         self.joint.lock = lock;
@@ -131,6 +142,9 @@ impl ClearanceJointBuilder {
         }
         crate::error::positive("min_impact_speed", j.min_impact_speed)?;
         crate::error::non_negative("min_separation", j.min_separation)?;
+        if let Some(d) = j.max_valid_penetration {
+            crate::error::positive("max_valid_penetration", d)?;
+        }
         Ok(self.joint)
     }
 }
@@ -173,8 +187,14 @@ pub struct ClearanceReport {
     pub impact_rate: f64,
     /// The force pair applied.
     pub force: ForcePair,
-    /// Largest stable step for the contact as linearised now (infinite in free flight), s.
+    /// Largest stable step for the contact as linearised now (infinite in free flight), s:
+    /// stiffness and damping along the normal. Beyond it the explicit step blows up.
     pub max_stable_dt: f64,
+    /// Largest step that resolves friction as linearised now, `2 m_t/(F_N dmu/dv)` (infinite
+    /// without contact), s: a friction law whose coefficient rises steeply with slip, like Bai's
+    /// near zero slip, acts as a stiff tangential damper. Friction is bounded by `mu_s F_N`, so a
+    /// longer step does not blow up; it turns stiction into a numerical chatter of the slip.
+    pub friction_stable_dt: f64,
     /// Linearised natural frequency of the contact, rad/s.
     pub omega: f64,
     /// Linearised damping ratio of the contact.
@@ -196,6 +216,7 @@ pub struct ClearanceJoint {
     friction_law: FrictionModel,
     min_impact_speed: f64,
     min_separation: f64,
+    max_valid_penetration: Option<f64>,
     lock: OutOfPlaneLock,
     body1: RigidBodyHandle,
     body2: RigidBodyHandle,
@@ -219,6 +240,25 @@ pub const DEFAULT_MIN_SEPARATION: f64 = 1e-7;
 const APPROACH_FRACTION: f64 = 0.5;
 /// Margin on the damped stability limit used by the adaptive step.
 const STABILITY_SAFETY: f64 = 0.8;
+
+/// The dynamic state of a joint between steps (what a rejected step must restore).
+#[derive(Clone, Copy, Debug)]
+struct JointDynamics {
+    contact: ContactHistory,
+    report: ClearanceReport,
+    previous_rate: Option<f64>,
+    last_wrenches: Option<[Wrench; 2]>,
+    prepared: bool,
+}
+
+/// Slope `dmu/dv` of a friction law at slip speed `v` (one-sided difference at 0, where the
+/// regularised laws are steepest).
+fn friction_slope(law: &impl FrictionLaw, v: f64) -> f64 {
+    let h = (1e-4 * v).max(1e-9);
+    let lo = (v - h).max(0.0);
+    let hi = v + h;
+    (law.coefficient(hi) - law.coefficient(lo)) / (hi - lo)
+}
 
 impl ClearanceJoint {
     /// The joint's name.
@@ -269,6 +309,16 @@ impl ClearanceJoint {
     pub fn report(&self) -> &ClearanceReport {
         &self.report
     }
+    /// The deepest penetration at which the contact law is trusted, m
+    /// ([`ClearanceJointBuilder::max_valid_penetration`]; default a tenth of the clearance).
+    pub fn max_valid_penetration(&self) -> f64 {
+        self.max_valid_penetration
+            .unwrap_or(0.1 * self.geometry.clearance())
+    }
+    /// Whether the joint was in contact at its last application.
+    pub fn in_contact(&self) -> bool {
+        self.contact.in_contact
+    }
     /// Elastic energy stored in the contact at the last application, J.
     pub fn elastic_energy(&self) -> f64 {
         self.normal_law
@@ -292,31 +342,11 @@ impl ClearanceJoint {
         }
         let delta = r.state.penetration;
         let rate = r.state.penetration_rate;
-        let contact_step = |approach_speed: f64, depth: f64| {
-            let energy =
-                0.5 * m * approach_speed * approach_speed + self.normal_law.elastic_energy(depth);
-            let peak =
-                crate::laws::penetration_for_energy(&self.normal_law, energy, 1e-6).max(depth);
-            let stiffness = self.normal_law.tangent_stiffness(peak);
-            if !(stiffness > 0.0) {
-                return f64::INFINITY;
-            }
-            let impact_rate = if self.contact.in_contact {
-                self.contact.impact_rate
-            } else {
-                approach_speed.max(self.min_impact_speed)
-            };
-            let c = NormalContact {
-                penetration: peak,
-                penetration_rate: approach_speed,
-                impact_rate,
-            };
-            let (stable, omega, _) =
-                stable_step(stiffness, self.normal_law.damping_coefficient(&c), m);
-            (tolerance * std::f64::consts::TAU / omega).min(STABILITY_SAFETY * stable)
-        };
+        let contact_step =
+            |approach_speed: f64, depth: f64| self.contact_step(approach_speed, depth, tolerance);
         if delta > 0.0 {
-            return contact_step(rate.max(0.0), delta).min(STABILITY_SAFETY * r.max_stable_dt);
+            return contact_step(rate.max(0.0), delta)
+                .min(STABILITY_SAFETY * r.max_stable_dt.min(r.friction_stable_dt));
         }
         let gap = -delta;
         let accel = match self.previous_rate {
@@ -343,6 +373,83 @@ impl ClearanceJoint {
         }
         let speed_at_contact = (rate + accel * time_to_contact).max(0.0);
         (APPROACH_FRACTION * time_to_contact).max(contact_step(speed_at_contact, 0.0))
+    }
+
+    /// The step that resolves a contact entered at `approach_speed` (m/s) and now `depth` deep
+    /// (m) to `tolerance` of its natural period, taken at the deepest point the contact can reach
+    /// (its elastic energy plus the kinetic energy of the approach), and within the damped
+    /// stability limit there.
+    fn contact_step(&self, approach_speed: f64, depth: f64, tolerance: f64) -> f64 {
+        let m = self.report.effective_mass;
+        let energy =
+            0.5 * m * approach_speed * approach_speed + self.normal_law.elastic_energy(depth);
+        let peak = crate::laws::penetration_for_energy(&self.normal_law, energy, 1e-6).max(depth);
+        let stiffness = self.normal_law.tangent_stiffness(peak);
+        if !(stiffness > 0.0) {
+            return f64::INFINITY;
+        }
+        let impact_rate = if self.contact.in_contact {
+            self.contact.impact_rate
+        } else {
+            approach_speed.max(self.min_impact_speed)
+        };
+        let c = NormalContact {
+            penetration: peak,
+            penetration_rate: approach_speed,
+            impact_rate,
+        };
+        let (stable, omega, _) = stable_step(stiffness, self.normal_law.damping_coefficient(&c), m);
+        (tolerance * std::f64::consts::TAU / omega).min(STABILITY_SAFETY * stable)
+    }
+
+    /// Judges a step of `dt` that ended in the state of the last application, for a joint that
+    /// was (`was_in_contact`) or was not in contact when the step began. `None` when the step
+    /// resolved the contact; otherwise the shorter step to retry with:
+    /// - the step went beyond the stability limit of the contact it ended in;
+    /// - a contact began inside the step and got deeper than a step of the contact's own size
+    ///   (`tolerance` of its period) would have let it: the step crossed the onset blind;
+    /// - the step was longer than friction's limit ([`ClearanceReport::friction_stable_dt`]).
+    pub fn judge_step(&self, dt: f64, tolerance: f64, was_in_contact: bool) -> Option<f64> {
+        let r = &self.report;
+        let delta = r.state.penetration;
+        if !(delta > 0.0) {
+            return None;
+        }
+        let limit = r.max_stable_dt.min(r.friction_stable_dt);
+        if dt > limit {
+            return Some((STABILITY_SAFETY * limit).min(0.5 * dt));
+        }
+        if was_in_contact {
+            return None;
+        }
+        let rate = r.state.penetration_rate.max(0.0);
+        let h_c = self.contact_step(rate, delta, tolerance);
+        if dt <= h_c || delta <= rate * h_c {
+            return None;
+        }
+        // Retry with a step that ends shortly before the onset (then the approach shrinks the
+        // steps to the contact's own), or with the contact's own step.
+        let inside = if rate > 0.0 { delta / rate } else { dt };
+        let before = (dt - inside).max(0.0);
+        Some(h_c.max(0.9 * before).min(0.5 * dt))
+    }
+
+    fn dynamics(&self) -> JointDynamics {
+        JointDynamics {
+            contact: self.contact,
+            report: self.report,
+            previous_rate: self.previous_rate,
+            last_wrenches: self.last_wrenches,
+            prepared: self.prepared,
+        }
+    }
+
+    fn set_dynamics(&mut self, d: JointDynamics) {
+        self.contact = d.contact;
+        self.report = d.report;
+        self.previous_rate = d.previous_rate;
+        self.last_wrenches = d.last_wrenches;
+        self.prepared = d.prepared;
     }
 
     fn evaluate(&mut self, bodies: &RigidBodySet) -> Option<(Wrench, Wrench)> {
@@ -412,6 +519,22 @@ impl ClearanceJoint {
         } else {
             (f64::INFINITY, 0.0, 0.0)
         };
+        // Friction as a tangential damper: `d(mu F_N)/dv = F_N dmu/dv` along the slip.
+        let mut friction_stable_dt = f64::INFINITY;
+        if force.normal_force > 0.0 {
+            let v = state.slip.length();
+            let slope = friction_slope(&self.friction_law, v);
+            if slope > 0.0 {
+                let t = if v > 0.0 {
+                    state.slip / v
+                } else {
+                    state.normal.cross(axis)
+                };
+                let inv_m = inverse_mass_along(rb1, state.contact_point, t)
+                    + inverse_mass_along(rb2, state.contact_point, t);
+                friction_stable_dt = 2.0 / (inv_m * force.normal_force * slope);
+            }
+        }
         if self.prepared_report() {
             self.previous_rate = Some(self.report.state.penetration_rate);
         }
@@ -423,6 +546,7 @@ impl ClearanceJoint {
             impact_rate: self.contact.impact_rate,
             force,
             max_stable_dt,
+            friction_stable_dt,
             omega,
             zeta,
             effective_mass,
@@ -478,6 +602,8 @@ pub struct ClearanceJointSet {
     joints: Vec<ClearanceJoint>,
     ledger: ForceLedger,
     wrenches: Vec<Wrench>,
+    saved: Vec<JointDynamics>,
+    saved_ledger: Vec<Wrench>,
 }
 
 impl ClearanceJointSet {
@@ -630,6 +756,36 @@ impl ClearanceJointSet {
             }
         }
         Ok(())
+    }
+
+    /// Saves every joint's contact history and report and the forces applied last (before a
+    /// step that may be rejected; no allocation after the first call).
+    pub fn save_state(&mut self) {
+        self.saved.clear();
+        self.saved.extend(self.joints.iter().map(|j| j.dynamics()));
+        self.ledger.save(&mut self.saved_ledger);
+    }
+
+    /// Restores what [`save_state`](Self::save_state) saved (the bodies' forces are restored by
+    /// the caller).
+    pub fn restore_state(&mut self) {
+        for (j, d) in self.joints.iter_mut().zip(&self.saved) {
+            j.set_dynamics(*d);
+        }
+        self.ledger.restore(&self.saved_ledger);
+    }
+
+    /// [`ClearanceJoint::judge_step`] over all joints, with their contact state saved by the last
+    /// [`save_state`](Self::save_state): the shortest retry step asked for, if any.
+    pub fn judge_step(&self, dt: f64, tolerance: f64) -> Option<f64> {
+        self.joints
+            .iter()
+            .enumerate()
+            .filter_map(|(i, j)| {
+                let was = self.saved.get(i).is_some_and(|d| d.contact.in_contact);
+                j.judge_step(dt, tolerance, was)
+            })
+            .reduce(f64::min)
     }
 
     /// Smallest [`ClearanceJoint::adaptive_step`] over all joints (infinite without joints).

@@ -137,10 +137,19 @@ pub fn contact_force(
 /// Largest stable step of symplectic Euler for the contact linearised at `state`:
 /// `m x'' = -k x - d x'` is stable for `omega dt <= 2 (sqrt(1 + zeta^2) - zeta)`,
 /// `omega = sqrt(k/m)`, `zeta = d/(2 m omega)` (the eigenvalues of the one-step map).
-/// Returns `(dt_max, omega, zeta)`; `dt_max` is infinite without stiffness.
+/// Returns `(dt_max, omega, zeta)`. Without stiffness (`k <= 0`) damping alone limits the step to
+/// `2 m/d` (reported with `omega = 0`, `zeta` infinite); without either `dt_max` is infinite.
 pub fn stable_step(stiffness: f64, damping: f64, effective_mass: f64) -> (f64, f64, f64) {
-    if !(stiffness > 0.0) || !(effective_mass > 0.0) || !effective_mass.is_finite() {
+    if !(effective_mass > 0.0) || !effective_mass.is_finite() {
         return (f64::INFINITY, 0.0, 0.0);
+    }
+    if !(stiffness > 0.0) {
+        // Pure damping `m x'' = -d x'`: `v (1 - dt d/m)` per step, stable for `dt <= 2 m/d`.
+        return if damping > 0.0 {
+            (2.0 * effective_mass / damping, 0.0, f64::INFINITY)
+        } else {
+            (f64::INFINITY, 0.0, 0.0)
+        };
     }
     let omega = (stiffness / effective_mass).sqrt();
     let zeta = damping.max(0.0) / (2.0 * effective_mass * omega);
@@ -234,6 +243,9 @@ mod tests {
         // zeta = 1: 2 (sqrt 2 - 1)/omega
         let (dt, _, zeta) = stable_step(4e8, 2.0 * 4.0 * 1e4, 4.0);
         assert!((zeta - 1.0).abs() < 1e-15 && (dt - 2.0 * (2f64.sqrt() - 1.0) / 1e4).abs() < 1e-15);
-        assert!(stable_step(0.0, 1.0, 1.0).0.is_infinite());
+        assert!(stable_step(0.0, 0.0, 1.0).0.is_infinite());
+        // pure damping: 2 m/d
+        assert!((stable_step(0.0, 4.0, 2.0).0 - 1.0).abs() < 1e-15);
+        assert!((stable_step(-5.0, 8.0, 2.0).0 - 0.5).abs() < 1e-15);
     }
 }

@@ -12,9 +12,11 @@ pub mod kinematics;
 pub mod laws;
 pub mod ledger;
 pub mod output;
+pub mod reaction;
 pub mod report;
 pub mod scene;
 pub mod sim;
+pub mod stepper;
 pub mod study;
 pub use error::{Error, Result};
 

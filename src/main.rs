@@ -121,9 +121,12 @@ struct MergeArgs {
 /// The run-settings shortcuts shared by `run` and `sweep` (for a sweep, they hold for every point).
 #[derive(Args, Debug, Clone, Default)]
 struct TimeArgs {
-    /// Step size, s (same as `--set run.dt_s=...`; the largest step with adaptive stepping).
+    /// Fixed step, s (same as `--set run.dt_s=...`).
     #[arg(long)]
     dt: Option<f64>,
+    /// Adaptive steps: the largest step, s (`run.max_dt_s`).
+    #[arg(long)]
+    max_dt: Option<f64>,
     /// Simulated time, s.
     #[arg(long)]
     end: Option<f64>,
@@ -137,6 +140,7 @@ impl TimeArgs {
     fn overrides(&self) -> Vec<String> {
         [
             ("run.dt_s", self.dt),
+            ("run.max_dt_s", self.max_dt),
             ("run.end_s", self.end),
             ("run.output_interval_s", self.output_interval),
         ]

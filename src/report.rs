@@ -23,6 +23,11 @@ pub struct Summary {
     /// No gravity and no fixed body: total momentum must be conserved, and the drift metrics mean
     /// something (with gravity or a ground body they do not).
     pub free_floating: bool,
+    /// The step control in words.
+    pub stepping: String,
+    /// What the run-time guards saw: rejected steps, the deepest penetration against its law's
+    /// validity, steps at the floor, and violations in words (empty when the run stayed valid).
+    pub guards: crate::stepper::GuardReport,
 }
 
 /// Metrics of one twin.
@@ -44,10 +49,11 @@ pub struct TwinSummary {
     pub first_impact_peak_n: Option<f64>,
     /// Largest penetration over all hinges, um.
     pub max_penetration_um: f64,
-    /// Relative drift of total linear momentum.
-    pub linear_momentum_drift: f64,
-    /// Relative drift of total angular momentum.
-    pub angular_momentum_drift: f64,
+    /// Relative drift of total linear momentum (null when the scene is not free-floating: then
+    /// momentum is not conserved and the energy balance in `invariants` is the check).
+    pub linear_momentum_drift: Option<f64>,
+    /// Relative drift of total angular momentum (null when not free-floating).
+    pub angular_momentum_drift: Option<f64>,
     /// Energy invariants.
     pub invariants: Invariants,
     /// Per hinge.
@@ -102,6 +108,8 @@ impl RunResult {
             comparison: self.comparison.clone(),
             free_floating: self.scene.gravity == [0.0; 3]
                 && self.scene.bodies.iter().all(|b| !b.fixed),
+            stepping: self.scene.run.stepping(),
+            guards: self.guards.clone(),
         }
     }
 
@@ -137,7 +145,14 @@ pub fn summary_json(summary: &Summary) -> Result<String> {
         serde_json::to_value(summary).map_err(|e| Error::invalid("summary", e.to_string()))?;
     // serde_json writes a non-finite float as null: a null is allowed only where a metric is
     // legitimately absent (no impact yet, only one twin), so a NaN anywhere else is caught here.
-    const MAY_BE_NULL: [&str; 3] = ["first_impact_t_s", "first_impact_peak_n", "comparison"];
+    const MAY_BE_NULL: [&str; 6] = [
+        "first_impact_t_s",
+        "first_impact_peak_n",
+        "comparison",
+        "linear_momentum_drift",
+        "angular_momentum_drift",
+        "first_invalid_penetration",
+    ];
     fn check(v: &serde_json::Value, key: &str, path: &str, end: f64) -> Result<()> {
         match v {
             serde_json::Value::Null if !MAY_BE_NULL.contains(&key) => Err(Error::Diverged {
@@ -210,16 +225,19 @@ pub fn comparison_table(summary: &Summary) -> String {
         "momentum drift lin/ang".into(),
         twins
             .iter()
-            .map(|(_, t)| {
-                if summary.free_floating {
-                    format!(
-                        "{:.1e}/{:.1e}",
-                        t.linear_momentum_drift, t.angular_momentum_drift
-                    )
-                } else {
-                    "n/a (not free-floating)".to_string()
-                }
-            })
+            .map(
+                |(_, t)| match (t.linear_momentum_drift, t.angular_momentum_drift) {
+                    (Some(l), Some(a)) => format!("{l:.1e}/{a:.1e}"),
+                    _ => "n/a (not free-floating)".to_string(),
+                },
+            )
+            .collect(),
+    ));
+    rows.push((
+        "energy balance growth".into(),
+        twins
+            .iter()
+            .map(|(_, t)| format!("{:.1e}", t.invariants.energy_growth))
             .collect(),
     ));
     let w0 = rows.iter().map(|r| r.0.len()).max().unwrap_or(0);
@@ -234,6 +252,16 @@ pub fn comparison_table(summary: &Summary) -> String {
             s.push_str(&format!("  {v:>16}"));
         }
         s.push('\n');
+    }
+    if summary.guards.is_clean() {
+        s.push_str(&format!(
+            "guards: clean ({} rejected steps, deepest penetration {:.3} of its law's validity)\n",
+            summary.guards.rejected_steps, summary.guards.worst_penetration_ratio
+        ));
+    } else {
+        for v in &summary.guards.violations {
+            s.push_str(&format!("WARNING: {v}\n"));
+        }
     }
     s
 }

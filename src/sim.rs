@@ -4,10 +4,13 @@
 
 use crate::angle::{HingeAngle, UnwrappedAngle, twist_angle};
 use crate::drive::{DriveSet, TorsionSpring};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::joint::{ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet};
+use crate::laws::NormalForceLaw;
 use crate::output::Table;
-use crate::scene::{Scene, StepMode};
+use crate::reaction::{IdealRevolute, ReactionSolver};
+use crate::scene::Scene;
+use crate::stepper::{ForceSource, GuardReport, StepInfo, Stepper};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::*;
 use serde::Serialize;
@@ -63,6 +66,12 @@ struct BodyTrack {
     fixed: bool,
     angle: UnwrappedAngle,
     linvel_before: Vector,
+    /// The user force on the body over the current step (the sources' at the step's start).
+    force_before: Vector,
+    /// Angular velocity, centre of mass and rotation at the state before the current step.
+    angvel_before: Vector,
+    com_before: Vector,
+    rotation_before: rapier3d_f64::math::Rotation,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -81,9 +90,26 @@ struct HingeTrack {
     local_u1: Vector,
     local_v1: Vector,
     angle: HingeAngle,
-    /// Force magnitude acting over the current step, N.
+    /// Force magnitude at the state before the current step (the clearance hook's force, or the
+    /// ideal reaction once the step determined it), N.
     force: f64,
+    /// The clearance contact at the state before the current step.
+    sample: ContactSample,
     metrics: HingeMetrics,
+}
+
+/// What a clearance hinge's hook saw at one state (read before the step it drives).
+#[derive(Clone, Copy, Debug, Default)]
+struct ContactSample {
+    onset: bool,
+    impact: bool,
+    penetration: f64,
+    /// Penetration rate, m/s (positive approaching).
+    rate: f64,
+    /// The damping part of the normal force (total minus elastic), N.
+    damping_force: f64,
+    /// Friction force magnitude, N.
+    friction_force: f64,
 }
 
 /// Per-hinge metrics over every internal step.
@@ -113,6 +139,14 @@ pub struct HingeMetrics {
     force_sq_time: f64,
     #[serde(skip)]
     contact_time: f64,
+    /// Largest apparent restitution of an impact, the separation speed over the approach speed
+    /// (from the first state out of and into contact), over impacts that approached faster than
+    /// 1 mm/s; above 1 a contact gave back more than it took (0 without such an impact).
+    pub max_restitution: f64,
+    #[serde(skip)]
+    onset_rate: f64,
+    #[serde(skip)]
+    was_in_contact: bool,
     /// Final relative angle, deg.
     pub final_angle_deg: f64,
     #[serde(skip)]
@@ -130,34 +164,52 @@ pub struct Twin {
     pub clearance: ClearanceJointSet,
     /// The drives of this twin.
     pub drives: DriveSet,
-    reaction_order: Vec<(usize, usize, f64)>,
-    /// Per body, the momentum change not explained by known forces since the window began, N s.
-    window_impulse: Vec<Vector>,
-    /// Length of the current reaction window, s.
-    window_time: f64,
+    /// The ideal revolute joints, and the hinge index of each.
+    ideal_joints: Vec<IdealRevolute>,
+    ideal_hinges: Vec<usize>,
+    reactions: ReactionSolver,
+    /// Spring and contact elastic energy at the state before the current step, J.
+    source_energy_before: f64,
     reference_axis: Vector,
     /// Output rows.
     pub table: Table,
+    /// Row values at the previous and the current state.
+    row_prev: Vec<f64>,
+    row_cur: Vec<f64>,
+    /// Columns holding a contact flag (taken from the nearer state, not interpolated).
+    contact_columns: Vec<usize>,
     /// Invariants and energy over every step.
     pub invariants: Invariants,
 }
 
-/// Conservation checks over every step (free-floating scenes).
+/// Conservation checks over every step.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Invariants {
-    /// Largest `|P(t) - P(0)|` over the largest single-body linear momentum seen.
-    pub linear_momentum_drift: f64,
-    /// Largest `|L(t) - L(0)|` (about the origin) over the largest single-body angular momentum seen.
-    pub angular_momentum_drift: f64,
-    /// Largest growth of total energy (kinetic + spring + contact elastic) above its initial
-    /// value, over the peak kinetic energy (with gravity, its potential is included).
+    /// Largest `|P(t) - P(0)|` over the largest single-body linear momentum seen; null when the
+    /// scene is not free-floating (gravity or a fixed body: momentum is not conserved).
+    pub linear_momentum_drift: Option<f64>,
+    /// Largest `|L(t) - L(0)|` (about the origin) over the largest single-body angular momentum
+    /// seen; null when the scene is not free-floating.
+    pub angular_momentum_drift: Option<f64>,
+    /// Largest growth of the energy balance `E(t) + D(t) - E(0)` (E: kinetic, gravity, spring and
+    /// contact elastic energy; D: the work dissipated so far by contact damping and friction) over
+    /// the energy scale. Fixed supports and ideal joints do no work, so the balance holds with
+    /// gravity and grounds too, and energy gained by the integration shows even in a run that
+    /// dissipates.
     pub energy_growth: f64,
-    /// Largest `|E(t) - E(0)|` over the peak kinetic energy.
+    /// Largest `|E(t) + D(t) - E(0)|` over the energy scale.
     pub energy_error: f64,
+    /// The energy scale: the larger of the peak kinetic energy and the largest change of the
+    /// potential energy, J.
+    pub energy_scale_j: f64,
     /// Peak kinetic energy, J.
     pub peak_kinetic_energy_j: f64,
+    /// Work dissipated by contact damping and friction over the run, J.
+    pub dissipated_j: f64,
     #[serde(skip)]
-    p0: Option<(Vector, Vector, f64)>,
+    free_floating: bool,
+    #[serde(skip)]
+    p0: Option<(Vector, Vector, f64, f64)>,
     #[serde(skip)]
     max_p: f64,
     #[serde(skip)]
@@ -170,7 +222,16 @@ pub struct Invariants {
     max_de: f64,
     #[serde(skip)]
     max_abs_de: f64,
+    #[serde(skip)]
+    max_dpe: f64,
 }
+
+/// Impacts slower than this (m/s) are not judged by their apparent restitution: at a grazing
+/// approach the separation speed is set by the other forces, not by the contact.
+const RESTITUTION_MIN_SPEED: f64 = 1e-3;
+
+/// Energy growth above this fraction of the energy scale is a guard violation.
+pub const ENERGY_GROWTH_LIMIT: f64 = 1e-2;
 
 /// A scene built in a Rapier world, ready to step.
 pub struct Simulation {
@@ -178,40 +239,20 @@ pub struct Simulation {
     pub world: PhysicsWorld,
     /// The twins, ideal first.
     pub twins: Vec<Twin>,
+    /// The step control (the same public piece a plain-Rapier loop uses).
+    pub stepper: Stepper,
     scene: Scene,
-    steps_done: u64,
-    /// Simulated time: `steps_done * dt` with fixed steps, the sum of the steps otherwise.
-    t: f64,
-    /// The step before the current one (0 before the first).
-    last_dt: f64,
-    /// Fixed steps: the number of steps to `end_s`.
-    n_steps: u64,
-    /// Fixed steps: steps between rows.
-    stride: u64,
-    /// Index of the next output row.
+    /// Index of the next output row (row `k` is at `k * output_interval_s`, the last at `end_s`).
     next_row: u64,
+    /// Time of the previous state (rows between it and the current one are interpolated).
+    t_prev: f64,
+    /// The row at `end_s` is written.
+    rows_done: bool,
     skip_rows: bool,
     comparison: ComparisonSums,
 }
 
-/// With adaptive steps, the ideal reactions are momentum balances over this many largest steps
-/// (2 ms at the defaults): a step-size change leaves a net impulse in one step (Rapier's joint
-/// solver restores the position/velocity staggering of the integrator), which a window spreads;
-/// measured on the paper's scene, the ideal peak is 0.3497 N with a window of 10 steps, 0.3662 N
-/// with 5, against 0.3275 N with fixed steps.
-const ADAPTIVE_REACTION_WINDOW: f64 = 20.0;
-
-/// Smallest adaptive step: below it a contact cannot be resolved in f64 time arithmetic.
-const MIN_ADAPTIVE_DT: f64 = 1e-10;
-
-/// `Some(speed)` when `rb` has left the physical range: disabled by Rapier's quarantine,
-/// non-finite, or faster than half Rapier's speed clamp (Rapier clamps a blown-up body instead of
-/// producing NaN, so a clamped speed is the sign of a silent blow-up).
-pub(crate) fn left_physical_range(rb: &RigidBody, params: &IntegrationParameters) -> Option<f64> {
-    let (v, w) = (rb.linvel(), rb.angvel());
-    let bad = !rb.is_enabled() || !rb.translation().is_finite() || !v.is_finite() || !w.is_finite();
-    (bad || v.length() > 0.5 * params.max_linear_velocity()).then(|| v.length())
-}
+pub use crate::stepper::left_physical_range;
 
 /// The clearance twin against the ideal twin, from every internal step (both twins built).
 #[derive(Clone, Debug, Default, Serialize)]
@@ -335,16 +376,20 @@ pub struct RunResult {
     pub wall_s: f64,
     /// Clearance twin against ideal twin (when both were built).
     pub comparison: Option<Comparison>,
+    /// What the run-time guards saw (the stepper's, plus energy growth).
+    pub guards: GuardReport,
 }
 
 impl Simulation {
     /// Builds the world for `scene`.
     pub fn new(scene: &Scene, options: RunOptions) -> Result<Simulation> {
         scene.validate()?;
+        let control = scene.run.step_control();
+        control.validate().map_err(|e| e.within("run"))?;
         let mut world = PhysicsWorld::new();
         world.gravity = Vector::from(scene.gravity);
         world.integration_parameters.dt = scene.run.dt_s;
-        // One substep: the hook's force is constant over the step (RAPIER_NOTES: substeps gain energy).
+        // One substep: the hook's force is constant over the step (substeps gain energy).
         world.integration_parameters.num_solver_iterations = 1;
         let kinds: &[TwinKind] = match options.twins {
             Twins::Both => &[TwinKind::Ideal, TwinKind::Clearance],
@@ -355,20 +400,17 @@ impl Simulation {
         for &kind in kinds {
             twins.push(Twin::build(scene, kind, &mut world)?);
         }
-        let n_steps = (scene.run.end_s / scene.run.dt_s).round().max(1.0) as u64;
-        let stride = (scene.run.output_interval_s / scene.run.dt_s)
-            .round()
-            .max(1.0) as u64;
+        // Mass properties before the first step (Rapier computes them in it; the reactions and
+        // the hooks need them at the initial state).
+        crate::reaction::prepare_mass_properties(&mut world.bodies);
         Ok(Simulation {
             world,
             twins,
+            stepper: Stepper::new(control),
             scene: scene.clone(),
-            steps_done: 0,
-            t: 0.0,
-            last_dt: 0.0,
-            n_steps,
-            stride,
             next_row: 0,
+            t_prev: 0.0,
+            rows_done: false,
             skip_rows: options.skip_rows,
             comparison: ComparisonSums::default(),
         })
@@ -376,76 +418,48 @@ impl Simulation {
 
     /// Simulated time, s.
     pub fn time(&self) -> f64 {
-        self.t
-    }
-
-    fn adaptive(&self) -> bool {
-        self.scene.run.step == StepMode::Adaptive
+        self.stepper.time()
     }
 
     fn done(&self) -> bool {
-        if self.adaptive() {
-            self.t >= self.scene.run.end_s
-        } else {
-            self.steps_done >= self.n_steps
-        }
+        self.time() >= self.scene.run.end_s
     }
 
-    /// Whether the state at the current time is an output row.
-    fn row_due(&self) -> bool {
+    /// Writes the rows whose times lie in `(t_prev, t]` (and the row at 0 at the first state),
+    /// interpolated between the previous state and the current one: rows sit exactly at
+    /// multiples of `output_interval_s` (and at `end_s`) whatever the steps, and never change them.
+    fn write_rows(&mut self, t: f64) {
         if self.skip_rows {
-            false
-        } else if self.adaptive() {
-            self.t >= self.next_row as f64 * self.scene.run.output_interval_s
-        } else {
-            self.steps_done % self.stride == 0
+            return;
+        }
+        let run = &self.scene.run;
+        let (oi, end) = (run.output_interval_s, run.end_s);
+        // Rounding of summed steps: a row within a billionth of a step counts as reached.
+        let slack = 1e-9 * run.max_dt_s.max(run.dt_s);
+        while !self.rows_done {
+            let grid = self.next_row as f64 * oi;
+            let last = grid >= end - slack;
+            let r = if last { end } else { grid };
+            if r > t + slack {
+                return;
+            }
+            let w = if t > self.t_prev {
+                ((r - self.t_prev) / (t - self.t_prev)).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            for twin in &mut self.twins {
+                twin.write_row(r, w);
+            }
+            self.next_row += 1;
+            self.rows_done = last;
         }
     }
 
-    /// The next step: fixed, or the adaptive choice landing exactly on row times and the end.
-    fn choose_dt(&self) -> f64 {
-        let run = &self.scene.run;
-        if !self.adaptive() {
-            return run.dt_s;
-        }
-        let mut dt = run.dt_s;
-        for twin in &self.twins {
-            dt = dt.min(twin.clearance.adaptive_step(run.tolerance, self.last_dt));
-        }
-        dt = dt.max(MIN_ADAPTIVE_DT);
-        // The nearest target (next row, end): divide what is left into equal steps no larger than
-        // dt, so no sliver step is left before it (Rapier's joints correct their position error
-        // fully each step: a 1e-8 s step turns a tiny error into a velocity kick).
-        let mut target = run.end_s;
-        let row = self.next_row as f64 * run.output_interval_s;
-        if !self.skip_rows && row > self.t {
-            target = target.min(row);
-        }
-        let left = target - self.t;
-        if left > 0.0 {
-            dt = left / (left / dt).ceil();
-        }
-        dt
-    }
-
-    /// Time after a step of `dt`: exact multiples with fixed steps, exact landing on row times and
-    /// the end with adaptive ones.
-    fn advance_time(&self, dt: f64) -> f64 {
-        let run = &self.scene.run;
-        if !self.adaptive() {
-            return (self.steps_done + 1) as f64 * run.dt_s;
-        }
-        let row = self.next_row as f64 * run.output_interval_s;
-        let t = self.t + dt;
-        // Snap to a target reached up to rounding, or the next step would be a sliver of 1e-17 s.
-        let reached = |target: f64| t >= target - 1e-9 * dt;
-        if !self.skip_rows && row > self.t && reached(row) {
-            row
-        } else if reached(run.end_s) {
-            run.end_s
-        } else {
-            t
-        }
+    /// Where the next step may go at most: the end. Rows never shorten a step (a row is the
+    /// first state at or after its time), so the physics is the same for any output interval.
+    fn target(&self) -> f64 {
+        self.scene.run.end_s
     }
 
     /// Runs to `run.end_s`.
@@ -462,7 +476,7 @@ impl Simulation {
             progress(&Progress {
                 t: self.time(),
                 end: self.scene.run.end_s,
-                steps: self.steps_done,
+                steps: self.stepper.steps(),
             });
         }
         self.finish()?;
@@ -470,89 +484,88 @@ impl Simulation {
             [ideal, _] => Some(self.comparison.finish(ideal, self.time())),
             _ => None,
         };
+        let mut guards = self.stepper.guards().clone();
+        for twin in &self.twins {
+            let g = twin.invariants.energy_growth;
+            if g > ENERGY_GROWTH_LIMIT {
+                guards.violation(&format!("energy:{}", twin.kind.name()), || {
+                    format!(
+                        "the {} twin gained energy: {} of its energy scale (limit {})",
+                        twin.kind.name(),
+                        crate::error::sig4(g),
+                        ENERGY_GROWTH_LIMIT
+                    )
+                });
+            }
+        }
+        if self.scene.run.strict && !guards.is_clean() {
+            return Err(crate::Error::Guard {
+                t: self.time(),
+                violations: guards.violations.join("; "),
+            });
+        }
         Ok(RunResult {
             comparison,
             scene: self.scene,
             twins: self.twins,
-            steps: self.steps_done,
+            steps: self.stepper.steps(),
             wall_s: start.elapsed().as_secs_f64(),
+            guards,
         })
     }
 
-    /// Advances one internal step: forces from the hooks, Rapier's step, then records.
+    /// Advances one accepted internal step: records the state before it (invariants, a row when
+    /// due, the contact samples), lets the stepper take it, then completes what only the step
+    /// determines (ideal reactions, metrics).
     pub fn step(&mut self) -> Result<()> {
-        let record = self.row_due();
-        let t = self.time();
-        self.before_step(record)?;
-        let dt = self.choose_dt();
-        for twin in &self.twins {
-            if let Err(mut e) = twin.clearance.check_step(dt) {
-                // Name the scene's field and the time: the set knows neither.
-                if let Error::StepTooLarge { field, t: at, .. } = &mut e {
-                    *field = "run.dt_s".into();
-                    *at = Some(t);
-                }
-                return Err(e);
-            }
+        {
+            // The sources' forces at the first state, before it is read.
+            let mut sources = sources(&mut self.twins);
+            self.stepper.prepare(&mut self.world, &mut sources)?;
         }
-        self.world.integration_parameters.dt = dt;
-        self.world.step();
+        let t = self.time();
         let gravity = self.world.gravity;
-        // Ideal reactions: one step with fixed steps; with adaptive ones a window of 20 largest
-        // steps, over which the impulses of step-size changes average out (see solve_ideal_reactions).
-        let window = if self.adaptive() {
-            ADAPTIVE_REACTION_WINDOW * self.scene.run.dt_s
-        } else {
-            self.scene.run.dt_s
+        let rows = !self.skip_rows;
+        for twin in &mut self.twins {
+            twin.before_step(&self.world.bodies, gravity, t, rows);
+        }
+        self.write_rows(t);
+        self.t_prev = t;
+        let target = self.target();
+        let info = {
+            let mut sources = sources(&mut self.twins);
+            self.stepper
+                .step(&mut self.world, &mut sources, target)
+                .map_err(|e| name_step_field(e, "run.dt_s"))?
         };
         for twin in &mut self.twins {
-            twin.solve_ideal_reactions(&self.world.bodies, dt, gravity, window);
-            twin.update_force_metrics(t, dt);
-            if record {
-                twin.fill_forces_of_last_row();
-            }
+            twin.after_step(&self.world.bodies, &info, gravity);
         }
         if let [ideal, clear] = self.twins.as_slice() {
             self.comparison
-                .record(ideal, clear, &self.world.bodies, t, dt);
-        }
-        self.t = self.advance_time(dt);
-        self.steps_done += 1;
-        self.last_dt = dt;
-        self.check_health()
-    }
-
-    /// Evaluates hooks at the current state and records invariants (and a row).
-    fn before_step(&mut self, record: bool) -> Result<()> {
-        let t = self.time();
-        let params = self.world.integration_parameters;
-        for twin in &mut self.twins {
-            twin.drives.apply(&mut self.world.bodies);
-            twin.clearance.apply_forces(&mut self.world.bodies);
-            twin.clearance.check_substeps(&params)?;
-            for b in &mut twin.bodies {
-                b.linvel_before = self.world.bodies[b.handle].linvel();
-            }
-            twin.update_invariants(&self.world.bodies, self.world.gravity);
-            if record {
-                twin.push_row(t, &self.world.bodies);
-            }
-        }
-        if record {
-            self.next_row += 1;
+                .record(ideal, clear, &self.world.bodies, info.t0, info.dt);
         }
         Ok(())
     }
 
-    /// Records the final state (a last row at `end_s`) and final angles.
+    /// Records the final state: invariants, a last row at `end_s` whose forces are those at that
+    /// state (ideal reactions from one more step, taken and undone), final metrics.
     fn finish(&mut self) -> Result<()> {
-        let record = !self.skip_rows;
-        self.before_step(record)?;
+        {
+            let mut sources = sources(&mut self.twins);
+            self.stepper.prepare(&mut self.world, &mut sources)?;
+        }
+        let t = self.time();
+        let gravity = self.world.gravity;
+        let rows = !self.skip_rows;
+        for twin in &mut self.twins {
+            twin.before_step(&self.world.bodies, gravity, t, rows);
+        }
+        self.write_rows(t);
         let duration = self.time();
         for twin in &mut self.twins {
-            if record {
-                twin.fill_forces_of_last_row();
-            }
+            // The final state counts for peaks and onsets (it carries no time).
+            twin.update_force_metrics(t, 0.0);
             for h in &mut twin.hinges {
                 let m = &mut h.metrics;
                 m.final_angle_deg = h.angle.value().to_degrees();
@@ -564,25 +577,24 @@ impl Simulation {
         }
         Ok(())
     }
+}
 
-    fn check_health(&self) -> Result<()> {
-        for twin in &self.twins {
-            for b in &twin.bodies {
-                let rb = &self.world.bodies[b.handle];
-                if let Some(speed) = left_physical_range(rb, &self.world.integration_parameters) {
-                    return Err(Error::Diverged {
-                        t: self.time(),
-                        reason: format!(
-                            "body `{}` of the {} twin left the physical range (speed {speed:.3e} m/s)",
-                            b.name,
-                            twin.kind.name(),
-                        ),
-                    });
-                }
-            }
-        }
-        Ok(())
+/// The force sources of all twins, for the stepper.
+fn sources(twins: &mut [Twin]) -> Vec<&mut dyn ForceSource> {
+    let mut v: Vec<&mut dyn ForceSource> = Vec::with_capacity(2 * twins.len());
+    for t in twins.iter_mut() {
+        v.push(&mut t.drives);
+        v.push(&mut t.clearance);
     }
+    v
+}
+
+/// Names the scene's step field in a step-limit error (the stepper knows only `dt`).
+fn name_step_field(mut e: crate::Error, name: &str) -> crate::Error {
+    if let crate::Error::StepTooLarge { field, .. } = &mut e {
+        *field = name.into();
+    }
+    e
 }
 
 impl Twin {
@@ -612,6 +624,10 @@ impl Twin {
                 fixed: b.fixed,
                 angle: UnwrappedAngle::default(),
                 linvel_before: Vector::ZERO,
+                force_before: Vector::ZERO,
+                angvel_before: Vector::ZERO,
+                com_before: com,
+                rotation_before: rapier3d_f64::math::Rotation::IDENTITY,
             });
         }
         let mut clearance = ClearanceJointSet::new();
@@ -665,6 +681,7 @@ impl Twin {
                 local_v1: axis.cross(u),
                 angle: HingeAngle::default(),
                 force: 0.0,
+                sample: ContactSample::default(),
                 metrics: HingeMetrics::default(),
             });
         }
@@ -683,8 +700,22 @@ impl Twin {
             .map_err(|e| e.within(&format!("drives[{}]", d.name)))?;
             drives.insert(spring);
         }
-        let fixed: Vec<bool> = bodies.iter().map(|b| b.fixed).collect();
-        let reaction_order = reaction_order(&hinges, &fixed);
+        let (mut ideal_joints, mut ideal_hinges) = (Vec::new(), Vec::new());
+        for (i, h) in hinges.iter().enumerate() {
+            if let HingeJoint::Ideal = h.joint {
+                let hs = &scene.hinges[i];
+                let point = Vector::from(hs.point_m);
+                let com = |k: usize| Vector::from(scene.bodies[k].center_of_mass_m);
+                ideal_joints.push(IdealRevolute {
+                    body1: bodies[h.bearing].handle,
+                    body2: bodies[h.journal].handle,
+                    local_anchor1: point - com(h.bearing),
+                    local_anchor2: point - com(h.journal),
+                    local_axis1: h.local_axis1,
+                });
+                ideal_hinges.push(i);
+            }
+        }
         let mut columns = vec!["t_s".to_string()];
         for b in &bodies {
             columns.push(format!("{}_angle_deg", b.name));
@@ -709,78 +740,134 @@ impl Twin {
             hinges,
             clearance,
             drives,
-            reaction_order,
-            window_impulse: vec![Vector::ZERO; scene.bodies.len()],
-            window_time: 0.0,
+            ideal_joints,
+            ideal_hinges,
+            reactions: ReactionSolver::default(),
+            source_energy_before: 0.0,
             reference_axis: Vector::from(scene.reference_axis).normalize(),
+            contact_columns: columns
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| c.ends_with("_contact"))
+                .map(|(i, _)| i)
+                .collect(),
             table: Table::new(columns),
-            invariants: Invariants::default(),
+            row_prev: Vec::new(),
+            row_cur: Vec::new(),
+            invariants: Invariants {
+                free_floating: scene.gravity == [0.0; 3] && scene.bodies.iter().all(|b| !b.fixed),
+                ..Invariants::default()
+            },
         })
     }
 
-    /// Ideal-joint reactions from the momentum balance of the bodies,
-    /// `F_joint = (m dv - (F_user + m g) dt) / T`, eliminated from the leaves of the joint tree,
-    /// over windows of at least `window` seconds (one step with fixed steps, where it is exact per
-    /// step). With steps of varying size a single step is not enough: Rapier's joint
-    /// stabilisation removes the position error of one step within the next, so impulse moves
-    /// between steps of different length; the smooth ideal reaction is exact over the window.
-    fn solve_ideal_reactions(
-        &mut self,
-        bodies: &RigidBodySet,
-        dt: f64,
-        gravity: Vector,
-        window: f64,
-    ) {
+    /// Reads the state before a step (from the sources' evaluation at it): invariants, the
+    /// clearance samples and forces, the angles, and (with `rows`) the row values of the state.
+    fn before_step(&mut self, bodies: &RigidBodySet, gravity: Vector, t: f64, rows: bool) {
+        let axis_ref = self.reference_axis;
+        for b in &mut self.bodies {
+            let rb = &bodies[b.handle];
+            b.linvel_before = rb.linvel();
+            b.angvel_before = rb.angvel();
+            b.com_before = crate::ledger::world_center_of_mass(rb);
+            b.rotation_before = *rb.rotation();
+            b.force_before = rb.user_force();
+            // Bodies start unrotated: the body's rotation is its rotation since t = 0.
+            b.angle.update(twist_angle(rb.rotation(), axis_ref));
+        }
         for h in &mut self.hinges {
+            let (r1, r2) = (
+                &bodies[self.bodies[h.bearing].handle],
+                &bodies[self.bodies[h.journal].handle],
+            );
+            // Every state, so the unwrapped angle never aliases whatever the output interval.
+            h.angle.update(r1.rotation(), r2.rotation(), h.local_axis1);
             if let HingeJoint::Clearance(c) = h.joint {
-                h.force = self
-                    .clearance
-                    .get(c)
-                    .map_or(0.0, |j| j.report().force.on_journal.length());
+                let j = self.clearance.get(c).expect("handle of this twin");
+                let r = j.report();
+                let f = &r.force;
+                let elastic = j.normal_law().elastic_force(r.state.penetration);
+                h.force = f.on_journal.length();
+                h.sample = ContactSample {
+                    onset: r.onset,
+                    impact: r.impact,
+                    penetration: r.state.penetration,
+                    rate: r.state.penetration_rate,
+                    damping_force: if f.normal_force > 0.0 {
+                        f.normal_force - elastic
+                    } else {
+                        0.0
+                    },
+                    friction_force: f.friction_force,
+                };
             }
         }
-        if self.reaction_order.is_empty() {
-            return;
+        self.solve_ideal_reactions(bodies, gravity);
+        self.source_energy_before = self.drives.potential_energy()
+            + self
+                .clearance
+                .iter()
+                .map(|(_, j)| j.elastic_energy())
+                .sum::<f64>();
+        if rows {
+            std::mem::swap(&mut self.row_prev, &mut self.row_cur);
+            self.fill_row(t, bodies);
         }
-        for (b, impulse) in self.bodies.iter().zip(&mut self.window_impulse) {
-            let rb = &bodies[b.handle];
-            *impulse += b.mass * (rb.linvel() - b.linvel_before)
-                - (rb.user_force() + b.mass * gravity) * dt;
-        }
-        self.window_time += dt;
-        if self.window_time < window * (1.0 - 1e-9) {
-            return; // the hinges keep the last window's reaction
-        }
-        // Eliminate in place on the window's impulses (no allocation per step).
-        let window_time = self.window_time;
-        let residual = &mut self.window_impulse;
-        for r in residual.iter_mut() {
-            *r /= window_time;
-        }
-        for &(hi, body, sign) in &self.reaction_order {
-            let h = &mut self.hinges[hi];
-            // Force on the journal body.
-            let f = sign * residual[body];
-            residual[h.journal] -= f;
-            residual[h.bearing] += f;
-            h.force = f.length();
-        }
-        self.window_impulse.fill(Vector::ZERO);
-        self.window_time = 0.0;
     }
 
+    /// Completes the step that started from the state [`before_step`](Self::before_step) read:
+    /// ideal reactions (which only the step determines), metrics of that state over the step.
+    fn after_step(&mut self, bodies: &RigidBodySet, info: &StepInfo, gravity: Vector) {
+        self.update_force_metrics(info.t0, info.dt);
+        self.update_invariants(bodies, gravity, info);
+        // Work of the step's damping and friction forces over the step's motion: the
+        // penetration change, and the slip at the step's velocity.
+        for h in &self.hinges {
+            if let HingeJoint::Clearance(c) = h.joint {
+                let r = self.clearance.get(c).expect("handle of this twin").report();
+                let sample = &h.sample;
+                if sample.penetration > 0.0 {
+                    self.invariants.dissipated_j += sample.damping_force
+                        * (r.state.penetration - sample.penetration)
+                        + sample.friction_force * r.state.slip.length() * info.dt;
+                }
+            }
+        }
+    }
+
+    /// Ideal-joint reactions at the current state, exact: the constrained rigid-body equations
+    /// solved for the joint forces ([`ReactionSolver`]), whatever the step control.
+    fn solve_ideal_reactions(&mut self, bodies: &RigidBodySet, gravity: Vector) {
+        if self.ideal_joints.is_empty() {
+            return;
+        }
+        if let Some(forces) = self.reactions.solve(bodies, &self.ideal_joints, gravity) {
+            for (&hi, f) in self.ideal_hinges.iter().zip(forces) {
+                self.hinges[hi].force = f.length();
+            }
+        }
+    }
+
+    /// Metrics of the state before the step (its sample and force), weighted by the step.
     fn update_force_metrics(&mut self, t: f64, dt: f64) {
         for h in &mut self.hinges {
             let m = &mut h.metrics;
             m.peak_force_n = m.peak_force_n.max(h.force);
             m.force_sq_time += h.force * h.force * dt;
-            if let HingeJoint::Clearance(c) = h.joint {
-                let r = self.clearance.get(c).expect("handle of this twin").report();
-                let in_contact = r.state.penetration > 0.0;
-                if r.impact {
+            if let HingeJoint::Clearance(_) = h.joint {
+                let sample = h.sample;
+                let in_contact = sample.penetration > 0.0;
+                if sample.impact {
                     m.separated_impacts += 1;
                 }
-                if r.onset {
+                if sample.onset {
+                    m.onset_rate = sample.rate;
+                }
+                if m.was_in_contact && !in_contact && m.onset_rate > RESTITUTION_MIN_SPEED {
+                    m.max_restitution = m.max_restitution.max(-sample.rate / m.onset_rate);
+                }
+                m.was_in_contact = in_contact;
+                if sample.onset {
                     m.impacts += 1;
                     if m.first_impact_t_s.is_none() {
                         m.first_impact_t_s = Some(t);
@@ -796,25 +883,37 @@ impl Twin {
                         m.in_first_contact = false;
                     }
                 }
-                if in_contact {
+                if in_contact && dt > 0.0 {
                     m.contact_steps += 1;
                     m.contact_time += dt;
-                    m.max_penetration_um = m.max_penetration_um.max(r.state.penetration * 1e6);
+                }
+                if in_contact {
+                    m.max_penetration_um = m.max_penetration_um.max(sample.penetration * 1e6);
                 }
             }
         }
     }
 
-    fn update_invariants(&mut self, bodies: &RigidBodySet, gravity: Vector) {
+    /// Momentum and energy at the state before the step just taken, with its synchronous
+    /// velocities: the half-step velocities around it weighted by the steps,
+    /// `(h v_before + h_prev v_after)/(h_prev + h)` (second order, where the stored half-step
+    /// velocities alone would make the energy balance first order).
+    fn update_invariants(&mut self, bodies: &RigidBodySet, gravity: Vector, info: &StepInfo) {
+        let (h, h_prev) = (info.dt, (2.0 * info.kick - info.dt).max(0.0));
+        let sync = |before: Vector, after: Vector| (h * before + h_prev * after) / (h_prev + h);
         let (mut p, mut l, mut ke, mut pe) = (Vector::ZERO, Vector::ZERO, 0.0, 0.0);
         let inv = &mut self.invariants;
         for b in &self.bodies {
+            if b.fixed {
+                continue;
+            }
             let rb = &bodies[b.handle];
-            let com = crate::ledger::world_center_of_mass(rb);
-            let (v, w) = (rb.linvel(), rb.angvel());
+            let com = b.com_before;
+            let v = sync(b.linvel_before, rb.linvel());
+            let w = sync(b.angvel_before, rb.angvel());
             let mp = &rb.mass_properties().local_mprops;
-            // I w in world: R I_principal R^T w (principal frame = body frame here).
-            let rot = *rb.rotation() * mp.principal_inertia_local_frame;
+            // I w in world: R I_principal R^T w.
+            let rot = b.rotation_before * mp.principal_inertia_local_frame;
             let iw = rot * (mp.principal_inertia() * (rot.inverse() * w));
             let pb = b.mass * v;
             let lb = com.cross(pb) + iw;
@@ -825,47 +924,45 @@ impl Twin {
             inv.max_p = inv.max_p.max(pb.length());
             inv.max_l = inv.max_l.max(lb.length());
         }
-        pe += self.drives.potential_energy();
-        pe += self
-            .clearance
-            .iter()
-            .map(|(_, j)| j.elastic_energy())
-            .sum::<f64>();
-        let e = ke + pe;
-        let (p0, l0, e0) = *inv.p0.get_or_insert((p, l, e));
+        pe += self.source_energy_before;
+        let e = ke + pe + inv.dissipated_j;
+        let (p0, l0, e0, pe0) = *inv.p0.get_or_insert((p, l, e, pe));
         inv.max_dp = inv.max_dp.max((p - p0).length());
         inv.max_dl = inv.max_dl.max((l - l0).length());
         inv.max_de = inv.max_de.max(e - e0);
         inv.max_abs_de = inv.max_abs_de.max((e - e0).abs());
+        inv.max_dpe = inv.max_dpe.max((pe - pe0).abs());
         inv.peak_kinetic_energy_j = inv.peak_kinetic_energy_j.max(ke);
+        inv.energy_scale_j = inv.peak_kinetic_energy_j.max(inv.max_dpe);
         let rel = |d: f64, scale: f64| if scale > 0.0 { d / scale } else { 0.0 };
-        inv.linear_momentum_drift = rel(inv.max_dp, inv.max_p);
-        inv.angular_momentum_drift = rel(inv.max_dl, inv.max_l);
-        inv.energy_growth = rel(inv.max_de, inv.peak_kinetic_energy_j);
-        inv.energy_error = rel(inv.max_abs_de, inv.peak_kinetic_energy_j);
+        if inv.free_floating {
+            inv.linear_momentum_drift = Some(rel(inv.max_dp, inv.max_p));
+            inv.angular_momentum_drift = Some(rel(inv.max_dl, inv.max_l));
+        }
+        inv.energy_growth = rel(inv.max_de, inv.energy_scale_j);
+        inv.energy_error = rel(inv.max_abs_de, inv.energy_scale_j);
     }
 
-    fn push_row(&mut self, t: f64, bodies: &RigidBodySet) {
+    /// The row values of the current state into `row_cur`.
+    fn fill_row(&mut self, t: f64, bodies: &RigidBodySet) {
         let axis_ref = self.reference_axis;
-        let v = &mut self.table.values;
+        let v = &mut self.row_cur;
+        v.clear();
         v.push(t);
-        for b in &mut self.bodies {
+        for b in &self.bodies {
             let rb = &bodies[b.handle];
-            // Bodies start unrotated: the body's rotation is its rotation since t = 0.
-            let q = *rb.rotation();
-            v.push(b.angle.update(twist_angle(&q, axis_ref)).to_degrees());
+            v.push(b.angle.value().to_degrees());
             v.push(rb.angvel().dot(axis_ref).to_degrees());
         }
-        for h in &mut self.hinges {
+        for h in &self.hinges {
             let (r1, r2) = (
                 &bodies[self.bodies[h.bearing].handle],
                 &bodies[self.bodies[h.journal].handle],
             );
-            let angle = h.angle.update(r1.rotation(), r2.rotation(), h.local_axis1);
             let axis = *r1.rotation() * h.local_axis1;
-            v.push(angle.to_degrees());
+            v.push(h.angle.value().to_degrees());
             v.push((r2.angvel() - r1.angvel()).dot(axis).to_degrees());
-            v.push(f64::NAN); // force over the step, filled after it
+            v.push(h.force);
             match h.joint {
                 HingeJoint::Clearance(c) => {
                     let r = self.clearance.get(c).expect("handle of this twin").report();
@@ -880,12 +977,24 @@ impl Twin {
         }
     }
 
-    fn fill_forces_of_last_row(&mut self) {
-        let n = self.table.columns.len();
-        let start = self.table.values.len() - n;
-        let first_hinge_col = 1 + 2 * self.bodies.len();
-        for (k, h) in self.hinges.iter().enumerate() {
-            self.table.values[start + first_hinge_col + 7 * k + 2] = h.force;
+    /// Appends the row at time `t`, `w` of the way from the previous state to the current one
+    /// (linear; the contact flag from the nearer state).
+    fn write_row(&mut self, t: f64, w: f64) {
+        let contact_cols = &self.contact_columns;
+        let (prev, cur) = (&self.row_prev, &self.row_cur);
+        let v = &mut self.table.values;
+        v.push(t);
+        for i in 1..cur.len() {
+            let (a, b) = (prev.get(i).copied().unwrap_or(cur[i]), cur[i]);
+            v.push(if w >= 1.0 {
+                b
+            } else if w <= 0.0 {
+                a
+            } else if contact_cols.contains(&i) {
+                if w >= 0.5 { b } else { a }
+            } else {
+                a + (b - a) * w
+            });
         }
     }
 
@@ -921,43 +1030,4 @@ fn in_plane_u(axis: Vector) -> Vector {
         }
     }
     (best - best.dot(axis) * axis).normalize()
-}
-
-/// Elimination order for the ideal-joint reactions: repeatedly take a body with exactly one
-/// unsolved ideal joint; its residual momentum change is that joint's force. Returns
-/// `(hinge, body, sign)` with force on the journal `= sign * residual[body]`. A fixed body's
-/// balance is unknown (the ground supplies any force), so it is never used.
-fn reaction_order(hinges: &[HingeTrack], fixed: &[bool]) -> Vec<(usize, usize, f64)> {
-    let mut unsolved: Vec<usize> = hinges
-        .iter()
-        .enumerate()
-        .filter(|(_, h)| matches!(h.joint, HingeJoint::Ideal))
-        .map(|(i, _)| i)
-        .collect();
-    let mut order = Vec::new();
-    while !unsolved.is_empty() {
-        let count = |b: usize, u: &[usize]| {
-            u.iter()
-                .filter(|&&i| hinges[i].bearing == b || hinges[i].journal == b)
-                .count()
-        };
-        let pick = unsolved.iter().enumerate().find_map(|(k, &i)| {
-            let h = &hinges[i];
-            if !fixed[h.journal] && count(h.journal, &unsolved) == 1 {
-                Some((k, i, h.journal, 1.0))
-            } else if !fixed[h.bearing] && count(h.bearing, &unsolved) == 1 {
-                Some((k, i, h.bearing, -1.0))
-            } else {
-                None
-            }
-        });
-        match pick {
-            Some((k, i, b, s)) => {
-                order.push((i, b, s));
-                unsolved.remove(k);
-            }
-            None => break, // a closed loop: its reactions are not determined by momentum alone
-        }
-    }
-    order
 }

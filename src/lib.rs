@@ -1,5 +1,7 @@
 #![doc = include_str!("../README.md")]
 #![warn(missing_docs)]
+// `!(x > 0.0)` is how this crate rejects NaN along with non-positive values: intended.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 pub mod angle;
 pub mod convert;

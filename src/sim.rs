@@ -1,5 +1,5 @@
 //! The runner: builds a scene twice in one Rapier world, an ideal twin (every hinge a Rapier
-//! revolute joint) and a clearance twin (hinges with clearance become [`ClearanceJoint`]s), steps
+//! revolute joint) and a clearance twin (hinges with clearance become [`ClearanceJoint`](crate::joint::ClearanceJoint)s), steps
 //! both together, and records both.
 
 use crate::angle::{HingeAngle, UnwrappedAngle, twist_angle};
@@ -984,8 +984,8 @@ impl Twin {
         let (prev, cur) = (&self.row_prev, &self.row_cur);
         let v = &mut self.table.values;
         v.push(t);
-        for i in 1..cur.len() {
-            let (a, b) = (prev.get(i).copied().unwrap_or(cur[i]), cur[i]);
+        for (i, &b) in cur.iter().enumerate().skip(1) {
+            let a = prev.get(i).copied().unwrap_or(b);
             v.push(if w >= 1.0 {
                 b
             } else if w <= 0.0 {

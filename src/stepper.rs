@@ -474,13 +474,13 @@ impl Stepper {
             let scale = kick / dt;
             if scale != 1.0 {
                 for b in &self.saved {
-                    if let Some(rb) = world.bodies.get_mut(b.handle) {
-                        if rb.is_dynamic() {
-                            rb.reset_forces(false);
-                            rb.reset_torques(false);
-                            rb.add_force(b.force * scale, false);
-                            rb.add_torque(b.torque * scale, false);
-                        }
+                    if let Some(rb) = world.bodies.get_mut(b.handle)
+                        && rb.is_dynamic()
+                    {
+                        rb.reset_forces(false);
+                        rb.reset_torques(false);
+                        rb.add_force(b.force * scale, false);
+                        rb.add_torque(b.torque * scale, false);
                     }
                 }
                 world.gravity = gravity * scale;
@@ -607,13 +607,13 @@ impl Stepper {
 
     fn restore_forces(&self, world: &mut PhysicsWorld) {
         for b in &self.saved {
-            if let Some(rb) = world.bodies.get_mut(b.handle) {
-                if rb.is_dynamic() {
-                    rb.reset_forces(false);
-                    rb.reset_torques(false);
-                    rb.add_force(b.force, false);
-                    rb.add_torque(b.torque, false);
-                }
+            if let Some(rb) = world.bodies.get_mut(b.handle)
+                && rb.is_dynamic()
+            {
+                rb.reset_forces(false);
+                rb.reset_torques(false);
+                rb.add_force(b.force, false);
+                rb.add_torque(b.torque, false);
             }
         }
     }
@@ -674,17 +674,17 @@ impl Stepper {
         dt: f64,
     ) -> Result<()> {
         for b in &self.saved {
-            if let Some(rb) = world.bodies.get(b.handle) {
-                if let Some(speed) = left_physical_range(rb, &world.integration_parameters) {
-                    return Err(Error::Diverged {
-                        t: self.t,
-                        reason: format!(
-                            "body {:?} left the physical range (speed {} m/s)",
-                            b.handle.into_raw_parts(),
-                            crate::error::sig4(speed)
-                        ),
-                    });
-                }
+            if let Some(rb) = world.bodies.get(b.handle)
+                && let Some(speed) = left_physical_range(rb, &world.integration_parameters)
+            {
+                return Err(Error::Diverged {
+                    t: self.t,
+                    reason: format!(
+                        "body {:?} left the physical range (speed {} m/s)",
+                        b.handle.into_raw_parts(),
+                        crate::error::sig4(speed)
+                    ),
+                });
             }
         }
         let t = self.t + dt;

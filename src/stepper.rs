@@ -176,6 +176,12 @@ impl StepControl {
         }
     }
 
+    /// Sets the adaptive tolerance, the fraction of a contact period one step may cover.
+    pub fn with_tolerance(mut self, tolerance: f64) -> Self {
+        self.tolerance = tolerance;
+        self
+    }
+
     /// Sets the floor of the adaptive step, s.
     pub fn min_dt(mut self, dt: f64) -> Self {
         self.min_dt = dt;

@@ -1,0 +1,381 @@
+//! The public stepper: consistent variable steps, step acceptance, guards, and the numbers they
+//! make trustworthy (agreement with converged fixed steps, independence of the output interval,
+//! exact ideal reactions), on the paper's scene and on a kinematically driven mechanism.
+
+use clearance_joint::convert::Clearance;
+use clearance_joint::error::Error;
+use clearance_joint::joint::ClearanceJointSet;
+use clearance_joint::laws::{BearingGeometry, Hertz, NormalModel};
+use clearance_joint::reaction::{IdealRevolute, ReactionSolver, prepare_mass_properties};
+use clearance_joint::scene::Scene;
+use clearance_joint::sim::{RunOptions, RunResult, Simulation, TwinKind, Twins};
+use clearance_joint::stepper::{StepControl, Stepper};
+use rapier3d_f64::math::Vector;
+use rapier3d_f64::prelude::*;
+
+fn run(overrides: &[&str], twins: Twins, skip_rows: bool) -> RunResult {
+    let scene = Scene::solar_panel().with_overrides(overrides).unwrap();
+    Simulation::new(&scene, RunOptions { twins, skip_rows })
+        .unwrap()
+        .run()
+        .unwrap()
+}
+
+/// The clearance metrics the reports use, of the paper's hinge.
+fn metrics(r: &RunResult) -> (f64, f64, f64, f64, f64) {
+    let twin = r.twin(TwinKind::Clearance).unwrap();
+    let m = &twin.hinge_metrics()["hinge"];
+    (
+        m.first_impact_peak_n.unwrap(),
+        m.impacts as f64,
+        m.contact_fraction,
+        m.rms_force_n,
+        twin.final_angles_deg()["hinge"],
+    )
+}
+
+#[test]
+fn adaptive_steps_converge_to_fine_fixed_steps_and_tightening_never_moves_away() {
+    // 1 s of the paper's scene (the first impact and 49 onsets with a 2e-6 s fixed step).
+    let end = "run.end_s=1";
+    let fine = metrics(&run(
+        &[end, "run.step=Fixed", "run.dt_s=2e-6"],
+        Twins::ClearanceOnly,
+        true,
+    ));
+    let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+    let mut last = [f64::INFINITY; 3];
+    for tol in ["0.03", "0.0075", "0.002"] {
+        let m = metrics(&run(
+            &[end, &format!("run.tolerance={tol}")],
+            Twins::ClearanceOnly,
+            true,
+        ));
+        let err = [rel(m.0, fine.0), rel(m.1, fine.1), rel(m.2, fine.2)];
+        if tol == "0.0075" {
+            // The default: the bounds (peak 1 %, onsets 3 %, contact time 5 %, 0.01 deg).
+            assert!(err[0] < 0.01, "first-impact peak {} vs {}", m.0, fine.0);
+            assert!(err[1] < 0.03, "onsets {} vs {}", m.1, fine.1);
+            assert!(err[2] < 0.05, "contact fraction {} vs {}", m.2, fine.2);
+            assert!((m.4 - fine.4).abs() < 0.01, "angle {} vs {}", m.4, fine.4);
+        }
+        // Tightening the tolerance does not move away (a slack of 1 % of the value for ties).
+        for k in 0..3 {
+            assert!(
+                err[k] <= last[k] + 0.01,
+                "metric {k} at tolerance {tol}: error {} after {}",
+                err[k],
+                last[k]
+            );
+        }
+        last = err;
+    }
+}
+
+#[test]
+fn the_output_interval_never_changes_the_physics() {
+    let a = run(
+        &["run.end_s=1", "run.output_interval_s=1e-4"],
+        Twins::Both,
+        false,
+    );
+    let b = run(
+        &["run.end_s=1", "run.output_interval_s=3.7e-3"],
+        Twins::Both,
+        false,
+    );
+    let c = run(&["run.end_s=1"], Twins::Both, true);
+    assert_eq!(a.steps, b.steps);
+    assert_eq!(a.steps, c.steps);
+    for kind in [TwinKind::Ideal, TwinKind::Clearance] {
+        let (ta, tb, tc) = (
+            a.twin(kind).unwrap(),
+            b.twin(kind).unwrap(),
+            c.twin(kind).unwrap(),
+        );
+        assert_eq!(ta.final_angles_deg(), tb.final_angles_deg());
+        assert_eq!(ta.final_angles_deg(), tc.final_angles_deg());
+        let (ma, mb) = (&ta.hinge_metrics()["hinge"], &tb.hinge_metrics()["hinge"]);
+        assert_eq!(ma.impacts, mb.impacts);
+        assert_eq!(ma.peak_force_n, mb.peak_force_n);
+        assert_eq!(ma.contact_fraction, mb.contact_fraction);
+    }
+    // Rows sit exactly on the grid and at the end, whatever the steps.
+    let t = &b.twin(TwinKind::Clearance).unwrap().table;
+    let times: Vec<f64> = t.values.chunks(t.columns.len()).map(|r| r[0]).collect();
+    assert_eq!(times.len(), 272, "0, 3.7 ms, ..., 999 ms, and 1 s");
+    assert_eq!(times[1], 3.7e-3);
+    assert_eq!(*times.last().unwrap(), 1.0);
+}
+
+#[test]
+fn angles_are_tracked_every_step_whatever_the_rows() {
+    // A fast spin (no spring, 20 times the torque): about 437 deg in 3 s. Rows every second
+    // would alias a per-row unwrapping; skipped rows would leave it at 0.
+    let o = [
+        "drive.stiffness_nm_per_deg=0",
+        "drive.torque_scale=20",
+        "run.end_s=3",
+    ];
+    let sparse = run(
+        &[o[0], o[1], o[2], "run.output_interval_s=1"],
+        Twins::IdealOnly,
+        false,
+    );
+    let dense = run(
+        &[o[0], o[1], o[2], "run.output_interval_s=1e-3"],
+        Twins::IdealOnly,
+        false,
+    );
+    let none = run(&o, Twins::IdealOnly, true);
+    let angle = |r: &RunResult| r.twin(TwinKind::Ideal).unwrap().final_angles_deg()["hinge"];
+    assert!(angle(&dense) > 400.0, "{}", angle(&dense));
+    assert_eq!(angle(&sparse), angle(&dense));
+    assert_eq!(angle(&none), angle(&dense));
+    // The last row is the final state: its angle column equals the final angle.
+    let t = &sparse.twin(TwinKind::Ideal).unwrap().table;
+    let col = t
+        .columns
+        .iter()
+        .position(|c| c == "hinge_angle_deg")
+        .unwrap();
+    assert_eq!(
+        t.values[t.values.len() - t.columns.len() + col],
+        angle(&sparse)
+    );
+}
+
+#[test]
+fn coarse_fixed_steps_give_the_exact_ideal_reaction_at_every_row() {
+    // 5 ms steps over 50 ms: every row's ideal reaction is the reaction at that state (0.25189 N
+    // at rest, from the spring's preload), not a lagging or zero momentum estimate.
+    let r = run(
+        &[
+            "run.step=Fixed",
+            "run.dt_s=5e-3",
+            "run.end_s=0.05",
+            "run.output_interval_s=5e-3",
+        ],
+        Twins::IdealOnly,
+        false,
+    );
+    let t = &r.twin(TwinKind::Ideal).unwrap().table;
+    let col = t.columns.iter().position(|c| c == "hinge_force_n").unwrap();
+    let forces: Vec<f64> = t.values.chunks(t.columns.len()).map(|r| r[col]).collect();
+    assert_eq!(forces.len(), 11);
+    for f in &forces {
+        assert!((f - 0.25189).abs() < 5e-5, "{forces:?}");
+    }
+}
+
+#[test]
+fn an_ideal_mechanism_conserves_energy_under_adaptive_steps() {
+    // The ideal twin has no dissipation: with consistent variable steps its energy (synchronous
+    // velocities) holds to 1e-6 of its scale over 1 s, while the clearance twin's contacts
+    // change the step all the time (a step-size change with plain symplectic Euler kicks
+    // `a (h1 - h0)/2` into the velocity).
+    let r = run(&["run.end_s=1"], Twins::Both, true);
+    let ideal = &r.twin(TwinKind::Ideal).unwrap().invariants;
+    assert!(ideal.energy_error < 1e-6, "{}", ideal.energy_error);
+    let clear = &r.twin(TwinKind::Clearance).unwrap().invariants;
+    assert!(clear.energy_growth < 1e-3, "{}", clear.energy_growth);
+    assert!(r.guards.is_clean(), "{:?}", r.guards);
+}
+
+#[test]
+fn a_fixed_step_never_passes_the_end_and_its_last_step_is_checked() {
+    // A 1 s step asked for a 0.5 s run: the step is shortened to land on 0.5 s, and the contact
+    // it ends in (hundreds of um deep) is refused, never written with exit 0.
+    let scene = Scene::solar_panel()
+        .with_overrides(&["run.step=Fixed", "run.dt_s=1", "run.end_s=0.5"])
+        .unwrap();
+    let e = Simulation::new(&scene, RunOptions::default())
+        .unwrap()
+        .run()
+        .unwrap_err();
+    assert!(
+        matches!(&e, Error::StepTooLarge { field, t: Some(t), .. } if field == "run.dt_s" && *t == 0.0),
+        "{e}"
+    );
+    // A step that divides the run evenly ends exactly at the end.
+    let r = run(
+        &["run.step=Fixed", "run.dt_s=1e-4", "run.end_s=0.01"],
+        Twins::Both,
+        true,
+    );
+    assert_eq!(r.steps, 100);
+}
+
+/// The mechanism: a crank (kinematic, 5000 rpm, 50 mm) drives a rod (0.2 m, 0.5 kg) whose
+/// far end sits in a clearance joint (0.5 mm radial play, steel) on a slider (0.5 kg) guided by
+/// a prismatic joint; no gravity. Returns the world, the clearance set and the slider.
+fn crank_mechanism(clearance: Clearance) -> (PhysicsWorld, ClearanceJointSet, RigidBodyHandle) {
+    let (omega, r, l) = (5000.0 * std::f64::consts::TAU / 60.0, 0.05, 0.2);
+    let mut world = PhysicsWorld::new();
+    world.gravity = Vector::ZERO;
+    world.integration_parameters.num_solver_iterations = 1;
+    let ground = world.bodies.insert(RigidBodyBuilder::fixed());
+    let crank = world
+        .bodies
+        .insert(RigidBodyBuilder::kinematic_velocity_based().angvel(Vector::new(0.0, 0.0, omega)));
+    // At top dead centre the slider is at rest and the rod turns about its slider end.
+    let rod_omega = -omega * r / l;
+    let rod = world.bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(Vector::new(r + 0.5 * l, 0.0, 0.0))
+            .linvel(Vector::new(0.0, -rod_omega * 0.5 * l, 0.0))
+            .angvel(Vector::new(0.0, 0.0, rod_omega))
+            .additional_mass_properties(MassProperties::new(
+                Vector::ZERO,
+                0.5,
+                Vector::new(1e-4, 0.5 * l * l / 12.0, 0.5 * l * l / 12.0),
+            ))
+            .can_sleep(false),
+    );
+    let slider = world.bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(Vector::new(r + l, 0.0, 0.0))
+            .additional_mass_properties(MassProperties::new(Vector::ZERO, 0.5, Vector::splat(1e-3)))
+            .can_sleep(false),
+    );
+    let pin = RevoluteJointBuilder::new(Vector::Z)
+        .local_anchor1(Vector::new(r, 0.0, 0.0))
+        .local_anchor2(Vector::new(-0.5 * l, 0.0, 0.0))
+        .contacts_enabled(false);
+    world.impulse_joints.insert(crank, rod, pin, true);
+    let guide = PrismaticJointBuilder::new(Vector::X)
+        .local_anchor1(Vector::new(r + l, 0.0, 0.0))
+        .contacts_enabled(false);
+    world.impulse_joints.insert(ground, slider, guide, true);
+    let mut joints = ClearanceJointSet::new();
+    let joint = clearance
+        .joint(
+            Vector::ZERO,
+            Vector::new(0.5 * l, 0.0, 0.0),
+            Vector::Z,
+            Vector::Z,
+        )
+        .unwrap();
+    joints.insert(slider, rod, joint, &mut world.impulse_joints);
+    (world, joints, slider)
+}
+
+/// What a crank run saw.
+struct CrankRun {
+    /// Deepest penetration of the first contact, m.
+    first: f64,
+    /// Largest ratio of a contact's depth at its onset state to its deepest point, over contacts
+    /// that began faster than 1 cm/s: a step that crossed the gap blind enters at full depth.
+    onset_ratio: f64,
+    stepper: Stepper,
+}
+
+fn crank_run(control: StepControl, end: f64) -> clearance_joint::Result<CrankRun> {
+    let (mut world, mut joints, _) = crank_mechanism(Clearance::steel(0.010, 0.5e-3, 0.016)?);
+    let mut stepper = Stepper::new(control);
+    let (mut first, mut contacts, mut onset_ratio) = (0.0f64, 0u32, 0.0f64);
+    let (mut onset_depth, mut peak, mut fast) = (0.0, 0.0f64, false);
+    while stepper.time() < end {
+        stepper.step(&mut world, &mut [&mut joints], end)?;
+        let (_, j) = joints.iter().next().unwrap();
+        let r = j.report();
+        let depth = r.state.penetration;
+        if r.onset {
+            contacts += 1;
+            (onset_depth, peak, fast) = (depth, depth, r.state.penetration_rate > 0.01);
+        }
+        if depth > 0.0 {
+            peak = peak.max(depth);
+            if contacts == 1 {
+                first = first.max(depth);
+            }
+        } else if peak > 0.0 {
+            if fast {
+                onset_ratio = onset_ratio.max(onset_depth / peak);
+            }
+            peak = 0.0;
+        }
+    }
+    Ok(CrankRun {
+        first,
+        onset_ratio,
+        stepper,
+    })
+}
+
+#[test]
+fn a_driven_mechanism_at_the_default_step_control_never_enters_deeper_than_allowed() {
+    // Two crank turns at the scene defaults (largest step 1e-3 s, tolerance 0.0075). A resolved
+    // impact enters the wall by about `2 pi tolerance` of its depth at the first state in contact;
+    // a predictor from the gap's acceleration alone once took a full step and went 225 um deep.
+    let control = Scene::solar_panel().run.step_control();
+    let end = 0.024;
+    let run = crank_run(control, end).unwrap();
+    assert!(
+        run.onset_ratio < 0.2,
+        "onset at {} of the depth",
+        run.onset_ratio
+    );
+    assert!(
+        run.stepper.guards().rejected_steps > 0,
+        "the predictor alone sufficed"
+    );
+    assert_eq!(run.stepper.guards().floor_steps, 0);
+    // The first impact agrees with a run resolved 15 times finer.
+    let fine = crank_run(control.with_tolerance(0.0005), end).unwrap();
+    let rel = (run.first - fine.first).abs() / fine.first;
+    assert!(
+        rel < 0.05,
+        "first impact {} um vs {} um",
+        run.first * 1e6,
+        fine.first * 1e6
+    );
+    // The test can fail: a fixed 1e-4 s step crosses the gap blind and is refused.
+    let e = crank_run(StepControl::fixed(1e-4), end).err().unwrap();
+    assert!(matches!(e, Error::StepTooLarge { .. }), "{e}");
+}
+
+#[test]
+fn a_contact_no_step_can_resolve_stops_with_a_named_error() {
+    // A Hertz contact of absurd stiffness: stable only far below the step floor.
+    let geometry = BearingGeometry::from_clearance(0.010, 0.5e-3, 0.016).unwrap();
+    let law = NormalModel::Hertz(Hertz::new(1e30, 1.5).unwrap());
+    let (mut world, mut joints, _) = crank_mechanism(Clearance::new(geometry, law));
+    let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.0075));
+    let e = loop {
+        match stepper.step(&mut world, &mut [&mut joints], 0.05) {
+            Ok(_) => assert!(stepper.time() < 0.05, "never stalled"),
+            Err(e) => break e,
+        }
+    };
+    assert!(matches!(e, Error::Stalled { .. }), "{e}");
+}
+
+#[test]
+fn the_reaction_solver_matches_a_hand_computed_static_load() {
+    // The ideal solar-panel hinge at rest carries the preload's reaction; a 2 kg arm hanging
+    // from a pivot carries its weight: both from the same public solver.
+    let mut bodies = RigidBodySet::new();
+    let base = bodies.insert(RigidBodyBuilder::fixed());
+    let arm = bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(Vector::new(0.0, -0.3, 0.0))
+            .additional_mass_properties(MassProperties::new(
+                Vector::ZERO,
+                2.0,
+                Vector::splat(0.02),
+            )),
+    );
+    prepare_mass_properties(&mut bodies);
+    let j = IdealRevolute {
+        body1: base,
+        body2: arm,
+        local_anchor1: Vector::ZERO,
+        local_anchor2: Vector::new(0.0, 0.3, 0.0),
+        local_axis1: Vector::Z,
+    };
+    let f = ReactionSolver::default()
+        .solve(&bodies, &[j], Vector::new(0.0, -9.81, 0.0))
+        .unwrap()[0];
+    assert!((f - Vector::new(0.0, 19.62, 0.0)).length() < 1e-9, "{f:?}");
+}

@@ -179,7 +179,12 @@ pub fn in_range_open_closed(field: &str, value: f64, lo: f64, hi: f64) -> Result
     if value <= lo || value > hi {
         Err(Error::invalid(
             field,
-            format!("must be in ({}, {}] (got {})", sig4(lo), sig4(hi), sig4(value)),
+            format!(
+                "must be in ({}, {}] (got {})",
+                sig4(lo),
+                sig4(hi),
+                sig4(value)
+            ),
         ))
     } else {
         Ok(value)
@@ -311,8 +316,8 @@ fn step_advice(
              shrinks the step inside contacts; or soften the contact: {soft}.",
             sig4(0.8 * dt_max)
         ),
-        None => format!(
-            "Use a smaller `{field}` or adaptive stepping, or soften the contact: {soft}."
-        ),
+        None => {
+            format!("Use a smaller `{field}` or adaptive stepping, or soften the contact: {soft}.")
+        }
     }
 }

@@ -12,6 +12,7 @@ pub mod kinematics;
 pub mod laws;
 pub mod ledger;
 pub mod output;
+pub mod progress;
 pub mod report;
 pub mod scene;
 pub mod sim;

@@ -231,7 +231,7 @@ pub fn in_range(field: &str, value: f64, lo: f64, hi: f64, unit: &str) -> Result
 }
 
 /// Most characters of quoted input an error message carries.
-pub const MAX_QUOTE: usize = 300;
+pub const MAX_QUOTE: usize = 500;
 
 /// `text` cut to `max` characters, with a note of how much was left out.
 pub fn excerpt(text: &str, max: usize) -> String {

@@ -348,7 +348,7 @@ impl Scene {
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let scene: Scene = ron::from_str(text).map_err(|e| {
             let hint = variant_hint(text, &e.span.end).map_or(String::new(), |h| format!(" ({h})"));
-            Error::parse(origin, format!("{}{hint}", excerpt(&e.to_string(), 200)))
+            Error::parse(origin, format!("{}{hint}", excerpt(&e.to_string(), 300)))
         })?;
         scene.validate()?;
         Ok(scene)

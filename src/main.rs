@@ -235,8 +235,6 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&scene.name));
-    // Before any work: the folder exists, is writable and is ours alone until the set is written.
-    let _lock = DirLock::acquire(&out)?;
     if let Some(budget) = args
         .memory
         .budget()?
@@ -244,6 +242,8 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     {
         MemoryEstimate::of(&scene).check(&scene, 1, budget)?;
     }
+    // Before any work: the folder exists, is writable and is ours alone until the set is written.
+    let _lock = DirLock::acquire(&out)?;
     eprintln!(
         "running `{}`: {}, {} s simulated, ideal and clearance twins",
         scene.name,

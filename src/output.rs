@@ -347,9 +347,11 @@ impl MemoryEstimate {
             crate::scene::StepMode::Fixed => {
                 let steps = (r.end_s / r.dt_s).round().max(1.0);
                 let stride = (r.output_interval_s / r.dt_s).round().max(1.0);
-                (steps / stride).floor() + 2.0
+                (steps / stride + 1e-9).floor() + 2.0
             }
-            crate::scene::StepMode::Adaptive => (r.end_s / r.output_interval_s).floor() + 2.0,
+            crate::scene::StepMode::Adaptive => {
+                (r.end_s / r.output_interval_s + 1e-9).floor() + 2.0
+            }
         };
         let rows = if rows.is_finite() {
             rows.min(u64::MAX as f64 / 1e3) as u64
@@ -378,16 +380,26 @@ impl MemoryEstimate {
         }
         let per_run = budget / concurrent.max(1);
         let fit_rows = per_run.saturating_sub(BASE_BYTES) / (16 * self.values_per_row.max(1));
-        let interval = if fit_rows > 2 {
-            scene.run.end_s / (fit_rows - 2) as f64
+        let advice = if fit_rows > 2 {
+            format!(
+                "use --output-interval {} or larger (or a shorter --end; --max-memory sets the budget)",
+                sig4(round_up_sig(scene.run.end_s / (fit_rows - 2) as f64))
+            )
         } else {
-            f64::INFINITY
+            format!(
+                "that is less than the {} a run needs beyond its rows: raise --max-memory{}",
+                bytes_text(BASE_BYTES),
+                if concurrent > 1 {
+                    " or lower --jobs"
+                } else {
+                    ""
+                }
+            )
         };
         Err(Error::invalid(
             "run.output_interval_s",
             format!(
-                "{} rows of {} values{} would need about {} of memory, more than the {} available{}: \
-                 use --output-interval {} or larger (or a shorter --end; --max-memory sets the budget)",
+                "{} rows of {} values{} would need about {} of memory, more than the {} available{}: {advice}",
                 sig4(self.rows as f64),
                 self.values_per_row,
                 if concurrent > 1 {
@@ -402,7 +414,6 @@ impl MemoryEstimate {
                 } else {
                     ""
                 },
-                sig4(round_up_sig(interval)),
             ),
         ))
     }

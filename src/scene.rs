@@ -1048,8 +1048,14 @@ fn locate<'a>(root: &'a mut serde_json::Value, path: &str) -> Result<&'a mut ser
         .and_then(|f| f.split_once('['))
         .filter(|(l, _)| ["bodies", "hinges", "drives"].contains(l))
     {
-        let start = item(list, name)
-            .ok_or_else(|| unknown(format!("no {} named `{name}`", &list[..list.len() - 1])))?;
+        let start = item(list, name).ok_or_else(|| {
+            let what = match list {
+                "bodies" => "body",
+                "hinges" => "hinge",
+                _ => "drive",
+            };
+            unknown(format!("no {what} named `{name}`"))
+        })?;
         starts.push((format!("{list}[{name}]"), start));
     } else {
         if obj.contains_key(first) {

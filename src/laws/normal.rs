@@ -711,7 +711,10 @@ mod tests {
     #[test]
     fn invalid_parameters_are_named() {
         let err = Hertz::new(-1.0, 1.5).unwrap_err().to_string();
-        assert!(err.contains("stiffness") && err.contains("between 1 and 1e16"), "{err}");
+        assert!(
+            err.contains("stiffness") && err.contains("between 1 and 1e16"),
+            "{err}"
+        );
         let err = HuntCrossley::new(1.0, 1.5, 1.5).unwrap_err().to_string();
         assert!(err.contains("restitution"), "{err}");
         let err = ImprovedLiu::new(1e11, 0.01, f64::NAN, 1.0, 1e-4, MaxDamping::Eta(0.01))

@@ -704,7 +704,7 @@ fn unit(v: &[f64; 3], field: &str) -> Result<()> {
     if (n - 1.0).abs() > 1e-6 {
         return Err(Error::invalid(
             field,
-            format!("must be a unit vector (length {n})"),
+            format!("must be a unit vector (length {})", sig4(n)),
         ));
     }
     Ok(())

@@ -77,9 +77,7 @@ impl RunProgress {
             Mode::Bar => {
                 let bar = self.bar.get_or_insert_with(|| {
                     let b = ProgressBar::new(1000);
-                    if let Ok(style) =
-                        ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {msg}")
-                    {
+                    if let Ok(style) = ProgressStyle::with_template("[{bar:20}] {msg}") {
                         b.set_style(style.progress_chars("=> "));
                     }
                     b
@@ -111,8 +109,8 @@ impl RunProgress {
     }
 }
 
-/// `t = 12.5 of 100 s (12.5 %), 1.2e6 steps, 4.1e5 steps/s, ETA 3 min 2 s`: the ETA from the
-/// simulated time covered per wall second so far.
+/// `t = 12.5/100 s (12.5 %), 4.1e5 steps/s, ETA 3 min 2 s`: the ETA from the simulated time
+/// covered per wall second so far (short enough for an 80-column terminal with the bar).
 pub fn status(p: &Progress, elapsed_s: f64) -> String {
     use crate::error::sig4;
     let rate = p.steps as f64 / elapsed_s.max(1e-9);
@@ -123,11 +121,10 @@ pub fn status(p: &Progress, elapsed_s: f64) -> String {
         "unknown".into()
     };
     format!(
-        "t = {} of {} s ({} %), {} steps, {} steps/s, ETA {eta}",
+        "t = {}/{} s ({} %), {} steps/s, ETA {eta}",
         sig4(p.t),
         sig4(p.end),
         sig4(100.0 * p.t / p.end),
-        sig4(p.steps as f64),
         sig4(rate)
     )
 }

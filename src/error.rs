@@ -30,7 +30,7 @@ pub enum Error {
         "`{field}` = {} s is too large for the contact of hinge `{hinge}`{at}: the explicit step is \
          stable only below {} s there (penetration {} um, natural frequency {} rad/s, damping ratio {}). {}",
         sig4(*dt), sig4(*dt_max), sig4(*penetration_um), sig4(*omega), sig4(*zeta),
-        step_advice(field, hinge, law, *dt_max, *zeta, *adaptive),
+        step_advice(field, hinge, *law, *dt_max, *zeta, *adaptive),
         at = t.map_or(String::new(), |t| format!(" at t = {} s", sig4(t)))
     )]
     StepTooLarge {
@@ -50,9 +50,8 @@ pub enum Error {
         omega: f64,
         /// Linearised damping ratio of the contact.
         zeta: f64,
-        /// The contact law's name as written in scenes (`ImprovedLiu`, `Hertz`, ...): it tells
-        /// which parameter sets the stiffness and the damping.
-        law: &'static str,
+        /// The contact law: it tells which parameter sets the stiffness and the damping.
+        law: crate::laws::LawKind,
         /// Whether the step was adaptive (`Some(true)`), fixed (`Some(false)`) or unknown to the
         /// code that raised the error (`None`); see [`Error::with_step_mode`].
         adaptive: Option<bool>,
@@ -276,20 +275,20 @@ pub fn sig4(x: f64) -> String {
 
 /// The contact parameter that sets a contact's stiffness (or, when it is over-damped, its
 /// damping), as a scene path under `hinges[<hinge>].clearance`.
-fn stiff_field(hinge: &str, law: &str, zeta: f64) -> String {
+fn stiff_field(hinge: &str, law: crate::laws::LawKind, zeta: f64) -> String {
+    use crate::laws::LawKind as L;
     let p = format!("hinges[{hinge}].clearance");
     let damped = zeta > 1.0;
     match law {
-        "ImprovedLiu" if damped => format!("`{p}.contact.eta_s` (or `d_max_n_s_per_m`)"),
-        "KelvinVoigt" if damped => format!("`{p}.contact.damping`"),
-        "HuntCrossley" | "LankaraniNikravesh" | "FloresEtAl" | "GonthierEtAl" if damped => {
+        L::ImprovedLiu if damped => format!("`{p}.contact.eta_s` (or `d_max_n_s_per_m`)"),
+        L::KelvinVoigt if damped => format!("`{p}.contact.damping`"),
+        L::HuntCrossley | L::LankaraniNikravesh | L::FloresEtAl | L::GonthierEtAl if damped => {
             format!("`{p}.contact.restitution` (a lower restitution damps harder)")
         }
-        "ImprovedLiu" | "LiuEtAl" => format!(
+        L::ImprovedLiu | L::LiuEtAl => format!(
             "`{p}.bearing_material.youngs_modulus_pa`, `{p}.journal_material.youngs_modulus_pa` and \
              `{p}.width_mm` (the law's stiffness is (pi/2) E* L)"
         ),
-        "" => format!("`{p}.contact`"),
         _ => format!(
             "`{p}.contact.stiffness` (or the materials' `youngs_modulus_pa` when the stiffness is left to the geometry)"
         ),
@@ -300,7 +299,7 @@ fn stiff_field(hinge: &str, law: &str, zeta: f64) -> String {
 fn step_advice(
     field: &str,
     hinge: &str,
-    law: &str,
+    law: crate::laws::LawKind,
     dt_max: f64,
     zeta: f64,
     adaptive: Option<bool>,

@@ -3,6 +3,7 @@
 //! memory, too many threads) leave no mixed, partial or stale files.
 
 use clearance_joint::Error;
+use clearance_joint::laws::LawKind;
 use clearance_joint::output::{MemoryEstimate, clean_stale_temps, write_all_atomic};
 use clearance_joint::progress::{RunProgress, status};
 use clearance_joint::scene::{SOLAR_PANEL_RON, Scene};
@@ -54,7 +55,6 @@ fn edited(from: &str, to: &str) -> String {
 
 const IMPROVED: &str = "contact: ImprovedLiu(exponent: 1.0, delta_max_mm: 0.1, eta_s: 0.01)";
 const DRY: &str = "friction: Dry";
-const PANEL: &str = "(name: \"panel\", mass_kg: 7.68, inertia_kg_m2: (1.6137, 0.4156, 2.0293), center_of_mass_m: (0.4, 0.0, 0.0))";
 
 /// A bad input, as a scene-file edit or as `--set` overrides.
 enum Bad {
@@ -427,7 +427,7 @@ fn names_paths_fixed_bodies_and_warnings() {
 /// the stiffness (or the damping) and gives advice fitting the step mode.
 #[test]
 fn step_limit_messages() {
-    let error = |law: &'static str, zeta: f64, adaptive: Option<bool>| Error::StepTooLarge {
+    let error = |law: LawKind, zeta: f64, adaptive: Option<bool>| Error::StepTooLarge {
         field: "run.dt_s".into(),
         hinge: "hinge".into(),
         dt: 1e-3,
@@ -442,35 +442,35 @@ fn step_limit_messages() {
     let p = "hinges[hinge].clearance";
     let cases = [
         (
-            "ImprovedLiu",
+            LawKind::ImprovedLiu,
             0.1234567890123,
             Some(false),
             format!("{p}.bearing_material.youngs_modulus_pa"),
             "--set run.step=Adaptive",
         ),
         (
-            "ImprovedLiu",
+            LawKind::ImprovedLiu,
             4.2,
             Some(false),
             format!("{p}.contact.eta_s"),
             "below 1.05e-4 s",
         ),
         (
-            "Hertz",
+            LawKind::Hertz,
             0.0,
             Some(true),
             format!("{p}.contact.stiffness"),
             "Adaptive stepping is on",
         ),
         (
-            "KelvinVoigt",
+            LawKind::KelvinVoigt,
             3.0,
             Some(true),
             format!("{p}.contact.damping"),
             "too stiff (or too damped)",
         ),
         (
-            "HuntCrossley",
+            LawKind::HuntCrossley,
             0.3,
             None,
             format!("{p}.contact.stiffness"),
@@ -480,7 +480,7 @@ fn step_limit_messages() {
     for (law, zeta, adaptive, field, advice) in cases {
         let e = error(law, zeta, adaptive).to_string();
         assert!(e.contains("1.312e-4 s") && e.contains("t = 0.088 s"), "{e}");
-        assert!(e.contains(&field) && e.contains(advice), "{law}: {e}");
+        assert!(e.contains(&field) && e.contains(advice), "{law:?}: {e}");
         assert!(longest_digit_run(&e) <= 5, "{e}");
         if adaptive == Some(true) {
             assert!(!e.contains("run.step=Adaptive"), "{e}");

@@ -65,7 +65,7 @@ pub trait NormalForceLaw {
 /// every step: a fixed-point iteration on the local power law `F = C delta^p` through the current
 /// estimate (exact for Hertz-type laws, within a few per cent for Liu's), starting from `guess`.
 pub fn penetration_for_energy(law: &impl NormalForceLaw, energy: f64, guess: f64) -> f64 {
-    if !(energy > 0.0) {
+    if energy.is_nan() || energy <= 0.0 {
         return 0.0;
     }
     let mut d = if guess > 0.0 && guess.is_finite() {
@@ -98,7 +98,7 @@ fn gauss_legendre_16(f: impl Fn(f64) -> f64) -> f64 {
         0.2816035507792589,
         0.4580167776572274,
         0.6178762444026438,
-        0.7554044083550030,
+        0.755404408355003,
         0.8656312023878318,
         0.9445750230732326,
         0.9894009349916499,
@@ -564,15 +564,57 @@ impl NormalForceLaw for NormalModel {
 impl NormalModel {
     /// The law's name as written in scene files.
     pub fn name(&self) -> &'static str {
+        self.kind().name()
+    }
+
+    /// Which law this is, without its parameters.
+    pub fn kind(&self) -> LawKind {
         match self {
-            NormalModel::Hertz(_) => "Hertz",
-            NormalModel::KelvinVoigt(_) => "KelvinVoigt",
-            NormalModel::HuntCrossley(_) => "HuntCrossley",
-            NormalModel::LankaraniNikravesh(_) => "LankaraniNikravesh",
-            NormalModel::FloresEtAl(_) => "FloresEtAl",
-            NormalModel::GonthierEtAl(_) => "GonthierEtAl",
-            NormalModel::LiuEtAl(_) => "LiuEtAl",
-            NormalModel::ImprovedLiu(_) => "ImprovedLiu",
+            NormalModel::Hertz(_) => LawKind::Hertz,
+            NormalModel::KelvinVoigt(_) => LawKind::KelvinVoigt,
+            NormalModel::HuntCrossley(_) => LawKind::HuntCrossley,
+            NormalModel::LankaraniNikravesh(_) => LawKind::LankaraniNikravesh,
+            NormalModel::FloresEtAl(_) => LawKind::FloresEtAl,
+            NormalModel::GonthierEtAl(_) => LawKind::GonthierEtAl,
+            NormalModel::LiuEtAl(_) => LawKind::LiuEtAl,
+            NormalModel::ImprovedLiu(_) => LawKind::ImprovedLiu,
+        }
+    }
+}
+
+/// A normal law's kind, without parameters (one byte: it travels in errors).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LawKind {
+    /// [`Hertz`].
+    Hertz,
+    /// [`KelvinVoigt`].
+    KelvinVoigt,
+    /// [`HuntCrossley`].
+    HuntCrossley,
+    /// [`LankaraniNikravesh`].
+    LankaraniNikravesh,
+    /// [`FloresEtAl`].
+    FloresEtAl,
+    /// [`GonthierEtAl`].
+    GonthierEtAl,
+    /// [`LiuEtAl`].
+    LiuEtAl,
+    /// [`ImprovedLiu`].
+    ImprovedLiu,
+}
+
+impl LawKind {
+    /// The name as written in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            LawKind::Hertz => "Hertz",
+            LawKind::KelvinVoigt => "KelvinVoigt",
+            LawKind::HuntCrossley => "HuntCrossley",
+            LawKind::LankaraniNikravesh => "LankaraniNikravesh",
+            LawKind::FloresEtAl => "FloresEtAl",
+            LawKind::GonthierEtAl => "GonthierEtAl",
+            LawKind::LiuEtAl => "LiuEtAl",
+            LawKind::ImprovedLiu => "ImprovedLiu",
         }
     }
 }

@@ -79,8 +79,7 @@ fn run(overrides: &[String]) -> Result<Outcome, String> {
 /// over the first impacts (um).
 fn errors(o: &Outcome, reference: &Outcome) -> [f64; 8] {
     let mut e = [0.0; 8];
-    for k in 0..7 {
-        let (a, b) = (o.values[k], reference.values[k]);
+    for (k, (a, b)) in o.values.iter().zip(&reference.values).enumerate() {
         e[k] = if k == 1 || k == 2 {
             (a - b).abs()
         } else {

@@ -23,12 +23,15 @@ pub enum Error {
         reason: String,
     },
     /// The time step is too large for the stiffness (and damping) of a contact: the explicit
-    /// integration would blow up. Raised before the state is destroyed, never silently.
+    /// integration would blow up. Raised before the state is destroyed, never silently. The
+    /// message names the contact parameter that makes the contact this stiff and gives advice
+    /// fitting the step mode (when the caller knows it, see [`Error::with_step_mode`]).
     #[error(
-        "`{field}` = {dt:e} s is too large for the contact stiffness of hinge `{hinge}`{at} \
-         (penetration {penetration_um:.3} um, natural frequency {omega:.4e} rad/s, damping ratio {zeta:.3}): \
-         the explicit step is stable only below {dt_max:e} s; use a smaller step or adaptive stepping",
-        at = t.map_or(String::new(), |t| format!(" at t = {t:.6} s"))
+        "`{field}` = {} s is too large for the contact of hinge `{hinge}`{at}: the explicit step is \
+         stable only below {} s there (penetration {} um, natural frequency {} rad/s, damping ratio {}). {}",
+        sig4(*dt), sig4(*dt_max), sig4(*penetration_um), sig4(*omega), sig4(*zeta),
+        step_advice(field, hinge, *law, *dt_max, *zeta, *adaptive),
+        at = t.map_or(String::new(), |t| format!(" at t = {} s", sig4(t)))
     )]
     StepTooLarge {
         /// The parameter that sets the step (`run.dt_s`).
@@ -47,6 +50,11 @@ pub enum Error {
         omega: f64,
         /// Linearised damping ratio of the contact.
         zeta: f64,
+        /// The contact law: it tells which parameter sets the stiffness and the damping.
+        law: crate::laws::LawKind,
+        /// Whether the step was adaptive (`Some(true)`), fixed (`Some(false)`) or unknown to the
+        /// code that raised the error (`None`); see [`Error::with_step_mode`].
+        adaptive: Option<bool>,
     },
     /// The simulation state became non-physical (non-finite, or energy/momentum destroyed).
     #[error("simulation diverged at t = {t:.6} s: {reason}")]
@@ -98,6 +106,24 @@ impl Error {
         }
     }
 
+    /// An [`Error::Parse`] for `what` with `reason`, each cut to [`MAX_QUOTE`] characters: a
+    /// parser may quote the offending input, which can be a whole file of garbage.
+    pub fn parse(what: impl AsRef<str>, reason: impl AsRef<str>) -> Self {
+        Error::Parse {
+            what: excerpt(what.as_ref(), MAX_QUOTE),
+            reason: excerpt(reason.as_ref(), MAX_QUOTE),
+        }
+    }
+
+    /// Tells an [`Error::StepTooLarge`] whether the step was adaptive, so its message gives the
+    /// advice that fits the mode; other variants pass through.
+    pub fn with_step_mode(mut self, is_adaptive: bool) -> Self {
+        if let Error::StepTooLarge { adaptive, .. } = &mut self {
+            *adaptive = Some(is_adaptive);
+        }
+        self
+    }
+
     /// Prefixes the field path of an [`Error::Invalid`] with `prefix` (`prefix.field`);
     /// other variants pass through. Used when a nested value is validated in context.
     pub fn within(self, prefix: &str) -> Self {
@@ -118,10 +144,13 @@ pub fn positive(field: &str, value: f64) -> Result<f64> {
     } else if !value.is_finite() {
         Err(Error::invalid(
             field,
-            format!("must be finite (got {value})"),
+            format!("must be finite (got {})", sig4(value)),
         ))
     } else if value <= 0.0 {
-        Err(Error::invalid(field, format!("must be > 0 (got {value})")))
+        Err(Error::invalid(
+            field,
+            format!("must be > 0 (got {})", sig4(value)),
+        ))
     } else {
         Ok(value)
     }
@@ -134,10 +163,13 @@ pub fn non_negative(field: &str, value: f64) -> Result<f64> {
     } else if !value.is_finite() {
         Err(Error::invalid(
             field,
-            format!("must be finite (got {value})"),
+            format!("must be finite (got {})", sig4(value)),
         ))
     } else if value < 0.0 {
-        Err(Error::invalid(field, format!("must be >= 0 (got {value})")))
+        Err(Error::invalid(
+            field,
+            format!("must be >= 0 (got {})", sig4(value)),
+        ))
     } else {
         Ok(value)
     }
@@ -150,7 +182,7 @@ pub fn finite(field: &str, value: f64) -> Result<f64> {
     } else if !value.is_finite() {
         Err(Error::invalid(
             field,
-            format!("must be finite (got {value})"),
+            format!("must be finite (got {})", sig4(value)),
         ))
     } else {
         Ok(value)
@@ -163,7 +195,12 @@ pub fn in_range_open_closed(field: &str, value: f64, lo: f64, hi: f64) -> Result
     if value <= lo || value > hi {
         Err(Error::invalid(
             field,
-            format!("must be in ({lo}, {hi}] (got {value})"),
+            format!(
+                "must be in ({}, {}] (got {})",
+                sig4(lo),
+                sig4(hi),
+                sig4(value)
+            ),
         ))
     } else {
         Ok(value)
@@ -185,21 +222,118 @@ pub fn unit_vector(
     Ok(v / n)
 }
 
-/// `x` with 4 significant digits, in plain or scientific notation as fits (for messages).
+/// Checks that `value` lies in its physical range `[lo, hi]` (`unit` is appended to the bounds
+/// in the message). A value far outside (an exponent of 1e300) is a typo, and refusing it at
+/// load beats a run that crawls at its smallest step or blames a body for leaving its range.
+pub fn in_range(field: &str, value: f64, lo: f64, hi: f64, unit: &str) -> Result<f64> {
+    finite(field, value)?;
+    if value < lo || value > hi {
+        let unit = if unit.is_empty() {
+            String::new()
+        } else {
+            format!(" {unit}")
+        };
+        return Err(Error::invalid(
+            field,
+            format!(
+                "must be between {} and {}{unit} (got {}): outside the physical range this crate accepts",
+                sig4(lo),
+                sig4(hi),
+                sig4(value)
+            ),
+        ));
+    }
+    Ok(value)
+}
+
+/// Most characters of quoted input an error message carries.
+pub const MAX_QUOTE: usize = 500;
+
+/// `text` cut to `max` characters, with a note of how much was left out.
+pub fn excerpt(text: &str, max: usize) -> String {
+    match text.char_indices().nth(max) {
+        None => text.to_string(),
+        Some((cut, _)) => format!(
+            "{}... ({} more characters)",
+            &text[..cut],
+            text[cut..].chars().count()
+        ),
+    }
+}
+
+/// A number with 4 significant digits for messages: plain between 1e-3 and 1e5 (`0.0875`,
+/// `182`), scientific otherwise (`1.312e-4`), trailing zeros dropped.
 pub fn sig4(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() {
+    if x == 0.0 {
+        return "0".into();
+    }
+    if !x.is_finite() {
         return format!("{x}");
     }
     let a = x.abs();
-    if (1e-3..1e5).contains(&a) {
-        let decimals = (3 - a.log10().floor() as i32).max(0) as usize;
-        let s = format!("{x:.decimals$}");
-        if s.contains('.') {
-            s.trim_end_matches('0').trim_end_matches('.').to_string()
+    let trim = |m: &str| -> String {
+        if m.contains('.') {
+            m.trim_end_matches('0').trim_end_matches('.').to_string()
         } else {
-            s
+            m.to_string()
         }
+    };
+    if (1e-3..1e5).contains(&a) {
+        let decimals = (3 - a.log10().floor() as i32).clamp(0, 6) as usize;
+        trim(&format!("{x:.decimals$}"))
     } else {
-        format!("{x:.3e}")
+        let s = format!("{x:.3e}");
+        match s.split_once('e') {
+            Some((m, e)) => format!("{}e{e}", trim(m)),
+            None => s,
+        }
+    }
+}
+
+/// The contact parameter that sets a contact's stiffness (or, when it is over-damped, its
+/// damping), as a scene path under `hinges[<hinge>].clearance`.
+fn stiff_field(hinge: &str, law: crate::laws::LawKind, zeta: f64) -> String {
+    use crate::laws::LawKind as L;
+    let p = format!("hinges[{hinge}].clearance");
+    let damped = zeta > 1.0;
+    match law {
+        L::ImprovedLiu if damped => format!("`{p}.contact.eta_s` (or `d_max_n_s_per_m`)"),
+        L::KelvinVoigt if damped => format!("`{p}.contact.damping`"),
+        L::HuntCrossley | L::LankaraniNikravesh | L::FloresEtAl | L::GonthierEtAl if damped => {
+            format!("`{p}.contact.restitution` (a lower restitution damps harder)")
+        }
+        L::ImprovedLiu | L::LiuEtAl => format!(
+            "`{p}.bearing_material.youngs_modulus_pa`, `{p}.journal_material.youngs_modulus_pa` and \
+             `{p}.width_mm` (the law's stiffness is (pi/2) E* L)"
+        ),
+        _ => format!(
+            "`{p}.contact.stiffness` (or the materials' `youngs_modulus_pa` when the stiffness is left to the geometry)"
+        ),
+    }
+}
+
+/// What to do about a step beyond a contact's stability limit, fitting the step mode.
+fn step_advice(
+    field: &str,
+    hinge: &str,
+    law: crate::laws::LawKind,
+    dt_max: f64,
+    zeta: f64,
+    adaptive: Option<bool>,
+) -> String {
+    let soft = stiff_field(hinge, law, zeta);
+    match adaptive {
+        Some(true) => format!(
+            "Adaptive stepping is on and this is already its smallest step: no step the runner takes \
+             resolves this contact. It is too stiff (or too damped) for the bodies' masses: check {soft}."
+        ),
+        Some(false) => format!(
+            "Use `{field}` below {} s (`--dt`), or adaptive stepping (`--set run.step=Adaptive`), which \
+             shrinks the step inside contacts; or soften the contact: {soft}.",
+            sig4(0.8 * dt_max)
+        ),
+        None => {
+            format!("Use a smaller `{field}` or adaptive stepping, or soften the contact: {soft}.")
+        }
     }
 }

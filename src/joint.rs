@@ -752,6 +752,8 @@ impl ClearanceJointSet {
                     penetration_um: r.state.penetration * 1e6,
                     omega: r.omega,
                     zeta: r.zeta,
+                    law: j.normal_law.kind(),
+                    adaptive: None,
                 });
             }
         }

@@ -14,6 +14,7 @@ pub mod kinematics;
 pub mod laws;
 pub mod ledger;
 pub mod output;
+pub mod progress;
 pub mod reaction;
 pub mod report;
 pub mod scene;

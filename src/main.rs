@@ -1,8 +1,10 @@
 //! Command-line front end: parses arguments, runs, prints. The work is in the library.
 
 use clap::{Args, Parser, Subcommand};
+use clearance_joint::output::{DirLock, MemoryEstimate};
+use clearance_joint::progress::RunProgress;
 use clearance_joint::report::comparison_table;
-use clearance_joint::scene::Scene;
+use clearance_joint::scene::{Scene, StepMode};
 use clearance_joint::sim::{RunOptions, Simulation};
 use clearance_joint::study::sweep::{self, ExecOptions, MetricsTable, Progress, Sweep};
 use clearance_joint::study::{Axis, Grid, Shard, StudyKind, StudyOptions, run_studies};
@@ -35,9 +37,11 @@ enum Command {
 /// Parallelism and progress, shared by `sweep` and `study`.
 #[derive(Args, Debug, Clone, Default)]
 struct ExecArgs {
-    /// Worker threads; default one per core (or RAYON_NUM_THREADS).
+    /// Worker threads; default one per core (or RAYON_NUM_THREADS), at most one per core.
     #[arg(long)]
     jobs: Option<usize>,
+    #[command(flatten)]
+    memory: MemoryArgs,
     /// Recompute every point, even those finished by an earlier run.
     #[arg(long)]
     rerun: bool,
@@ -47,17 +51,55 @@ struct ExecArgs {
 }
 
 impl ExecArgs {
-    fn options(&self) -> ExecOptions {
-        ExecOptions {
-            progress: match self.progress.as_str() {
-                "bar" => Progress::Bar,
-                "lines" => Progress::Lines,
-                "quiet" => Progress::Quiet,
-                _ => Progress::Auto,
-            },
-            threads: self.jobs,
-            rerun: self.rerun,
+    /// The options, with the thread count capped at the cores (saying so) and used for the
+    /// global pool too (figures), so no setting spawns thousands of threads.
+    fn options(&self) -> clearance_joint::Result<ExecOptions> {
+        let requested = self.jobs.or_else(|| {
+            std::env::var("RAYON_NUM_THREADS")
+                .ok()
+                .and_then(|v| v.trim().parse().ok())
+                .filter(|&n: &usize| n > 0)
+        });
+        let (threads, note) = sweep::thread_count(requested)?;
+        if let Some(note) = note {
+            eprintln!("note: {note}");
         }
+        let _ = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build_global();
+        Ok(ExecOptions {
+            progress: progress_mode(&self.progress),
+            threads: Some(threads),
+            rerun: self.rerun,
+            max_memory: self.memory.budget()?,
+        })
+    }
+}
+
+fn progress_mode(name: &str) -> Progress {
+    match name {
+        "bar" => Progress::Bar,
+        "lines" => Progress::Lines,
+        "quiet" => Progress::Quiet,
+        _ => Progress::Auto,
+    }
+}
+
+/// The memory budget, shared by every command that runs.
+#[derive(Args, Debug, Clone, Default)]
+struct MemoryArgs {
+    /// Memory the runs may hold (e.g. 4G, 512M, 2GiB); default 80 % of what the system has
+    /// available. A run that would need more is refused before it starts.
+    #[arg(long, value_name = "SIZE")]
+    max_memory: Option<String>,
+}
+
+impl MemoryArgs {
+    fn budget(&self) -> clearance_joint::Result<Option<u64>> {
+        self.max_memory
+            .as_deref()
+            .map(clearance_joint::output::parse_bytes)
+            .transpose()
     }
 }
 
@@ -116,22 +158,26 @@ struct MergeArgs {
     /// Folder for the merged `metrics.csv` and `metrics.json`; default: the first input folder.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// With points missing (a shard not run), write `metrics.incomplete.{csv,json}` listing
+    /// them instead of refusing; `metrics.csv` is only ever written for a whole grid.
+    #[arg(long)]
+    incomplete: bool,
 }
 
 /// The run-settings shortcuts shared by `run` and `sweep` (for a sweep, they hold for every point).
 #[derive(Args, Debug, Clone, Default)]
 struct TimeArgs {
     /// Fixed step, s (same as `--set run.dt_s=...`).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     dt: Option<f64>,
     /// Adaptive steps: the largest step, s (`run.max_dt_s`).
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     max_dt: Option<f64>,
     /// Simulated time, s.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     end: Option<f64>,
     /// Interval between CSV rows, s.
-    #[arg(long)]
+    #[arg(long, allow_hyphen_values = true)]
     output_interval: Option<f64>,
 }
 
@@ -164,6 +210,12 @@ struct RunArgs {
     /// Output folder; default `out/<scene name>`.
     #[arg(long)]
     out: Option<PathBuf>,
+    /// Progress of a long run: auto (a bar on a terminal once the run has taken 2 s, nothing
+    /// otherwise), bar, lines or quiet.
+    #[arg(long, default_value = "auto", value_parser = ["auto", "bar", "lines", "quiet"])]
+    progress: String,
+    #[command(flatten)]
+    memory: MemoryArgs,
 }
 
 impl RunArgs {
@@ -174,19 +226,40 @@ impl RunArgs {
     }
 }
 
+fn warn(scene: &Scene) {
+    for w in scene.warnings() {
+        eprintln!("warning: {w}");
+    }
+}
+
 fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     let scene = args.scene()?;
+    warn(&scene);
     let out = args
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&scene.name));
+    if let Some(budget) = args
+        .memory
+        .budget()?
+        .or_else(clearance_joint::output::available_memory)
+    {
+        MemoryEstimate::of(&scene).check(&scene, 1, budget)?;
+    }
+    // Before any work: the folder exists, is writable and is ours alone until the set is written.
+    let _lock = DirLock::acquire(&out)?;
     eprintln!(
         "running `{}`: {}, {} s simulated, ideal and clearance twins",
         scene.name,
         scene.run.stepping(),
-        scene.run.end_s
+        clearance_joint::error::sig4(scene.run.end_s)
     );
-    let result = Simulation::new(&scene, RunOptions::default())?.run()?;
+    let mut progress = RunProgress::new(progress_mode(&args.progress));
+    let result = Simulation::new(&scene, RunOptions::default())?
+        .run_with_progress(|p| progress.update(p))
+        .map_err(|e| e.with_step_mode(scene.run.step == StepMode::Adaptive));
+    progress.finish();
+    let result = result?;
     let summary = result.write(&out)?;
     println!("{}", comparison_table(&summary));
     println!(
@@ -207,6 +280,8 @@ fn base_scene(path: &Option<PathBuf>) -> clearance_joint::Result<Scene> {
 
 fn sweep(args: &SweepArgs) -> clearance_joint::Result<()> {
     let base = base_scene(&args.scene)?;
+    warn(&base);
+    let exec = args.exec.options()?;
     let axes = args
         .axes
         .iter()
@@ -222,6 +297,14 @@ fn sweep(args: &SweepArgs) -> clearance_joint::Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out/sweep"));
     let sweep = Sweep::new("sweep", base, fixed, Grid::new(axes)?);
+    // Claim this shard's table (and check the folder) before any point runs; the points claim
+    // their own folders, so shards of one sweep can share it.
+    let stem = if shard.is_all() {
+        "metrics".to_string()
+    } else {
+        format!("metrics.shard-{}-of-{}", shard.index(), shard.count())
+    };
+    let _lock = DirLock::acquire_named(&out, &format!(".{stem}.lock"))?;
     let n = shard.points(&sweep.grid).len();
     eprintln!(
         "sweep of {} points{}: {n} to run or reuse, into {}",
@@ -234,7 +317,7 @@ fn sweep(args: &SweepArgs) -> clearance_joint::Result<()> {
         out.display()
     );
     let start = Instant::now();
-    let outcome = sweep.run(&out, shard, args.exec.options())?;
+    let outcome = sweep.run(&out, shard, exec)?;
     let reused = outcome.points.iter().filter(|p| p.reused).count();
     println!(
         "{} points finished ({} run, {reused} reused), {} failed, in {:.2} s; table {}",
@@ -264,6 +347,8 @@ fn fail_on_failures(table: &MetricsTable) -> clearance_joint::Result<()> {
 
 fn study(args: &StudyArgs) -> clearance_joint::Result<()> {
     let base = base_scene(&args.scene)?;
+    clearance_joint::study::preset::check_names(&base)?;
+    warn(&base);
     let kinds: Vec<StudyKind> = if args.name == "all" {
         StudyKind::ALL.to_vec()
     } else {
@@ -274,7 +359,7 @@ fn study(args: &StudyArgs) -> clearance_joint::Result<()> {
         .clone()
         .unwrap_or_else(|| PathBuf::from("out/studies"));
     let options = StudyOptions {
-        exec: args.exec.options(),
+        exec: args.exec.options()?,
         extra_overrides: args.overrides.clone(),
         no_figures: args.no_figures,
     };
@@ -331,6 +416,16 @@ fn merge(args: &MergeArgs) -> clearance_joint::Result<()> {
         .map(|f| MetricsTable::load(f))
         .collect::<clearance_joint::Result<Vec<_>>>()?;
     let merged = sweep::merge(&tables)?;
+    if !merged.missing.is_empty() && !args.incomplete {
+        return Err(clearance_joint::Error::invalid(
+            "merge",
+            format!(
+                "points {:?} are in no table, so nothing was written: run their shards (point i belongs to \
+                 shard i % N), or pass --incomplete to write metrics.incomplete.{{csv,json}} listing them",
+                merged.missing
+            ),
+        ));
+    }
     let out = match &args.out {
         Some(o) => o.clone(),
         None => {
@@ -342,7 +437,12 @@ fn merge(args: &MergeArgs) -> clearance_joint::Result<()> {
             }
         }
     };
-    merged.write(&out)?;
+    let stem = if merged.missing.is_empty() {
+        "metrics"
+    } else {
+        "metrics.incomplete"
+    };
+    merged.write_named(&out, stem)?;
     println!(
         "merged {} table(s): {} of {} points, {} failed, {} missing -> {}",
         tables.len(),
@@ -350,7 +450,7 @@ fn merge(args: &MergeArgs) -> clearance_joint::Result<()> {
         merged.sweep.points,
         merged.failures.len(),
         merged.missing.len(),
-        out.join("metrics.csv").display()
+        out.join(format!("{stem}.csv")).display()
     );
     if !merged.missing.is_empty() {
         return Err(clearance_joint::Error::invalid(
@@ -365,6 +465,17 @@ fn merge(args: &MergeArgs) -> clearance_joint::Result<()> {
 }
 
 fn main() -> ExitCode {
+    // Ctrl-C (or a kill with SIGTERM/SIGHUP): remove our temporaries and lock files, then exit.
+    // A set being renamed into place is finished first; finished points of a sweep stay.
+    if let Err(e) = ctrlc::set_handler(|| {
+        clearance_joint::output::remove_inflight();
+        eprintln!("\ninterrupted: temporary files removed");
+        std::process::exit(130);
+    }) {
+        eprintln!(
+            "warning: no interrupt handler ({e}): an interrupted run may leave temporary files"
+        );
+    }
     let cli = Cli::parse();
     let outcome = match &cli.command {
         Some(Command::Run(a)) => run(a),

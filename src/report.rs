@@ -1,7 +1,7 @@
 //! Run summaries (`summary.json`), result files and the printed comparison table.
 
 use crate::error::{Error, Result};
-use crate::output::write_all_atomic;
+use crate::output::{Render, write_set};
 use crate::sim::{HingeMetrics, Invariants, RunResult, Twin};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -118,23 +118,48 @@ impl RunResult {
         self.twins.iter().find(|t| t.kind == kind)
     }
 
-    /// Writes `<twin>.csv` for each twin and `summary.json` into `dir` as a set: all are rendered
-    /// (and checked finite) first, written to temporary names, then renamed into place.
+    /// Writes `<twin>.csv` for each twin and `summary.json` into `dir` as one set
+    /// ([`write_set`]): the tables are streamed (and checked finite) into temporary files, then
+    /// renamed into place, `summary.json` last.
     pub fn write(&self, dir: &Path) -> Result<Summary> {
-        let csvs: Vec<(String, String)> = self
-            .twins
-            .iter()
-            .map(|t| Ok((format!("{}.csv", t.kind.name()), t.table.to_csv()?)))
-            .collect::<Result<_>>()?;
         let summary = self.summary();
         let json = summary_json(&summary)?;
-        let mut files: Vec<(std::path::PathBuf, &[u8])> = csvs
+        let paths: Vec<std::path::PathBuf> = self
+            .twins
             .iter()
-            .map(|(name, text)| (dir.join(name), text.as_bytes()))
+            .map(|t| dir.join(format!("{}.csv", t.kind.name())))
             .collect();
-        files.push((dir.join("summary.json"), json.as_bytes()));
-        let files: Vec<(&Path, &[u8])> = files.iter().map(|(p, b)| (p.as_path(), *b)).collect();
-        write_all_atomic(&files)?;
+        let mut files: Vec<(&Path, Render)> = self
+            .twins
+            .iter()
+            .zip(&paths)
+            .map(|(t, path)| {
+                let render: Render = Box::new(move |w: &mut dyn std::io::Write| {
+                    t.table.write_csv(w).map_err(|e| match e {
+                        Error::Io { action, source, .. } => Error::Io {
+                            action,
+                            path: path.clone(),
+                            source,
+                        },
+                        other => other,
+                    })
+                });
+                (path.as_path(), render)
+            })
+            .collect();
+        let summary_path = dir.join("summary.json");
+        let json_path = summary_path.clone();
+        files.push((
+            summary_path.as_path(),
+            Box::new(move |w: &mut dyn std::io::Write| {
+                w.write_all(json.as_bytes()).map_err(|source| Error::Io {
+                    action: "cannot write",
+                    path: json_path.clone(),
+                    source,
+                })
+            }),
+        ));
+        write_set(&files)?;
         Ok(summary)
     }
 }

@@ -1,12 +1,12 @@
 //! Scenes as data (RON): bodies, hinges (ideal or with clearance), drives and run settings.
 //! Every value is validated with an error naming its path, e.g. `hinges[hinge].clearance.clearance_mm`.
 
-use crate::error::{Error, Result, finite, non_negative, positive};
+use crate::error::{Error, Result, excerpt, finite, in_range, non_negative, positive, sig4};
 use crate::joint::OutOfPlaneLock;
 use crate::laws::{
-    Ambrosio, Bai, BearingGeometry, Coulomb, FloresEtAl, FrictionModel, GonthierEtAl, Hertz,
-    HuntCrossley, ImprovedLiu, KelvinVoigt, LankaraniNikravesh, LiuEtAl, Material, MaxDamping,
-    NormalModel, Threlfall, effective_modulus,
+    Ambrosio, Bai, BearingGeometry, Coulomb, DELTA_MAX_RANGE, EXPONENT_RANGE, FloresEtAl,
+    FrictionModel, GonthierEtAl, Hertz, HuntCrossley, ImprovedLiu, KelvinVoigt, LankaraniNikravesh,
+    LiuEtAl, Material, MaxDamping, NormalModel, Threlfall, effective_modulus,
 };
 use rapier3d_f64::math::Vector;
 use serde::{Deserialize, Serialize};
@@ -360,9 +360,11 @@ impl Default for RunSettings {
 impl Scene {
     /// Parses a scene from RON text; `origin` names the source in errors.
     pub fn from_ron(text: &str, origin: &str) -> Result<Scene> {
-        let scene: Scene = ron::from_str(text).map_err(|e| Error::Parse {
-            what: origin.to_string(),
-            reason: e.to_string(),
+        // Editors on some systems start UTF-8 files with a byte-order mark: not RON, but harmless.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let scene: Scene = ron::from_str(text).map_err(|e| {
+            let hint = variant_hint(text, &e.span.end).map_or(String::new(), |h| format!(" ({h})"));
+            Error::parse(origin, format!("{}{hint}", excerpt(&e.to_string(), 300)))
         })?;
         scene.validate()?;
         Ok(scene)
@@ -402,21 +404,24 @@ impl Scene {
             serde_json::to_value(self).map_err(|e| Error::invalid("scene", e.to_string()))?;
         for o in overrides {
             let o = o.as_ref();
-            let (path, raw) = o.split_once('=').ok_or_else(|| Error::Parse {
-                what: format!("override `{o}`"),
-                reason: "expected `path=value`".into(),
-            })?;
+            let (path, raw) = o
+                .split_once('=')
+                .ok_or_else(|| Error::parse(format!("override `{o}`"), "expected `path=value`"))?;
             let new: serde_json::Value = serde_json::from_str(raw.trim())
                 .unwrap_or_else(|_| serde_json::Value::String(raw.trim().to_string()));
-            let slot = locate(&mut value, path.trim())?;
+            let path = path.trim();
+            let slot = locate(&mut value, path)?;
+            check_group(path, slot, &new)?;
             *slot = new;
         }
-        let scene: Scene = serde_json::from_value(value).map_err(|e| Error::Parse {
-            what: format!(
-                "overrides {:?}",
-                overrides.iter().map(|s| s.as_ref()).collect::<Vec<_>>()
-            ),
-            reason: e.to_string(),
+        let scene: Scene = serde_json::from_value(value).map_err(|e| {
+            Error::parse(
+                format!(
+                    "overrides {:?}",
+                    overrides.iter().map(|s| s.as_ref()).collect::<Vec<_>>()
+                ),
+                e.to_string(),
+            )
         })?;
         scene.validate()?;
         Ok(scene)
@@ -441,7 +446,13 @@ impl Scene {
             ));
         }
         for (i, g) in self.gravity.iter().enumerate() {
-            finite(&format!("gravity[{i}]"), *g)?;
+            in_range(
+                &format!("gravity[{i}]"),
+                *g,
+                -GRAVITY_MAX,
+                GRAVITY_MAX,
+                "m/s^2",
+            )?;
         }
         unit(&self.reference_axis, "reference_axis")?;
         if self.bodies.is_empty() {
@@ -459,19 +470,29 @@ impl Scene {
             if !names.insert(b.name.as_str()) {
                 return Err(Error::invalid(p, "duplicate name"));
             }
-            positive(&format!("{p}.mass_kg"), b.mass_kg)?;
-            for (i, j) in b.inertia_kg_m2.iter().enumerate() {
-                positive(&format!("{p}.inertia_kg_m2[{i}]"), *j)?;
-            }
-            let [a, bb, c] = b.inertia_kg_m2;
-            if a + bb < c || bb + c < a || a + c < bb {
-                return Err(Error::invalid(
-                    format!("{p}.inertia_kg_m2"),
-                    "violates the triangle inequality of principal moments",
-                ));
+            if b.fixed {
+                // A ground body does not move: its mass and inertia are ignored (0 is fine).
+                non_negative(&format!("{p}.mass_kg"), b.mass_kg)?;
+                for (i, j) in b.inertia_kg_m2.iter().enumerate() {
+                    non_negative(&format!("{p}.inertia_kg_m2[{i}]"), *j)?;
+                }
+            } else {
+                let (lo, hi) = MASS_RANGE;
+                in_range(&format!("{p}.mass_kg"), b.mass_kg, lo, hi, "kg")?;
+                let (lo, hi) = INERTIA_RANGE;
+                for (i, j) in b.inertia_kg_m2.iter().enumerate() {
+                    in_range(&format!("{p}.inertia_kg_m2[{i}]"), *j, lo, hi, "kg m^2")?;
+                }
+                let [a, bb, c] = b.inertia_kg_m2;
+                if a + bb < c || bb + c < a || a + c < bb {
+                    return Err(Error::invalid(
+                        format!("{p}.inertia_kg_m2"),
+                        "violates the triangle inequality of principal moments",
+                    ));
+                }
             }
             for (i, x) in b.center_of_mass_m.iter().enumerate() {
-                finite(&format!("{p}.center_of_mass_m[{i}]"), *x)?;
+                position(&format!("{p}.center_of_mass_m[{i}]"), *x)?;
             }
         }
         for h in &self.hinges {
@@ -503,7 +524,7 @@ impl Scene {
                 ));
             }
             for (i, x) in h.point_m.iter().enumerate() {
-                finite(&format!("{p}.point_m[{i}]"), *x)?;
+                position(&format!("{p}.point_m[{i}]"), *x)?;
             }
             unit(&h.axis, &format!("{p}.axis"))?;
             if let Some(c) = &h.clearance {
@@ -535,33 +556,53 @@ impl Scene {
                     format!("no hinge named `{}`", d.hinge),
                 ));
             }
-            finite(&format!("{p}.torque0_nm"), d.torque0_nm)?;
-            non_negative(&format!("{p}.stiffness_nm_per_deg"), d.stiffness_nm_per_deg)?;
-            finite(&format!("{p}.torque_scale"), d.torque_scale)?;
+            let t = TORQUE_MAX;
+            in_range(&format!("{p}.torque0_nm"), d.torque0_nm, -t, t, "N m")?;
+            in_range(
+                &format!("{p}.stiffness_nm_per_deg"),
+                d.stiffness_nm_per_deg,
+                0.0,
+                t,
+                "N m/deg",
+            )?;
+            let s = TORQUE_SCALE_MAX;
+            in_range(&format!("{p}.torque_scale"), d.torque_scale, -s, s, "")?;
         }
         let r = &self.run;
         positive("run.dt_s", r.dt_s)?;
-        positive("run.max_dt_s", r.max_dt_s)?;
+        in_range("run.dt_s", r.dt_s, DT_RANGE.0, DT_RANGE.1, "s")?;
+        in_range("run.max_dt_s", r.max_dt_s, DT_RANGE.0, DT_RANGE.1, "s")?;
         positive("run.end_s", r.end_s)?;
+        in_range("run.end_s", r.end_s, END_RANGE.0, END_RANGE.1, "s")?;
         positive("run.output_interval_s", r.output_interval_s)?;
+        in_range(
+            "run.output_interval_s",
+            r.output_interval_s,
+            DT_RANGE.0,
+            END_RANGE.1,
+            "s",
+        )?;
         crate::error::in_range_open_closed("run.tolerance", r.tolerance, 0.0, 1.0)?;
+        in_range("run.tolerance", r.tolerance, TOLERANCE_MIN, 1.0, "")?;
         if r.end_s / r.output_interval_s > MAX_ROWS {
             return Err(Error::invalid(
                 "run.output_interval_s",
                 format!(
-                    "{} rows to reach run.end_s = {}: more than {MAX_ROWS:e} (memory); use a larger interval",
-                    r.end_s / r.output_interval_s,
-                    r.end_s
+                    "{} rows to reach run.end_s = {} s: more than {} (memory); use a larger interval",
+                    sig4(r.end_s / r.output_interval_s),
+                    sig4(r.end_s),
+                    sig4(MAX_ROWS)
                 ),
             ));
         }
-        if r.step == StepMode::Fixed && r.end_s / r.dt_s > 1e9 {
+        if r.step == StepMode::Fixed && r.end_s / r.dt_s > MAX_STEPS {
             return Err(Error::invalid(
                 "run.dt_s",
                 format!(
-                    "{} steps to reach run.end_s = {}: too many",
-                    r.end_s / r.dt_s,
-                    r.end_s
+                    "{} steps to reach run.end_s = {} s: more than {}; use a larger step or a shorter run",
+                    sig4(r.end_s / r.dt_s),
+                    sig4(r.end_s),
+                    sig4(MAX_STEPS)
                 ),
             ));
         }
@@ -570,6 +611,28 @@ impl Scene {
 }
 
 impl Scene {
+    /// Settings that are valid but probably not what was meant, each naming its field (the CLI
+    /// prints them as warnings before running).
+    pub fn warnings(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for h in &self.hinges {
+            let Some(c) = &h.clearance else { continue };
+            if let FrictionSpec::Bai { mu_s, mu_d, .. } = c.friction
+                && mu_s < mu_d
+            {
+                out.push(format!(
+                    "`hinges[{}].clearance.friction`: Bai with mu_s = {} below mu_d = {} is not stiction \
+                     (the coefficient rises from mu_s to mu_d as the journal slips faster); swap them if \
+                     stiction was meant",
+                    h.name,
+                    sig4(mu_s),
+                    sig4(mu_d)
+                ));
+            }
+        }
+        out
+    }
+
     /// The clearance model is planar (MODEL.md §4): contact and friction act in the plane normal
     /// to each clearance hinge's axis, and the out-of-plane degrees of freedom are held rigidly.
     /// A scene whose loads would act out of that plane is refused, naming what cannot be represented.
@@ -603,8 +666,44 @@ impl Scene {
     }
 }
 
-/// Most output rows a run may keep (each row is a few hundred bytes for a small scene).
+/// Most output rows a run may keep (each row is a few hundred bytes for a small scene; the CLI
+/// also checks the bytes of a run against the memory available before it starts).
 const MAX_ROWS: f64 = 1e7;
+/// Most steps (`run.end_s / run.dt_s`) a run may take.
+const MAX_STEPS: f64 = 1e9;
+
+/// Physical range of a body's mass, kg (fixed bodies: ignored).
+pub const MASS_RANGE: (f64, f64) = (1e-6, 1e9);
+/// Physical range of a principal moment of inertia, kg m^2.
+pub const INERTIA_RANGE: (f64, f64) = (1e-12, 1e12);
+/// Largest coordinate of a body's centre of mass or a hinge point, m.
+pub const POSITION_MAX: f64 = 1e4;
+/// Largest gravity component, m/s^2 (100 g).
+pub const GRAVITY_MAX: f64 = 1e3;
+/// Largest drive preload, N m (and stiffness, N m/deg).
+pub const TORQUE_MAX: f64 = 1e6;
+/// Largest drive `torque_scale` (either sign).
+pub const TORQUE_SCALE_MAX: f64 = 1e3;
+/// Range of `run.dt_s`, s (also the smallest `run.output_interval_s`).
+pub const DT_RANGE: (f64, f64) = (1e-9, 1.0);
+/// Range of `run.end_s`, s (also the largest `run.output_interval_s`).
+pub const END_RANGE: (f64, f64) = (1e-6, 1e7);
+/// Smallest `run.tolerance` (the largest is 1).
+pub const TOLERANCE_MIN: f64 = 1e-4;
+/// Range of a bearing diameter or width, mm (1 um to 10 m).
+pub const LENGTH_MM_RANGE: (f64, f64) = (1e-3, 1e4);
+/// Range of a radial clearance, mm (1 nm to 1 m; it must also be below the bearing radius).
+pub const CLEARANCE_MM_RANGE: (f64, f64) = (1e-6, 1e3);
+/// Range of a speed given in mm/s (friction transition speeds, impact-speed floor).
+pub const SPEED_MM_S_RANGE: (f64, f64) = (1e-9, 1e5);
+
+fn position(field: &str, x: f64) -> Result<f64> {
+    in_range(field, x, -POSITION_MAX, POSITION_MAX, "m")
+}
+
+fn speed_mm_s(field: &str, v: f64) -> Result<f64> {
+    in_range(field, v, SPEED_MM_S_RANGE.0, SPEED_MM_S_RANGE.1, "mm/s")
+}
 
 /// Letters, digits, `_` and `-`: safe in CSV headers and file names.
 fn is_plain_name(name: &str) -> bool {
@@ -622,7 +721,7 @@ fn unit(v: &[f64; 3], field: &str) -> Result<()> {
     if (n - 1.0).abs() > 1e-6 {
         return Err(Error::invalid(
             field,
-            format!("must be a unit vector (length {n})"),
+            format!("must be a unit vector (length {})", sig4(n)),
         ));
     }
     Ok(())
@@ -646,16 +745,30 @@ pub struct ClearanceParams {
 impl ClearanceSpec {
     /// Validates and converts to SI laws; errors name the field relative to this spec.
     pub fn build(&self) -> Result<ClearanceParams> {
+        let (lo, hi) = LENGTH_MM_RANGE;
         let c = positive("clearance_mm", self.clearance_mm)? * 1e-3;
-        let rb = positive("bearing_diameter_mm", self.bearing_diameter_mm)? * 0.5e-3;
-        let len = positive("width_mm", self.width_mm)? * 1e-3;
+        in_range(
+            "clearance_mm",
+            self.clearance_mm,
+            CLEARANCE_MM_RANGE.0,
+            CLEARANCE_MM_RANGE.1,
+            "mm",
+        )?;
+        let rb = in_range(
+            "bearing_diameter_mm",
+            self.bearing_diameter_mm,
+            lo,
+            hi,
+            "mm",
+        )? * 0.5e-3;
+        let len = in_range("width_mm", self.width_mm, lo, hi, "mm")? * 1e-3;
         if c >= rb {
             return Err(Error::invalid(
                 "clearance_mm",
                 format!(
                     "the journal would be larger than nothing: clearance {} mm >= bearing radius {} mm",
-                    self.clearance_mm,
-                    rb * 1e3
+                    sig4(self.clearance_mm),
+                    sig4(rb * 1e3)
                 ),
             ));
         }
@@ -674,14 +787,17 @@ impl ClearanceSpec {
         );
         // The geometric stiffness is Lankarani-Nikravesh's, in N/m^1.5: a default only for n = 1.5.
         let k_n = |s: &Option<f64>, n: f64| -> Result<f64> {
+            // The exponent first: a NaN or absurd exponent is the fault, not the missing stiffness.
+            in_range("exponent", n, EXPONENT_RANGE.0, EXPONENT_RANGE.1, "")?;
             match s {
                 Some(k) => Ok(*k),
                 None if n == LankaraniNikravesh::EXPONENT => Ok(geometric),
                 None => Err(Error::invalid(
                     "stiffness",
                     format!(
-                        "must be given for exponent {n}: the default (the Lankarani-Nikravesh geometric stiffness) \
-                         is in N/m^1.5 and holds only for exponent 1.5"
+                        "must be given for exponent {}: the default (the Lankarani-Nikravesh geometric stiffness) \
+                         is in N/m^1.5 and holds only for exponent 1.5",
+                        sig4(n)
                     ),
                 )),
             }
@@ -746,7 +862,13 @@ impl ClearanceSpec {
                         len,
                         c,
                         *exponent,
-                        positive("delta_max_mm", *delta_max_mm)? * 1e-3,
+                        in_range(
+                            "delta_max_mm",
+                            *delta_max_mm,
+                            DELTA_MAX_RANGE.0 * 1e3,
+                            DELTA_MAX_RANGE.1 * 1e3,
+                            "mm",
+                        )? * 1e-3,
                         damping,
                     )?)
                 }
@@ -758,29 +880,41 @@ impl ClearanceSpec {
             Ok(match &self.friction {
                 FrictionSpec::None => FrictionModel::None,
                 FrictionSpec::Coulomb { mu_d, v_eps_mm_s } => {
+                    speed_mm_s("v_eps_mm_s", *v_eps_mm_s)?;
                     FrictionModel::Coulomb(Coulomb::new(*mu_d, v_eps_mm_s * mm)?)
                 }
                 FrictionSpec::Threlfall { mu_d, v0_mm_s } => {
+                    speed_mm_s("v0_mm_s", *v0_mm_s)?;
                     FrictionModel::Threlfall(Threlfall::new(*mu_d, v0_mm_s * mm)?)
                 }
                 FrictionSpec::Ambrosio {
                     mu_d,
                     v0_mm_s,
                     v1_mm_s,
-                } => FrictionModel::Ambrosio(Ambrosio::new(*mu_d, v0_mm_s * mm, v1_mm_s * mm)?),
+                } => {
+                    in_range("v0_mm_s", *v0_mm_s, 0.0, SPEED_MM_S_RANGE.1, "mm/s")?;
+                    speed_mm_s("v1_mm_s", *v1_mm_s)?;
+                    FrictionModel::Ambrosio(Ambrosio::new(*mu_d, v0_mm_s * mm, v1_mm_s * mm)?)
+                }
                 FrictionSpec::Bai {
                     mu_s,
                     mu_d,
                     v_s_mm_s,
                     v_d_mm_s,
-                } => FrictionModel::Bai(Bai::new(*mu_s, *mu_d, v_s_mm_s * mm, v_d_mm_s * mm)?),
+                } => {
+                    speed_mm_s("v_s_mm_s", *v_s_mm_s)?;
+                    speed_mm_s("v_d_mm_s", *v_d_mm_s)?;
+                    FrictionModel::Bai(Bai::new(*mu_s, *mu_d, v_s_mm_s * mm, v_d_mm_s * mm)?)
+                }
                 FrictionSpec::Dry => FrictionModel::Bai(Bai::DRY),
                 FrictionSpec::Lubricated => FrictionModel::Bai(Bai::LUBRICATED),
             })
         })()
         .map_err_within("friction")?;
-        let min_impact_speed = positive("min_impact_speed_mm_s", self.min_impact_speed_mm_s)? * mm;
-        let min_separation = non_negative("min_separation_um", self.min_separation_um)? * 1e-6;
+        let min_impact_speed =
+            speed_mm_s("min_impact_speed_mm_s", self.min_impact_speed_mm_s)? * mm;
+        let min_separation =
+            in_range("min_separation_um", self.min_separation_um, 0.0, 1e4, "um")? * 1e-6;
         Ok(ClearanceParams {
             geometry,
             normal,
@@ -800,7 +934,113 @@ impl<T> WithinExt<T> for Result<T> {
     }
 }
 
-/// Finds the JSON slot an override path names (see [`Scene::with_overrides`]).
+/// The enum variants of a scene (contact and friction laws) and how each is written, for hints
+/// when a variant is written in the wrong form (`LiuEtAl()`, a bare `ImprovedLiu`).
+const VARIANT_FORMS: [(&str, &str); 16] = [
+    (
+        "Hertz",
+        "Hertz(stiffness: Some(K), exponent: n), or Hertz() for n = 1.5 and the geometric stiffness",
+    ),
+    ("KelvinVoigt", "KelvinVoigt(stiffness: K, damping: D)"),
+    (
+        "HuntCrossley",
+        "HuntCrossley(restitution: cr), optionally with stiffness: Some(K) and exponent: n",
+    ),
+    (
+        "LankaraniNikravesh",
+        "LankaraniNikravesh(restitution: cr), optionally with stiffness: Some(K)",
+    ),
+    (
+        "FloresEtAl",
+        "FloresEtAl(restitution: cr), optionally with stiffness: Some(K) and exponent: n",
+    ),
+    (
+        "GonthierEtAl",
+        "GonthierEtAl(restitution: cr), optionally with stiffness: Some(K) and exponent: n",
+    ),
+    ("LiuEtAl", "LiuEtAl, with no parameters and no parentheses"),
+    (
+        "ImprovedLiu",
+        "ImprovedLiu(exponent: n, delta_max_mm: d, eta_s: eta), or ImprovedLiu() for the defaults",
+    ),
+    ("None", "None, with no parameters and no parentheses"),
+    ("Coulomb", "Coulomb(mu_d: mu, v_eps_mm_s: v)"),
+    ("Threlfall", "Threlfall(mu_d: mu, v0_mm_s: v)"),
+    ("Ambrosio", "Ambrosio(mu_d: mu, v0_mm_s: v0, v1_mm_s: v1)"),
+    (
+        "Bai",
+        "Bai(mu_s: mu_s, mu_d: mu_d, v_s_mm_s: v_s, v_d_mm_s: v_d)",
+    ),
+    ("Dry", "Dry, with no parameters and no parentheses"),
+    (
+        "Lubricated",
+        "Lubricated, with no parameters and no parentheses",
+    ),
+    ("Some", "Some(value), or None"),
+];
+
+/// When a RON error comes right after the name of a law, how that law is written.
+fn variant_hint(text: &str, at: &ron::error::Position) -> Option<String> {
+    // The text up to the error (line and column count characters, from 1).
+    let mut prefix = String::new();
+    for (i, line) in text.split('\n').enumerate() {
+        if i + 1 < at.line {
+            prefix.push_str(line);
+            prefix.push('\n');
+        } else {
+            prefix.extend(line.chars().take(at.col.saturating_sub(1)));
+            break;
+        }
+    }
+    let before =
+        prefix.trim_end_matches(|c: char| c.is_whitespace() || c == '(' || c == ')' || c == ',');
+    let start = before
+        .rfind(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+        .map_or(0, |i| i + 1);
+    let word = &before[start..];
+    VARIANT_FORMS
+        .iter()
+        .find(|(name, _)| *name == word)
+        .map(|(name, form)| format!("`{name}` is written {form}"))
+}
+
+/// Refuses a scalar written over a group of settings (`--set run=5`): only one of its fields
+/// can be meant. A law (an enum) may be replaced by a bare name or an object, and an optional
+/// group by `null`.
+fn check_group(path: &str, slot: &serde_json::Value, new: &serde_json::Value) -> Result<()> {
+    let Some(fields) = slot.as_object() else {
+        return Ok(());
+    };
+    let is_enum = fields.len() == 1
+        && fields
+            .keys()
+            .next()
+            .is_some_and(|k| k.starts_with(|c: char| c.is_ascii_uppercase()));
+    if is_enum || new.is_object() || new.is_null() {
+        return Ok(());
+    }
+    let names: Vec<&str> = fields.keys().map(String::as_str).collect();
+    let example = names.first().copied().unwrap_or("field");
+    Err(Error::invalid(
+        path,
+        format!(
+            "is a group of settings ({}): set one of them, e.g. `--set {path}.{example}=VALUE`",
+            names.join(", ")
+        ),
+    ))
+}
+
+/// One step of a path into the scene's JSON: an object key or an array index.
+#[derive(Clone, Debug)]
+enum Step {
+    Key(String),
+    Index(usize),
+}
+
+/// Finds the JSON slot an override path names (see [`Scene::with_overrides`]). The first
+/// segment is a top-level field, the name of a body, hinge or drive, or `bodies[name]`,
+/// `hinges[name]`, `drives[name]` (the form error messages use). A name that is also a
+/// top-level field (a body called `run`) is taken where the rest of the path exists.
 fn locate<'a>(root: &'a mut serde_json::Value, path: &str) -> Result<&'a mut serde_json::Value> {
     let unknown = |reason: String| Error::invalid(path, reason);
     let mut segments = path.split('.');
@@ -808,41 +1048,126 @@ fn locate<'a>(root: &'a mut serde_json::Value, path: &str) -> Result<&'a mut ser
         .next()
         .filter(|s| !s.is_empty())
         .ok_or_else(|| unknown("empty parameter path".into()))?;
+    let rest: Vec<&str> = segments.collect();
     let obj = root
-        .as_object_mut()
+        .as_object()
         .ok_or_else(|| unknown("scene is not an object".into()))?;
-    let mut cur: &mut serde_json::Value = if obj.contains_key(first) {
-        obj.get_mut(first).unwrap()
-    } else {
-        let named = |it: &serde_json::Value| it.get("name").and_then(|n| n.as_str()) == Some(first);
-        let list = ["bodies", "hinges", "drives"].into_iter().find(|l| {
-            obj.get(*l)
-                .and_then(|v| v.as_array())
-                .is_some_and(|items| items.iter().any(named))
-        });
-        list.and_then(|l| {
-            obj.get_mut(l)?
-                .as_array_mut()?
-                .iter_mut()
-                .find(|it| named(it))
-        })
-        .ok_or_else(|| {
-            unknown(format!(
-                "`{first}` is neither a top-level field nor the name of a body, hinge or drive"
-            ))
-        })?
+    let item = |list: &str, name: &str| -> Option<Vec<Step>> {
+        let items = obj.get(list)?.as_array()?;
+        let i = items
+            .iter()
+            .position(|it| it.get("name").and_then(|n| n.as_str()) == Some(name))?;
+        Some(vec![Step::Key(list.to_string()), Step::Index(i)])
     };
-    for seg in segments {
-        cur = descend(cur, seg).map_err(unknown)?;
+    let mut starts: Vec<(String, Vec<Step>)> = Vec::new();
+    if let Some((list, name)) = first
+        .strip_suffix(']')
+        .and_then(|f| f.split_once('['))
+        .filter(|(l, _)| ["bodies", "hinges", "drives"].contains(l))
+    {
+        let start = item(list, name).ok_or_else(|| {
+            let what = match list {
+                "bodies" => "body",
+                "hinges" => "hinge",
+                _ => "drive",
+            };
+            unknown(format!("no {what} named `{name}`"))
+        })?;
+        starts.push((format!("{list}[{name}]"), start));
+    } else {
+        if obj.contains_key(first) {
+            starts.push((
+                format!("the top-level field `{first}`"),
+                vec![Step::Key(first.to_string())],
+            ));
+        }
+        for (list, what) in [("bodies", "body"), ("hinges", "hinge"), ("drives", "drive")] {
+            if let Some(start) = item(list, first) {
+                starts.push((format!("the {what} `{first}` ({list}[{first}])"), start));
+            }
+        }
+    }
+    if starts.is_empty() {
+        return Err(unknown(format!(
+            "`{first}` is neither a top-level field nor the name of a body, hinge or drive"
+        )));
+    }
+    let resolved: Vec<(String, std::result::Result<Vec<Step>, String>)> = starts
+        .into_iter()
+        .map(|(what, start)| {
+            let found = resolve(root_at(root, &start), &rest).map(|tail| {
+                let mut steps = start;
+                steps.extend(tail);
+                steps
+            });
+            (what, found)
+        })
+        .collect();
+    let ok: Vec<&(String, std::result::Result<Vec<Step>, String>)> =
+        resolved.iter().filter(|(_, r)| r.is_ok()).collect();
+    let steps = match ok.as_slice() {
+        [(_, Ok(steps))] => steps.clone(),
+        [] => {
+            let (_, Err(reason)) = &resolved[0] else {
+                unreachable!("no start resolved")
+            };
+            return Err(unknown(reason.clone()));
+        }
+        several => {
+            return Err(unknown(format!(
+                "`{first}` names {}: write `{}.{}` for the body, hinge or drive, or rename it",
+                several
+                    .iter()
+                    .map(|(w, _)| w.as_str())
+                    .collect::<Vec<_>>()
+                    .join(" and "),
+                several
+                    .iter()
+                    .find_map(|(w, _)| w.split_once('(').map(|(_, p)| p.trim_end_matches(')')))
+                    .unwrap_or(first),
+                rest.join(".")
+            )));
+        }
+    };
+    let mut cur = root;
+    for step in &steps {
+        cur = match step {
+            Step::Key(k) => cur.get_mut(k.as_str()),
+            Step::Index(i) => cur.get_mut(*i),
+        }
+        .expect("path just resolved");
     }
     Ok(cur)
 }
 
-/// The child `key` of `v`, or the unique field called `key` at any depth below it.
-fn descend<'a>(
-    v: &'a mut serde_json::Value,
-    key: &str,
-) -> std::result::Result<&'a mut serde_json::Value, String> {
+fn root_at<'a>(root: &'a serde_json::Value, steps: &[Step]) -> &'a serde_json::Value {
+    let mut cur = root;
+    for step in steps {
+        cur = match step {
+            Step::Key(k) => &cur[k.as_str()],
+            Step::Index(i) => &cur[*i],
+        };
+    }
+    cur
+}
+
+/// The steps below `v` to the field named by `segments`, each segment a direct child or the
+/// unique field of that name at any depth.
+fn resolve(v: &serde_json::Value, segments: &[&str]) -> std::result::Result<Vec<Step>, String> {
+    let mut steps = Vec::new();
+    let mut cur = v;
+    for seg in segments {
+        let found = descend(cur, seg)?;
+        for k in found {
+            cur = &cur[k.as_str()];
+            steps.push(Step::Key(k));
+        }
+    }
+    Ok(steps)
+}
+
+/// The key path to the child `key` of `v`, or to the unique field called `key` at any depth below it.
+fn descend(v: &serde_json::Value, key: &str) -> std::result::Result<Vec<String>, String> {
     fn paths(
         v: &serde_json::Value,
         key: &str,
@@ -860,19 +1185,16 @@ fn descend<'a>(
             }
         }
     }
+    if v.get(key).is_some() {
+        return Ok(vec![key.to_string()]);
+    }
     let mut found = Vec::new();
     paths(v, key, &mut Vec::new(), &mut found);
     match found.len() {
         0 => Err(format!(
             "no field `{key}` here (is the hinge ideal, or the name misspelt?)"
         )),
-        1 => {
-            let mut cur = v;
-            for k in &found[0] {
-                cur = cur.get_mut(k.as_str()).expect("path just found");
-            }
-            Ok(cur)
-        }
+        1 => Ok(found.remove(0)),
         _ => Err(format!(
             "`{key}` is ambiguous: {}",
             found

@@ -746,11 +746,12 @@ impl Stepper {
         Ok(())
     }
 
+    /// Adds the time and the step mode to a step-limit error (the joints know neither).
     fn locate(&self, mut e: Error) -> Error {
         if let Error::StepTooLarge { t, .. } = &mut e {
             *t = Some(self.t);
         }
-        e
+        e.with_step_mode(self.control.mode == StepMode::Adaptive)
     }
 }
 

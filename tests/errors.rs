@@ -202,7 +202,7 @@ fn names_that_would_break_outputs() {
 
 #[test]
 fn too_many_rows() {
-    let e = override_err(&["run.output_interval_s=1e-12"]);
+    let e = override_err(&["run.end_s=1e4", "run.output_interval_s=1e-6"]);
     assert!(
         e.contains("run.output_interval_s") && e.contains("rows"),
         "{e}"

@@ -2,7 +2,20 @@
 //! friction force is `mu(v) F_N`, opposing the slip.
 
 use super::step::step;
-use crate::error::{Error, Result, non_negative, positive};
+use crate::error::{Error, Result, in_range, sig4};
+
+/// Physical range of a friction coefficient (0 to 2: beyond clean metals in vacuum).
+pub const MU_RANGE: (f64, f64) = (0.0, 2.0);
+/// Physical range of a friction law's characteristic speed, m/s (up to 100 m/s).
+pub const SPEED_RANGE: (f64, f64) = (1e-12, 100.0);
+
+fn mu(field: &str, value: f64) -> Result<f64> {
+    in_range(field, value, MU_RANGE.0, MU_RANGE.1, "")
+}
+
+fn speed(field: &str, value: f64) -> Result<f64> {
+    in_range(field, value, SPEED_RANGE.0, SPEED_RANGE.1, "m/s")
+}
 
 /// A friction law `mu(v)`.
 pub trait FrictionLaw {
@@ -23,8 +36,8 @@ impl Coulomb {
     /// Dynamic coefficient `mu_d >= 0`, regularisation speed `v_eps > 0` (m/s).
     pub fn new(mu_d: f64, v_eps: f64) -> Result<Self> {
         Ok(Coulomb {
-            mu_d: non_negative("mu_d", mu_d)?,
-            v_eps: positive("v_eps", v_eps)?,
+            mu_d: mu("mu_d", mu_d)?,
+            v_eps: speed("v_eps", v_eps)?,
         })
     }
 }
@@ -49,8 +62,8 @@ impl Threlfall {
     /// Dynamic coefficient `mu_d >= 0`, characteristic speed `v_0 > 0` (m/s).
     pub fn new(mu_d: f64, v0: f64) -> Result<Self> {
         Ok(Threlfall {
-            mu_d: non_negative("mu_d", mu_d)?,
-            v0: positive("v0", v0)?,
+            mu_d: mu("mu_d", mu_d)?,
+            v0: speed("v0", v0)?,
         })
     }
 }
@@ -75,13 +88,13 @@ pub struct Ambrosio {
 impl Ambrosio {
     /// Dynamic coefficient `mu_d >= 0`, speeds `0 <= v_0 < v_1` (m/s).
     pub fn new(mu_d: f64, v0: f64, v1: f64) -> Result<Self> {
-        non_negative("mu_d", mu_d)?;
-        non_negative("v0", v0)?;
-        positive("v1", v1)?;
+        mu("mu_d", mu_d)?;
+        in_range("v0", v0, 0.0, SPEED_RANGE.1, "m/s")?;
+        speed("v1", v1)?;
         if v1 <= v0 {
             return Err(Error::invalid(
                 "v1",
-                format!("must be greater than v0 = {v0} (got {v1})"),
+                format!("must be greater than v0 = {} (got {})", sig4(v0), sig4(v1)),
             ));
         }
         Ok(Ambrosio { mu_d, v0, v1 })
@@ -132,14 +145,18 @@ impl Bai {
 
     /// Static `mu_s` and dynamic `mu_d` coefficients (`>= 0`), transition speeds `0 < v_s < v_d` (m/s).
     pub fn new(mu_s: f64, mu_d: f64, v_s: f64, v_d: f64) -> Result<Self> {
-        non_negative("mu_s", mu_s)?;
-        non_negative("mu_d", mu_d)?;
-        positive("v_s", v_s)?;
-        positive("v_d", v_d)?;
+        mu("mu_s", mu_s)?;
+        mu("mu_d", mu_d)?;
+        speed("v_s", v_s)?;
+        speed("v_d", v_d)?;
         if v_d <= v_s {
             return Err(Error::invalid(
                 "v_d",
-                format!("must be greater than v_s = {v_s} (got {v_d})"),
+                format!(
+                    "must be greater than v_s = {} (got {})",
+                    sig4(v_s),
+                    sig4(v_d)
+                ),
             ));
         }
         Ok(Bai {

@@ -1,7 +1,10 @@
 //! Elastic materials of the journal and bearing (MODEL.md §2).
 
-use crate::error::{Error, in_range_open_closed};
-use crate::error::{Result, positive};
+use crate::error::{Error, in_range, in_range_open_closed};
+use crate::error::{Result, positive, sig4};
+
+/// Physical range of Young's modulus, Pa: from soft rubber (1e5) to beyond diamond (1e13).
+pub const YOUNGS_MODULUS_RANGE: (f64, f64) = (1e5, 1e13);
 use serde::{Deserialize, Serialize};
 
 /// An isotropic linear-elastic material.
@@ -33,7 +36,13 @@ impl Material {
 
     /// Checks the domain of both constants.
     pub fn validate(&self) -> Result<()> {
-        positive("youngs_modulus_pa", self.youngs_modulus_pa)?;
+        in_range(
+            "youngs_modulus_pa",
+            self.youngs_modulus_pa,
+            YOUNGS_MODULUS_RANGE.0,
+            YOUNGS_MODULUS_RANGE.1,
+            "Pa",
+        )?;
         in_range_open_closed("poisson_ratio", self.poisson_ratio, -1.0, 0.5)?;
         Ok(())
     }
@@ -68,8 +77,10 @@ impl BearingGeometry {
             return Err(Error::invalid(
                 "journal_radius",
                 format!(
-                    "the journal ({journal_radius} m) must be smaller than the bearing ({bearing_radius} m): \
-                     the radial clearance R_b - R_j must be > 0"
+                    "the journal ({} m) must be smaller than the bearing ({} m): \
+                     the radial clearance R_b - R_j must be > 0",
+                    sig4(journal_radius),
+                    sig4(bearing_radius)
                 ),
             ));
         }
@@ -88,7 +99,9 @@ impl BearingGeometry {
             return Err(Error::invalid(
                 "clearance",
                 format!(
-                    "the clearance ({clearance} m) must be smaller than the bearing radius ({bearing_radius} m)"
+                    "the clearance ({} m) must be smaller than the bearing radius ({} m)",
+                    sig4(clearance),
+                    sig4(bearing_radius)
                 ),
             ));
         }

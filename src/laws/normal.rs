@@ -1,7 +1,7 @@
 //! Normal contact-force laws (MODEL.md §2).
 
 use super::step::{step, step_slope};
-use crate::error::{Error, Result, in_range_open_closed, non_negative, positive};
+use crate::error::{Result, in_range, in_range_open_closed, positive};
 use std::f64::consts::PI;
 
 /// The state a normal law is evaluated at.
@@ -65,7 +65,7 @@ pub trait NormalForceLaw {
 /// every step: a fixed-point iteration on the local power law `F = C delta^p` through the current
 /// estimate (exact for Hertz-type laws, within a few per cent for Liu's), starting from `guess`.
 pub fn penetration_for_energy(law: &impl NormalForceLaw, energy: f64, guess: f64) -> f64 {
-    if !(energy > 0.0) {
+    if energy.is_nan() || energy <= 0.0 {
         return 0.0;
     }
     let mut d = if guess > 0.0 && guess.is_finite() {
@@ -124,15 +124,29 @@ fn penetration_power(delta: f64, n: f64) -> f64 {
     if delta <= 0.0 { 0.0 } else { delta.powf(n) }
 }
 
+/// Physical range of a contact stiffness `K`, N/m^n: from a soft polymer pad to beyond diamond.
+pub const STIFFNESS_RANGE: (f64, f64) = (1.0, 1e16);
+/// Physical range of a force exponent `n`: 1 (linear, Liu) to 3 (beyond every published fit;
+/// Hertz's point contact is 1.5). Below 1 the stiffness at first contact is infinite.
+pub const EXPONENT_RANGE: (f64, f64) = (1.0, 3.0);
+/// Physical range of a damping coefficient, N s/m.
+pub const DAMPING_RANGE: (f64, f64) = (0.0, 1e12);
+/// Physical range of the improved law's damping saturation depth `delta_max`, m (up to 10 mm).
+pub const DELTA_MAX_RANGE: (f64, f64) = (1e-12, 1e-2);
+/// Physical range of the improved law's damping time `eta`, s.
+pub const ETA_RANGE: (f64, f64) = (0.0, 1.0);
+
+/// Checks a stiffness and an exponent against their physical ranges (exponent first: an
+/// invalid exponent is the cause, whatever the stiffness).
 fn check_stiffness_exponent(k: f64, n: f64) -> Result<()> {
-    positive("stiffness", k)?;
-    positive("exponent", n)?;
-    if n < 1.0 {
-        return Err(Error::invalid(
-            "exponent",
-            format!("must be >= 1 for a force with finite stiffness at contact (got {n})"),
-        ));
-    }
+    in_range("exponent", n, EXPONENT_RANGE.0, EXPONENT_RANGE.1, "")?;
+    in_range(
+        "stiffness",
+        k,
+        STIFFNESS_RANGE.0,
+        STIFFNESS_RANGE.1,
+        "N/m^n",
+    )?;
     Ok(())
 }
 
@@ -183,8 +197,20 @@ pub struct KelvinVoigt {
 impl KelvinVoigt {
     /// `K` in N/m, `D` in N s/m (`D >= 0`).
     pub fn new(stiffness: f64, damping: f64) -> Result<Self> {
-        positive("stiffness", stiffness)?;
-        non_negative("damping", damping)?;
+        in_range(
+            "stiffness",
+            stiffness,
+            STIFFNESS_RANGE.0,
+            STIFFNESS_RANGE.1,
+            "N/m",
+        )?;
+        in_range(
+            "damping",
+            damping,
+            DAMPING_RANGE.0,
+            DAMPING_RANGE.1,
+            "N s/m",
+        )?;
         Ok(KelvinVoigt { stiffness, damping })
     }
 }
@@ -417,14 +443,14 @@ impl ImprovedLiu {
         positive("effective_modulus", effective_modulus)?;
         positive("length", length)?;
         positive("clearance", clearance)?;
-        positive("exponent", exponent)?;
-        if exponent < 1.0 {
-            return Err(Error::invalid(
-                "exponent",
-                format!("must be >= 1 (got {exponent})"),
-            ));
-        }
-        positive("delta_max", delta_max)?;
+        in_range("exponent", exponent, EXPONENT_RANGE.0, EXPONENT_RANGE.1, "")?;
+        in_range(
+            "delta_max",
+            delta_max,
+            DELTA_MAX_RANGE.0,
+            DELTA_MAX_RANGE.1,
+            "m",
+        )?;
         let mut law = ImprovedLiu {
             scale: 0.5 * PI * effective_modulus * length,
             clearance,
@@ -433,8 +459,13 @@ impl ImprovedLiu {
             d_max: 0.0,
         };
         law.d_max = match damping {
-            MaxDamping::Eta(eta) => non_negative("eta_s", eta)? * law.tangent_stiffness(delta_max),
-            MaxDamping::Explicit(d) => non_negative("d_max", d)?,
+            MaxDamping::Eta(eta) => {
+                in_range("eta_s", eta, ETA_RANGE.0, ETA_RANGE.1, "s")?
+                    * law.tangent_stiffness(delta_max)
+            }
+            MaxDamping::Explicit(d) => {
+                in_range("d_max", d, DAMPING_RANGE.0, DAMPING_RANGE.1, "N s/m")?
+            }
         };
         Ok(law)
     }
@@ -533,15 +564,57 @@ impl NormalForceLaw for NormalModel {
 impl NormalModel {
     /// The law's name as written in scene files.
     pub fn name(&self) -> &'static str {
+        self.kind().name()
+    }
+
+    /// Which law this is, without its parameters.
+    pub fn kind(&self) -> LawKind {
         match self {
-            NormalModel::Hertz(_) => "Hertz",
-            NormalModel::KelvinVoigt(_) => "KelvinVoigt",
-            NormalModel::HuntCrossley(_) => "HuntCrossley",
-            NormalModel::LankaraniNikravesh(_) => "LankaraniNikravesh",
-            NormalModel::FloresEtAl(_) => "FloresEtAl",
-            NormalModel::GonthierEtAl(_) => "GonthierEtAl",
-            NormalModel::LiuEtAl(_) => "LiuEtAl",
-            NormalModel::ImprovedLiu(_) => "ImprovedLiu",
+            NormalModel::Hertz(_) => LawKind::Hertz,
+            NormalModel::KelvinVoigt(_) => LawKind::KelvinVoigt,
+            NormalModel::HuntCrossley(_) => LawKind::HuntCrossley,
+            NormalModel::LankaraniNikravesh(_) => LawKind::LankaraniNikravesh,
+            NormalModel::FloresEtAl(_) => LawKind::FloresEtAl,
+            NormalModel::GonthierEtAl(_) => LawKind::GonthierEtAl,
+            NormalModel::LiuEtAl(_) => LawKind::LiuEtAl,
+            NormalModel::ImprovedLiu(_) => LawKind::ImprovedLiu,
+        }
+    }
+}
+
+/// A normal law's kind, without parameters (one byte: it travels in errors).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LawKind {
+    /// [`Hertz`].
+    Hertz,
+    /// [`KelvinVoigt`].
+    KelvinVoigt,
+    /// [`HuntCrossley`].
+    HuntCrossley,
+    /// [`LankaraniNikravesh`].
+    LankaraniNikravesh,
+    /// [`FloresEtAl`].
+    FloresEtAl,
+    /// [`GonthierEtAl`].
+    GonthierEtAl,
+    /// [`LiuEtAl`].
+    LiuEtAl,
+    /// [`ImprovedLiu`].
+    ImprovedLiu,
+}
+
+impl LawKind {
+    /// The name as written in scene files.
+    pub fn name(self) -> &'static str {
+        match self {
+            LawKind::Hertz => "Hertz",
+            LawKind::KelvinVoigt => "KelvinVoigt",
+            LawKind::HuntCrossley => "HuntCrossley",
+            LawKind::LankaraniNikravesh => "LankaraniNikravesh",
+            LawKind::FloresEtAl => "FloresEtAl",
+            LawKind::GonthierEtAl => "GonthierEtAl",
+            LawKind::LiuEtAl => "LiuEtAl",
+            LawKind::ImprovedLiu => "ImprovedLiu",
         }
     }
 }
@@ -680,7 +753,10 @@ mod tests {
     #[test]
     fn invalid_parameters_are_named() {
         let err = Hertz::new(-1.0, 1.5).unwrap_err().to_string();
-        assert!(err.contains("stiffness") && err.contains("> 0"), "{err}");
+        assert!(
+            err.contains("stiffness") && err.contains("between 1 and 1e16"),
+            "{err}"
+        );
         let err = HuntCrossley::new(1.0, 1.5, 1.5).unwrap_err().to_string();
         assert!(err.contains("restitution"), "{err}");
         let err = ImprovedLiu::new(1e11, 0.01, f64::NAN, 1.0, 1e-4, MaxDamping::Eta(0.01))

@@ -28,10 +28,7 @@ impl Axis {
     /// Parses `path=v1,v2,...`. Commas inside brackets, braces or double quotes belong to the
     /// value (`gravity=[0,0,-9.81],[0,0,0]` has two values).
     pub fn parse(arg: &str) -> Result<Axis> {
-        let parse_err = |reason: &str| Error::Parse {
-            what: format!("sweep axis `{arg}`"),
-            reason: reason.to_string(),
-        };
+        let parse_err = |reason: &str| Error::parse(format!("sweep axis `{arg}`"), reason);
         let (path, raw) = arg
             .split_once('=')
             .ok_or_else(|| parse_err("expected `path=value1,value2,...`"))?;
@@ -275,10 +272,7 @@ impl Shard {
 
     /// Parses `K/N`.
     pub fn parse(s: &str) -> Result<Shard> {
-        let err = |reason: String| Error::Parse {
-            what: format!("shard `{s}`"),
-            reason,
-        };
+        let err = |reason: String| Error::parse(format!("shard `{s}`"), reason);
         let (k, n) = s
             .split_once('/')
             .ok_or_else(|| err("expected K/N, e.g. 0/4".into()))?;

@@ -195,9 +195,13 @@ pub fn run_studies(
     root: &Path,
     options: &StudyOptions,
 ) -> Result<Vec<StudyOutcome>> {
+    check_names(base)?;
     let mut plans: Vec<(StudyKind, PathBuf, Sweep, Vec<Job>)> = Vec::new();
+    // Each study's folder is claimed (created, checked writable, locked) before any case runs.
+    let mut locks = Vec::new();
     for &kind in kinds {
         let dir = root.join(kind.name());
+        locks.push(crate::output::DirLock::acquire(&dir)?);
         let sweep = kind.sweep(base, &options.extra_overrides);
         let jobs = sweep.jobs(&dir, Shard::ALL)?;
         plans.push((kind, dir, sweep, jobs));
@@ -280,6 +284,46 @@ pub fn run_studies(
         Some(e) => Err(e),
         None => Ok(outcomes),
     }
+}
+
+/// The presets set `hinge.clearance_mm`, `hinge.friction` and `drive.torque_scale`: the scene
+/// must have a clearance hinge named `hinge` and a drive named `drive`. Says so, and what the
+/// scene has, before anything runs.
+pub fn check_names(base: &Scene) -> Result<()> {
+    let hinge_ok = base
+        .hinges
+        .iter()
+        .any(|h| h.name == "hinge" && h.clearance.is_some());
+    let drive_ok = base.drives.iter().any(|d| d.name == "drive");
+    if hinge_ok && drive_ok {
+        return Ok(());
+    }
+    let names = |v: Vec<&str>| {
+        if v.is_empty() {
+            "none".to_string()
+        } else {
+            v.iter()
+                .map(|n| format!("`{n}`"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        }
+    };
+    Err(Error::invalid(
+        format!("study --scene ({})", base.name),
+        format!(
+            "the studies need a clearance hinge named `hinge` and a drive named `drive` (they set \
+             hinge.clearance_mm, hinge.friction and drive.torque_scale); this scene has clearance hinges {} \
+             and drives {}: rename them in the scene file, or run your own grid with `sweep --set ...`",
+            names(
+                base.hinges
+                    .iter()
+                    .filter(|h| h.clearance.is_some())
+                    .map(|h| h.name.as_str())
+                    .collect()
+            ),
+            names(base.drives.iter().map(|d| d.name.as_str()).collect()),
+        ),
+    ))
 }
 
 /// Figures and report of a study whose cases all finished.

@@ -28,7 +28,13 @@ pub enum Verdict {
     NotShown,
     /// The study does not vary the parameter the conclusion is about.
     NotTested,
+    /// The runs hold too few impacts to judge (a run too short): see [`MIN_IMPACTS`].
+    TooLittleData,
 }
+
+/// Impacts (contact onsets) every case needs before a verdict is given: the conclusions are
+/// about impacts, impact forces and the rattle they cause, and a run without them shows none.
+pub const MIN_IMPACTS: u64 = 10;
 
 impl Verdict {
     /// Short text for reports.
@@ -38,6 +44,7 @@ impl Verdict {
             Verdict::Partly => "partly reproduced",
             Verdict::NotShown => "not reproduced",
             Verdict::NotTested => "not tested here",
+            Verdict::TooLittleData => "too little data to judge",
         }
     }
 
@@ -742,6 +749,20 @@ pub fn conclusions(
         });
     } else {
         out.push(elsewhere(4, StudyKind::Friction));
+    }
+    let impacts: Vec<u64> = cases.iter().map(|c| hm(c).impacts).collect();
+    if impacts.iter().any(|&n| n < MIN_IMPACTS) {
+        for c in out.iter_mut().filter(|c| c.verdict != Verdict::NotTested) {
+            c.verdict = Verdict::TooLittleData;
+            c.finding = format!(
+                "**Too little data to judge.** The cases hold {} impacts in {} s; a verdict needs at least \
+                 {MIN_IMPACTS} in every case (run longer: the studies' default is 5 s). The numbers, for \
+                 what they are worth: {}",
+                list(cases, |c| hm(c).impacts.to_string()),
+                num(end),
+                c.finding
+            );
+        }
     }
     out
 }

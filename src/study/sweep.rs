@@ -12,7 +12,7 @@
 use super::grid::{Axis, Grid, Point, Shard};
 use super::metrics::RunMetrics;
 use crate::error::{Error, Result};
-use crate::output::write_atomic;
+use crate::output::{DirLock, MemoryEstimate, write_all_atomic, write_atomic};
 use crate::scene::Scene;
 use crate::sim::{RunOptions, Simulation};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -113,6 +113,27 @@ pub struct ExecOptions {
     pub threads: Option<usize>,
     /// Recompute finished points instead of reusing them.
     pub rerun: bool,
+    /// Memory the parallel runs may hold, bytes (`None`: 80 % of what the system reports
+    /// available, see [`crate::output::available_memory`]).
+    pub max_memory: Option<u64>,
+}
+
+/// The number of worker threads for `requested` (`None`: one per core), at most one per core:
+/// more threads than cores only add memory and switching. Returns the count and, when the
+/// request was cut, a message saying so.
+pub fn thread_count(requested: Option<usize>) -> Result<(usize, Option<String>)> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    match requested {
+        Some(0) => Err(Error::invalid("--jobs", "must be at least 1 (got 0)")),
+        Some(n) if n > cores => Ok((
+            cores,
+            Some(format!(
+                "--jobs {n} capped at {cores}: this machine has {cores} core(s)"
+            )),
+        )),
+        Some(n) => Ok((n, None)),
+        None => Ok((cores, None)),
+    }
 }
 
 /// A point that failed, with the reason.
@@ -249,8 +270,14 @@ impl Job {
     /// Runs the point and writes its files, the manifest last. An old manifest is removed
     /// first, so an interrupted rerun never looks finished.
     pub fn run(&self) -> Result<Manifest> {
+        // One process per point folder: a second sweep running the same point is refused
+        // rather than mixing its files with ours.
+        let _lock = DirLock::acquire(&self.dir)?;
         remove_if_present(&self.dir.join(MANIFEST))?;
-        let result = Simulation::new(&self.scene, RunOptions::default())?.run()?;
+        let adaptive = self.scene.run.step == crate::scene::StepMode::Adaptive;
+        let result = Simulation::new(&self.scene, RunOptions::default())?
+            .run()
+            .map_err(|e| e.with_step_mode(adaptive))?;
         let metrics = RunMetrics::of(&result)?;
         result.write(&self.dir)?;
         let mut files = Vec::new();
@@ -308,6 +335,8 @@ pub(crate) fn json_bytes<T: Serialize>(value: &T, what: &str) -> Result<Vec<u8>>
 /// Runs `jobs` (reusing finished ones unless `rerun`) in parallel; results in job order.
 /// Fails only if the thread pool cannot be built; each job has its own result.
 pub fn execute(jobs: &[Job], options: ExecOptions) -> Result<Vec<Result<PointOutcome>>> {
+    let (threads, _) = thread_count(options.threads)?;
+    check_memory(jobs, threads, options.max_memory)?;
     let progress = Reporter::new(jobs.len(), options.progress);
     let work = || -> Vec<Result<PointOutcome>> {
         jobs.par_iter()
@@ -330,16 +359,39 @@ pub fn execute(jobs: &[Job], options: ExecOptions) -> Result<Vec<Result<PointOut
             })
             .collect()
     };
-    let results = match options.threads {
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n.max(1))
-            .build()
-            .map_err(|e| Error::invalid("--jobs", e.to_string()))?
-            .install(work),
-        None => work(),
-    };
+    let results = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error::invalid("--jobs", e.to_string()))?
+        .install(work);
     progress.finish();
     Ok(results)
+}
+
+/// Refuses, before any point runs, a batch whose parallel runs would hold more memory than
+/// `budget` (default: what the system has available): the largest point's estimate times the
+/// runs in flight at once.
+pub fn check_memory(jobs: &[Job], threads: usize, budget: Option<u64>) -> Result<()> {
+    let Some(budget) = budget.or_else(crate::output::available_memory) else {
+        return Ok(());
+    };
+    let Some((job, estimate)) = jobs
+        .iter()
+        .map(|j| (j, MemoryEstimate::of(&j.scene)))
+        .max_by_key(|(_, e)| e.bytes)
+    else {
+        return Ok(());
+    };
+    let concurrent = threads.min(jobs.len()).max(1) as u64;
+    estimate
+        .check(&job.scene, concurrent, budget)
+        .map_err(|e| match e {
+            Error::Invalid { field, reason } => Error::Invalid {
+                field,
+                reason: format!("{reason} (sweep point `{}`)", job.point.dir),
+            },
+            other => other,
+        })
 }
 
 /// Progress display: an indicatif bar or plain lines on standard error.
@@ -513,15 +565,23 @@ impl MetricsTable {
         Ok(s)
     }
 
-    /// Writes `<stem>.csv` and `<stem>.json` into `out`, each whole or not at all.
+    /// Writes `<stem>.csv` and `<stem>.json` into `out` as one set (see [`MetricsTable::stem`]).
     pub fn write(&self, out: &Path) -> Result<()> {
+        self.write_named(out, &self.stem())
+    }
+
+    /// Writes `<stem>.csv` and `<stem>.json` into `out` as one set, the JSON last.
+    pub fn write_named(&self, out: &Path, stem: &str) -> Result<()> {
         for r in &self.rows {
             r.metrics.check_finite()?;
         }
         let csv = self.to_csv()?;
         let json = json_bytes(self, "metrics table")?;
-        write_atomic(&out.join(format!("{}.csv", self.stem())), csv.as_bytes())?;
-        write_atomic(&out.join(format!("{}.json", self.stem())), &json)
+        // One set, the JSON (which `merge` reads) last.
+        write_all_atomic(&[
+            (&out.join(format!("{stem}.csv")), csv.as_bytes()),
+            (&out.join(format!("{stem}.json")), &json),
+        ])
     }
 
     /// Reads a table written by [`MetricsTable::write`] (its JSON file).

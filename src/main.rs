@@ -173,6 +173,12 @@ struct TimeArgs {
     /// Adaptive steps: the largest step, s (`run.max_dt_s`).
     #[arg(long, allow_hyphen_values = true)]
     max_dt: Option<f64>,
+    /// Fail the run (exit code 1) when a run-time guard is violated: a penetration beyond the
+    /// contact law's validity, energy gained, steps at the floor, a fixed step longer than
+    /// friction's limit (`run.strict`). Without it they are warnings on the console and in
+    /// `summary.json`'s `guards`.
+    #[arg(long)]
+    strict: bool,
     /// Simulated time, s.
     #[arg(long, allow_hyphen_values = true)]
     end: Option<f64>,
@@ -192,6 +198,7 @@ impl TimeArgs {
         ]
         .into_iter()
         .filter_map(|(key, v)| v.map(|v| format!("{key}={v:e}")))
+        .chain(self.strict.then(|| "run.strict=true".to_string()))
         .collect()
     }
 }

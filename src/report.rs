@@ -170,13 +170,15 @@ pub fn summary_json(summary: &Summary) -> Result<String> {
         serde_json::to_value(summary).map_err(|e| Error::invalid("summary", e.to_string()))?;
     // serde_json writes a non-finite float as null: a null is allowed only where a metric is
     // legitimately absent (no impact yet, only one twin), so a NaN anywhere else is caught here.
-    const MAY_BE_NULL: [&str; 6] = [
+    const MAY_BE_NULL: [&str; 8] = [
         "first_impact_t_s",
         "first_impact_peak_n",
         "comparison",
         "linear_momentum_drift",
         "angular_momentum_drift",
         "first_invalid_penetration",
+        "energy_growth",
+        "energy_error",
     ];
     fn check(v: &serde_json::Value, key: &str, path: &str, end: f64) -> Result<()> {
         match v {
@@ -262,7 +264,11 @@ pub fn comparison_table(summary: &Summary) -> String {
         "energy balance growth".into(),
         twins
             .iter()
-            .map(|(_, t)| format!("{:.1e}", t.invariants.energy_growth))
+            .map(|(_, t)| {
+                t.invariants
+                    .energy_growth
+                    .map_or("n/a (at rest)".to_string(), |g| format!("{g:.1e}"))
+            })
             .collect(),
     ));
     let w0 = rows.iter().map(|r| r.0.len()).max().unwrap_or(0);

@@ -195,10 +195,10 @@ pub struct Invariants {
     /// contact elastic energy; D: the work dissipated so far by contact damping and friction) over
     /// the energy scale. Fixed supports and ideal joints do no work, so the balance holds with
     /// gravity and grounds too, and energy gained by the integration shows even in a run that
-    /// dissipates.
-    pub energy_growth: f64,
-    /// Largest `|E(t) + D(t) - E(0)|` over the energy scale.
-    pub energy_error: f64,
+    /// dissipates. Null when nothing moved (an energy scale below 1e-9 J: no scale to judge by).
+    pub energy_growth: Option<f64>,
+    /// Largest `|E(t) + D(t) - E(0)|` over the energy scale (null when nothing moved).
+    pub energy_error: Option<f64>,
     /// The energy scale: the larger of the peak kinetic energy and the largest change of the
     /// potential energy, J.
     pub energy_scale_j: f64,
@@ -229,6 +229,9 @@ pub struct Invariants {
 /// Impacts slower than this (m/s) are not judged by their apparent restitution: at a grazing
 /// approach the separation speed is set by the other forces, not by the contact.
 const RESTITUTION_MIN_SPEED: f64 = 1e-3;
+
+/// Below this energy scale (J) nothing moved enough for the energy balance to be judged.
+const MIN_ENERGY_SCALE_J: f64 = 1e-9;
 
 /// Energy growth above this fraction of the energy scale is a guard violation.
 pub const ENERGY_GROWTH_LIMIT: f64 = 1e-2;
@@ -486,7 +489,7 @@ impl Simulation {
         };
         let mut guards = self.stepper.guards().clone();
         for twin in &self.twins {
-            let g = twin.invariants.energy_growth;
+            let g = twin.invariants.energy_growth.unwrap_or(0.0);
             if g > ENERGY_GROWTH_LIMIT {
                 guards.violation(&format!("energy:{}", twin.kind.name()), || {
                     format!(
@@ -939,8 +942,10 @@ impl Twin {
             inv.linear_momentum_drift = Some(rel(inv.max_dp, inv.max_p));
             inv.angular_momentum_drift = Some(rel(inv.max_dl, inv.max_l));
         }
-        inv.energy_growth = rel(inv.max_de, inv.energy_scale_j);
-        inv.energy_error = rel(inv.max_abs_de, inv.energy_scale_j);
+        if inv.energy_scale_j >= MIN_ENERGY_SCALE_J {
+            inv.energy_growth = Some(inv.max_de / inv.energy_scale_j);
+            inv.energy_error = Some(inv.max_abs_de / inv.energy_scale_j);
+        }
     }
 
     /// The row values of the current state into `row_cur`.

@@ -30,6 +30,13 @@ pub struct RunMetrics {
     pub bodies: BTreeMap<String, BodyRunMetrics>,
     /// Per hinge.
     pub hinges: BTreeMap<String, HingeRunMetrics>,
+    /// Steps the step control rejected and retried shorter.
+    #[serde(default)]
+    pub rejected_steps: u64,
+    /// Run-time guard violations in words (empty when the run stayed within the model's
+    /// validity; see `summary.json`'s `guards`).
+    #[serde(default)]
+    pub guard_violations: Vec<String>,
 }
 
 /// Metrics of one body: the clearance twin against the ideal twin, about the scene's reference axis.
@@ -138,6 +145,8 @@ impl RunMetrics {
             end_s: end,
             steps: sc.steps,
             wall_s: sc.wall_s,
+            rejected_steps: summary.guards.rejected_steps,
+            guard_violations: summary.guards.violations.clone(),
             ..Default::default()
         };
         for b in scene.bodies.iter().filter(|b| !b.fixed) {

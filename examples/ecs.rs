@@ -145,7 +145,7 @@ pub fn report(runs: &[Run; 3]) -> String {
         format!("{:.3}", r.elbow.peak_force)
     });
     row("elbow impacts", &|r| r.elbow.impacts.to_string());
-    s.push_str("* ideal: Rapier's joint impulse / dt; clearance: the contact force\n");
+    s.push_str("* ideal: the exact reaction of the ideal joint; clearance: the contact force\n");
     s
 }
 

@@ -31,5 +31,7 @@ pub mod prelude {
         OutOfPlaneLock,
     };
     pub use crate::laws::*;
+    pub use crate::reaction::{IdealRevolute, ReactionSolver};
+    pub use crate::stepper::{ForceSource, StepControl, StepInfo, Stepper};
     pub use rapier3d_f64::math::Vector;
 }

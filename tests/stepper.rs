@@ -176,9 +176,17 @@ fn an_ideal_mechanism_conserves_energy_under_adaptive_steps() {
     // `a (h1 - h0)/2` into the velocity).
     let r = run(&["run.end_s=1"], Twins::Both, true);
     let ideal = &r.twin(TwinKind::Ideal).unwrap().invariants;
-    assert!(ideal.energy_error.unwrap() < 1e-6, "{:?}", ideal.energy_error);
+    assert!(
+        ideal.energy_error.unwrap() < 1e-6,
+        "{:?}",
+        ideal.energy_error
+    );
     let clear = &r.twin(TwinKind::Clearance).unwrap().invariants;
-    assert!(clear.energy_growth.unwrap() < 1e-3, "{:?}", clear.energy_growth);
+    assert!(
+        clear.energy_growth.unwrap() < 1e-3,
+        "{:?}",
+        clear.energy_growth
+    );
     assert!(r.guards.is_clean(), "{:?}", r.guards);
 }
 

@@ -865,7 +865,10 @@ pub fn study_report(
             list(cases, |c| c.metrics.rejected_steps.to_string())
         );
     } else {
-        let _ = writeln!(s, "**Run-time guards violated** (see each case's `summary.json`):\n");
+        let _ = writeln!(
+            s,
+            "**Run-time guards violated** (see each case's `summary.json`):\n"
+        );
         for c in flagged {
             let _ = writeln!(
                 s,

@@ -291,17 +291,16 @@ mod tests {
         assert!(!solve_dense(&mut a, &mut [1.0, 2.0], 2));
     }
 
-    #[test]
-    fn spinning_arm_needs_the_centripetal_force() {
-        // Arm of 2 kg, COM 0.3 m from a fixed pivot, spinning at 5 rad/s about z, no gravity:
-        // the pivot pulls with m w^2 r = 15 N towards itself; no angular acceleration.
+    /// A 2 kg arm, centre of mass 0.3 m along x from a fixed pivot about z, with the given
+    /// velocities: the bodies and the pivot.
+    fn arm(linvel: Vector, angvel: Vector) -> (RigidBodySet, RigidBodyHandle, IdealRevolute) {
         let mut bodies = RigidBodySet::new();
         let base = bodies.insert(RigidBodyBuilder::fixed());
         let arm = bodies.insert(
             RigidBodyBuilder::dynamic()
                 .translation(Vector::new(0.3, 0.0, 0.0))
-                .linvel(Vector::new(0.0, 1.5, 0.0))
-                .angvel(Vector::new(0.0, 0.0, 5.0))
+                .linvel(linvel)
+                .angvel(angvel)
                 .additional_mass_properties(MassProperties::new(
                     Vector::ZERO,
                     2.0,
@@ -316,6 +315,14 @@ mod tests {
             local_anchor2: Vector::new(-0.3, 0.0, 0.0),
             local_axis1: Vector::Z,
         };
+        (bodies, arm, j)
+    }
+
+    #[test]
+    fn spinning_arm_needs_the_centripetal_force() {
+        // Spinning at 5 rad/s about z, no gravity: the pivot pulls with m w^2 r = 15 N towards
+        // itself; no angular acceleration.
+        let (bodies, _, j) = arm(Vector::new(0.0, 1.5, 0.0), Vector::new(0.0, 0.0, 5.0));
         let mut s = ReactionSolver::default();
         let f = s.solve(&bodies, &[j], Vector::ZERO).unwrap()[0];
         assert!((f - Vector::new(-15.0, 0.0, 0.0)).length() < 1e-9, "{f:?}");
@@ -325,26 +332,8 @@ mod tests {
     fn torque_driven_arm_by_hand() {
         // Torque 1 N m about z on the arm at rest: I_pivot = 0.03 + 2 * 0.09 = 0.21,
         // alpha = 1/0.21, the pivot supplies m alpha r = 2 * 0.3/0.21 N along +y.
-        let mut bodies = RigidBodySet::new();
-        let base = bodies.insert(RigidBodyBuilder::fixed());
-        let arm = bodies.insert(
-            RigidBodyBuilder::dynamic()
-                .translation(Vector::new(0.3, 0.0, 0.0))
-                .additional_mass_properties(MassProperties::new(
-                    Vector::ZERO,
-                    2.0,
-                    Vector::new(0.01, 0.02, 0.03),
-                )),
-        );
-        prepare_mass_properties(&mut bodies);
+        let (mut bodies, arm, j) = arm(Vector::ZERO, Vector::ZERO);
         bodies[arm].add_torque(Vector::new(0.0, 0.0, 1.0), false);
-        let j = IdealRevolute {
-            body1: base,
-            body2: arm,
-            local_anchor1: Vector::ZERO,
-            local_anchor2: Vector::new(-0.3, 0.0, 0.0),
-            local_axis1: Vector::Z,
-        };
         let mut s = ReactionSolver::default();
         let f = s.solve(&bodies, &[j], Vector::ZERO).unwrap()[0];
         let expected = 2.0 * 0.3 / 0.21;

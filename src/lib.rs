@@ -9,6 +9,7 @@ pub mod ecs;
 pub mod error;
 pub mod joint;
 pub mod kinematics;
+pub mod large_step;
 pub mod laws;
 pub mod ledger;
 pub mod output;
@@ -24,6 +25,9 @@ pub mod prelude {
     pub use crate::joint::{
         ClearanceJoint, ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet,
         OutOfPlaneLock,
+    };
+    pub use crate::large_step::{
+        LargeStepJoint, LargeStepJointBuilder, LargeStepJointHandle, LargeStepJointSet, Restitution,
     };
     pub use crate::laws::*;
     pub use rapier3d_f64::math::Vector;

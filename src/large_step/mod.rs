@@ -633,12 +633,12 @@ impl LargeStepJointSet {
         }
         for body in [joint.body1, joint.body2] {
             let used = self.iter().any(|(_, j)| j.body1 == body || j.body2 == body);
-            if !used && let Some(base) = self.base_extra.remove(&body.into_raw_parts()) {
-                if let Some(rb) = bodies.get_mut(body) {
-                    if rb.additional_solver_iterations() != base {
-                        rb.set_additional_solver_iterations(base);
-                    }
-                }
+            if !used
+                && let Some(base) = self.base_extra.remove(&body.into_raw_parts())
+                && let Some(rb) = bodies.get_mut(body)
+                && rb.additional_solver_iterations() != base
+            {
+                rb.set_additional_solver_iterations(base);
             }
         }
         Some(joint)

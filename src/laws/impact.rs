@@ -19,17 +19,15 @@ pub fn impact_restitution(
     effective_mass: f64,
     approach_speed: f64,
 ) -> f64 {
-    if !(effective_mass > 0.0 && approach_speed > 0.0)
-        || !effective_mass.is_finite()
-        || !approach_speed.is_finite()
-    {
+    let valid = |x: f64| x > 0.0 && x.is_finite();
+    if !valid(effective_mass) || !valid(approach_speed) {
         return 0.0;
     }
     let m = effective_mass;
     let v0 = approach_speed;
     let deepest = penetration_for_energy(law, 0.5 * m * v0 * v0, 1e-6);
     let stiffness = law.tangent_stiffness(deepest);
-    if !(stiffness > 0.0 && stiffness.is_finite()) {
+    if !valid(stiffness) {
         return 0.0;
     }
     let half_period = std::f64::consts::PI * (m / stiffness).sqrt();

@@ -80,7 +80,7 @@ use crate::ledger::{ensure_mass_properties, world_center_of_mass};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     GenericJoint, GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, IntegrationParameters,
-    JointAxesMask, JointAxis, RigidBody, RigidBodyHandle, RigidBodySet,
+    JointAxesMask, JointAxis, RigidBody, RigidBodyHandle, RigidBodySet, RigidBodyType,
 };
 use resolution::{quantized_substeps, rocking_frequency, substeps_needed};
 use std::collections::BTreeMap;
@@ -319,6 +319,8 @@ struct JointState {
     low_steps: u32,
     impacts: u64,
     pre: Option<PreStep>,
+    /// In-plane relative velocity before the last step.
+    last_relative_velocity: Option<Vector>,
 }
 
 /// A revolute hinge with radial play between two Rapier rigid bodies, solved as a constraint.
@@ -440,10 +442,17 @@ impl LargeStepJoint {
     }
 
     /// Velocity of the journal centre relative to the material point of the bearing body under
-    /// it, world.
-    fn relative_velocity(&self, rb1: &RigidBody, rb2: &RigidBody) -> Vector {
+    /// it, world. Before a step (`dt` given), a position-based kinematic body moves by the pose
+    /// its user set for that step, not by its last velocity.
+    fn relative_velocity(&self, rb1: &RigidBody, rb2: &RigidBody, dt: Option<f64>) -> Vector {
         let p2 = *rb2.position() * self.local_anchor2;
-        let at = |rb: &RigidBody| rb.linvel() + rb.angvel().cross(p2 - world_center_of_mass(rb));
+        let at = |rb: &RigidBody| match dt {
+            Some(dt) if dt > 0.0 && rb.body_type() == RigidBodyType::KinematicPositionBased => {
+                let local = rb.position().inverse() * p2;
+                (*rb.next_position() * local - p2) / dt
+            }
+            _ => rb.linvel() + rb.angvel().cross(p2 - world_center_of_mass(rb)),
+        };
         at(rb2) - at(rb1)
     }
 
@@ -469,6 +478,19 @@ impl LargeStepJoint {
             axis.any_orthonormal_vector()
         };
         let tangent = axis.cross(normal);
+        // Sliding along the wall: in contact the tangential part of the relative velocity; in
+        // free flight all of it (where the journal will strike is not known), plus the change
+        // the last step saw (gravity, driven bodies and impacts change it within the step).
+        let v = in_plane(self.relative_velocity(rb1, rb2, Some(dt)));
+        let change = self
+            .state
+            .last_relative_velocity
+            .map_or(0.0, |last| (v - last).length());
+        let sliding = if self.state.in_contact {
+            (v - v.dot(normal) * normal).length()
+        } else {
+            v.length()
+        } + change;
         let w = inverse_mass_along(rb1, p2, tangent) + inverse_mass_along(rb2, p2, tangent);
         let rocking = if w > 0.0 {
             rocking_frequency(load, 1.0 / w, self.clearance())
@@ -476,7 +498,7 @@ impl LargeStepJoint {
             0.0
         };
         (
-            substeps_needed(dt, rocking, drift, self.clearance()),
+            substeps_needed(dt, rocking, drift, sliding, self.clearance()),
             rocking,
         )
     }
@@ -536,7 +558,7 @@ impl LargeStepJoint {
                 let w = inverse_mass_along(rb1, p2, normal) + inverse_mass_along(rb2, p2, normal);
                 let m_n = if w > 0.0 { 1.0 / w } else { 0.0 };
                 let e_coef = self.restitution.coefficient(m_n, approach).clamp(0.0, 1.0);
-                let now = self.relative_velocity(rb1, rb2).dot(normal);
+                let now = self.relative_velocity(rb1, rb2, None).dot(normal);
                 let target = -e_coef * approach;
                 if now > target && m_n > 0.0 {
                     // Newton's impact law: the normal separation speed e v_approach.
@@ -758,8 +780,12 @@ impl LargeStepJointSet {
                 joint.state.normal_force
             };
             let friction_limit = joint.friction * load * joint.geometry.journal_radius();
+            let relative_velocity = joint.relative_velocity(rb1, rb2, Some(dt));
+            let axis = *rb1.rotation() * joint.local_axis1;
+            joint.state.last_relative_velocity =
+                Some(relative_velocity - relative_velocity.dot(axis) * axis);
             joint.state.pre = Some(PreStep {
-                relative_velocity: joint.relative_velocity(rb1, rb2),
+                relative_velocity,
                 dt,
                 substeps: base + extra,
                 friction_limit,

@@ -321,6 +321,8 @@ struct JointState {
     pre: Option<PreStep>,
     /// In-plane relative velocity before the last step.
     last_relative_velocity: Option<Vector>,
+    /// The `additional_solver_iterations` of body 1 and body 2 before the set touched them.
+    floors: [usize; 2],
 }
 
 /// A revolute hinge with radial play between two Rapier rigid bodies, solved as a constraint.
@@ -456,8 +458,9 @@ impl LargeStepJoint {
         at(rb2) - at(rb1)
     }
 
-    /// The substeps this joint needs for the coming step of `dt`, and the rocking frequency used.
-    fn needs(&self, rb1: &RigidBody, rb2: &RigidBody, dt: f64) -> (f64, f64) {
+    /// The substeps this joint needs for the coming step of `dt`, the rocking frequency used, and
+    /// the relative velocity before the step.
+    fn needs(&self, rb1: &RigidBody, rb2: &RigidBody, dt: f64) -> (f64, f64, Vector) {
         let (p2, axis, e) = self.geometry_now(rb1, rb2);
         let in_plane = |v: Vector| v - v.dot(axis) * axis;
         // Rotation drift of the journal centre relative to the bearing point under it.
@@ -481,7 +484,8 @@ impl LargeStepJoint {
         // Sliding along the wall: in contact the tangential part of the relative velocity; in
         // free flight all of it (where the journal will strike is not known), plus the change
         // the last step saw (gravity, driven bodies and impacts change it within the step).
-        let v = in_plane(self.relative_velocity(rb1, rb2, Some(dt)));
+        let relative_velocity = self.relative_velocity(rb1, rb2, Some(dt));
+        let v = in_plane(relative_velocity);
         let change = self
             .state
             .last_relative_velocity
@@ -500,6 +504,7 @@ impl LargeStepJoint {
         (
             substeps_needed(dt, rocking, drift, sliding, self.clearance()),
             rocking,
+            relative_velocity,
         )
     }
 
@@ -615,6 +620,22 @@ pub struct LargeStepJointSet {
     joints: Vec<Option<LargeStepJoint>>,
     /// `additional_solver_iterations` of each managed body before the set touched it.
     base_extra: BTreeMap<(u32, u32), usize>,
+    /// Group of each joint slot (joints sharing a dynamic body), rebuilt after insertions and
+    /// removals.
+    groups: Vec<Option<usize>>,
+    groups_valid: bool,
+    /// Per-step scratch: what each slot needs, and each group's largest count.
+    needs: Vec<Need>,
+    group_max: Vec<usize>,
+}
+
+/// What one joint asks of the coming step.
+#[derive(Clone, Copy, Debug, Default)]
+struct Need {
+    substeps: usize,
+    needed: f64,
+    rocking: f64,
+    relative_velocity: Vector,
 }
 
 impl LargeStepJointSet {
@@ -638,6 +659,7 @@ impl LargeStepJointSet {
         joint.report = LargeStepReport::default();
         joint.handle = Some(impulse_joints.insert(body1, body2, joint.rapier_joint(), true));
         self.joints.push(Some(joint));
+        self.groups_valid = false;
         LargeStepJointHandle(self.joints.len() - 1)
     }
 
@@ -650,6 +672,7 @@ impl LargeStepJointSet {
         impulse_joints: &mut ImpulseJointSet,
     ) -> Option<LargeStepJoint> {
         let mut joint = self.joints.get_mut(handle.0)?.take()?;
+        self.groups_valid = false;
         if let Some(h) = joint.handle.take() {
             impulse_joints.remove(h, true);
         }
@@ -701,16 +724,17 @@ impl LargeStepJointSet {
         let base = params.num_solver_iterations.max(1);
         let dt = params.dt;
         // 1. What each joint needs.
-        let mut wanted = vec![0usize; self.joints.len()];
-        let mut needed = vec![(1.0f64, 0.0f64); self.joints.len()];
+        self.needs.clear();
+        self.needs.resize(self.joints.len(), Need::default());
         for (i, slot) in self.joints.iter_mut().enumerate() {
             let Some(joint) = slot else { continue };
             if !joint.state.prepared {
                 ensure_mass_properties(bodies, None, joint.body1);
                 ensure_mass_properties(bodies, None, joint.body2);
-                for body in [joint.body1, joint.body2] {
+                for (k, body) in [joint.body1, joint.body2].into_iter().enumerate() {
                     if let Some(rb) = bodies.get(body) {
-                        self.base_extra
+                        joint.state.floors[k] = *self
+                            .base_extra
                             .entry(body.into_raw_parts())
                             .or_insert(rb.additional_solver_iterations());
                     }
@@ -720,9 +744,8 @@ impl LargeStepJointSet {
             let (Some(rb1), Some(rb2)) = (bodies.get(joint.body1), bodies.get(joint.body2)) else {
                 continue;
             };
-            let (n, rocking) = joint.needs(rb1, rb2, dt);
-            needed[i] = (n, rocking);
-            let target = quantized_substeps(n, base, joint.max_substeps);
+            let (needed, rocking, relative_velocity) = joint.needs(rb1, rb2, dt);
+            let target = quantized_substeps(needed, base, joint.max_substeps);
             let s = &mut joint.state;
             // Rise at once; fall only after the lower count has sufficed for a while.
             if target >= s.substeps || s.substeps < base {
@@ -735,31 +758,38 @@ impl LargeStepJointSet {
                     s.low_steps = 0;
                 }
             }
-            wanted[i] = s.substeps;
+            self.needs[i] = Need {
+                substeps: s.substeps,
+                needed,
+                rocking,
+                relative_velocity,
+            };
         }
         // 2. Joints sharing a dynamic body are substepped together: one count per group.
-        let group = self.groups(bodies);
-        let mut group_max: BTreeMap<usize, usize> = BTreeMap::new();
-        for (i, g) in group.iter().enumerate() {
+        if !self.groups_valid {
+            self.groups = self.groups(bodies);
+            self.groups_valid = true;
+        }
+        self.group_max.clear();
+        self.group_max.resize(self.joints.len(), 0);
+        for (need, g) in self.needs.iter().zip(&self.groups) {
             if let Some(g) = g {
-                let m = group_max.entry(*g).or_insert(0);
-                *m = (*m).max(wanted[i]);
+                self.group_max[*g] = self.group_max[*g].max(need.substeps);
             }
         }
-        for (i, slot) in self.joints.iter().enumerate() {
-            let (Some(joint), Some(g)) = (slot, group[i]) else {
+        for (slot, g) in self.joints.iter().zip(&self.groups) {
+            let (Some(joint), Some(g)) = (slot, g) else {
                 continue;
             };
-            let extra = group_max[&g].saturating_sub(base);
-            for body in [joint.body1, joint.body2] {
-                let floor = self
-                    .base_extra
-                    .get(&body.into_raw_parts())
-                    .copied()
-                    .unwrap_or(0);
-                if let Some(rb) = bodies.get_mut(body)
+            let extra = self.group_max[*g].saturating_sub(base);
+            for (body, floor) in [joint.body1, joint.body2]
+                .into_iter()
+                .zip(joint.state.floors)
+            {
+                if let Some(rb) = bodies.get(body)
                     && rb.is_dynamic()
                     && rb.additional_solver_iterations() != extra.max(floor)
+                    && let Some(rb) = bodies.get_mut(body)
                 {
                     rb.set_additional_solver_iterations(extra.max(floor));
                 }
@@ -780,7 +810,8 @@ impl LargeStepJointSet {
                 joint.state.normal_force
             };
             let friction_limit = joint.friction * load * joint.geometry.journal_radius();
-            let relative_velocity = joint.relative_velocity(rb1, rb2, Some(dt));
+            let need = self.needs[i];
+            let relative_velocity = need.relative_velocity;
             let axis = *rb1.rotation() * joint.local_axis1;
             joint.state.last_relative_velocity =
                 Some(relative_velocity - relative_velocity.dot(axis) * axis);
@@ -789,8 +820,8 @@ impl LargeStepJointSet {
                 dt,
                 substeps: base + extra,
                 friction_limit,
-                substeps_needed: needed[i].0,
-                rocking_frequency: needed[i].1,
+                substeps_needed: need.needed,
+                rocking_frequency: need.rocking,
             });
             if joint.friction > 0.0
                 && let Some(h) = joint.handle

@@ -189,10 +189,15 @@ fn run(model: Model, dt: f64, end: f64, start: Start) -> Option<(f64, usize, f64
     Some((clock / steps as f64 * 1e6, substeps, worst))
 }
 
+/// One run of a variant: us per step, largest substeps, largest joint error over c.
+type Measured = (f64, usize, f64);
+/// A variant of the chain to time.
+type Variant<'a> = dyn Fn() -> Option<Measured> + 'a;
+
 /// Medians over 5 rounds, the variants interleaved within each round (so a busy machine slows
 /// them alike); `None` if any run of a variant fails.
-fn medians(variants: &[&dyn Fn() -> Option<(f64, usize, f64)>]) -> Vec<Option<(f64, usize, f64)>> {
-    let mut runs: Vec<Vec<(f64, usize, f64)>> = vec![Vec::new(); variants.len()];
+fn medians(variants: &[&Variant<'_>]) -> Vec<Option<Measured>> {
+    let mut runs: Vec<Vec<Measured>> = vec![Vec::new(); variants.len()];
     let mut failed = vec![false; variants.len()];
     for _ in 0..5 {
         for (k, v) in variants.iter().enumerate() {
@@ -236,12 +241,11 @@ fn main() {
         ),
     ];
     for (label, dt) in [("1e-3", 1e-3), ("1/60", 1.0 / 60.0)] {
-        let closures: Vec<Box<dyn Fn() -> Option<(f64, usize, f64)>>> = models
+        let closures: Vec<Box<Variant<'_>>> = models
             .iter()
-            .map(|&(_, m)| Box::new(move || run(m, dt, 2.0, start)) as Box<dyn Fn() -> _>)
+            .map(|&(_, m)| Box::new(move || run(m, dt, 2.0, start)) as Box<Variant<'_>>)
             .collect();
-        let refs: Vec<&dyn Fn() -> Option<(f64, usize, f64)>> =
-            closures.iter().map(|c| c.as_ref()).collect();
+        let refs: Vec<&Variant<'_>> = closures.iter().map(|c| c.as_ref()).collect();
         let results = medians(&refs);
         let ideal = results[0].expect("ideal joints run");
         for ((name, _), r) in models.iter().zip(results) {

@@ -278,9 +278,9 @@ pub fn run_at(dt: f64, end: f64) -> Result<Outcome> {
     o.ideal_tip_error_mm.0 = rms(sq[0]);
     o.play_tip_error_mm.0 = rms(sq[1]);
     o.play_effect_mm.0 = rms(sq[2]);
-    for k in 0..2 {
+    for (k, pin) in play.pins.iter().enumerate() {
         o.angle_effect_deg[k] = (angle_sq[k] / n).sqrt().to_degrees();
-        o.impacts[k] = play.play.get(play.pins[k]).expect("inserted").impacts();
+        o.impacts[k] = play.play.get(*pin).expect("inserted").impacts();
     }
     o.us_per_step = (wall[0] / n * 1e6, wall[1] / n * 1e6);
     Ok(o)

@@ -298,7 +298,7 @@ impl ClearanceJoint {
             let peak =
                 crate::laws::penetration_for_energy(&self.normal_law, energy, 1e-6).max(depth);
             let stiffness = self.normal_law.tangent_stiffness(peak);
-            if !(stiffness > 0.0) {
+            if stiffness.is_nan() || stiffness <= 0.0 {
                 return f64::INFINITY;
             }
             let impact_rate = if self.contact.in_contact {

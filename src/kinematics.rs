@@ -139,7 +139,8 @@ pub fn contact_force(
 /// `omega = sqrt(k/m)`, `zeta = d/(2 m omega)` (the eigenvalues of the one-step map).
 /// Returns `(dt_max, omega, zeta)`; `dt_max` is infinite without stiffness.
 pub fn stable_step(stiffness: f64, damping: f64, effective_mass: f64) -> (f64, f64, f64) {
-    if !(stiffness > 0.0) || !(effective_mass > 0.0) || !effective_mass.is_finite() {
+    let positive = |x: f64| x > 0.0;
+    if !positive(stiffness) || !positive(effective_mass) || !effective_mass.is_finite() {
         return (f64::INFINITY, 0.0, 0.0);
     }
     let omega = (stiffness / effective_mass).sqrt();

@@ -61,10 +61,11 @@ pub(crate) fn ensure_mass_properties(
     colliders: Option<&rapier3d_f64::prelude::ColliderSet>,
     handle: RigidBodyHandle,
 ) {
-    if let Some(rb) = bodies.get_mut(handle) {
-        if rb.is_dynamic() && rb.mass_properties().local_mprops.inv_mass == 0.0 {
-            let empty = rapier3d_f64::prelude::ColliderSet::new();
-            rb.recompute_mass_properties_from_colliders(colliders.unwrap_or(&empty));
-        }
+    if let Some(rb) = bodies.get_mut(handle)
+        && rb.is_dynamic()
+        && rb.mass_properties().local_mprops.inv_mass == 0.0
+    {
+        let empty = rapier3d_f64::prelude::ColliderSet::new();
+        rb.recompute_mass_properties_from_colliders(colliders.unwrap_or(&empty));
     }
 }

@@ -104,7 +104,7 @@ pub enum Restitution {
     Coefficient(f64),
     /// The restitution this compliant law gives each impact, at its approach speed and the
     /// effective mass of the two bodies along the normal
-    /// ([`impact_restitution`](crate::laws::impact_restitution)): the large-step model bounces as
+    /// ([`impact_restitution`]): the large-step model bounces as
     /// the compliant model would.
     Law(NormalModel),
 }

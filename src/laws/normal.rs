@@ -65,7 +65,7 @@ pub trait NormalForceLaw {
 /// every step: a fixed-point iteration on the local power law `F = C delta^p` through the current
 /// estimate (exact for Hertz-type laws, within a few per cent for Liu's), starting from `guess`.
 pub fn penetration_for_energy(law: &impl NormalForceLaw, energy: f64, guess: f64) -> f64 {
-    if !(energy > 0.0) {
+    if energy.is_nan() || energy <= 0.0 {
         return 0.0;
     }
     let mut d = if guess > 0.0 && guess.is_finite() {
@@ -98,7 +98,7 @@ fn gauss_legendre_16(f: impl Fn(f64) -> f64) -> f64 {
         0.2816035507792589,
         0.4580167776572274,
         0.6178762444026438,
-        0.7554044083550030,
+        0.755404408355003,
         0.8656312023878318,
         0.9445750230732326,
         0.9894009349916499,

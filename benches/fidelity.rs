@@ -429,7 +429,11 @@ fn resolution(clearance: f64, cap: Option<usize>) -> (f64, f64, u64) {
     let (mut worst, mut substeps, mut flagged) = (0.0f64, 0usize, 0u64);
     let steps = 1200;
     for _ in 0..steps {
-        play.before_step(&mut w.bodies, &mut w.impulse_joints, &w.integration_parameters);
+        play.before_step(
+            &mut w.bodies,
+            &mut w.impulse_joints,
+            &w.integration_parameters,
+        );
         w.step();
         play.after_step(&mut w.bodies, &w.impulse_joints);
         match pin {

@@ -35,6 +35,39 @@
 //! # Ok::<(), clearance_joint::Error>(())
 //! ```
 //!
+//! The same call builds the large-step model (radial play solved inside Rapier's solver, for
+//! 1/60 s and 1 kHz worlds with any number of solver iterations) into a [`LargeStepJointSet`]:
+//!
+//! ```
+//! use clearance_joint::convert::{Clearance, ClearanceModel, ConvertRevolute};
+//! use clearance_joint::large_step::LargeStepJointSet;
+//! use rapier3d_f64::prelude::*;
+//!
+//! let mut world = PhysicsWorld::new(); // Rapier's defaults: dt = 1/60 s, 4 solver iterations
+//! let base = world.bodies.insert(RigidBodyBuilder::fixed());
+//! let arm = world.bodies.insert(
+//!     RigidBodyBuilder::dynamic()
+//!         .translation(Vector::new(0.0, -0.3, 0.0))
+//!         .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02))),
+//! );
+//! let revolute = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0));
+//! let hinge = world.impulse_joints.insert(base, arm, revolute, true);
+//! let mut play = LargeStepJointSet::new();
+//!
+//! // The one line, with the model chosen: 0.5 mm of play, restitution 0.5.
+//! let hinge = play.convert_revolute(hinge, Clearance::steel(0.010, 0.5e-3, 0.016)?.model(ClearanceModel::LargeStep).restitution(0.5), &mut world.impulse_joints)?;
+//!
+//! for _ in 0..60 {
+//!     play.before_step(&mut world.bodies, &mut world.impulse_joints, &world.integration_parameters);
+//!     world.step();
+//!     play.after_step(&mut world.bodies, &world.impulse_joints);
+//! }
+//! let report = play.get(hinge).unwrap().report();
+//! assert!(report.eccentricity_ratio < 1.1, "{}", report.eccentricity_ratio);
+//! assert!((report.normal_force - 2.0 * 9.81).abs() < 0.01);
+//! # Ok::<(), clearance_joint::Error>(())
+//! ```
+//!
 //! What a clearance joint cannot carry is refused with an error before anything changes: a joint
 //! that is not a revolute, a revolute with a motor or limits (use a
 //! [`TorsionSpring`](crate::drive::TorsionSpring) for a drive), or a disabled joint.
@@ -43,8 +76,11 @@ use crate::error::{Error, Result};
 use crate::joint::{
     ClearanceJoint, ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet, OutOfPlaneLock,
 };
+use crate::large_step::{
+    LargeStepJoint, LargeStepJointBuilder, LargeStepJointHandle, LargeStepJointSet,
+};
 use crate::laws::{
-    BearingGeometry, FrictionModel, ImprovedLiu, Material, MaxDamping, NormalModel,
+    BearingGeometry, FrictionLaw, FrictionModel, ImprovedLiu, Material, MaxDamping, NormalModel,
     effective_modulus,
 };
 use crate::scene::{ClearanceParams, ClearanceSpec};
@@ -53,6 +89,23 @@ use rapier3d_f64::prelude::{
     GenericJoint, GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, JointAxesMask,
     RevoluteJoint, RigidBodySet,
 };
+
+/// Which model of the clearance joint to build: the same bearing, two ways of solving it.
+///
+/// | model | solved | steps it is stable at | what it gives |
+/// |---|---|---|---|
+/// | [`Compliant`](Self::Compliant) | contact law, force hook outside Rapier's solver | about 1e-5..1e-4 s for steel, `num_solver_iterations = 1` | force histories, peak forces, penetrations |
+/// | [`LargeStep`](Self::LargeStep) | radial limit inside Rapier's solver, Newton restitution, friction moment | any step (1/60 s, 1e-3 s), any iterations | play, rattle, orbit, sustained forces, impulses |
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum ClearanceModel {
+    /// The compliant contact-law joint ([`ClearanceJoint`] in a [`ClearanceJointSet`]).
+    #[default]
+    Compliant,
+    /// The large-step joint ([`LargeStepJoint`] in a [`LargeStepJointSet`]): restitution from
+    /// [`Clearance::restitution`] (or, when unset, the normal law's own restitution at each
+    /// impact) and Coulomb friction with the friction law's sliding coefficient.
+    LargeStep,
+}
 
 /// Everything a clearance joint needs beyond the revolute joint it replaces: the radial
 /// geometry, the normal and friction laws, and options. Built with chained setters.
@@ -72,6 +125,12 @@ pub struct Clearance {
     pub lock: OutOfPlaneLock,
     /// Name used in errors and reports (default: the builder's default name).
     pub name: Option<String>,
+    /// Which model to build (default [`ClearanceModel::Compliant`]).
+    pub model: ClearanceModel,
+    /// Coefficient of restitution of the large-step model's impacts; `None` (the default): the
+    /// normal law's own restitution at each impact ([`crate::large_step::Restitution::Law`]).
+    /// The compliant model takes its restitution from the law and ignores this.
+    pub restitution: Option<f64>,
 }
 
 impl Clearance {
@@ -85,6 +144,8 @@ impl Clearance {
             min_separation: crate::joint::DEFAULT_MIN_SEPARATION,
             lock: OutOfPlaneLock::Joint,
             name: None,
+            model: ClearanceModel::Compliant,
+            restitution: None,
         }
     }
 
@@ -156,6 +217,18 @@ impl Clearance {
         self
     }
 
+    /// Chooses the model: `.model(ClearanceModel::LargeStep)` for 1/60 s or 1 kHz worlds.
+    pub fn model(mut self, model: ClearanceModel) -> Self {
+        self.model = model;
+        self
+    }
+
+    /// Sets the large-step model's coefficient of restitution (in [0, 1]).
+    pub fn restitution(mut self, coefficient: f64) -> Self {
+        self.restitution = Some(coefficient);
+        self
+    }
+
     /// A validated clearance joint with these laws, about `local_axis1` / `local_axis2` through
     /// `local_anchor1` / `local_anchor2` (body frames; body 1 carries the bearing).
     pub fn joint(
@@ -165,6 +238,14 @@ impl Clearance {
         local_axis1: Vector,
         local_axis2: Vector,
     ) -> Result<ClearanceJoint> {
+        if self.model != ClearanceModel::Compliant {
+            return Err(Error::invalid(
+                "model",
+                "is LargeStep, but a compliant clearance joint was asked for: insert it into a \
+                 LargeStepJointSet (or use `Clearance::large_step_joint`), or choose \
+                 ClearanceModel::Compliant",
+            ));
+        }
         let mut b = ClearanceJointBuilder::new(local_axis1, self.geometry, self.normal)
             .local_axis2(local_axis2)
             .local_anchor1(local_anchor1)
@@ -173,6 +254,35 @@ impl Clearance {
             .min_impact_speed(self.min_impact_speed)
             .min_separation(self.min_separation)
             .lock(self.lock);
+        if let Some(name) = &self.name {
+            b = b.name(name.clone());
+        }
+        b.build()
+    }
+}
+
+impl Clearance {
+    /// A validated large-step clearance joint with this geometry (whatever [`model`](Self::model)
+    /// says): restitution [`restitution`](Self::restitution) or the normal law's own, Coulomb
+    /// friction with the friction law's sliding coefficient (`mu_d`), the same impact-speed floor
+    /// and name, about `local_axis1` / `local_axis2` through `local_anchor1` / `local_anchor2`.
+    pub fn large_step_joint(
+        &self,
+        local_anchor1: Vector,
+        local_anchor2: Vector,
+        local_axis1: Vector,
+        local_axis2: Vector,
+    ) -> Result<LargeStepJoint> {
+        let mut b = LargeStepJointBuilder::new(local_axis1, self.geometry)
+            .local_axis2(local_axis2)
+            .local_anchor1(local_anchor1)
+            .local_anchor2(local_anchor2)
+            .friction(self.friction.sliding_coefficient())
+            .min_impact_speed(self.min_impact_speed);
+        b = match self.restitution {
+            Some(e) => b.restitution(e),
+            None => b.restitution_law(self.normal),
+        };
         if let Some(name) = &self.name {
             b = b.name(name.clone());
         }
@@ -198,6 +308,24 @@ pub fn clearance_joint_from_revolute(
     joint: &GenericJoint,
     clearance: &Clearance,
 ) -> Result<ClearanceJoint> {
+    let [a1, a2, x1, x2] = revolute_frames(joint)?;
+    clearance.joint(a1, a2, x1, x2)
+}
+
+/// The large-step clearance joint equivalent to the revolute `joint` (same anchors and axes),
+/// with the geometry and laws of `clearance` (see [`Clearance::large_step_joint`]). Refuses what
+/// [`clearance_joint_from_revolute`] refuses.
+pub fn large_step_joint_from_revolute(
+    joint: &GenericJoint,
+    clearance: &Clearance,
+) -> Result<LargeStepJoint> {
+    let [a1, a2, x1, x2] = revolute_frames(joint)?;
+    clearance.large_step_joint(a1, a2, x1, x2)
+}
+
+/// Anchors and axes `[anchor1, anchor2, axis1, axis2]` of a convertible revolute joint; refuses a
+/// joint that does not lock exactly the revolute axes, motors, limits and a disabled joint.
+fn revolute_frames(joint: &GenericJoint) -> Result<[Vector; 4]> {
     if joint.locked_axes != JointAxesMask::LOCKED_REVOLUTE_AXES {
         return Err(Error::invalid(
             "revolute",
@@ -233,23 +361,43 @@ pub fn clearance_joint_from_revolute(
     }
     // The X axis of each joint frame. Not `GenericJoint::local_axis1()`: in Rapier 0.36 it
     // transforms X as a point by the whole frame, so it adds the anchor to the axis.
-    clearance.joint(
+    Ok([
         joint.local_anchor1(),
         joint.local_anchor2(),
         joint.local_frame1.rotation * Vector::X,
         joint.local_frame2.rotation * Vector::X,
-    )
+    ])
 }
 
 /// The ideal revolute joint with the anchors and axes of `joint`. Contacts between the two
 /// bodies are disabled, as by the clearance joint's own out-of-plane lock (re-enable them with
 /// `GenericJoint::set_contacts_enabled` if your colliders need them).
 pub fn revolute_from_clearance(joint: &ClearanceJoint) -> RevoluteJoint {
+    revolute_with([
+        joint.local_anchor1(),
+        joint.local_anchor2(),
+        joint.local_axis1(),
+        joint.local_axis2(),
+    ])
+}
+
+/// The ideal revolute joint with the anchors and axes of the large-step `joint` (contacts
+/// between the bodies disabled, as in [`revolute_from_clearance`]).
+pub fn revolute_from_large_step(joint: &LargeStepJoint) -> RevoluteJoint {
+    revolute_with([
+        joint.local_anchor1(),
+        joint.local_anchor2(),
+        joint.local_axis1(),
+        joint.local_axis2(),
+    ])
+}
+
+fn revolute_with([anchor1, anchor2, axis1, axis2]: [Vector; 4]) -> RevoluteJoint {
     let data = GenericJointBuilder::new(JointAxesMask::LOCKED_REVOLUTE_AXES)
-        .local_axis1(joint.local_axis1())
-        .local_axis2(joint.local_axis2())
-        .local_anchor1(joint.local_anchor1())
-        .local_anchor2(joint.local_anchor2())
+        .local_axis1(axis1)
+        .local_axis2(axis2)
+        .local_anchor1(anchor1)
+        .local_anchor2(anchor2)
         .contacts_enabled(false)
         .build();
     RevoluteJoint { data }
@@ -305,26 +453,99 @@ pub fn clearance_to_revolute(
     ))
 }
 
-/// The conversions as methods of [`ClearanceJointSet`].
+/// Replaces the revolute joint `revolute` of `impulse_joints` by a large-step clearance joint in
+/// `set` between the same bodies (body 1 carries the bearing), with the same anchors and axes and
+/// the geometry and laws of `clearance` (its [`model`](Clearance::model) is not consulted: the
+/// set is the choice). Nothing changes when it fails.
+pub fn revolute_to_large_step(
+    set: &mut LargeStepJointSet,
+    revolute: ImpulseJointHandle,
+    clearance: Clearance,
+    impulse_joints: &mut ImpulseJointSet,
+) -> Result<LargeStepJointHandle> {
+    let ij = impulse_joints.get(revolute).ok_or_else(|| {
+        Error::invalid(
+            "revolute",
+            format!("no joint with handle {revolute:?} in the ImpulseJointSet"),
+        )
+    })?;
+    let (body1, body2) = (ij.body1(), ij.body2());
+    let joint = large_step_joint_from_revolute(&ij.data, &clearance)?;
+    impulse_joints.remove(revolute, true);
+    Ok(set.insert(body1, body2, joint, impulse_joints))
+}
+
+/// Replaces the large-step joint `handle` of `set` by an ideal revolute joint with the same
+/// bodies, anchors and axes; the bodies get their substep settings back. The other handles of
+/// `set` stay valid.
+pub fn large_step_to_revolute(
+    set: &mut LargeStepJointSet,
+    handle: LargeStepJointHandle,
+    bodies: &mut RigidBodySet,
+    impulse_joints: &mut ImpulseJointSet,
+) -> Result<ImpulseJointHandle> {
+    let joint = set.remove(handle, bodies, impulse_joints).ok_or_else(|| {
+        Error::invalid(
+            "large-step joint",
+            format!("no joint with handle {handle:?} in the LargeStepJointSet"),
+        )
+    })?;
+    Ok(impulse_joints.insert(
+        joint.body1(),
+        joint.body2(),
+        revolute_from_large_step(&joint),
+        true,
+    ))
+}
+
+/// The conversions as methods of the joint sets: [`ClearanceJointSet`] (the compliant model)
+/// and [`LargeStepJointSet`] (the large-step model).
 pub trait ConvertRevolute {
-    /// See [`revolute_to_clearance`].
+    /// The set's joint handle.
+    type Handle;
+
+    /// See [`revolute_to_clearance`] and [`revolute_to_large_step`].
     fn convert_revolute(
         &mut self,
         revolute: ImpulseJointHandle,
         clearance: Clearance,
         impulse_joints: &mut ImpulseJointSet,
-    ) -> Result<ClearanceJointHandle>;
+    ) -> Result<Self::Handle>;
 
-    /// See [`clearance_to_revolute`].
+    /// See [`clearance_to_revolute`] and [`large_step_to_revolute`].
     fn revert_to_revolute(
         &mut self,
-        handle: ClearanceJointHandle,
+        handle: Self::Handle,
         bodies: &mut RigidBodySet,
         impulse_joints: &mut ImpulseJointSet,
     ) -> Result<ImpulseJointHandle>;
 }
 
+impl ConvertRevolute for LargeStepJointSet {
+    type Handle = LargeStepJointHandle;
+
+    fn convert_revolute(
+        &mut self,
+        revolute: ImpulseJointHandle,
+        clearance: Clearance,
+        impulse_joints: &mut ImpulseJointSet,
+    ) -> Result<LargeStepJointHandle> {
+        revolute_to_large_step(self, revolute, clearance, impulse_joints)
+    }
+
+    fn revert_to_revolute(
+        &mut self,
+        handle: LargeStepJointHandle,
+        bodies: &mut RigidBodySet,
+        impulse_joints: &mut ImpulseJointSet,
+    ) -> Result<ImpulseJointHandle> {
+        large_step_to_revolute(self, handle, bodies, impulse_joints)
+    }
+}
+
 impl ConvertRevolute for ClearanceJointSet {
+    type Handle = ClearanceJointHandle;
+
     fn convert_revolute(
         &mut self,
         revolute: ImpulseJointHandle,
@@ -589,6 +810,98 @@ mod tests {
             "min_impact_speed",
         );
         assert!(r.world.impulse_joints.get(h).is_some(), "revolute kept");
+    }
+
+    #[test]
+    fn large_step_conversion_keeps_frames_and_maps_the_laws() {
+        let mut r = rig();
+        let h = r
+            .world
+            .impulse_joints
+            .insert(r.base, r.arm, revolute(), true);
+        // A LargeStep clearance is refused by the compliant set, naming the field.
+        let mut compliant = ClearanceJointSet::new();
+        let msg = compliant
+            .convert_revolute(
+                h,
+                clearance().model(ClearanceModel::LargeStep),
+                &mut r.world.impulse_joints,
+            )
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("`model`"), "{msg}");
+        assert!(r.world.impulse_joints.get(h).is_some(), "revolute kept");
+
+        let mut play = LargeStepJointSet::new();
+        let k = play
+            .convert_revolute(
+                h,
+                clearance().model(ClearanceModel::LargeStep),
+                &mut r.world.impulse_joints,
+            )
+            .unwrap();
+        let j = play.get(k).unwrap();
+        assert_eq!(j.name(), "pivot");
+        assert_eq!((j.body1(), j.body2()), (r.base, r.arm));
+        assert_eq!(j.local_anchor1(), Vector::new(0.01, 0.0, 0.0));
+        assert_eq!(j.local_anchor2(), Vector::new(0.01, 0.3, 0.0));
+        assert!((j.local_axis1() - Vector::Z).length() < 1e-15);
+        assert!((j.clearance() - 0.2e-3).abs() < 1e-15);
+        // Bai DRY slides at mu_d = 0.25; restitution from the law unless set.
+        assert_eq!(j.friction(), 0.25);
+        assert!(matches!(
+            j.restitution(),
+            crate::large_step::Restitution::Law(NormalModel::ImprovedLiu(_))
+        ));
+        assert_eq!(
+            r.world.impulse_joints.len(),
+            1,
+            "one Rapier joint carries it all"
+        );
+        let data = &r
+            .world
+            .impulse_joints
+            .get(j.rapier_handle().unwrap())
+            .unwrap()
+            .data;
+        assert_eq!(
+            data.coupled_axes,
+            JointAxesMask::LIN_Y | JointAxesMask::LIN_Z
+        );
+        assert!((data.limits[1].max - 0.2e-3).abs() < 1e-15);
+
+        // And back to the same revolute.
+        let back = play
+            .revert_to_revolute(k, &mut r.world.bodies, &mut r.world.impulse_joints)
+            .unwrap();
+        assert!(play.is_empty());
+        let d = &r.world.impulse_joints.get(back).unwrap().data;
+        assert!(d.as_revolute().is_some());
+        assert_eq!(d.local_anchor2(), Vector::new(0.01, 0.3, 0.0));
+        // A set restitution is a fixed coefficient; refusals are the revolute's.
+        let j = clearance()
+            .restitution(0.4)
+            .large_step_joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
+            .unwrap();
+        assert_eq!(
+            *j.restitution(),
+            crate::large_step::Restitution::Coefficient(0.4)
+        );
+        let msg = clearance()
+            .restitution(1.5)
+            .large_step_joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("`restitution`"), "{msg}");
+        let h = r
+            .world
+            .impulse_joints
+            .insert(r.base, r.arm, revolute().limits([-1.0, 1.0]), true);
+        let msg = play
+            .convert_revolute(h, clearance(), &mut r.world.impulse_joints)
+            .unwrap_err()
+            .to_string();
+        assert!(msg.contains("limits"), "{msg}");
     }
 
     #[test]

@@ -11,6 +11,7 @@ pub mod ecs;
 pub mod error;
 pub mod joint;
 pub mod kinematics;
+pub mod large_step;
 pub mod laws;
 pub mod ledger;
 pub mod output;
@@ -29,6 +30,9 @@ pub mod prelude {
     pub use crate::joint::{
         ClearanceJoint, ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet,
         OutOfPlaneLock,
+    };
+    pub use crate::large_step::{
+        LargeStepJoint, LargeStepJointBuilder, LargeStepJointHandle, LargeStepJointSet, Restitution,
     };
     pub use crate::laws::*;
     pub use crate::reaction::{IdealRevolute, ReactionSolver};

@@ -13,6 +13,12 @@ mod drop_in;
 #[path = "../examples/ecs.rs"]
 mod ecs;
 #[allow(dead_code)]
+#[path = "../examples/game_rate.rs"]
+mod game_rate;
+#[allow(dead_code)]
+#[path = "../examples/robot_backlash.rs"]
+mod robot_backlash;
+#[allow(dead_code)]
 #[path = "../examples/solar_panel.rs"]
 mod solar_panel;
 
@@ -131,6 +137,72 @@ fn solar_panel_in_code_is_the_scene_file() {
     assert!(text.contains("final deployment angle (deg)"), "{text}");
 }
 
+#[test]
+fn game_rate_sign_rattles_within_its_play_at_60_hz() {
+    let runs = game_rate::run().unwrap();
+    let game_rate::Runs {
+        ideal,
+        play,
+        capped,
+    } = &runs;
+    // Rapier's defaults: 1/60 s and four solver iterations.
+    assert_eq!(play.dt, 1.0 / 60.0);
+    assert_eq!(play.iterations, 4);
+    // The play holds: the pin stays within 10 % of its clearance at every step's end.
+    assert!(
+        play.max_eccentricity_ratio > 1.0 && play.max_eccentricity_ratio < 1.1,
+        "{}",
+        play.max_eccentricity_ratio
+    );
+    // It rattles on the cobbles and rests once the cart stops, carrying the sign's weight.
+    assert!(play.impacts_rolling > 10, "{}", play.impacts_rolling);
+    assert_eq!(play.impacts_stopped, 0);
+    assert!(
+        (play.final_force_n - 2.0 * 9.81).abs() < 1e-6,
+        "{}",
+        play.final_force_n
+    );
+    // Nothing drives the sign after the stop: its energy never rises (1e-9 J tolerance on a
+    // swing of about 0.08 J), and friction takes the swing.
+    for r in [ideal, play, capped] {
+        assert!(r.max_energy_rise_j < 1e-9, "{}", r.max_energy_rise_j);
+    }
+    assert!(play.energy_at_stop_j > 0.01);
+    assert!(play.final_swing_deg < 0.1 * play.max_swing_deg);
+    // The swing itself barely changes.
+    assert!((play.max_swing_deg - ideal.max_swing_deg).abs() < 2.0);
+    // Capped at Rapier's four substeps it is cheaper and says it is under-resolved.
+    assert_eq!(capped.max_substeps, 4);
+    assert!(capped.under_resolved > 0);
+    assert!(play.mean_substeps > capped.mean_substeps);
+    let text = game_rate::report(&runs);
+    assert!(
+        text.contains("largest |e|/c") && text.contains("play@4"),
+        "{text}"
+    );
+}
+
+#[test]
+fn robot_backlash_shows_the_tracking_error_of_the_play() {
+    let o = robot_backlash::run().unwrap();
+    // The pins rattle at every load turn-over and stay in their play.
+    assert!(o.impacts[0] > 5 && o.impacts[1] > 5, "{:?}", o.impacts);
+    for r in o.max_eccentricity_ratio {
+        assert!(r > 0.99 && r < 1.1, "{r}");
+    }
+    // The play moves the hand off the ideal arm's by about the play of two pins (0.1 mm each,
+    // levered by the links) and more in the rattle.
+    assert!(
+        o.play_effect_mm.0 > 0.05 && o.play_effect_mm.1 < 2.0,
+        "{:?}",
+        o.play_effect_mm
+    );
+    assert!(o.play_effect_mm.1 > 0.2, "{:?}", o.play_effect_mm);
+    assert_eq!(o.under_resolved, 0);
+    let text = robot_backlash::report(&o);
+    assert!(text.contains("hand off the ideal arm's"), "{text}");
+}
+
 /// `target/<profile>/examples`, next to this test's `deps` folder.
 fn examples_dir() -> PathBuf {
     let exe = std::env::current_exe().unwrap();
@@ -171,6 +243,10 @@ fn example_binaries_run_headless_and_print_the_comparison() {
             "ecs",
             "--example",
             "solar_panel",
+            "--example",
+            "game_rate",
+            "--example",
+            "robot_backlash",
         ])
         .output()
         .unwrap();
@@ -185,6 +261,11 @@ fn example_binaries_run_headless_and_print_the_comparison() {
         (
             "solar_panel",
             &["ideal", "clearance", "final deployment angle"][..],
+        ),
+        ("game_rate", &["ideal", "play", "largest |e|/c"][..]),
+        (
+            "robot_backlash",
+            &["ideal", "play", "hand off the ideal arm's"][..],
         ),
     ] {
         let exe = dir.join(format!("{name}{}", std::env::consts::EXE_SUFFIX));

@@ -23,6 +23,12 @@ pub trait FrictionLaw {
     fn coefficient(&self, slip_speed: f64) -> f64;
     /// The largest coefficient the law can return: friction never exceeds `max_coefficient F_N`.
     fn max_coefficient(&self) -> f64;
+    /// The coefficient of steady sliding, `mu_d` for every law here: the law at a slip speed far
+    /// above its transition speeds (1 km/s). A Coulomb constraint (stick below it, slide at it)
+    /// takes this one coefficient.
+    fn sliding_coefficient(&self) -> f64 {
+        self.coefficient(1e3)
+    }
 }
 
 /// Regularised Coulomb: `mu = mu_d min(1, v/v_eps)`.

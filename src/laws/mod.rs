@@ -6,11 +6,13 @@
 //! naming it.
 
 mod friction;
+mod impact;
 mod material;
 mod normal;
 mod step;
 
 pub use friction::*;
+pub use impact::impact_restitution;
 pub use material::*;
 pub use normal::*;
 pub use step::step;

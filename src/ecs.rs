@@ -64,9 +64,9 @@ use crate::drive::{DriveSet, TorsionSpring};
 use crate::error::{Error, Result, unit_vector};
 use crate::joint::{ClearanceJoint, ClearanceJointHandle, ClearanceJointSet};
 use crate::kinematics::ContactMode;
+use crate::large_step::{LargeStepJoint, LargeStepJointHandle, LargeStepJointSet};
 use crate::reaction::{IdealRevolute, ReactionSolver};
 use crate::stepper::{ForceSource, GuardReport, StepControl, StepMode, Stepper};
-use crate::large_step::{LargeStepJoint, LargeStepJointHandle, LargeStepJointSet};
 use bevy_ecs::prelude::*;
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::{
@@ -1060,7 +1060,9 @@ pub fn add_physics_systems(schedule: &mut Schedule) {
         record.in_set(PhysicsSet::Record),
     ));
     schedule.add_systems((
-        prepare_large_step.in_set(PhysicsSet::Forces).after(apply_forces),
+        prepare_large_step
+            .in_set(PhysicsSet::Forces)
+            .after(apply_forces),
         finish_large_step.in_set(PhysicsSet::Record).before(record),
     ));
 }

@@ -312,6 +312,11 @@ impl ComparisonSums {
         }
         for (k, (hi, hc)) in ideal.hinges.iter().zip(&clear.hinges).enumerate() {
             let excess = hc.force - hi.force;
+            // The band is the ideal peak at the end, at least the peak so far: an excess within
+            // it can never be the answer, so it is not stored (memory stays bounded in practice).
+            if excess <= hi.metrics.peak_force_n {
+                continue;
+            }
             let stack = &mut self.excess[k];
             while stack.last().is_some_and(|&(_, e)| e <= excess) {
                 stack.pop();

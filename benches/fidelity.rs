@@ -86,7 +86,7 @@ fn world(model: Model, gravity: Vector, dt: f64) -> PhysicsWorld {
     w.gravity = gravity;
     w.integration_parameters = IntegrationParameters {
         dt,
-        // The compliant hook holds its force over the step: one substep (RAPIER_NOTES).
+        // The compliant hook holds its force over the step: one substep (substeps make every impact gain energy).
         num_solver_iterations: if model == Model::Compliant { 1 } else { 4 },
         ..IntegrationParameters::default()
     };

@@ -140,7 +140,8 @@ pub struct Physics {
 
 impl Physics {
     /// An empty world stepping by `dt` (s) under `gravity` (m/s^2), with one solver iteration
-    /// (the clearance hook's force is constant over a step; RAPIER_NOTES).
+    /// (the clearance hook's force is constant over a step; Rapier's substeps would make every
+    /// impact gain energy).
     pub fn new(dt: f64, gravity: Vector) -> Self {
         let mut world = PhysicsWorld::new();
         world.integration_parameters.dt = dt;
@@ -529,7 +530,7 @@ pub struct Body {
 
 impl Body {
     /// A body to insert, e.g. from `RigidBodyBuilder::dynamic()...`. Use `can_sleep(false)` for
-    /// slow mechanisms: Rapier's sleep thresholds freeze them (RAPIER_NOTES).
+    /// slow mechanisms: Rapier's sleep thresholds freeze them (the paper's panel fell asleep at 0.5 s).
     pub fn new(body: impl Into<RigidBody>) -> Self {
         Body {
             pending: Some(Box::new(body.into())),

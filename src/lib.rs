@@ -14,6 +14,11 @@ pub mod kinematics;
 pub mod large_step;
 pub mod laws;
 pub mod ledger;
+/// The model: the equations of every law and of the kinematics, the conventions, the
+/// interpretations and their parameters, the paper's scene, the time integration and the ideal
+/// reactions (`docs/MODEL.md`, the page the source code cites as "MODEL.md §N").
+#[doc = include_str!("../docs/MODEL.md")]
+pub mod model {}
 pub mod output;
 pub mod progress;
 pub mod reaction;

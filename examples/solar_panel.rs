@@ -199,7 +199,12 @@ pub fn run() -> Result<(Outcome, Outcome)> {
             let o = &mut out[k];
             let force = match twin.clearance {
                 None => reactions
-                    .solve(&world.bodies, &ideal_hinge, world.gravity)
+                    .solve_with(
+                        &world.bodies,
+                        &ideal_hinge,
+                        world.gravity,
+                        ideal.drives.wrenches(),
+                    )
                     .map_or(0.0, |f| f[0].length()),
                 Some(c) => {
                     let r = set.get(c).expect("inserted").report();

@@ -94,7 +94,7 @@ pub struct DriveSet {
     ledger: ForceLedger,
     wrenches: Vec<Wrench>,
     saved: Vec<(HingeAngle, f64)>,
-    saved_ledger: Vec<Wrench>,
+    saved_wrenches: Vec<Wrench>,
 }
 
 impl DriveSet {
@@ -111,8 +111,17 @@ impl DriveSet {
     pub fn drives(&self) -> &[TorsionSpring] {
         &self.drives
     }
-    /// Replaces the torques applied at the previous call by the current ones.
+    /// Replaces the torques applied at the previous call by the current ones (for a loop that
+    /// calls `world.step()` itself; the [`Stepper`](crate::stepper::Stepper) uses
+    /// [`evaluate`](Self::evaluate) and adds the torques for its step only).
     pub fn apply(&mut self, bodies: &mut RigidBodySet) {
+        self.evaluate(bodies);
+        self.ledger.replace(bodies, self.wrenches.iter().copied());
+    }
+
+    /// Measures the angles and computes the torques of [`wrenches`](Self::wrenches), without
+    /// touching the bodies' forces.
+    pub fn evaluate(&mut self, bodies: &RigidBodySet) {
         self.wrenches.clear();
         for d in &mut self.drives {
             if let Some((w1, w2)) = d.evaluate(bodies) {
@@ -120,7 +129,11 @@ impl DriveSet {
                 self.wrenches.push(w2);
             }
         }
-        self.ledger.replace(bodies, self.wrenches.iter().copied());
+    }
+
+    /// The torques of the last evaluation, two per drive.
+    pub fn wrenches(&self) -> &[Wrench] {
+        &self.wrenches
     }
     /// Takes back, exactly, every torque this set applied at its last [`apply`](Self::apply)
     /// (for a drive removed from the world).
@@ -134,17 +147,16 @@ impl DriveSet {
         self.saved.clear();
         self.saved
             .extend(self.drives.iter().map(|d| (d.angle, d.last_torque)));
-        self.ledger.save(&mut self.saved_ledger);
+        self.saved_wrenches.clone_from(&self.wrenches);
     }
 
-    /// Restores what [`save_state`](Self::save_state) saved (the bodies' forces are restored by
-    /// the caller).
+    /// Restores what [`save_state`](Self::save_state) saved.
     pub fn restore_state(&mut self) {
         for (d, &(angle, torque)) in self.drives.iter_mut().zip(&self.saved) {
             d.angle = angle;
             d.last_torque = torque;
         }
-        self.ledger.restore(&self.saved_ledger);
+        self.wrenches.clone_from(&self.saved_wrenches);
     }
 
     /// Total potential energy of the springs at their last measured angles, J.

@@ -136,6 +136,7 @@ pub struct Physics {
     changed: bool,
     reactions: ReactionSolver,
     ideal_joints: Vec<IdealRevolute>,
+    source_wrenches: Vec<crate::ledger::Wrench>,
 }
 
 impl Physics {
@@ -166,12 +167,15 @@ impl Physics {
             changed: true,
             reactions: ReactionSolver::default(),
             ideal_joints: Vec::new(),
+            source_wrenches: Vec::new(),
         }
     }
 
     /// The step control: fixed steps of `world.integration_parameters.dt` by default (changing
     /// `dt` between steps is followed). With [`StepControl::adaptive`] each run of the schedule
-    /// takes one accepted step of the stepper's choice towards the frame's end, `time() + dt`.
+    /// takes ONE accepted step of the stepper's choice, at most up to `time() + dt`: inside
+    /// contacts that step is far shorter than a frame, so a game loop must run the schedule until
+    /// `time()` reaches the frame's time (each run records its state and impacts).
     pub fn set_step_control(&mut self, control: StepControl) {
         self.stepper.set_control(control);
     }
@@ -689,7 +693,10 @@ pub struct HingeState {
     pub rate: f64,
     /// Joint force magnitude over the last step, N. Clearance: the contact force (exact). Large
     /// step: the normal force of the radial limit (its last substep's impulse over the substep).
-    /// Ideal: Rapier's joint impulse divided by the step (approximate: the last substep's impulse).
+    /// Ideal: the exact reaction at the state the step reached, from the constrained equations of
+    /// the ideal revolute hinges under gravity, your forces and the drives
+    /// ([`ReactionSolver`](crate::reaction::ReactionSolver)); contacts with colliders and other
+    /// kinds of joints on the same bodies are not part of it.
     pub force: f64,
     /// Largest `force` so far, N.
     pub peak_force: f64,
@@ -861,9 +868,19 @@ pub fn apply_forces(mut physics: ResMut<Physics>) {
     if std::mem::take(changed) {
         stepper.invalidate(false);
     }
+    follow_dt(stepper, world);
     let mut sources = ecs_sources(clearance, drives);
     if let Err(e) = stepper.prepare(world, &mut sources) {
         physics.fail(e);
+    }
+}
+
+/// Fixed steps follow `integration_parameters.dt` as the user sets it, between any two steps.
+fn follow_dt(stepper: &mut Stepper, world: &PhysicsWorld) {
+    let mut control = *stepper.control();
+    if control.mode == StepMode::Fixed {
+        control.max_dt = world.integration_parameters.dt;
+        stepper.set_control(control);
     }
 }
 
@@ -896,11 +913,7 @@ pub fn step_physics(mut physics: ResMut<Physics>) {
         ..
     } = &mut *physics;
     let dt = world.integration_parameters.dt;
-    let mut control = *stepper.control();
-    if control.mode == StepMode::Fixed {
-        control.max_dt = dt;
-        stepper.set_control(control);
-    }
+    follow_dt(stepper, world);
     let until = stepper.time() + dt;
     let mut sources = ecs_sources(clearance, drives);
     let result = stepper.step(world, &mut sources, until);
@@ -969,9 +982,26 @@ pub fn record(
         }
     }
     let gravity = physics.world.gravity;
+    // The sources' wrenches act during the steps only: the solver gets them explicitly.
+    physics.source_wrenches.clear();
+    let Physics {
+        drives,
+        clearance,
+        source_wrenches,
+        ..
+    } = &mut *physics;
+    for d in drives.values() {
+        source_wrenches.extend_from_slice(d.set.wrenches());
+    }
+    source_wrenches.extend_from_slice(clearance.wrenches());
     let ideal_forces: BTreeMap<Entity, f64> = physics
         .reactions
-        .solve(&physics.world.bodies, &physics.ideal_joints, gravity)
+        .solve_with(
+            &physics.world.bodies,
+            &physics.ideal_joints,
+            gravity,
+            &physics.source_wrenches,
+        )
         .map(|f| {
             ideal_entities
                 .iter()

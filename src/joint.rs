@@ -603,7 +603,7 @@ pub struct ClearanceJointSet {
     ledger: ForceLedger,
     wrenches: Vec<Wrench>,
     saved: Vec<JointDynamics>,
-    saved_ledger: Vec<Wrench>,
+    saved_wrenches: Vec<Wrench>,
 }
 
 impl ClearanceJointSet {
@@ -709,6 +709,16 @@ impl ClearanceJointSet {
     /// the step after seeing the contact state (adaptive stepping) and then call
     /// [`check_step`](Self::check_step) themselves.
     pub fn apply_forces(&mut self, bodies: &mut RigidBodySet) {
+        self.evaluate(bodies);
+        self.ledger.replace(bodies, self.wrenches.iter().copied());
+    }
+
+    /// Evaluates every joint at the bodies' current state (contact history, report, the
+    /// wrenches of [`wrenches`](Self::wrenches)) without touching the bodies' forces: the
+    /// [`Stepper`](crate::stepper::Stepper) adds the wrenches for the duration of its step only,
+    /// so the bodies carry nothing but the user's own forces between steps. A joint whose body is
+    /// gone reports free flight and applies nothing.
+    pub fn evaluate(&mut self, bodies: &mut RigidBodySet) {
         self.wrenches.clear();
         for joint in &mut self.joints {
             if !joint.prepared {
@@ -717,10 +727,20 @@ impl ClearanceJointSet {
                 joint.prepared = true;
             }
             joint.last_wrenches = joint.evaluate(bodies).map(|(w1, w2)| [w1, w2]);
+            if joint.last_wrenches.is_none() {
+                joint.contact = ContactHistory::default();
+                joint.report = ClearanceReport::default();
+                joint.previous_rate = None;
+            }
             self.wrenches
                 .extend(joint.last_wrenches.into_iter().flatten());
         }
-        self.ledger.replace(bodies, self.wrenches.iter().copied());
+    }
+
+    /// The force and torque on each body from the last evaluation (two per joint: bearing,
+    /// journal).
+    pub fn wrenches(&self) -> &[Wrench] {
+        &self.wrenches
     }
 
     /// Refuses Rapier substeps (`num_solver_iterations != 1`) when the set holds joints.
@@ -760,21 +780,20 @@ impl ClearanceJointSet {
         Ok(())
     }
 
-    /// Saves every joint's contact history and report and the forces applied last (before a
-    /// step that may be rejected; no allocation after the first call).
+    /// Saves every joint's contact history and report and its last wrenches (before a step that
+    /// may be rejected; no allocation after the first call).
     pub fn save_state(&mut self) {
         self.saved.clear();
         self.saved.extend(self.joints.iter().map(|j| j.dynamics()));
-        self.ledger.save(&mut self.saved_ledger);
+        self.saved_wrenches.clone_from(&self.wrenches);
     }
 
-    /// Restores what [`save_state`](Self::save_state) saved (the bodies' forces are restored by
-    /// the caller).
+    /// Restores what [`save_state`](Self::save_state) saved.
     pub fn restore_state(&mut self) {
         for (j, d) in self.joints.iter_mut().zip(&self.saved) {
             j.set_dynamics(*d);
         }
-        self.ledger.restore(&self.saved_ledger);
+        self.wrenches.clone_from(&self.saved_wrenches);
     }
 
     /// [`ClearanceJoint::judge_step`] over all joints, with their contact state saved by the last

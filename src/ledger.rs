@@ -25,20 +25,6 @@ pub struct ForceLedger {
 }
 
 impl ForceLedger {
-    /// Copies what was applied last into `into` (its previous content is replaced, its
-    /// allocation reused): with [`restore`](Self::restore), how a rejected step is undone.
-    pub fn save(&self, into: &mut Vec<Wrench>) {
-        into.clear();
-        into.extend_from_slice(&self.applied);
-    }
-
-    /// Makes `from` the wrenches applied last (the bodies' user forces must be restored to the
-    /// matching values by the caller).
-    pub fn restore(&mut self, from: &[Wrench]) {
-        self.applied.clear();
-        self.applied.extend_from_slice(from);
-    }
-
     /// Takes back every wrench of the previous application and adds `wrenches` instead.
     pub fn replace(
         &mut self,

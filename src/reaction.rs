@@ -36,6 +36,7 @@
 //! assert!((forces[0] - Vector::new(0.0, 2.0 * 9.81, 0.0)).length() < 1e-9);
 //! ```
 
+use crate::ledger::Wrench;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{RigidBody, RigidBodyHandle, RigidBodySet};
 
@@ -68,6 +69,7 @@ pub struct ReactionSolver {
     b: Vec<f64>,
     a_copy: Vec<f64>,
     b_copy: Vec<f64>,
+    extra: Vec<Wrench>,
     /// Per joint and row: the Jacobian blocks `(linear, angular)` for body 1 and body 2.
     rows: Vec<[Vector; 4]>,
     forces: Vec<Vector>,
@@ -84,7 +86,12 @@ struct BodyTerms {
     dynamic: bool,
 }
 
-fn terms(rb: &RigidBody, gravity: Vector) -> BodyTerms {
+fn terms(rb: &RigidBody, handle: RigidBodyHandle, gravity: Vector, extra: &[Wrench]) -> BodyTerms {
+    let (mut f_extra, mut t_extra) = (Vector::ZERO, Vector::ZERO);
+    for w in extra.iter().filter(|w| w.body == handle) {
+        f_extra += w.force;
+        t_extra += w.torque;
+    }
     let mp = &rb.mass_properties().local_mprops;
     let com = crate::ledger::world_center_of_mass(rb);
     let w = rb.angvel();
@@ -105,8 +112,8 @@ fn terms(rb: &RigidBody, gravity: Vector) -> BodyTerms {
         inv_mass: if dynamic { mp.inv_mass } else { 0.0 },
         com,
         angvel: w,
-        force: rb.user_force() + mass * rb.gravity_scale() * gravity,
-        torque: rb.user_torque() - gyro,
+        force: rb.user_force() + f_extra + mass * rb.gravity_scale() * gravity,
+        torque: rb.user_torque() + t_extra - gyro,
         dynamic,
     }
 }
@@ -137,7 +144,10 @@ fn orthonormal_pair(axis: Vector) -> (Vector, Vector) {
 
 impl ReactionSolver {
     /// The force on each joint's body 2 (N, world frame), in the order of `joints`, at the bodies'
-    /// current state under their user forces and torques and `gravity`. Redundant constraints (a
+    /// current state under their user forces and torques and `gravity`. Only these revolute
+    /// joints are taken as constraints: contacts with colliders and other joints are not (see
+    /// [`solve_with`](Self::solve_with) for forces you know of, such as the wrenches of
+    /// [`ForceSource`](crate::stepper::ForceSource)s). Redundant constraints (a
     /// closed loop, whose reactions rigid dynamics alone do not determine) get a least-norm
     /// share through a relative regularisation of 1e-12, used only when the system is singular. `None` when a body is missing.
     pub fn solve(
@@ -146,6 +156,21 @@ impl ReactionSolver {
         joints: &[IdealRevolute],
         gravity: Vector,
     ) -> Option<&[Vector]> {
+        self.solve_with(bodies, joints, gravity, &[])
+    }
+
+    /// [`solve`](Self::solve) with further applied wrenches on the bodies: those of the force
+    /// sources the [`Stepper`](crate::stepper::Stepper) adds during its steps only (drives,
+    /// clearance contacts), which the bodies' user forces do not hold between steps.
+    pub fn solve_with(
+        &mut self,
+        bodies: &RigidBodySet,
+        joints: &[IdealRevolute],
+        gravity: Vector,
+        extra: &[Wrench],
+    ) -> Option<&[Vector]> {
+        self.extra.clear();
+        self.extra.extend_from_slice(extra);
         let n = joints.len() * ROWS;
         self.a.clear();
         self.a.resize(n * n, 0.0);
@@ -155,7 +180,10 @@ impl ReactionSolver {
         // Jacobian rows and right-hand sides.
         for j in joints {
             let (rb1, rb2) = (bodies.get(j.body1)?, bodies.get(j.body2)?);
-            let (t1, t2) = (terms(rb1, gravity), terms(rb2, gravity));
+            let (t1, t2) = (
+                terms(rb1, j.body1, gravity, &self.extra),
+                terms(rb2, j.body2, gravity, &self.extra),
+            );
             let r1 = *rb1.position() * j.local_anchor1 - t1.com;
             let r2 = *rb2.position() * j.local_anchor2 - t2.com;
             let axis = (*rb1.rotation() * j.local_axis1).normalize();
@@ -187,7 +215,7 @@ impl ReactionSolver {
                             continue;
                         }
                         let rb = bodies.get(hp)?;
-                        let t = terms(rb, gravity);
+                        let t = terms(rb, hp, gravity, &self.extra);
                         if !t.dynamic {
                             continue;
                         }

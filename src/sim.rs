@@ -66,8 +66,6 @@ struct BodyTrack {
     fixed: bool,
     angle: UnwrappedAngle,
     linvel_before: Vector,
-    /// The user force on the body over the current step (the sources' at the step's start).
-    force_before: Vector,
     /// Angular velocity, centre of mass and rotation at the state before the current step.
     angvel_before: Vector,
     com_before: Vector,
@@ -168,6 +166,8 @@ pub struct Twin {
     ideal_joints: Vec<IdealRevolute>,
     ideal_hinges: Vec<usize>,
     reactions: ReactionSolver,
+    /// The drives' and clearance joints' wrenches at the current state (scratch).
+    source_wrenches: Vec<crate::ledger::Wrench>,
     /// Spring and contact elastic energy at the state before the current step, J.
     source_energy_before: f64,
     reference_axis: Vector,
@@ -632,7 +632,6 @@ impl Twin {
                 fixed: b.fixed,
                 angle: UnwrappedAngle::default(),
                 linvel_before: Vector::ZERO,
-                force_before: Vector::ZERO,
                 angvel_before: Vector::ZERO,
                 com_before: com,
                 rotation_before: rapier3d_f64::math::Rotation::IDENTITY,
@@ -751,6 +750,7 @@ impl Twin {
             ideal_joints,
             ideal_hinges,
             reactions: ReactionSolver::default(),
+            source_wrenches: Vec::new(),
             source_energy_before: 0.0,
             reference_axis: Vector::from(scene.reference_axis).normalize(),
             contact_columns: columns
@@ -779,7 +779,6 @@ impl Twin {
             b.angvel_before = rb.angvel();
             b.com_before = crate::ledger::world_center_of_mass(rb);
             b.rotation_before = *rb.rotation();
-            b.force_before = rb.user_force();
             // Bodies start unrotated: the body's rotation is its rotation since t = 0.
             b.angle.update(twist_angle(rb.rotation(), axis_ref));
         }
@@ -849,7 +848,16 @@ impl Twin {
         if self.ideal_joints.is_empty() {
             return;
         }
-        if let Some(forces) = self.reactions.solve(bodies, &self.ideal_joints, gravity) {
+        // The sources' wrenches act during the steps only: the solver gets them explicitly.
+        self.source_wrenches.clear();
+        self.source_wrenches
+            .extend_from_slice(self.drives.wrenches());
+        self.source_wrenches
+            .extend_from_slice(self.clearance.wrenches());
+        if let Some(forces) =
+            self.reactions
+                .solve_with(bodies, &self.ideal_joints, gravity, &self.source_wrenches)
+        {
             for (&hi, f) in self.ideal_hinges.iter().zip(forces) {
                 self.hinges[hi].force = f.length();
             }

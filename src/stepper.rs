@@ -66,19 +66,23 @@
 use crate::drive::DriveSet;
 use crate::error::{Error, Result};
 use crate::joint::ClearanceJointSet;
+use crate::ledger::Wrench;
 use rapier3d_f64::math::{Pose, Vector};
 use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle};
 use serde::{Deserialize, Serialize};
 
-/// Something that applies forces to the bodies of a world from their state, evaluated by the
-/// [`Stepper`] at the start of every step: [`ClearanceJointSet`] and [`DriveSet`] are ones.
+/// Something that exerts forces on the bodies of a world, computed from their state:
+/// [`ClearanceJointSet`] and [`DriveSet`] are ones. The [`Stepper`] evaluates it at the state
+/// before each step and adds its wrenches to the bodies for the duration of that step only, so
+/// between steps the bodies carry nothing but your own forces (reset or replace them as you like).
 pub trait ForceSource {
-    /// Evaluates at the bodies' current state and applies the forces, replacing exactly what this
-    /// source applied at its previous call.
-    fn apply(&mut self, bodies: &mut rapier3d_f64::prelude::RigidBodySet);
+    /// Evaluates at the bodies' current state (without touching their forces).
+    fn evaluate(&mut self, bodies: &mut rapier3d_f64::prelude::RigidBodySet);
+    /// The wrenches of the last evaluation.
+    fn wrenches(&self) -> &[Wrench];
     /// Saves the internal state (before a step that may be rejected).
     fn save_state(&mut self);
-    /// Restores the state saved last (the stepper restores the bodies and their forces).
+    /// Restores the state saved last (the stepper restores the bodies).
     fn restore_state(&mut self);
     /// The clearance joints of this source, for the step choice and acceptance.
     fn clearance_joints(&self) -> Option<&ClearanceJointSet> {
@@ -87,8 +91,11 @@ pub trait ForceSource {
 }
 
 impl ForceSource for ClearanceJointSet {
-    fn apply(&mut self, bodies: &mut rapier3d_f64::prelude::RigidBodySet) {
-        self.apply_forces(bodies);
+    fn evaluate(&mut self, bodies: &mut rapier3d_f64::prelude::RigidBodySet) {
+        ClearanceJointSet::evaluate(self, bodies);
+    }
+    fn wrenches(&self) -> &[Wrench] {
+        ClearanceJointSet::wrenches(self)
     }
     fn save_state(&mut self) {
         ClearanceJointSet::save_state(self);
@@ -102,8 +109,11 @@ impl ForceSource for ClearanceJointSet {
 }
 
 impl ForceSource for DriveSet {
-    fn apply(&mut self, bodies: &mut rapier3d_f64::prelude::RigidBodySet) {
-        DriveSet::apply(self, bodies);
+    fn evaluate(&mut self, bodies: &mut rapier3d_f64::prelude::RigidBodySet) {
+        DriveSet::evaluate(self, bodies);
+    }
+    fn wrenches(&self) -> &[Wrench] {
+        DriveSet::wrenches(self)
     }
     fn save_state(&mut self) {
         DriveSet::save_state(self);
@@ -383,7 +393,7 @@ impl Stepper {
         }
         self.control.validate()?;
         for s in sources.iter_mut() {
-            s.apply(&mut world.bodies);
+            s.evaluate(&mut world.bodies);
             if let Some(j) = s.clearance_joints() {
                 j.check_substeps(&world.integration_parameters)?;
             }
@@ -412,16 +422,26 @@ impl Stepper {
         }
     }
 
-    /// Takes one accepted step towards `until` (s; the step never passes it and lands on it
-    /// exactly), with `sources` evaluated at the state before it (done by the previous call, or
-    /// by [`prepare`](Self::prepare) on the first) and again at the state after it. Returns what
-    /// the step did. `until` at or before the current time is refused.
+    /// Takes one accepted step towards `until` (s; the step lands on it exactly, a fixed step
+    /// being taken whole when the remainder is within 1e-6 of it; an infinite `until` is no
+    /// target), with `sources` evaluated at the state before it (done by the previous call, or by
+    /// [`prepare`](Self::prepare) on the first) and again at the state after it. Returns what the
+    /// step did. `until` at or before the current time is refused. An error after the step (a
+    /// fixed step beyond a contact's stability limit, a guard under `strict`, a diverged body)
+    /// leaves the world and the clock at the state the step reached.
+    ///
+    /// Between steps the bodies carry only your own forces: the sources' wrenches are added for
+    /// the step and taken away after it. Kinematic position targets
+    /// (`set_next_kinematic_position`) are reached within one step whatever its length: move such
+    /// bodies with velocities (velocity-based kinematic bodies) when the step is adaptive.
     pub fn step(
         &mut self,
         world: &mut PhysicsWorld,
         sources: &mut [&mut dyn ForceSource],
         until: f64,
     ) -> Result<StepInfo> {
+        // Cheap, and `set_control` may have changed it since the last step.
+        self.control.validate()?;
         self.prepare(world, sources)?;
         let left = until - self.t;
         if !(left > 0.0) {
@@ -437,8 +457,11 @@ impl Stepper {
         let mut dt = self.choose(sources);
         if adaptive {
             // Divide what is left into equal steps no larger than dt: no sliver step before the
-            // target (a 1e-8 s step after a 1e-4 s one would break the growth bound).
-            dt = left / (left / dt).ceil();
+            // target (a 1e-8 s step after a 1e-4 s one would break the growth bound). An
+            // infinite `until` is no target.
+            if left.is_finite() {
+                dt = left / (left / dt).ceil();
+            }
         } else {
             // The last step lands on `until`: a full step when `left` is one step up to rounding
             // (no sliver after it), else shortened.
@@ -480,27 +503,36 @@ impl Stepper {
         loop {
             let kick = 0.5 * (self.last_dt + dt);
             let scale = kick / dt;
-            if scale != 1.0 {
-                for b in &self.saved {
-                    if let Some(rb) = world.bodies.get_mut(b.handle)
+            // For this step only: your forces and the sources' wrenches, scaled to the kick.
+            for b in &self.saved {
+                if let Some(rb) = world.bodies.get_mut(b.handle)
+                    && rb.is_dynamic()
+                    && scale != 1.0
+                {
+                    rb.reset_forces(false);
+                    rb.reset_torques(false);
+                    rb.add_force(b.force * scale, false);
+                    rb.add_torque(b.torque * scale, false);
+                }
+            }
+            for s in sources.iter() {
+                for w in s.wrenches() {
+                    if let Some(rb) = world.bodies.get_mut(w.body)
                         && rb.is_dynamic()
                     {
-                        rb.reset_forces(false);
-                        rb.reset_torques(false);
-                        rb.add_force(b.force * scale, false);
-                        rb.add_torque(b.torque * scale, false);
+                        let wake = w.force != Vector::ZERO || w.torque != Vector::ZERO;
+                        rb.add_force(w.force * scale, wake);
+                        rb.add_torque(w.torque * scale, wake);
                     }
                 }
-                world.gravity = gravity * scale;
             }
+            world.gravity = gravity * scale;
             world.integration_parameters.dt = dt;
             world.step();
-            if scale != 1.0 {
-                world.gravity = gravity;
-                self.restore_forces(world);
-            }
+            world.gravity = gravity;
+            self.restore_forces(world);
             for s in sources.iter_mut() {
-                s.apply(&mut world.bodies);
+                s.evaluate(&mut world.bodies);
             }
             let retry = if adaptive {
                 sources
@@ -513,15 +545,8 @@ impl Stepper {
             };
             match retry {
                 None => {
-                    if !adaptive {
-                        // The last step is checked too: the contact it ended in.
-                        for s in sources.iter() {
-                            if let Some(j) = s.clearance_joints() {
-                                j.check_step(dt).map_err(|e| self.locate(e))?;
-                            }
-                        }
-                    }
-                    self.check_health(world, sources, dt)?;
+                    // The step is taken: the clock follows the world before any check can fail,
+                    // so an error leaves both at the state the step reached.
                     let info = StepInfo {
                         t0: self.t,
                         dt,
@@ -536,6 +561,15 @@ impl Stepper {
                     self.last_dt = dt;
                     self.steps += 1;
                     self.guards.rejected_steps += u64::from(rejected);
+                    if !adaptive {
+                        // The last step is checked too: the contact it ended in.
+                        for s in sources.iter() {
+                            if let Some(j) = s.clearance_joints() {
+                                j.check_step(dt).map_err(|e| self.locate(e))?;
+                            }
+                        }
+                    }
+                    self.check_health(world, sources, dt)?;
                     self.count_floor(dt)?;
                     return Ok(info);
                 }
@@ -549,7 +583,8 @@ impl Stepper {
                             reason: format!(
                                 "the step was rejected {rejected} times down to {} s: no step \
                                  resolves the contact (a contact law parameter out of its physical \
-                                 range, or a step floor `min_dt` too high)",
+                                 range, a step floor `min_dt` too high, or a body moved by hand or \
+                                 by a kinematic position target, which any step reaches at once)",
                                 crate::error::sig4(dt)
                             ),
                         });
@@ -642,7 +677,7 @@ impl Stepper {
                 });
             }
         }
-        let t = self.t + dt;
+        let t = self.t;
         let fixed = self.control.mode == StepMode::Fixed;
         for s in sources {
             let Some(set) = s.clearance_joints() else {

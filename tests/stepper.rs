@@ -202,7 +202,7 @@ fn a_fixed_step_never_passes_the_end_and_its_last_step_is_checked() {
         .run()
         .unwrap_err();
     assert!(
-        matches!(&e, Error::StepTooLarge { field, t: Some(t), .. } if field == "run.dt_s" && *t == 0.0),
+        matches!(&e, Error::StepTooLarge { field, t: Some(t), .. } if field == "run.dt_s" && *t == 0.5),
         "{e}"
     );
     // A step that divides the run evenly ends exactly at the end.

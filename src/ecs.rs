@@ -695,7 +695,7 @@ pub struct HingeState {
     /// step: the normal force of the radial limit (its last substep's impulse over the substep).
     /// Ideal: the exact reaction at the state the step reached, from the constrained equations of
     /// the ideal revolute hinges under gravity, your forces and the drives
-    /// ([`ReactionSolver`](crate::reaction::ReactionSolver)); contacts with colliders and other
+    /// ([`ReactionSolver`]); contacts with colliders and other
     /// kinds of joints on the same bodies are not part of it.
     pub force: f64,
     /// Largest `force` so far, N.

@@ -5,7 +5,7 @@
 //! `ImpulseJointSet`, and adds the equivalent [`ClearanceJoint`] to a [`ClearanceJointSet`]:
 //!
 //! ```
-//! use clearance_joint::convert::{Clearance, ConvertRevolute};
+//! use clearance_joint::convert::{BearingSide, Clearance, ConvertRevolute};
 //! use clearance_joint::prelude::*;
 //! use rapier3d_f64::prelude::*;
 //!
@@ -22,7 +22,7 @@
 //! let mut clearance = ClearanceJointSet::new();
 //!
 //! // The one line: 0.2 mm of radial play in a 20 mm steel bearing, 16 mm wide, dry friction.
-//! let hinge = clearance.convert_revolute(hinge, Clearance::steel(0.010, 0.2e-3, 0.016)?.friction(FrictionModel::Bai(Bai::DRY)), &mut world.impulse_joints)?;
+//! let hinge = clearance.convert_revolute(hinge, BearingSide::Body1, Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?.friction(FrictionModel::Bai(Bai::DRY)), &mut world.impulse_joints)?;
 //!
 //! assert_eq!(clearance.get(hinge).unwrap().local_anchor2(), Vector::new(0.0, 0.3, 0.0));
 //! // The revolute is gone; the only Rapier joint left is the lock of the out-of-plane motion.
@@ -53,6 +53,19 @@ use rapier3d_f64::prelude::{
     GenericJoint, GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, JointAxesMask,
     RevoluteJoint, RigidBodySet,
 };
+
+/// Which body of a revolute joint carries the bearing (the hole); the other carries the journal
+/// (the pin). The eccentricity is measured in the bearing's frame about the bearing's axis, and the
+/// contact points sit on each side's radius, so the choice changes the contact kinematics (a
+/// slider-crank's rod-slider pin gives different impact statistics either way).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum BearingSide {
+    /// The joint's body 1 carries the bearing.
+    Body1,
+    /// The joint's body 2 carries the bearing: the clearance joint's body 1 is then the
+    /// revolute's body 2 (anchors and axes swapped with it).
+    Body2,
+}
 
 /// Everything a clearance joint needs beyond the revolute joint it replaces: the radial
 /// geometry, the normal and friction laws, and options. Built with chained setters.
@@ -112,8 +125,22 @@ impl Clearance {
         Ok(Self::new(geometry, NormalModel::ImprovedLiu(law)))
     }
 
-    /// [`improved_liu`](Self::improved_liu) with structural steel on both sides (the paper's
-    /// table 2: E = 207 GPa, nu = 0.3). Lengths in m.
+    /// The paper's improved law ([`improved_liu`](Self::improved_liu), Liu's cylindrical
+    /// elastic term with the penetration-ramped damping) with structural steel on both sides (the
+    /// paper's table 2: E = 207 GPa, nu = 0.3). Lengths in m.
+    pub fn steel_improved_liu(bearing_radius: f64, clearance: f64, length: f64) -> Result<Self> {
+        Self::improved_liu(
+            bearing_radius,
+            clearance,
+            length,
+            Material::STEEL,
+            Material::STEEL,
+        )
+    }
+
+    /// The former name of [`steel_improved_liu`](Self::steel_improved_liu), kept as an alias:
+    /// steel on steel with the paper's *improved Liu* law (not Hertz, not Lankarani-Nikravesh).
+    #[deprecated(note = "says no law: use `Clearance::steel_improved_liu`")]
     pub fn steel(bearing_radius: f64, clearance: f64, length: f64) -> Result<Self> {
         Self::improved_liu(
             bearing_radius,
@@ -256,12 +283,13 @@ pub fn revolute_from_clearance(joint: &ClearanceJoint) -> RevoluteJoint {
 }
 
 /// Replaces the revolute joint `revolute` of `impulse_joints` by a clearance joint in `set`
-/// between the same bodies (body 1 carries the bearing), with the same anchors and axes and the
-/// laws of `clearance`. Nothing changes when it fails (unknown handle, not a convertible
-/// revolute, invalid clearance).
+/// between the same bodies, the bearing on the body `bearing` says, with the same anchors and
+/// axes and the laws of `clearance`. The clearance joint's body 1 is the bearing's body.
+/// Nothing changes when it fails (unknown handle, not a convertible revolute, invalid clearance).
 pub fn revolute_to_clearance(
     set: &mut ClearanceJointSet,
     revolute: ImpulseJointHandle,
+    bearing: BearingSide,
     clearance: Clearance,
     impulse_joints: &mut ImpulseJointSet,
 ) -> Result<ClearanceJointHandle> {
@@ -273,6 +301,19 @@ pub fn revolute_to_clearance(
     })?;
     let (body1, body2) = (ij.body1(), ij.body2());
     let joint = clearance_joint_from_revolute(&ij.data, &clearance)?;
+    let (body1, body2, joint) = match bearing {
+        BearingSide::Body1 => (body1, body2, joint),
+        BearingSide::Body2 => (
+            body2,
+            body1,
+            clearance.joint(
+                joint.local_anchor2(),
+                joint.local_anchor1(),
+                joint.local_axis2(),
+                joint.local_axis1(),
+            )?,
+        ),
+    };
     impulse_joints.remove(revolute, true);
     Ok(set.insert(body1, body2, joint, impulse_joints))
 }
@@ -307,10 +348,12 @@ pub fn clearance_to_revolute(
 
 /// The conversions as methods of [`ClearanceJointSet`].
 pub trait ConvertRevolute {
-    /// See [`revolute_to_clearance`].
+    /// See [`revolute_to_clearance`]: `bearing` says which body of the revolute carries the
+    /// bearing.
     fn convert_revolute(
         &mut self,
         revolute: ImpulseJointHandle,
+        bearing: BearingSide,
         clearance: Clearance,
         impulse_joints: &mut ImpulseJointSet,
     ) -> Result<ClearanceJointHandle>;
@@ -328,10 +371,11 @@ impl ConvertRevolute for ClearanceJointSet {
     fn convert_revolute(
         &mut self,
         revolute: ImpulseJointHandle,
+        bearing: BearingSide,
         clearance: Clearance,
         impulse_joints: &mut ImpulseJointSet,
     ) -> Result<ClearanceJointHandle> {
-        revolute_to_clearance(self, revolute, clearance, impulse_joints)
+        revolute_to_clearance(self, revolute, bearing, clearance, impulse_joints)
     }
 
     fn revert_to_revolute(
@@ -383,7 +427,7 @@ mod tests {
     }
 
     fn clearance() -> Clearance {
-        Clearance::steel(0.010, 0.2e-3, 0.016)
+        Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
             .unwrap()
             .friction(FrictionModel::Bai(Bai::DRY))
             .name("pivot")
@@ -398,7 +442,12 @@ mod tests {
             .insert(r.base, r.arm, revolute(), true);
         let mut set = ClearanceJointSet::new();
         let c = set
-            .convert_revolute(h, clearance(), &mut r.world.impulse_joints)
+            .convert_revolute(
+                h,
+                BearingSide::Body1,
+                clearance(),
+                &mut r.world.impulse_joints,
+            )
             .unwrap();
         assert!(r.world.impulse_joints.get(h).is_none(), "revolute removed");
         let j = set.get(c).unwrap();
@@ -420,6 +469,51 @@ mod tests {
     }
 
     #[test]
+    fn the_bearing_side_is_explicit() {
+        let mut r = rig();
+        let h = r
+            .world
+            .impulse_joints
+            .insert(r.base, r.arm, revolute(), true);
+        let mut set = ClearanceJointSet::new();
+        let c = set
+            .convert_revolute(
+                h,
+                BearingSide::Body2,
+                clearance(),
+                &mut r.world.impulse_joints,
+            )
+            .unwrap();
+        let j = set.get(c).unwrap();
+        // The arm carries the bearing: it is the clearance joint's body 1, with its anchor.
+        assert_eq!((j.body1(), j.body2()), (r.arm, r.base));
+        assert_eq!(j.local_anchor1(), Vector::new(0.01, 0.3, 0.0));
+        assert_eq!(j.local_anchor2(), Vector::new(0.01, 0.0, 0.0));
+        // Either way the contact carries the arm's weight at rest (2 kg x 9.81 m/s^2).
+        let mut stepper = crate::stepper::Stepper::new(crate::stepper::StepControl::fixed(1e-5));
+        while stepper.time() < 0.3 {
+            stepper.step(&mut r.world, &mut [&mut set], 0.3).unwrap();
+        }
+        let f = set.get(c).unwrap().report().force.normal_force;
+        assert!((f - 19.62).abs() < 1.0, "{f}");
+    }
+
+    #[test]
+    #[allow(deprecated)]
+    fn steel_is_the_improved_liu_alias() {
+        assert_eq!(
+            Clearance::steel(0.010, 0.2e-3, 0.016).unwrap(),
+            Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016).unwrap()
+        );
+        assert!(matches!(
+            Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
+                .unwrap()
+                .normal,
+            NormalModel::ImprovedLiu(_)
+        ));
+    }
+
+    #[test]
     fn converts_a_rotated_frame_pair() {
         // Different axes on the two bodies (body 2 built rotated by 90 deg about z).
         let mut r = rig();
@@ -431,8 +525,14 @@ mod tests {
             .build();
         let h = r.world.impulse_joints.insert(r.base, r.arm, data, true);
         let mut set = ClearanceJointSet::new();
-        let c =
-            revolute_to_clearance(&mut set, h, clearance(), &mut r.world.impulse_joints).unwrap();
+        let c = revolute_to_clearance(
+            &mut set,
+            h,
+            BearingSide::Body1,
+            clearance(),
+            &mut r.world.impulse_joints,
+        )
+        .unwrap();
         let j = set.get(c).unwrap();
         assert!((j.local_axis1() - Vector::Y).length() < 1e-15);
         assert!((j.local_axis2() - Vector::X).length() < 1e-15);
@@ -459,7 +559,12 @@ mod tests {
         let h = r.world.impulse_joints.insert(r.base, r.arm, original, true);
         let mut set = ClearanceJointSet::new();
         let c = set
-            .convert_revolute(h, clearance(), &mut r.world.impulse_joints)
+            .convert_revolute(
+                h,
+                BearingSide::Body1,
+                clearance(),
+                &mut r.world.impulse_joints,
+            )
             .unwrap();
         let back = set
             .revert_to_revolute(c, &mut r.world.bodies, &mut r.world.impulse_joints)
@@ -493,7 +598,12 @@ mod tests {
             r.world.step();
         }
         let c = set
-            .convert_revolute(h, clearance(), &mut r.world.impulse_joints)
+            .convert_revolute(
+                h,
+                BearingSide::Body1,
+                clearance(),
+                &mut r.world.impulse_joints,
+            )
             .unwrap();
         for _ in 0..20_000 {
             set.apply(&mut r.world.bodies, &r.world.integration_parameters)
@@ -538,8 +648,13 @@ mod tests {
             let h = r.world.impulse_joints.insert(r.base, r.arm, joint, true);
             let n = r.world.impulse_joints.len();
             check(
-                set.convert_revolute(h, clearance(), &mut r.world.impulse_joints)
-                    .unwrap_err(),
+                set.convert_revolute(
+                    h,
+                    BearingSide::Body1,
+                    clearance(),
+                    &mut r.world.impulse_joints,
+                )
+                .unwrap_err(),
                 needle,
             );
             assert_eq!(r.world.impulse_joints.len(), n, "nothing removed");
@@ -553,8 +668,13 @@ mod tests {
             .insert(r.base, r.arm, revolute(), true);
         r.world.impulse_joints.remove(h, false);
         check(
-            set.convert_revolute(h, clearance(), &mut r.world.impulse_joints)
-                .unwrap_err(),
+            set.convert_revolute(
+                h,
+                BearingSide::Body1,
+                clearance(),
+                &mut r.world.impulse_joints,
+            )
+            .unwrap_err(),
             "no joint with handle",
         );
         check(
@@ -568,11 +688,11 @@ mod tests {
         );
         // An invalid clearance is refused by the laws, naming the field.
         check(
-            Clearance::steel(0.010, 0.02, 0.016).unwrap_err(),
+            Clearance::steel_improved_liu(0.010, 0.02, 0.016).unwrap_err(),
             "clearance",
         );
         check(
-            Clearance::steel(0.010, 0.2e-3, -0.016).unwrap_err(),
+            Clearance::steel_improved_liu(0.010, 0.2e-3, -0.016).unwrap_err(),
             "length",
         );
         let h = r
@@ -582,6 +702,7 @@ mod tests {
         check(
             set.convert_revolute(
                 h,
+                BearingSide::Body1,
                 clearance().min_impact_speed(-1.0),
                 &mut r.world.impulse_joints,
             )
@@ -600,7 +721,9 @@ mod tests {
         assert_eq!(c.friction, FrictionModel::Bai(Bai::DRY));
         assert_eq!(
             c.normal,
-            Clearance::steel(0.010, 0.5e-3, 0.016).unwrap().normal
+            Clearance::steel_improved_liu(0.010, 0.5e-3, 0.016)
+                .unwrap()
+                .normal
         );
     }
 }

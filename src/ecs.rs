@@ -41,7 +41,7 @@
 //!     .spawn((
 //!         Hinge::new(base, arm, Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0)),
 //!         // Was: IdealHinge,
-//!         ClearanceHinge(Clearance::steel(0.010, 0.2e-3, 0.016)?),
+//!         ClearanceHinge(Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?),
 //!     ))
 //!     .id();
 //! let mut schedule = physics_schedule();
@@ -55,7 +55,7 @@
 //! ```
 
 use crate::angle::HingeAngle;
-use crate::convert::{Clearance, ConvertRevolute};
+use crate::convert::{BearingSide, Clearance, ConvertRevolute};
 use crate::drive::{DriveSet, TorsionSpring};
 use crate::error::{Error, Result, unit_vector};
 use crate::joint::{ClearanceJoint, ClearanceJointHandle, ClearanceJointSet};
@@ -323,7 +323,12 @@ impl Physics {
                     let c = named(c, entity);
                     let h = self
                         .clearance
-                        .convert_revolute(j, c.clone(), &mut self.world.impulse_joints)
+                        .convert_revolute(
+                            j,
+                            BearingSide::Body1,
+                            c.clone(),
+                            &mut self.world.impulse_joints,
+                        )
                         .map_err(context)?;
                     self.changed = true;
                     let r = self.hinges.get_mut(&entity).expect("realised");
@@ -969,7 +974,7 @@ mod tests {
     use rapier3d_f64::prelude::{MassProperties, RigidBodyBuilder};
 
     fn clearance() -> Clearance {
-        Clearance::steel(0.010, 0.2e-3, 0.016)
+        Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
             .unwrap()
             .friction(FrictionModel::Bai(Bai::DRY))
     }

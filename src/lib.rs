@@ -13,6 +13,7 @@ pub mod joint;
 pub mod kinematics;
 pub mod laws;
 pub mod ledger;
+pub mod metrics;
 pub mod output;
 pub mod progress;
 pub mod reaction;
@@ -25,7 +26,7 @@ pub use error::{Error, Result};
 
 /// The types most users need.
 pub mod prelude {
-    pub use crate::convert::{Clearance, ConvertRevolute};
+    pub use crate::convert::{BearingSide, Clearance, ConvertRevolute};
     pub use crate::joint::{
         ClearanceJoint, ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet,
         OutOfPlaneLock,

@@ -118,12 +118,31 @@ impl RunResult {
         self.twins.iter().find(|t| t.kind == kind)
     }
 
-    /// Writes `<twin>.csv` for each twin and `summary.json` into `dir` as one set
+    /// Writes `<twin>.csv` for each twin, `<twin>_<joint>_impacts.csv` for each clearance joint
+    /// (its impact list, [`ImpactRecorder::impacts_table`](crate::metrics::ImpactRecorder::impacts_table))
+    /// and `summary.json` into `dir` as one set
     /// ([`write_set`]): the tables are streamed (and checked finite) into temporary files, then
     /// renamed into place, `summary.json` last.
     pub fn write(&self, dir: &Path) -> Result<Summary> {
         let summary = self.summary();
         let json = summary_json(&summary)?;
+        // One impact list per clearance joint, `<twin>_<joint>_impacts.csv`.
+        let impact_tables: Vec<(std::path::PathBuf, crate::output::Table)> = self
+            .twins
+            .iter()
+            .flat_map(|t| {
+                let recorders = t.hinge_recorders();
+                t.clearance_hinges()
+                    .into_iter()
+                    .map(|h| {
+                        (
+                            dir.join(format!("{}_{h}_impacts.csv", t.kind.name())),
+                            recorders[h].impacts_table(),
+                        )
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
         let paths: Vec<std::path::PathBuf> = self
             .twins
             .iter()
@@ -147,6 +166,19 @@ impl RunResult {
                 (path.as_path(), render)
             })
             .collect();
+        for (path, table) in &impact_tables {
+            let render: Render = Box::new(move |w: &mut dyn std::io::Write| {
+                table.write_csv(w).map_err(|e| match e {
+                    Error::Io { action, source, .. } => Error::Io {
+                        action,
+                        path: path.clone(),
+                        source,
+                    },
+                    other => other,
+                })
+            });
+            files.push((path.as_path(), render));
+        }
         let summary_path = dir.join("summary.json");
         let json_path = summary_path.clone();
         files.push((

@@ -7,6 +7,7 @@ use crate::drive::{DriveSet, TorsionSpring};
 use crate::error::Result;
 use crate::joint::{ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet};
 use crate::laws::NormalForceLaw;
+use crate::metrics::{ContactObservation, ImpactRecorder};
 use crate::output::Table;
 use crate::reaction::{IdealRevolute, ReactionSolver};
 use crate::scene::Scene;
@@ -95,7 +96,23 @@ struct HingeTrack {
     force: f64,
     /// The clearance contact at the state before the current step.
     sample: ContactSample,
-    metrics: HingeMetrics,
+    recorder: ImpactRecorder,
+}
+
+impl HingeTrack {
+    /// The state before the current step, for the recorder.
+    fn observation(&self) -> ContactObservation {
+        match self.joint {
+            HingeJoint::Ideal => ContactObservation::ideal(self.force),
+            HingeJoint::Clearance(_) => ContactObservation {
+                force: self.force,
+                onset: self.sample.onset,
+                impact: self.sample.impact,
+                penetration: self.sample.penetration,
+                rate: self.sample.rate,
+            },
+        }
+    }
 }
 
 /// What a clearance hinge's hook saw at one state (read before the step it drives).
@@ -112,46 +129,7 @@ struct ContactSample {
     friction_force: f64,
 }
 
-/// Per-hinge metrics over every internal step.
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct HingeMetrics {
-    /// Largest joint force, N.
-    pub peak_force_n: f64,
-    /// Number of contact onsets (issue 2's definition of impacts), chatter of a journal
-    /// following the wall included.
-    pub impacts: u64,
-    /// Contact onsets after a free flight that opened at least the joint's `min_separation`
-    /// (0.1 um by default; the first contact always counts): impacts without the chatter.
-    pub separated_impacts: u64,
-    /// Time of the first contact onset, s.
-    pub first_impact_t_s: Option<f64>,
-    /// Largest force during the first contact, N.
-    pub first_impact_peak_n: Option<f64>,
-    /// Largest penetration, um.
-    pub max_penetration_um: f64,
-    /// Steps spent in contact.
-    pub contact_steps: u64,
-    /// Fraction of simulated time in contact.
-    pub contact_fraction: f64,
-    /// Root-mean-square joint force over the run (time-weighted), N.
-    pub rms_force_n: f64,
-    #[serde(skip)]
-    force_sq_time: f64,
-    #[serde(skip)]
-    contact_time: f64,
-    /// Largest apparent restitution of an impact, the separation speed over the approach speed
-    /// (from the first state out of and into contact), over impacts that approached faster than
-    /// 1 mm/s; above 1 a contact gave back more than it took (0 without such an impact).
-    pub max_restitution: f64,
-    #[serde(skip)]
-    onset_rate: f64,
-    #[serde(skip)]
-    was_in_contact: bool,
-    /// Final relative angle, deg.
-    pub final_angle_deg: f64,
-    #[serde(skip)]
-    in_first_contact: bool,
-}
+pub use crate::metrics::HingeMetrics;
 
 /// One twin: its bodies, joints, drives and records.
 #[derive(Debug)]
@@ -225,10 +203,6 @@ pub struct Invariants {
     #[serde(skip)]
     max_dpe: f64,
 }
-
-/// Impacts slower than this (m/s) are not judged by their apparent restitution: at a grazing
-/// approach the separation speed is set by the other forces, not by the contact.
-const RESTITUTION_MIN_SPEED: f64 = 1e-3;
 
 /// Below this energy scale (J) nothing moved enough for the energy balance to be judged.
 const MIN_ENERGY_SCALE_J: f64 = 1e-9;
@@ -337,7 +311,7 @@ impl ComparisonSums {
             );
         }
         for (k, h) in ideal.hinges.iter().enumerate() {
-            let band = h.metrics.peak_force_n;
+            let band = h.recorder.metrics().peak_force_n;
             let last = self
                 .excess
                 .get(k)
@@ -568,14 +542,10 @@ impl Simulation {
         let duration = self.time();
         for twin in &mut self.twins {
             // The final state counts for peaks and onsets (it carries no time).
-            twin.update_force_metrics(t, 0.0);
             for h in &mut twin.hinges {
-                let m = &mut h.metrics;
-                m.final_angle_deg = h.angle.value().to_degrees();
-                if duration > 0.0 {
-                    m.rms_force_n = (m.force_sq_time / duration).sqrt();
-                    m.contact_fraction = m.contact_time / duration;
-                }
+                let obs = h.observation();
+                h.recorder.finish(duration, &obs);
+                h.recorder.set_final_angle_deg(h.angle.value().to_degrees());
             }
         }
         Ok(())
@@ -685,7 +655,7 @@ impl Twin {
                 angle: HingeAngle::default(),
                 force: 0.0,
                 sample: ContactSample::default(),
-                metrics: HingeMetrics::default(),
+                recorder: ImpactRecorder::new(),
             });
         }
         let mut drives = DriveSet::new();
@@ -854,46 +824,8 @@ impl Twin {
     /// Metrics of the state before the step (its sample and force), weighted by the step.
     fn update_force_metrics(&mut self, t: f64, dt: f64) {
         for h in &mut self.hinges {
-            let m = &mut h.metrics;
-            m.peak_force_n = m.peak_force_n.max(h.force);
-            m.force_sq_time += h.force * h.force * dt;
-            if let HingeJoint::Clearance(_) = h.joint {
-                let sample = h.sample;
-                let in_contact = sample.penetration > 0.0;
-                if sample.impact {
-                    m.separated_impacts += 1;
-                }
-                if sample.onset {
-                    m.onset_rate = sample.rate;
-                }
-                if m.was_in_contact && !in_contact && m.onset_rate > RESTITUTION_MIN_SPEED {
-                    m.max_restitution = m.max_restitution.max(-sample.rate / m.onset_rate);
-                }
-                m.was_in_contact = in_contact;
-                if sample.onset {
-                    m.impacts += 1;
-                    if m.first_impact_t_s.is_none() {
-                        m.first_impact_t_s = Some(t);
-                        m.first_impact_peak_n = Some(0.0);
-                        m.in_first_contact = true;
-                    }
-                }
-                if m.in_first_contact {
-                    if in_contact {
-                        m.first_impact_peak_n =
-                            Some(m.first_impact_peak_n.unwrap_or(0.0).max(h.force));
-                    } else {
-                        m.in_first_contact = false;
-                    }
-                }
-                if in_contact && dt > 0.0 {
-                    m.contact_steps += 1;
-                    m.contact_time += dt;
-                }
-                if in_contact {
-                    m.max_penetration_um = m.max_penetration_um.max(sample.penetration * 1e6);
-                }
-            }
+            let obs = h.observation();
+            h.recorder.record(t, dt, &obs);
         }
     }
 
@@ -1007,7 +939,24 @@ impl Twin {
     pub fn hinge_metrics(&self) -> BTreeMap<String, HingeMetrics> {
         self.hinges
             .iter()
-            .map(|h| (h.name.clone(), h.metrics.clone()))
+            .map(|h| (h.name.clone(), h.recorder.metrics().clone()))
+            .collect()
+    }
+
+    /// The impact recorder of every hinge, by hinge name (ideal hinges record no impacts).
+    pub fn hinge_recorders(&self) -> BTreeMap<String, &ImpactRecorder> {
+        self.hinges
+            .iter()
+            .map(|h| (h.name.clone(), &h.recorder))
+            .collect()
+    }
+
+    /// Names of the hinges that are clearance joints in this twin, in scene order.
+    pub fn clearance_hinges(&self) -> Vec<&str> {
+        self.hinges
+            .iter()
+            .filter(|h| matches!(h.joint, HingeJoint::Clearance(_)))
+            .map(|h| h.name.as_str())
             .collect()
     }
 

@@ -32,7 +32,10 @@ pub mod prelude {
         OutOfPlaneLock,
     };
     pub use crate::laws::*;
-    pub use crate::reaction::{IdealRevolute, ReactionSolver};
+    pub use crate::metrics::{ContactObservation, ImpactRecorder};
+    pub use crate::reaction::{
+        IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, ReactionSolver,
+    };
     pub use crate::stepper::{ForceSource, StepControl, StepInfo, Stepper};
     pub use rapier3d_f64::math::Vector;
 }

@@ -171,6 +171,8 @@ fn example_binaries_run_headless_and_print_the_comparison() {
             "ecs",
             "--example",
             "solar_panel",
+            "--example",
+            "slider_crank",
         ])
         .output()
         .unwrap();
@@ -185,6 +187,10 @@ fn example_binaries_run_headless_and_print_the_comparison() {
         (
             "solar_panel",
             &["ideal", "clearance", "final deployment angle"][..],
+        ),
+        (
+            "slider_crank",
+            &["ideal slider acceleration", "closed form", "first impact"][..],
         ),
     ] {
         let exe = dir.join(format!("{name}{}", std::env::consts::EXE_SUFFIX));

@@ -1,0 +1,80 @@
+//! The slider-crank of `examples/slider_crank.rs` (plain API: kinematic crank at 5000 rpm,
+//! ideal crank pin, prismatic guide, clearance at the rod-slider pin, gravity, the `Stepper`):
+//! the ideal slider's acceleration against the closed form, the ideal pin force against a hand
+//! value, and the first impact's convergence under halving fixed steps.
+
+#[allow(dead_code)]
+#[path = "../examples/slider_crank.rs"]
+mod slider_crank;
+
+use slider_crank::*;
+use std::f64::consts::TAU;
+
+/// The extremes of the closed form over a turn, sampled finely.
+fn closed_form_extremes() -> (f64, f64) {
+    extremes((0..20_000).map(|k| closed_form_acceleration(k as f64 * TAU / 20_000.0)))
+}
+
+#[test]
+fn ideal_slider_acceleration_matches_the_closed_form() {
+    let turn = TAU / OMEGA;
+    let dt = 1.25e-7;
+    let run = simulate(None, dt, 2.0 * turn).unwrap();
+    // Over the second turn (the first begins with the start's transient).
+    let acc: Vec<(usize, f64)> = run
+        .acceleration()
+        .into_iter()
+        .filter(|&(n, _)| run.t[n] >= turn)
+        .collect();
+    let (hi, lo) = extremes(acc.iter().map(|&(_, a)| a));
+    let (c_hi, c_lo) = closed_form_extremes();
+    // Top dead centre: -omega^2 L1 (1 + L1/L2); bottom dead centre: omega^2 L1 (1 - L1/L2).
+    assert!((c_lo / (-OMEGA * OMEGA * CRANK * (1.0 + CRANK / ROD)) - 1.0).abs() < 1e-12);
+    assert!((c_hi / (OMEGA * OMEGA * CRANK * (1.0 - CRANK / ROD)) - 1.0).abs() < 1e-9);
+    assert!((hi / c_hi - 1.0).abs() < 1e-3, "max {hi} against {c_hi}");
+    assert!((lo / c_lo - 1.0).abs() < 1e-3, "min {lo} against {c_lo}");
+    // Everywhere, at the crank angle of the state, within 0.1 % of the largest acceleration.
+    let worst = acc
+        .iter()
+        .map(|&(n, a)| (a - closed_form_acceleration(run.theta[n])).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-3 * c_lo.abs(), "worst {worst} m/s^2");
+    // The crank turned at the prescribed speed.
+    let last = run.t.len() - 1;
+    assert!((run.theta[last] / (OMEGA * run.t[last]) - 1.0).abs() < 1e-9);
+    // At top dead centre the pin pushes the slider along x alone (the rod is along x): the
+    // pin force is m_slider |a| there, the largest over the turn; gravity adds ~2.5 N across.
+    let peak = run.metrics().peak_force_n;
+    assert!(
+        (peak / (SLIDER_MASS * c_lo.abs()) - 1.0).abs() < 1e-4,
+        "peak {peak} N against {}",
+        SLIDER_MASS * c_lo.abs()
+    );
+    assert!(run.recorder.impacts().is_empty());
+}
+
+#[test]
+fn clearance_pin_impacts_and_its_first_impact_converges() {
+    let ideal = simulate(None, 1.25e-7, FIRST_IMPACT_END).unwrap();
+    let runs: Vec<Run> = [2.5e-7, 1.25e-7, 6.25e-8]
+        .iter()
+        .map(|&dt| simulate(Some(pin_clearance().unwrap()), dt, FIRST_IMPACT_END).unwrap())
+        .collect();
+    let peaks: Vec<f64> = runs
+        .iter()
+        .map(|r| r.metrics().first_impact_peak_n.unwrap())
+        .collect();
+    // Halving the step shrinks the change of the peak.
+    let (d1, d2) = (peaks[1] - peaks[0], peaks[2] - peaks[1]);
+    assert!(d2.abs() < d1.abs(), "{peaks:?}");
+    assert!((d2 / peaks[2]).abs() < 0.02, "{peaks:?}");
+    // Onset and approach speed are resolved to 1e-3 relative.
+    let first: Vec<_> = runs.iter().map(|r| r.recorder.impacts()[0]).collect();
+    for w in first.windows(2) {
+        assert!((w[1].onset_t_s / w[0].onset_t_s - 1.0).abs() < 1e-3);
+        assert!((w[1].approach_speed_m_s / w[0].approach_speed_m_s - 1.0).abs() < 1e-3);
+    }
+    // The journal crosses the clearance fast: the impact is far above the ideal pin force.
+    assert!(first[2].approach_speed_m_s > 1.0);
+    assert!(peaks[2] > 10.0 * ideal.metrics().peak_force_n);
+}

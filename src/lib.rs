@@ -34,7 +34,7 @@ pub mod prelude {
     pub use crate::laws::*;
     pub use crate::metrics::{ContactObservation, ImpactRecorder};
     pub use crate::reaction::{
-        IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, ReactionSolver,
+        IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, ReactionSolver,
     };
     pub use crate::stepper::{ForceSource, StepControl, StepInfo, Stepper};
     pub use rapier3d_f64::math::Vector;

@@ -1,4 +1,4 @@
-//! Exact reactions of ideal joints (revolute, prismatic, fixed) at a state, from the constrained rigid-body equations
+//! Exact reactions of ideal joints (revolute, prismatic, fixed, spherical) at a state, from the constrained rigid-body equations
 //! (not from Rapier's impulses or momentum differences, which carry its integrator's lag).
 //!
 //! For bodies with mass matrices `M`, applied wrenches `F` (user forces and torques, gravity,
@@ -86,6 +86,20 @@ pub struct IdealFixed {
     pub local_anchor2: Vector,
 }
 
+/// An ideal spherical joint (ball and socket) for [`ReactionSolver::solve_joints`]: the anchors
+/// coincide, rotation is free.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IdealSpherical {
+    /// First body.
+    pub body1: RigidBodyHandle,
+    /// Second body: reactions are the forces on it.
+    pub body2: RigidBodyHandle,
+    /// The joint point in body 1's frame, m.
+    pub local_anchor1: Vector,
+    /// The joint point in body 2's frame, m.
+    pub local_anchor2: Vector,
+}
+
 /// Any ideal joint the solver handles.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum IdealJoint {
@@ -95,6 +109,8 @@ pub enum IdealJoint {
     Prismatic(IdealPrismatic),
     /// A weld: 3 linear and 3 angular constraints.
     Fixed(IdealFixed),
+    /// A ball joint: 3 linear constraints.
+    Spherical(IdealSpherical),
 }
 
 impl IdealJoint {
@@ -103,6 +119,7 @@ impl IdealJoint {
             IdealJoint::Revolute(j) => (j.body1, j.body2),
             IdealJoint::Prismatic(j) => (j.body1, j.body2),
             IdealJoint::Fixed(j) => (j.body1, j.body2),
+            IdealJoint::Spherical(j) => (j.body1, j.body2),
         }
     }
 
@@ -112,6 +129,7 @@ impl IdealJoint {
             IdealJoint::Revolute(_) => (5, 3),
             IdealJoint::Prismatic(_) => (5, 2),
             IdealJoint::Fixed(_) => (6, 3),
+            IdealJoint::Spherical(_) => (3, 3),
         }
     }
 }
@@ -125,6 +143,12 @@ impl From<IdealRevolute> for IdealJoint {
 impl From<IdealPrismatic> for IdealJoint {
     fn from(j: IdealPrismatic) -> Self {
         IdealJoint::Prismatic(j)
+    }
+}
+
+impl From<IdealSpherical> for IdealJoint {
+    fn from(j: IdealSpherical) -> Self {
+        IdealJoint::Spherical(j)
     }
 }
 
@@ -233,7 +257,7 @@ impl ReactionSolver {
         if ok { Some(&self.forces) } else { None }
     }
 
-    /// [`solve`](Self::solve) for any mix of revolute, prismatic and fixed joints: the force on
+    /// [`solve`](Self::solve) for any mix of revolute, prismatic, fixed and spherical joints: the force on
     /// each joint's body 2 at its anchor (N, world frame; for a prismatic joint the part normal to
     /// the axis, the only one an ideal slide carries). Every ideal joint of the mechanism must be
     /// listed: a joint left out is a free motion to the solver. Kinematic bodies are taken to move
@@ -305,6 +329,16 @@ impl ReactionSolver {
                     for e in [Vector::X, Vector::Y, Vector::Z] {
                         self.rows.push([Vector::ZERO, -e, Vector::ZERO, e]);
                         self.b.push(-(a2t - a1t).dot(e));
+                    }
+                }
+                IdealJoint::Spherical(j) => {
+                    let r1 = *rb1.position() * j.local_anchor1 - t1.com;
+                    let r2 = *rb2.position() * j.local_anchor2 - t2.com;
+                    let c_lin = w2.cross(w2.cross(r2)) - w1.cross(w1.cross(r1));
+                    let free_lin = a2f + a2t.cross(r2) - a1f - a1t.cross(r1);
+                    for d in [Vector::X, Vector::Y, Vector::Z] {
+                        self.rows.push([-d, -r1.cross(d), d, r2.cross(d)]);
+                        self.b.push(-(c_lin.dot(d) + free_lin.dot(d)));
                     }
                 }
                 IdealJoint::Fixed(j) => {
@@ -621,5 +655,32 @@ mod tests {
             (f - Vector::new(-15.0, 0.0, 19.62)).length() < 1e-9,
             "{f:?}"
         );
+    }
+
+    #[test]
+    fn ball_joint_pendulum_swinging_through_the_bottom() {
+        // A 2 kg point-like bob 0.5 m below a ball joint, passing the bottom at 1 m/s: the joint
+        // pulls up with m g + m v^2/L = 19.62 + 4 = 23.62 N.
+        let mut bodies = RigidBodySet::new();
+        let base = bodies.insert(RigidBodyBuilder::fixed());
+        let bob = slider(
+            &mut bodies,
+            Vector::new(0.0, -0.5, 0.0),
+            Vector::new(1.0, 0.0, 0.0),
+            Vector::new(0.0, 0.0, 2.0),
+        );
+        prepare_mass_properties(&mut bodies);
+        let j = IdealSpherical {
+            body1: base,
+            body2: bob,
+            local_anchor1: Vector::ZERO,
+            local_anchor2: Vector::new(0.0, 0.5, 0.0),
+        };
+        let mut solver = ReactionSolver::default();
+        let f = solver
+            .solve_joints(&bodies, &[j.into()], Vector::new(0.0, -9.81, 0.0))
+            .unwrap()[0];
+        // The bob's own spin (2 rad/s about z) is the pendulum's: no torque is needed at the ball.
+        assert!((f - Vector::new(0.0, 23.62, 0.0)).length() < 1e-9, "{f:?}");
     }
 }

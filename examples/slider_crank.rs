@@ -73,7 +73,8 @@ pub struct Mechanism {
     pub pin: Option<ClearanceJointHandle>,
     /// Ground, crank, rod and slider.
     pub bodies: [RigidBodyHandle; 4],
-    /// Every ideal joint, for the exact reactions (the slider pin last when ideal).
+    /// Every ideal joint, for the exact reactions: the crank pin, the slider pin when ideal,
+    /// the guide.
     pub ideal: Vec<IdealJoint>,
 }
 
@@ -112,7 +113,13 @@ pub fn build(clearance: Option<Clearance>) -> Result<Mechanism> {
             ))
             .can_sleep(false),
     );
-    let crank_pin = (Vector::new(r, 0.0, 0.0), Vector::new(-0.5 * l, 0.0, 0.0));
+    // Joint anchors from world points at t = 0, `point - body position`, and the joints in the
+    // order the scene runner inserts them (hinges, then the other joints), so that
+    // `assets/slider_crank.ron` gives the same bits.
+    let rod_at = Vector::new(r + 0.5 * l, 0.0, 0.0);
+    let slider_at = Vector::new(r + l, 0.0, 0.0);
+    let crank_pin_at = Vector::new(r, 0.0, 0.0);
+    let crank_pin = (crank_pin_at, crank_pin_at - rod_at);
     world.impulse_joints.insert(
         crank,
         rod,
@@ -122,55 +129,36 @@ pub fn build(clearance: Option<Clearance>) -> Result<Mechanism> {
             .contacts_enabled(false),
         true,
     );
-    let guide_anchor = Vector::new(r + l, 0.0, 0.0);
-    world.impulse_joints.insert(
-        ground,
-        slider,
-        PrismaticJointBuilder::new(Vector::X)
-            .local_anchor1(guide_anchor)
-            .contacts_enabled(false),
-        true,
-    );
-    // The rod-slider pin: rod is body 1, slider body 2.
-    let slider_pin = (Vector::new(0.5 * l, 0.0, 0.0), Vector::ZERO);
+    // The rod-slider pin, slider first: the slider carries the bearing.
+    let slider_pin = (Vector::ZERO, slider_at - rod_at);
     let pin_joint = world.impulse_joints.insert(
-        rod,
         slider,
+        rod,
         RevoluteJointBuilder::new(Vector::Z)
             .local_anchor1(slider_pin.0)
             .local_anchor2(slider_pin.1)
             .contacts_enabled(false),
         true,
     );
-    let mut ideal = vec![
-        IdealJoint::Revolute(IdealRevolute {
-            body1: crank,
-            body2: rod,
-            local_anchor1: crank_pin.0,
-            local_anchor2: crank_pin.1,
-            local_axis1: Vector::Z,
-        }),
-        IdealJoint::Prismatic(IdealPrismatic {
-            body1: ground,
-            body2: slider,
-            local_anchor1: guide_anchor,
-            local_anchor2: Vector::ZERO,
-            local_axis1: Vector::X,
-        }),
-    ];
+    let mut ideal = vec![IdealJoint::Revolute(IdealRevolute {
+        body1: crank,
+        body2: rod,
+        local_anchor1: crank_pin.0,
+        local_anchor2: crank_pin.1,
+        local_axis1: Vector::Z,
+    })];
     let mut set = ClearanceJointSet::new();
     let pin = match clearance {
-        // The slider carries the bearing: the revolute's body 2.
         Some(c) => Some(set.convert_revolute(
             pin_joint,
-            BearingSide::Body2,
+            BearingSide::Body1,
             c,
             &mut world.impulse_joints,
         )?),
         None => {
             ideal.push(IdealJoint::Revolute(IdealRevolute {
-                body1: rod,
-                body2: slider,
+                body1: slider,
+                body2: rod,
                 local_anchor1: slider_pin.0,
                 local_anchor2: slider_pin.1,
                 local_axis1: Vector::Z,
@@ -178,6 +166,21 @@ pub fn build(clearance: Option<Clearance>) -> Result<Mechanism> {
             None
         }
     };
+    world.impulse_joints.insert(
+        ground,
+        slider,
+        PrismaticJointBuilder::new(Vector::X)
+            .local_anchor1(slider_at)
+            .contacts_enabled(false),
+        true,
+    );
+    ideal.push(IdealJoint::Prismatic(IdealPrismatic {
+        body1: ground,
+        body2: slider,
+        local_anchor1: slider_at,
+        local_anchor2: Vector::ZERO,
+        local_axis1: Vector::X,
+    }));
     prepare_mass_properties(&mut world.bodies);
     Ok(Mechanism {
         world,
@@ -247,7 +250,7 @@ pub fn simulate(clearance: Option<Clearance>, dt: f64, end: f64) -> Result<Run> 
                 let g = m.world.gravity;
                 let f = reactions
                     .solve_joints(&m.world.bodies, &m.ideal, g)
-                    .map_or(f64::NAN, |f| f[2].length());
+                    .map_or(f64::NAN, |f| f[1].length());
                 ContactObservation::ideal(f)
             }
         };

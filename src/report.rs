@@ -297,9 +297,14 @@ pub fn comparison_table(summary: &Summary) -> String {
         twins
             .iter()
             .map(|(_, t)| {
+                let none = if t.invariants.driven {
+                    "n/a (driven)"
+                } else {
+                    "n/a (at rest)"
+                };
                 t.invariants
                     .energy_growth
-                    .map_or("n/a (at rest)".to_string(), |g| format!("{g:.1e}"))
+                    .map_or(none.to_string(), |g| format!("{g:.1e}"))
             })
             .collect(),
     ));

@@ -9,8 +9,10 @@ use crate::joint::{ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSe
 use crate::laws::NormalForceLaw;
 use crate::metrics::{ContactObservation, ImpactRecorder};
 use crate::output::Table;
-use crate::reaction::{IdealRevolute, ReactionSolver};
-use crate::scene::Scene;
+use crate::reaction::{
+    IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, ReactionSolver,
+};
+use crate::scene::{JointKindSpec, MotionSpec, Scene};
 use crate::stepper::{ForceSource, GuardReport, StepInfo, Stepper};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::*;
@@ -64,7 +66,12 @@ struct BodyTrack {
     name: String,
     handle: RigidBodyHandle,
     mass: f64,
+    /// Fixed or driven by a prescribed motion: outside the energy and momentum balances.
     fixed: bool,
+    /// Not a fixed body (driven bodies move).
+    moves: bool,
+    /// The centre of mass in the body's frame (not the origin for a spinning body), m.
+    local_com: Vector,
     angle: UnwrappedAngle,
     linvel_before: Vector,
     /// The user force on the body over the current step (the sources' at the step's start).
@@ -142,9 +149,13 @@ pub struct Twin {
     pub clearance: ClearanceJointSet,
     /// The drives of this twin.
     pub drives: DriveSet,
-    /// The ideal revolute joints, and the hinge index of each.
-    ideal_joints: Vec<IdealRevolute>,
+    /// The ideal joints: the ideal hinges' revolutes (with the hinge index of each), then the
+    /// scene's other joints.
+    ideal_joints: Vec<IdealJoint>,
     ideal_hinges: Vec<usize>,
+    /// The scene's other joints: name and force on body 2 at the current state, N.
+    joints: Vec<(String, f64)>,
+    body_motion: bool,
     reactions: ReactionSolver,
     /// Spring and contact elastic energy at the state before the current step, J.
     source_energy_before: f64,
@@ -163,6 +174,10 @@ pub struct Twin {
 /// Conservation checks over every step.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Invariants {
+    /// A prescribed motion drives the scene: it does work the balance does not know, so the
+    /// energy figures are null.
+    #[serde(skip)]
+    pub driven: bool,
     /// Largest `|P(t) - P(0)|` over the largest single-body linear momentum seen; null when the
     /// scene is not free-floating (gravity or a fixed body: momentum is not conserved).
     pub linear_momentum_drift: Option<f64>,
@@ -173,7 +188,8 @@ pub struct Invariants {
     /// contact elastic energy; D: the work dissipated so far by contact damping and friction) over
     /// the energy scale. Fixed supports and ideal joints do no work, so the balance holds with
     /// gravity and grounds too, and energy gained by the integration shows even in a run that
-    /// dissipates. Null when nothing moved (an energy scale below 1e-9 J: no scale to judge by).
+    /// dissipates. Null when nothing moved (an energy scale below 1e-9 J: no scale to judge by),
+    /// and when a prescribed motion drives the scene (its work is not in the balance).
     pub energy_growth: Option<f64>,
     /// Largest `|E(t) + D(t) - E(0)|` over the energy scale (null when nothing moved).
     pub energy_error: Option<f64>,
@@ -573,28 +589,54 @@ fn name_step_field(mut e: crate::Error, name: &str) -> crate::Error {
 impl Twin {
     fn build(scene: &Scene, kind: TwinKind, world: &mut PhysicsWorld) -> Result<Twin> {
         let mut bodies = Vec::new();
-        for b in &scene.bodies {
+        for (i, b) in scene.bodies.iter().enumerate() {
             let com = Vector::from(b.center_of_mass_m);
-            let builder = if b.fixed {
-                RigidBodyBuilder::fixed()
-            } else {
-                RigidBodyBuilder::dynamic()
+            let origin = Vector::from(scene.body_origin(i));
+            let rb = match &b.motion {
+                // A driven body: no mass properties, so Rapier turns it about its frame origin.
+                Some(m) => {
+                    let (v, w) = match m {
+                        MotionSpec::Spin {
+                            axis, rate_rad_s, ..
+                        } => (Vector::ZERO, Vector::from(*axis).normalize() * *rate_rad_s),
+                        MotionSpec::Translate { velocity_m_s } => {
+                            (Vector::from(*velocity_m_s), Vector::ZERO)
+                        }
+                    };
+                    RigidBodyBuilder::kinematic_velocity_based()
+                        .translation(origin)
+                        .linvel(v)
+                        .angvel(w)
+                        .can_sleep(false)
+                        .build()
+                }
+                None => {
+                    let builder = if b.fixed {
+                        RigidBodyBuilder::fixed()
+                    } else {
+                        RigidBodyBuilder::dynamic()
+                            .linvel(Vector::from(b.velocity_m_s))
+                            .angvel(Vector::from(b.angular_velocity_rad_s))
+                    };
+                    builder
+                        .translation(com)
+                        .additional_mass_properties(MassProperties::new(
+                            Vector::ZERO,
+                            b.mass_kg,
+                            Vector::from(b.inertia_kg_m2),
+                        ))
+                        .can_sleep(false)
+                        .build()
+                }
             };
-            let rb = builder
-                .translation(com)
-                .additional_mass_properties(MassProperties::new(
-                    Vector::ZERO,
-                    b.mass_kg,
-                    Vector::from(b.inertia_kg_m2),
-                ))
-                .can_sleep(false)
-                .build();
             let handle = world.bodies.insert(rb);
             bodies.push(BodyTrack {
                 name: b.name.clone(),
                 handle,
                 mass: b.mass_kg,
-                fixed: b.fixed,
+                fixed: b.fixed || b.motion.is_some(),
+                moves: !b.fixed,
+                local_com: com - origin,
                 angle: UnwrappedAngle::default(),
                 linvel_before: Vector::ZERO,
                 force_before: Vector::ZERO,
@@ -612,9 +654,10 @@ impl Twin {
             );
             let point = Vector::from(h.point_m);
             let axis = Vector::from(h.axis).normalize();
-            // Bodies start unrotated with their frame at the centre of mass.
-            let a1 = point - Vector::from(scene.bodies[ib].center_of_mass_m);
-            let a2 = point - Vector::from(scene.bodies[ij].center_of_mass_m);
+            // Bodies start unrotated with their frame at their origin (the centre of mass, or
+            // a spinning body's axis point).
+            let a1 = point - Vector::from(scene.body_origin(ib));
+            let a2 = point - Vector::from(scene.body_origin(ij));
             let (b1, b2) = (bodies[ib].handle, bodies[ij].handle);
             let joint = match (&h.clearance, kind) {
                 (Some(spec), TwinKind::Clearance) => {
@@ -678,22 +721,90 @@ impl Twin {
             if let HingeJoint::Ideal = h.joint {
                 let hs = &scene.hinges[i];
                 let point = Vector::from(hs.point_m);
-                let com = |k: usize| Vector::from(scene.bodies[k].center_of_mass_m);
-                ideal_joints.push(IdealRevolute {
+                let com = |k: usize| Vector::from(scene.body_origin(k));
+                ideal_joints.push(IdealJoint::Revolute(IdealRevolute {
                     body1: bodies[h.bearing].handle,
                     body2: bodies[h.journal].handle,
                     local_anchor1: point - com(h.bearing),
                     local_anchor2: point - com(h.journal),
                     local_axis1: h.local_axis1,
-                });
+                }));
                 ideal_hinges.push(i);
             }
+        }
+        let mut joints = Vec::new();
+        for j in &scene.joints {
+            let (i1, i2) = (
+                scene.body_index(&j.body1).unwrap(),
+                scene.body_index(&j.body2).unwrap(),
+            );
+            let point = Vector::from(j.point_m);
+            let a1 = point - Vector::from(scene.body_origin(i1));
+            let a2 = point - Vector::from(scene.body_origin(i2));
+            let (b1, b2) = (bodies[i1].handle, bodies[i2].handle);
+            let ideal = match &j.kind {
+                JointKindSpec::Prismatic { axis, limits_m } => {
+                    let axis = Vector::from(*axis).normalize();
+                    let mut rj = PrismaticJointBuilder::new(axis)
+                        .local_anchor1(a1)
+                        .local_anchor2(a2)
+                        .contacts_enabled(false);
+                    if let Some(l) = limits_m {
+                        rj = rj.limits(*l);
+                    }
+                    world.impulse_joints.insert(b1, b2, rj, true);
+                    IdealJoint::Prismatic(IdealPrismatic {
+                        body1: b1,
+                        body2: b2,
+                        local_anchor1: a1,
+                        local_anchor2: a2,
+                        local_axis1: axis,
+                    })
+                }
+                JointKindSpec::Fixed => {
+                    let rj = FixedJointBuilder::new()
+                        .local_anchor1(a1)
+                        .local_anchor2(a2)
+                        .contacts_enabled(false);
+                    world.impulse_joints.insert(b1, b2, rj, true);
+                    IdealJoint::Fixed(IdealFixed {
+                        body1: b1,
+                        body2: b2,
+                        local_anchor1: a1,
+                        local_anchor2: a2,
+                    })
+                }
+                JointKindSpec::Spherical => {
+                    let rj = SphericalJointBuilder::new()
+                        .local_anchor1(a1)
+                        .local_anchor2(a2)
+                        .contacts_enabled(false);
+                    world.impulse_joints.insert(b1, b2, rj, true);
+                    IdealJoint::Spherical(IdealSpherical {
+                        body1: b1,
+                        body2: b2,
+                        local_anchor1: a1,
+                        local_anchor2: a2,
+                    })
+                }
+            };
+            ideal_joints.push(ideal);
+            joints.push((j.name.clone(), 0.0));
         }
         let mut columns = vec!["t_s".to_string()];
         for b in &bodies {
             columns.push(format!("{}_angle_deg", b.name));
             columns.push(format!("{}_rate_deg_s", b.name));
         }
+        let body_motion = scene.run.body_motion;
+        if body_motion {
+            for b in bodies.iter().filter(|b| b.moves) {
+                for c in ["x_m", "y_m", "z_m", "vx_m_s", "vy_m_s", "vz_m_s"] {
+                    columns.push(format!("{}_{c}", b.name));
+                }
+            }
+        }
+
         for h in &hinges {
             for c in [
                 "angle_deg",
@@ -707,6 +818,9 @@ impl Twin {
                 columns.push(format!("{}_{c}", h.name));
             }
         }
+        for (name, _) in &joints {
+            columns.push(format!("{name}_force_n"));
+        }
         Ok(Twin {
             kind,
             bodies,
@@ -715,6 +829,8 @@ impl Twin {
             drives,
             ideal_joints,
             ideal_hinges,
+            joints,
+            body_motion,
             reactions: ReactionSolver::default(),
             source_energy_before: 0.0,
             reference_axis: Vector::from(scene.reference_axis).normalize(),
@@ -728,7 +844,9 @@ impl Twin {
             row_prev: Vec::new(),
             row_cur: Vec::new(),
             invariants: Invariants {
-                free_floating: scene.gravity == [0.0; 3] && scene.bodies.iter().all(|b| !b.fixed),
+                free_floating: scene.gravity == [0.0; 3]
+                    && scene.bodies.iter().all(|b| !b.fixed && b.motion.is_none()),
+                driven: scene.bodies.iter().any(|b| b.motion.is_some()),
                 ..Invariants::default()
             },
         })
@@ -814,9 +932,16 @@ impl Twin {
         if self.ideal_joints.is_empty() {
             return;
         }
-        if let Some(forces) = self.reactions.solve(bodies, &self.ideal_joints, gravity) {
+        if let Some(forces) = self
+            .reactions
+            .solve_joints(bodies, &self.ideal_joints, gravity)
+        {
+            let n = self.ideal_hinges.len();
             for (&hi, f) in self.ideal_hinges.iter().zip(forces) {
                 self.hinges[hi].force = f.length();
+            }
+            for (j, f) in self.joints.iter_mut().zip(&forces[n..]) {
+                j.1 = f.length();
             }
         }
     }
@@ -874,7 +999,7 @@ impl Twin {
             inv.linear_momentum_drift = Some(rel(inv.max_dp, inv.max_p));
             inv.angular_momentum_drift = Some(rel(inv.max_dl, inv.max_l));
         }
-        if inv.energy_scale_j >= MIN_ENERGY_SCALE_J {
+        if inv.energy_scale_j >= MIN_ENERGY_SCALE_J && !inv.driven {
             inv.energy_growth = Some(inv.max_de / inv.energy_scale_j);
             inv.energy_error = Some(inv.max_abs_de / inv.energy_scale_j);
         }
@@ -890,6 +1015,16 @@ impl Twin {
             let rb = &bodies[b.handle];
             v.push(b.angle.value().to_degrees());
             v.push(rb.angvel().dot(axis_ref).to_degrees());
+        }
+        if self.body_motion {
+            for b in self.bodies.iter().filter(|b| b.moves) {
+                let rb = &bodies[b.handle];
+                let p = *rb.position() * b.local_com;
+                // The velocity of the centre of mass (a driven body's frame turns about its
+                // origin, so its centre of mass moves with `w x r`).
+                let vel = rb.linvel() + rb.angvel().cross(p - rb.translation());
+                v.extend_from_slice(&[p.x, p.y, p.z, vel.x, vel.y, vel.z]);
+            }
         }
         for h in &self.hinges {
             let (r1, r2) = (
@@ -911,6 +1046,9 @@ impl Twin {
                 }
                 HingeJoint::Ideal => v.extend_from_slice(&[0.0, 0.0, 0.0, 0.0]),
             }
+        }
+        for (_, f) in &self.joints {
+            v.push(*f);
         }
     }
 

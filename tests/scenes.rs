@@ -158,6 +158,9 @@ fn double_pendulum() -> Scene {
         inertia_kg_m2: [0.0133, 0.001, 0.0133],
         center_of_mass_m: [0.0, -0.8, 0.0],
         fixed: false,
+        motion: None,
+        velocity_m_s: [0.0; 3],
+        angular_velocity_rad_s: [0.0; 3],
     });
     let pivot = scene.hinges[0].clone();
     scene.hinges.push(HingeSpec {

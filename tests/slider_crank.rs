@@ -78,3 +78,107 @@ fn clearance_pin_impacts_and_its_first_impact_converges() {
     assert!(first[2].approach_speed_m_s > 1.0);
     assert!(peaks[2] > 10.0 * ideal.metrics().peak_force_n);
 }
+
+/// The scene file `assets/slider_crank.ron` builds the same mechanism through the runner: its
+/// impact list and pin metrics are the plain-API example's, bit for bit.
+#[test]
+fn the_scene_run_is_the_plain_api_run_bit_for_bit() {
+    use clearance_joint::scene::Scene;
+    use clearance_joint::sim::{RunOptions, Simulation, TwinKind};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/slider_crank.ron");
+    let mut scene = Scene::load(&path).unwrap();
+    let end = 0.004;
+    scene.run.end_s = end;
+    let result = Simulation::new(&scene, RunOptions::default())
+        .unwrap()
+        .run()
+        .unwrap();
+    let twin = |k: TwinKind| result.twin(k).unwrap();
+    let clear = simulate(Some(pin_clearance().unwrap()), scene.run.dt_s, end).unwrap();
+    let ideal = simulate(None, scene.run.dt_s, end).unwrap();
+    let recorders = twin(TwinKind::Clearance).hinge_recorders();
+    let scene_pin = recorders["slider_pin"];
+    assert!(!clear.recorder.impacts().is_empty());
+    assert_eq!(scene_pin.impacts(), clear.recorder.impacts());
+    let (a, b) = (scene_pin.metrics(), clear.metrics());
+    assert_eq!(
+        (
+            a.peak_force_n,
+            a.rms_force_n,
+            a.contact_fraction,
+            a.first_impact_peak_n
+        ),
+        (
+            b.peak_force_n,
+            b.rms_force_n,
+            b.contact_fraction,
+            b.first_impact_peak_n
+        )
+    );
+    let ideal_pin = &twin(TwinKind::Ideal).hinge_metrics()["slider_pin"];
+    assert_eq!(
+        (ideal_pin.peak_force_n, ideal_pin.rms_force_n),
+        (ideal.metrics().peak_force_n, ideal.metrics().rms_force_n)
+    );
+}
+
+/// Mechanism fields are checked at load, each error naming its field.
+#[test]
+fn mechanism_fields_are_validated_with_their_paths() {
+    use clearance_joint::scene::{JointKindSpec, MotionSpec, Scene};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/slider_crank.ron");
+    let base = Scene::load(&path).unwrap();
+    let check = |edit: &dyn Fn(&mut Scene), needle: &str| {
+        let mut s = base.clone();
+        edit(&mut s);
+        let e = s.validate().unwrap_err().to_string();
+        assert!(e.contains(needle), "{e} (wanted {needle})");
+    };
+    check(
+        &|s| s.joints[0].body1 = "nowhere".into(),
+        "joints[guide].body1",
+    );
+    check(
+        &|s| s.joints[0].body2 = "ground".into(),
+        "joints[guide].body2",
+    );
+    check(
+        &|s| {
+            s.joints[0].kind = JointKindSpec::Prismatic {
+                axis: [1.0, 0.0, 0.0],
+                limits_m: Some([0.1, 0.2]),
+            }
+        },
+        "joints[guide].kind.limits_m",
+    );
+    check(
+        &|s| {
+            s.joints[0].kind = JointKindSpec::Prismatic {
+                axis: [0.0, 0.0, 0.0],
+                limits_m: None,
+            }
+        },
+        "joints[guide].kind.axis",
+    );
+    check(&|s| s.joints[0].name = "rod".into(), "duplicate name");
+    check(&|s| s.bodies[1].fixed = true, "bodies[crank].motion");
+    check(
+        &|s| {
+            s.bodies[1].motion = Some(MotionSpec::Spin {
+                axis: [0.0, 0.0, 1.0],
+                point_m: [0.0; 3],
+                rate_rad_s: f64::NAN,
+            })
+        },
+        "bodies[crank].motion.rate_rad_s",
+    );
+    check(
+        &|s| s.bodies[2].velocity_m_s[1] = 1e6,
+        "bodies[rod].velocity_m_s[1]",
+    );
+    // The scene format stays backward compatible: no `joints`, no motion, no velocities.
+    assert!(
+        Scene::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/pendulum.ron"))
+            .is_ok()
+    );
+}

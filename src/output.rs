@@ -358,7 +358,7 @@ impl MemoryEstimate {
         } else {
             u64::MAX / 1000
         };
-        let motion = if scene.run.body_motion { 6 } else { 0 };
+        let motion = if scene.run.body_motion { 9 } else { 0 };
         let per_twin = 1
             + (2 + motion) * scene.bodies.len() as u64
             + 7 * scene.hinges.len() as u64

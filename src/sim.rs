@@ -522,8 +522,6 @@ impl Simulation {
         for twin in &mut self.twins {
             twin.before_step(&self.world.bodies, gravity, t, rows);
         }
-        self.write_rows(t);
-        self.t_prev = t;
         let target = self.target();
         let info = {
             let mut sources = sources(&mut self.twins);
@@ -533,7 +531,13 @@ impl Simulation {
         };
         for twin in &mut self.twins {
             twin.after_step(&self.world.bodies, &info, gravity);
+            if rows {
+                twin.complete_row_motion(&self.world.bodies, &info);
+            }
         }
+        // Rows up to this state, now that its step gave its velocities and accelerations.
+        self.write_rows(t);
+        self.t_prev = t;
         if let [ideal, clear] = self.twins.as_slice() {
             self.comparison
                 .record(ideal, clear, &self.world.bodies, info.t0, info.dt);
@@ -553,6 +557,24 @@ impl Simulation {
         let rows = !self.skip_rows;
         for twin in &mut self.twins {
             twin.before_step(&self.world.bodies, gravity, t, rows);
+        }
+        if rows && self.scene.run.body_motion {
+            // The final state's velocities and accelerations from one more step, taken and
+            // undone.
+            let mut twins = std::mem::take(&mut self.twins);
+            let peeked = {
+                let mut sources = sources(&mut twins);
+                let dt = self.scene.run.dt_s;
+                self.stepper
+                    .peek(&mut self.world, &mut sources, dt, |world, info| {
+                        (world.bodies.clone(), *info)
+                    })
+            };
+            self.twins = twins;
+            let (bodies, info) = peeked.map_err(|e| name_step_field(e, "run.dt_s"))?;
+            for twin in &mut self.twins {
+                twin.complete_row_motion(&bodies, &info);
+            }
         }
         self.write_rows(t);
         let duration = self.time();
@@ -799,7 +821,10 @@ impl Twin {
         let body_motion = scene.run.body_motion;
         if body_motion {
             for b in bodies.iter().filter(|b| b.moves) {
-                for c in ["x_m", "y_m", "z_m", "vx_m_s", "vy_m_s", "vz_m_s"] {
+                for c in [
+                    "x_m", "y_m", "z_m", "vx_m_s", "vy_m_s", "vz_m_s", "ax_m_s2", "ay_m_s2",
+                    "az_m_s2",
+                ] {
                     columns.push(format!("{}_{c}", b.name));
                 }
             }
@@ -926,6 +951,38 @@ impl Twin {
         }
     }
 
+    /// Completes the body motion of the current row from the step taken from its state:
+    /// a dynamic body's velocity at the state is the synchronous one,
+    /// `(h v[n-1/2] + h_prev v[n+1/2])/(h_prev + h)`, and its acceleration
+    /// `(v[n+1/2] - v[n-1/2])/kick`, what the step applied (the stored velocities live at half
+    /// steps); a driven body's are exact (`w x r` and `w x (w x r)` for a spin, 0 for a
+    /// translation).
+    fn complete_row_motion(&mut self, bodies_after: &RigidBodySet, info: &StepInfo) {
+        if !self.body_motion {
+            return;
+        }
+        let (h, h_prev) = (info.dt, (2.0 * info.kick - info.dt).max(0.0));
+        let mut col = 1 + 2 * self.bodies.len();
+        for b in self.bodies.iter().filter(|b| b.moves) {
+            let (vel, acc) = if b.fixed {
+                // Driven: the row's velocity is exact; the acceleration is the spin's.
+                let rb = &bodies_after[b.handle];
+                let w = rb.angvel();
+                let r = b.rotation_before * b.local_com;
+                (None, w.cross(w.cross(r)))
+            } else {
+                let after = bodies_after[b.handle].linvel();
+                let sync = (h * b.linvel_before + h_prev * after) / (h_prev + h);
+                (Some(sync), (after - b.linvel_before) / info.kick)
+            };
+            if let Some(v) = vel {
+                self.row_cur[col + 3..col + 6].copy_from_slice(&[v.x, v.y, v.z]);
+            }
+            self.row_cur[col + 6..col + 9].copy_from_slice(&[acc.x, acc.y, acc.z]);
+            col += 9;
+        }
+    }
+
     /// Ideal-joint reactions at the current state, exact: the constrained rigid-body equations
     /// solved for the joint forces ([`ReactionSolver`]), whatever the step control.
     fn solve_ideal_reactions(&mut self, bodies: &RigidBodySet, gravity: Vector) {
@@ -1023,7 +1080,9 @@ impl Twin {
                 // The velocity of the centre of mass (a driven body's frame turns about its
                 // origin, so its centre of mass moves with `w x r`).
                 let vel = rb.linvel() + rb.angvel().cross(p - rb.translation());
-                v.extend_from_slice(&[p.x, p.y, p.z, vel.x, vel.y, vel.z]);
+                // Velocity and acceleration are completed by the step from this state
+                // (`complete_row_motion`).
+                v.extend_from_slice(&[p.x, p.y, p.z, vel.x, vel.y, vel.z, 0.0, 0.0, 0.0]);
             }
         }
         for h in &self.hinges {

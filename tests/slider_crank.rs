@@ -182,3 +182,53 @@ fn mechanism_fields_are_validated_with_their_paths() {
             .is_ok()
     );
 }
+
+/// The scene's rows carry the slider's acceleration (`slider_ax_m_s2`, the step's applied
+/// acceleration at each state): the ideal twin's matches the closed form at the row's crank
+/// angle, and its extremes to 0.1 %.
+#[test]
+fn scene_rows_carry_the_slider_acceleration() {
+    use clearance_joint::scene::Scene;
+    use clearance_joint::sim::{RunOptions, Simulation, TwinKind};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/slider_crank.ron");
+    let scene = Scene::load(&path).unwrap();
+    let result = Simulation::new(&scene, RunOptions::default())
+        .unwrap()
+        .run()
+        .unwrap();
+    let table = &result.twin(TwinKind::Ideal).unwrap().table;
+    let (t, theta, a, v) = (
+        table.column("t_s").unwrap(),
+        table.column("crank_angle_deg").unwrap(),
+        table.column("slider_ax_m_s2").unwrap(),
+        table.column("slider_vx_m_s").unwrap(),
+    );
+    let turn = TAU / OMEGA;
+    let (c_hi, c_lo) = closed_form_extremes();
+    let mut worst = 0.0f64;
+    let (mut hi, mut lo) = (f64::NEG_INFINITY, f64::INFINITY);
+    let mut worst_v = 0.0f64;
+    for i in 0..t.len() {
+        if t[i] < turn {
+            continue;
+        }
+        let th = theta[i].to_radians();
+        worst = worst.max((a[i] - closed_form_acceleration(th)).abs());
+        (hi, lo) = (hi.max(a[i]), lo.min(a[i]));
+        // The velocity: -omega (L1 sin + L1^2 sin cos / S).
+        let s = (ROD * ROD - (CRANK * th.sin()).powi(2)).sqrt();
+        let v_exact = -OMEGA * (CRANK * th.sin() + CRANK * CRANK * th.sin() * th.cos() / s);
+        worst_v = worst_v.max((v[i] - v_exact).abs());
+    }
+    assert!(worst < 1e-3 * c_lo.abs(), "worst {worst} m/s^2");
+    assert!(
+        (hi / c_hi - 1.0).abs() < 1e-3 && (lo / c_lo - 1.0).abs() < 1e-3,
+        "{hi} {lo}"
+    );
+    assert!(
+        worst_v < 1e-4 * OMEGA * CRANK,
+        "worst velocity error {worst_v} m/s"
+    );
+    // The last row (the end) holds a finite acceleration from the step taken and undone.
+    assert!(a.last().unwrap().is_finite() && a.last().unwrap().abs() > 1e3);
+}

@@ -273,6 +273,9 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     for t in &result.twins {
         for h in t.clearance_hinges() {
             files.push(format!("{}_{h}_impacts.csv", t.kind.name()));
+            if scene.drive_period().is_some() {
+                files.push(format!("{}_{h}_turns.csv", t.kind.name()));
+            }
         }
     }
     files.push("summary.json".into());

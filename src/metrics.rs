@@ -289,6 +289,92 @@ impl ImpactRecorder {
     }
 }
 
+/// One period (a crank turn) of a driven mechanism's clearance joint.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct PeriodStats {
+    /// Start of the period, s.
+    pub start_s: f64,
+    /// Its length, s (the last period may be cut short by the end of the run).
+    pub length_s: f64,
+    /// Contacts that began in it.
+    pub impacts: u64,
+    /// Contacts that began in it after a real separation.
+    pub separated_impacts: u64,
+    /// Largest peak force of the contacts that began in it, N (0 without one).
+    pub peak_force_n: f64,
+    /// Time in contact within it, s (contacts are split at the period's bounds).
+    pub contact_s: f64,
+}
+
+/// Per-period statistics of an impact list over `[0, end)` in periods of `period` (s): impacts,
+/// peak force and time in contact per crank turn. A contact's duration is the contiguous span
+/// from its onset, so the time in contact is split exactly at the bounds; its peak counts in the
+/// period of its onset. Empty for a non-positive period or end.
+pub fn per_period(impacts: &[Impact], period: f64, end: f64) -> Vec<PeriodStats> {
+    if !(period > 0.0) || !(end > 0.0) {
+        return Vec::new();
+    }
+    let n = (end / period).ceil().max(1.0) as usize;
+    let mut out: Vec<PeriodStats> = (0..n)
+        .map(|k| {
+            let start = k as f64 * period;
+            PeriodStats {
+                start_s: start,
+                length_s: ((k + 1) as f64 * period).min(end) - start,
+                ..Default::default()
+            }
+        })
+        .collect();
+    for i in impacts {
+        let k = ((i.onset_t_s / period) as usize).min(n - 1);
+        let p = &mut out[k];
+        p.impacts += 1;
+        p.separated_impacts += u64::from(i.separated);
+        p.peak_force_n = p.peak_force_n.max(i.peak_force_n);
+        let (a, b) = (i.onset_t_s, i.onset_t_s + i.duration_s);
+        for p in out.iter_mut().skip(k) {
+            let (lo, hi) = (p.start_s, p.start_s + p.length_s);
+            if lo >= b {
+                break;
+            }
+            p.contact_s += (b.min(hi) - a.max(lo)).max(0.0);
+        }
+    }
+    out
+}
+
+/// The per-period statistics as a table: `turn, start_s, impacts, separated_impacts,
+/// peak_force_n, contact_fraction`.
+pub fn per_period_table(periods: &[PeriodStats]) -> Table {
+    let mut t = Table::new(
+        [
+            "turn",
+            "start_s",
+            "impacts",
+            "separated_impacts",
+            "peak_force_n",
+            "contact_fraction",
+        ]
+        .map(String::from)
+        .to_vec(),
+    );
+    for (k, p) in periods.iter().enumerate() {
+        t.values.extend_from_slice(&[
+            k as f64,
+            p.start_s,
+            p.impacts as f64,
+            p.separated_impacts as f64,
+            p.peak_force_n,
+            if p.length_s > 0.0 {
+                p.contact_s / p.length_s
+            } else {
+                0.0
+            },
+        ]);
+    }
+    t
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -349,5 +435,28 @@ mod tests {
         assert_eq!(r.metrics().peak_force_n, 4.0);
         assert_eq!(r.metrics().contact_fraction, 0.0);
         assert_eq!(r.metrics().rms_force_n, 2.0);
+    }
+
+    #[test]
+    fn per_turn_statistics_by_hand() {
+        let imp = |t: f64, d: f64, f: f64| Impact {
+            onset_t_s: t,
+            duration_s: d,
+            peak_force_n: f,
+            separated: true,
+            ..Impact::default()
+        };
+        // Turns of 1 s over 2.5 s; a contact from 0.5 to 1.25 s spans the first bound.
+        let list = [imp(0.2, 0.1, 5.0), imp(0.5, 0.75, 9.0), imp(2.1, 0.2, 3.0)];
+        let p = per_period(&list, 1.0, 2.5);
+        assert_eq!(p.len(), 3);
+        assert_eq!((p[0].impacts, p[1].impacts, p[2].impacts), (2, 0, 1));
+        assert_eq!((p[0].peak_force_n, p[1].peak_force_n), (9.0, 0.0));
+        assert!((p[0].contact_s - 0.6).abs() < 1e-12);
+        assert!((p[1].contact_s - 0.25).abs() < 1e-12);
+        assert!((p[2].contact_s - 0.2).abs() < 1e-12 && p[2].length_s == 0.5);
+        let t = per_period_table(&p);
+        assert!((t.row(2)[5] - 0.4).abs() < 1e-12);
+        assert!(per_period(&list, 0.0, 1.0).is_empty());
     }
 }

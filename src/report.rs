@@ -119,7 +119,9 @@ impl RunResult {
     }
 
     /// Writes `<twin>.csv` for each twin, `<twin>_<joint>_impacts.csv` for each clearance joint
-    /// (its impact list, [`ImpactRecorder::impacts_table`](crate::metrics::ImpactRecorder::impacts_table))
+    /// (its impact list, [`ImpactRecorder::impacts_table`](crate::metrics::ImpactRecorder::impacts_table)),
+    /// `<twin>_<joint>_turns.csv` when a body spins (per-turn statistics,
+    /// [`per_period`](crate::metrics::per_period))
     /// and `summary.json` into `dir` as one set
     /// ([`write_set`]): the tables are streamed (and checked finite) into temporary files, then
     /// renamed into place, `summary.json` last.
@@ -132,13 +134,24 @@ impl RunResult {
             .iter()
             .flat_map(|t| {
                 let recorders = t.hinge_recorders();
+                let period = self.scene.drive_period();
+                let end = self.scene.run.end_s;
                 t.clearance_hinges()
                     .into_iter()
-                    .map(|h| {
-                        (
+                    .flat_map(|h| {
+                        let mut v = vec![(
                             dir.join(format!("{}_{h}_impacts.csv", t.kind.name())),
                             recorders[h].impacts_table(),
-                        )
+                        )];
+                        // Per crank turn when a body spins.
+                        if let Some(p) = period {
+                            let turns = crate::metrics::per_period(recorders[h].impacts(), p, end);
+                            v.push((
+                                dir.join(format!("{}_{h}_turns.csv", t.kind.name())),
+                                crate::metrics::per_period_table(&turns),
+                            ));
+                        }
+                        v
                     })
                     .collect::<Vec<_>>()
             })

@@ -517,6 +517,17 @@ impl Scene {
         }
     }
 
+    /// The period of the scene's drive, s: one turn of the first body spinning at a nonzero
+    /// rate (`None` without one). Per-turn statistics are taken over it.
+    pub fn drive_period(&self) -> Option<f64> {
+        self.bodies.iter().find_map(|b| match &b.motion {
+            Some(MotionSpec::Spin { rate_rad_s, .. }) if *rate_rad_s != 0.0 => {
+                Some(std::f64::consts::TAU / rate_rad_s.abs())
+            }
+            _ => None,
+        })
+    }
+
     /// Index of the hinge called `name`.
     pub fn hinge_index(&self, name: &str) -> Option<usize> {
         self.hinges.iter().position(|h| h.name == name)

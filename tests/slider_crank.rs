@@ -232,3 +232,41 @@ fn scene_rows_carry_the_slider_acceleration() {
     // The last row (the end) holds a finite acceleration from the step taken and undone.
     assert!(a.last().unwrap().is_finite() && a.last().unwrap().abs() > 1e3);
 }
+
+/// A scene with a spinning body writes per-turn statistics of each clearance joint, which add up
+/// to the joint's totals.
+#[test]
+fn per_turn_statistics_add_up() {
+    use clearance_joint::scene::Scene;
+    use clearance_joint::sim::{RunOptions, Simulation};
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/slider_crank.ron");
+    let mut scene = Scene::load(&path).unwrap();
+    scene.run.end_s = 0.018; // a turn and a half
+    let result = Simulation::new(&scene, RunOptions::default())
+        .unwrap()
+        .run()
+        .unwrap();
+    let dir = std::env::temp_dir().join(format!("cj_turns_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let summary = result.write(&dir).unwrap();
+    let csv = std::fs::read_to_string(dir.join("clearance_slider_pin_turns.csv")).unwrap();
+    let rows: Vec<Vec<f64>> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+        .collect();
+    assert_eq!(rows.len(), 2);
+    let turn = TAU / OMEGA;
+    assert!((rows[1][1] - turn).abs() < 1e-15);
+    let m = &summary.twins["clearance"].hinges["slider_pin"];
+    assert_eq!(rows.iter().map(|r| r[2]).sum::<f64>() as u64, m.impacts);
+    assert_eq!(
+        rows.iter().map(|r| r[4]).fold(0.0, f64::max),
+        m.peak_force_n
+    );
+    let contact = rows[0][5] * turn + rows[1][5] * (0.018 - turn);
+    assert!((contact / 0.018 - m.contact_fraction).abs() < 1e-9);
+    assert!(!dir.join("ideal_slider_pin_turns.csv").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -111,6 +111,10 @@ pub enum IdealJoint {
     Fixed(IdealFixed),
     /// A ball joint: 3 linear constraints.
     Spherical(IdealSpherical),
+    /// A revolute whose velocity motor holds the relative angular speed constant: the revolute's
+    /// constraints plus one along the axis (its multiplier is the motor torque). Exact for a
+    /// motor that holds its speed; a soft motor's speed error is not in it.
+    MotorRevolute(IdealRevolute),
 }
 
 impl IdealJoint {
@@ -120,6 +124,7 @@ impl IdealJoint {
             IdealJoint::Prismatic(j) => (j.body1, j.body2),
             IdealJoint::Fixed(j) => (j.body1, j.body2),
             IdealJoint::Spherical(j) => (j.body1, j.body2),
+            IdealJoint::MotorRevolute(j) => (j.body1, j.body2),
         }
     }
 
@@ -130,6 +135,7 @@ impl IdealJoint {
             IdealJoint::Prismatic(_) => (5, 2),
             IdealJoint::Fixed(_) => (6, 3),
             IdealJoint::Spherical(_) => (3, 3),
+            IdealJoint::MotorRevolute(_) => (6, 3),
         }
     }
 }
@@ -283,7 +289,7 @@ impl ReactionSolver {
             let (a1f, a1t) = t1.apply_inv_mass(rb1, t1.force, t1.torque);
             let (a2f, a2t) = t2.apply_inv_mass(rb2, t2.force, t2.torque);
             match j {
-                IdealJoint::Revolute(j) => {
+                IdealJoint::Revolute(j) | IdealJoint::MotorRevolute(j) => {
                     let r1 = *rb1.position() * j.local_anchor1 - t1.com;
                     let r2 = *rb2.position() * j.local_anchor2 - t2.com;
                     let axis = (*rb1.rotation() * j.local_axis1).normalize();
@@ -297,7 +303,10 @@ impl ReactionSolver {
                     }
                     // Angular rows: (w2 - w1).t = 0 for the two directions t normal to the
                     // axis, which turn with body 1.
-                    for t in [u1, u2] {
+                    let motor =
+                        matches!(joints[self.starts.len() - 1], IdealJoint::MotorRevolute(_));
+                    let dirs: &[Vector] = if motor { &[u1, u2, axis] } else { &[u1, u2] };
+                    for &t in dirs {
                         let c_ang = (w2 - w1).dot(w1.cross(t));
                         self.rows.push([Vector::ZERO, -t, Vector::ZERO, t]);
                         self.b.push(-(c_ang + (a2t - a1t).dot(t)));
@@ -682,5 +691,44 @@ mod tests {
             .unwrap()[0];
         // The bob's own spin (2 rad/s about z) is the pendulum's: no torque is needed at the ball.
         assert!((f - Vector::new(0.0, 23.62, 0.0)).length() < 1e-9, "{f:?}");
+    }
+
+    #[test]
+    fn motor_holding_an_arm_level_supplies_its_moment() {
+        // A 2 kg arm, centre of mass 0.3 m out along x from a pivot on a fixed base, at rest
+        // under gravity -y, held by a velocity motor at zero speed: the pivot carries the weight
+        // (19.62 N up), and the motor's moment m g r = 5.886 N m is in the extra row.
+        let mut bodies = RigidBodySet::new();
+        let base = bodies.insert(RigidBodyBuilder::fixed());
+        let arm = slider(
+            &mut bodies,
+            Vector::new(0.3, 0.0, 0.0),
+            Vector::ZERO,
+            Vector::ZERO,
+        );
+        prepare_mass_properties(&mut bodies);
+        let j = IdealRevolute {
+            body1: base,
+            body2: arm,
+            local_anchor1: Vector::ZERO,
+            local_anchor2: Vector::new(-0.3, 0.0, 0.0),
+            local_axis1: Vector::Z,
+        };
+        let mut solver = ReactionSolver::default();
+        let g = Vector::new(0.0, -9.81, 0.0);
+        let f = solver
+            .solve_joints(&bodies, &[IdealJoint::MotorRevolute(j)], g)
+            .unwrap()[0];
+        assert!((f - Vector::new(0.0, 19.62, 0.0)).length() < 1e-9, "{f:?}");
+        assert!(
+            (solver.b[5] - 2.0 * 9.81 * 0.3).abs() < 1e-9,
+            "{}",
+            solver.b[5]
+        );
+        // Without the motor the arm falls: the pivot carries less than the weight,
+        // m g (1 - m r^2 / I_pivot) with I_pivot = 0.03 + 2 * 0.09 = 0.21.
+        let f = solver.solve(&bodies, &[j], g).unwrap()[0];
+        let expected = 19.62 * (1.0 - 2.0 * 0.09 / 0.21);
+        assert!((f.y - expected).abs() < 1e-9, "{f:?} against {expected}");
     }
 }

@@ -78,7 +78,9 @@ fn steel(radius: f64, c: f64, width: f64, friction: bool) -> Clearance {
     } else {
         FrictionModel::None
     };
-    Clearance::steel(radius, c, width).unwrap().friction(law)
+    Clearance::steel_improved_liu(radius, c, width)
+        .unwrap()
+        .friction(law)
 }
 
 fn world(model: Model, gravity: Vector, dt: f64) -> PhysicsWorld {

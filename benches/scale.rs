@@ -48,7 +48,7 @@ fn clearance(friction: bool) -> Clearance {
     } else {
         FrictionModel::None
     };
-    Clearance::steel(0.004, 0.1e-3, 0.006)
+    Clearance::steel_improved_liu(0.004, 0.1e-3, 0.006)
         .unwrap()
         .friction(law)
 }

@@ -8,7 +8,7 @@
 
 use clearance_joint::Result;
 use clearance_joint::angle::{UnwrappedAngle, twist_angle};
-use clearance_joint::convert::{Clearance, ConvertRevolute};
+use clearance_joint::convert::{BearingSide, Clearance, ConvertRevolute};
 use clearance_joint::joint::ClearanceJointSet;
 use clearance_joint::laws::{Bai, FrictionModel};
 use clearance_joint::stepper::{StepControl, Stepper};
@@ -159,7 +159,7 @@ fn simulate(mut world: PhysicsWorld, arm: &Arm, mut clearance: ClearanceJointSet
 
 /// The elbow's clearance: a 10 mm steel bearing, 8 mm wide, 0.1 mm radial play, dry friction.
 pub fn elbow_clearance() -> Result<Clearance> {
-    Ok(Clearance::steel(0.005, 0.1e-3, 0.008)?
+    Ok(Clearance::steel_improved_liu(0.005, 0.1e-3, 0.008)?
         .friction(FrictionModel::Bai(Bai::DRY))
         .name("elbow"))
 }
@@ -175,7 +175,12 @@ pub fn clearance_run() -> Result<Run> {
     let (mut world, arm) = build();
     let mut clearance = ClearanceJointSet::new();
     // The whole change: the elbow's revolute joint becomes a clearance joint.
-    clearance.convert_revolute(arm.elbow, elbow_clearance()?, &mut world.impulse_joints)?;
+    clearance.convert_revolute(
+        arm.elbow,
+        BearingSide::Body1,
+        elbow_clearance()?,
+        &mut world.impulse_joints,
+    )?;
     simulate(world, &arm, clearance)
 }
 

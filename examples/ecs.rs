@@ -31,7 +31,7 @@ const LOWER: (f64, f64) = (0.5, 0.3);
 
 /// The elbow's clearance: a 10 mm steel bearing, 8 mm wide, 0.1 mm radial play, dry friction.
 pub fn elbow_clearance() -> Result<Clearance> {
-    Ok(Clearance::steel(0.005, 0.1e-3, 0.008)?
+    Ok(Clearance::steel_improved_liu(0.005, 0.1e-3, 0.008)?
         .friction(FrictionModel::Bai(Bai::DRY))
         .name("elbow"))
 }

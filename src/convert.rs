@@ -5,7 +5,7 @@
 //! `ImpulseJointSet`, and adds the equivalent [`ClearanceJoint`] to a [`ClearanceJointSet`]:
 //!
 //! ```
-//! use clearance_joint::convert::{Clearance, ConvertRevolute};
+//! use clearance_joint::convert::{BearingSide, Clearance, ConvertRevolute};
 //! use clearance_joint::prelude::*;
 //! use rapier3d_f64::prelude::*;
 //!
@@ -22,7 +22,7 @@
 //! let mut clearance = ClearanceJointSet::new();
 //!
 //! // The one line: 0.2 mm of radial play in a 20 mm steel bearing, 16 mm wide, dry friction.
-//! let hinge = clearance.convert_revolute(hinge, Clearance::steel(0.010, 0.2e-3, 0.016)?.friction(FrictionModel::Bai(Bai::DRY)), &mut world.impulse_joints)?;
+//! let hinge = clearance.convert_revolute(hinge, BearingSide::Body1, Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?.friction(FrictionModel::Bai(Bai::DRY)), &mut world.impulse_joints)?;
 //!
 //! assert_eq!(clearance.get(hinge).unwrap().local_anchor2(), Vector::new(0.0, 0.3, 0.0));
 //! // The revolute is gone; the only Rapier joint left is the lock of the out-of-plane motion.
@@ -39,7 +39,7 @@
 //! 1/60 s and 1 kHz worlds with any number of solver iterations) into a [`LargeStepJointSet`]:
 //!
 //! ```
-//! use clearance_joint::convert::{Clearance, ClearanceModel, ConvertRevolute};
+//! use clearance_joint::convert::{BearingSide, Clearance, ClearanceModel, ConvertRevolute};
 //! use clearance_joint::large_step::LargeStepJointSet;
 //! use rapier3d_f64::prelude::*;
 //!
@@ -55,7 +55,7 @@
 //! let mut play = LargeStepJointSet::new();
 //!
 //! // The one line, with the model chosen: 0.5 mm of play, restitution 0.5.
-//! let hinge = play.convert_revolute(hinge, Clearance::steel(0.010, 0.5e-3, 0.016)?.model(ClearanceModel::LargeStep).restitution(0.5), &mut world.impulse_joints)?;
+//! let hinge = play.convert_revolute(hinge, BearingSide::Body1, Clearance::steel_improved_liu(0.010, 0.5e-3, 0.016)?.model(ClearanceModel::LargeStep).restitution(0.5), &mut world.impulse_joints)?;
 //!
 //! for _ in 0..60 {
 //!     play.before_step(&mut world.bodies, &mut world.impulse_joints, &world.integration_parameters);
@@ -105,6 +105,19 @@ pub enum ClearanceModel {
     /// [`Clearance::restitution`] (or, when unset, the normal law's own restitution at each
     /// impact) and Coulomb friction with the friction law's sliding coefficient.
     LargeStep,
+}
+
+/// Which body of a revolute joint carries the bearing (the hole); the other carries the journal
+/// (the pin). The eccentricity is measured in the bearing's frame about the bearing's axis, and the
+/// contact points sit on each side's radius, so the choice changes the contact kinematics (a
+/// slider-crank's rod-slider pin gives different impact statistics either way).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum BearingSide {
+    /// The joint's body 1 carries the bearing.
+    Body1,
+    /// The joint's body 2 carries the bearing: the clearance joint's body 1 is then the
+    /// revolute's body 2 (anchors and axes swapped with it).
+    Body2,
 }
 
 /// Everything a clearance joint needs beyond the revolute joint it replaces: the radial
@@ -173,8 +186,22 @@ impl Clearance {
         Ok(Self::new(geometry, NormalModel::ImprovedLiu(law)))
     }
 
-    /// [`improved_liu`](Self::improved_liu) with structural steel on both sides (the paper's
-    /// table 2: E = 207 GPa, nu = 0.3). Lengths in m.
+    /// The paper's improved law ([`improved_liu`](Self::improved_liu), Liu's cylindrical
+    /// elastic term with the penetration-ramped damping) with structural steel on both sides (the
+    /// paper's table 2: E = 207 GPa, nu = 0.3). Lengths in m.
+    pub fn steel_improved_liu(bearing_radius: f64, clearance: f64, length: f64) -> Result<Self> {
+        Self::improved_liu(
+            bearing_radius,
+            clearance,
+            length,
+            Material::STEEL,
+            Material::STEEL,
+        )
+    }
+
+    /// The former name of [`steel_improved_liu`](Self::steel_improved_liu), kept as an alias:
+    /// steel on steel with the paper's *improved Liu* law (not Hertz, not Lankarani-Nikravesh).
+    #[deprecated(note = "says no law: use `Clearance::steel_improved_liu`")]
     pub fn steel(bearing_radius: f64, clearance: f64, length: f64) -> Result<Self> {
         Self::improved_liu(
             bearing_radius,
@@ -404,12 +431,13 @@ fn revolute_with([anchor1, anchor2, axis1, axis2]: [Vector; 4]) -> RevoluteJoint
 }
 
 /// Replaces the revolute joint `revolute` of `impulse_joints` by a clearance joint in `set`
-/// between the same bodies (body 1 carries the bearing), with the same anchors and axes and the
-/// laws of `clearance`. Nothing changes when it fails (unknown handle, not a convertible
-/// revolute, invalid clearance).
+/// between the same bodies, the bearing on the body `bearing` says, with the same anchors and
+/// axes and the laws of `clearance`. The clearance joint's body 1 is the bearing's body.
+/// Nothing changes when it fails (unknown handle, not a convertible revolute, invalid clearance).
 pub fn revolute_to_clearance(
     set: &mut ClearanceJointSet,
     revolute: ImpulseJointHandle,
+    bearing: BearingSide,
     clearance: Clearance,
     impulse_joints: &mut ImpulseJointSet,
 ) -> Result<ClearanceJointHandle> {
@@ -421,6 +449,19 @@ pub fn revolute_to_clearance(
     })?;
     let (body1, body2) = (ij.body1(), ij.body2());
     let joint = clearance_joint_from_revolute(&ij.data, &clearance)?;
+    let (body1, body2, joint) = match bearing {
+        BearingSide::Body1 => (body1, body2, joint),
+        BearingSide::Body2 => (
+            body2,
+            body1,
+            clearance.joint(
+                joint.local_anchor2(),
+                joint.local_anchor1(),
+                joint.local_axis2(),
+                joint.local_axis1(),
+            )?,
+        ),
+    };
     impulse_joints.remove(revolute, true);
     Ok(set.insert(body1, body2, joint, impulse_joints))
 }
@@ -504,10 +545,12 @@ pub trait ConvertRevolute {
     /// The set's joint handle.
     type Handle;
 
-    /// See [`revolute_to_clearance`] and [`revolute_to_large_step`].
+    /// See [`revolute_to_clearance`] and [`revolute_to_large_step`]: `bearing` says which body
+    /// of the revolute carries the bearing.
     fn convert_revolute(
         &mut self,
         revolute: ImpulseJointHandle,
+        bearing: BearingSide,
         clearance: Clearance,
         impulse_joints: &mut ImpulseJointSet,
     ) -> Result<Self::Handle>;
@@ -527,9 +570,19 @@ impl ConvertRevolute for LargeStepJointSet {
     fn convert_revolute(
         &mut self,
         revolute: ImpulseJointHandle,
+        bearing: BearingSide,
         clearance: Clearance,
         impulse_joints: &mut ImpulseJointSet,
     ) -> Result<LargeStepJointHandle> {
+        if bearing != BearingSide::Body1 {
+            // The radial limit is symmetric: which side is the hole only names the frames. The
+            // large-step model measures the eccentricity in the revolute's body-1 frame.
+            return Err(Error::invalid(
+                "bearing",
+                "the large-step model takes the bearing on the revolute's body 1 \
+                 (BearingSide::Body1); swap the bodies of the revolute joint instead",
+            ));
+        }
         revolute_to_large_step(self, revolute, clearance, impulse_joints)
     }
 
@@ -549,10 +602,11 @@ impl ConvertRevolute for ClearanceJointSet {
     fn convert_revolute(
         &mut self,
         revolute: ImpulseJointHandle,
+        bearing: BearingSide,
         clearance: Clearance,
         impulse_joints: &mut ImpulseJointSet,
     ) -> Result<ClearanceJointHandle> {
-        revolute_to_clearance(self, revolute, clearance, impulse_joints)
+        revolute_to_clearance(self, revolute, bearing, clearance, impulse_joints)
     }
 
     fn revert_to_revolute(
@@ -604,7 +658,7 @@ mod tests {
     }
 
     fn clearance() -> Clearance {
-        Clearance::steel(0.010, 0.2e-3, 0.016)
+        Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
             .unwrap()
             .friction(FrictionModel::Bai(Bai::DRY))
             .name("pivot")
@@ -619,7 +673,12 @@ mod tests {
             .insert(r.base, r.arm, revolute(), true);
         let mut set = ClearanceJointSet::new();
         let c = set
-            .convert_revolute(h, clearance(), &mut r.world.impulse_joints)
+            .convert_revolute(
+                h,
+                BearingSide::Body1,
+                clearance(),
+                &mut r.world.impulse_joints,
+            )
             .unwrap();
         assert!(r.world.impulse_joints.get(h).is_none(), "revolute removed");
         let j = set.get(c).unwrap();
@@ -641,6 +700,51 @@ mod tests {
     }
 
     #[test]
+    fn the_bearing_side_is_explicit() {
+        let mut r = rig();
+        let h = r
+            .world
+            .impulse_joints
+            .insert(r.base, r.arm, revolute(), true);
+        let mut set = ClearanceJointSet::new();
+        let c = set
+            .convert_revolute(
+                h,
+                BearingSide::Body2,
+                clearance(),
+                &mut r.world.impulse_joints,
+            )
+            .unwrap();
+        let j = set.get(c).unwrap();
+        // The arm carries the bearing: it is the clearance joint's body 1, with its anchor.
+        assert_eq!((j.body1(), j.body2()), (r.arm, r.base));
+        assert_eq!(j.local_anchor1(), Vector::new(0.01, 0.3, 0.0));
+        assert_eq!(j.local_anchor2(), Vector::new(0.01, 0.0, 0.0));
+        // Either way the contact carries the arm's weight at rest (2 kg x 9.81 m/s^2).
+        let mut stepper = crate::stepper::Stepper::new(crate::stepper::StepControl::fixed(1e-5));
+        while stepper.time() < 0.3 {
+            stepper.step(&mut r.world, &mut [&mut set], 0.3).unwrap();
+        }
+        let f = set.get(c).unwrap().report().force.normal_force;
+        assert!((f - 19.62).abs() < 1.0, "{f}");
+    }
+
+    #[test]
+    #[allow(deprecated)]
+    fn steel_is_the_improved_liu_alias() {
+        assert_eq!(
+            Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016).unwrap(),
+            Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016).unwrap()
+        );
+        assert!(matches!(
+            Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
+                .unwrap()
+                .normal,
+            NormalModel::ImprovedLiu(_)
+        ));
+    }
+
+    #[test]
     fn converts_a_rotated_frame_pair() {
         // Different axes on the two bodies (body 2 built rotated by 90 deg about z).
         let mut r = rig();
@@ -652,8 +756,14 @@ mod tests {
             .build();
         let h = r.world.impulse_joints.insert(r.base, r.arm, data, true);
         let mut set = ClearanceJointSet::new();
-        let c =
-            revolute_to_clearance(&mut set, h, clearance(), &mut r.world.impulse_joints).unwrap();
+        let c = revolute_to_clearance(
+            &mut set,
+            h,
+            BearingSide::Body1,
+            clearance(),
+            &mut r.world.impulse_joints,
+        )
+        .unwrap();
         let j = set.get(c).unwrap();
         assert!((j.local_axis1() - Vector::Y).length() < 1e-15);
         assert!((j.local_axis2() - Vector::X).length() < 1e-15);
@@ -680,7 +790,12 @@ mod tests {
         let h = r.world.impulse_joints.insert(r.base, r.arm, original, true);
         let mut set = ClearanceJointSet::new();
         let c = set
-            .convert_revolute(h, clearance(), &mut r.world.impulse_joints)
+            .convert_revolute(
+                h,
+                BearingSide::Body1,
+                clearance(),
+                &mut r.world.impulse_joints,
+            )
             .unwrap();
         let back = set
             .revert_to_revolute(c, &mut r.world.bodies, &mut r.world.impulse_joints)
@@ -714,7 +829,12 @@ mod tests {
             r.world.step();
         }
         let c = set
-            .convert_revolute(h, clearance(), &mut r.world.impulse_joints)
+            .convert_revolute(
+                h,
+                BearingSide::Body1,
+                clearance(),
+                &mut r.world.impulse_joints,
+            )
             .unwrap();
         for _ in 0..20_000 {
             set.apply(&mut r.world.bodies, &r.world.integration_parameters)
@@ -759,8 +879,13 @@ mod tests {
             let h = r.world.impulse_joints.insert(r.base, r.arm, joint, true);
             let n = r.world.impulse_joints.len();
             check(
-                set.convert_revolute(h, clearance(), &mut r.world.impulse_joints)
-                    .unwrap_err(),
+                set.convert_revolute(
+                    h,
+                    BearingSide::Body1,
+                    clearance(),
+                    &mut r.world.impulse_joints,
+                )
+                .unwrap_err(),
                 needle,
             );
             assert_eq!(r.world.impulse_joints.len(), n, "nothing removed");
@@ -774,8 +899,13 @@ mod tests {
             .insert(r.base, r.arm, revolute(), true);
         r.world.impulse_joints.remove(h, false);
         check(
-            set.convert_revolute(h, clearance(), &mut r.world.impulse_joints)
-                .unwrap_err(),
+            set.convert_revolute(
+                h,
+                BearingSide::Body1,
+                clearance(),
+                &mut r.world.impulse_joints,
+            )
+            .unwrap_err(),
             "no joint with handle",
         );
         check(
@@ -789,11 +919,11 @@ mod tests {
         );
         // An invalid clearance is refused by the laws, naming the field.
         check(
-            Clearance::steel(0.010, 0.02, 0.016).unwrap_err(),
+            Clearance::steel_improved_liu(0.010, 0.02, 0.016).unwrap_err(),
             "clearance",
         );
         check(
-            Clearance::steel(0.010, 0.2e-3, -0.016).unwrap_err(),
+            Clearance::steel_improved_liu(0.010, 0.2e-3, -0.016).unwrap_err(),
             "length",
         );
         let h = r
@@ -803,6 +933,7 @@ mod tests {
         check(
             set.convert_revolute(
                 h,
+                BearingSide::Body1,
                 clearance().min_impact_speed(-1.0),
                 &mut r.world.impulse_joints,
             )
@@ -824,6 +955,7 @@ mod tests {
         let msg = compliant
             .convert_revolute(
                 h,
+                BearingSide::Body1,
                 clearance().model(ClearanceModel::LargeStep),
                 &mut r.world.impulse_joints,
             )
@@ -836,6 +968,7 @@ mod tests {
         let k = play
             .convert_revolute(
                 h,
+                BearingSide::Body1,
                 clearance().model(ClearanceModel::LargeStep),
                 &mut r.world.impulse_joints,
             )
@@ -898,7 +1031,12 @@ mod tests {
             .impulse_joints
             .insert(r.base, r.arm, revolute().limits([-1.0, 1.0]), true);
         let msg = play
-            .convert_revolute(h, clearance(), &mut r.world.impulse_joints)
+            .convert_revolute(
+                h,
+                BearingSide::Body1,
+                clearance(),
+                &mut r.world.impulse_joints,
+            )
             .unwrap_err()
             .to_string();
         assert!(msg.contains("limits"), "{msg}");
@@ -913,7 +1051,9 @@ mod tests {
         assert_eq!(c.friction, FrictionModel::Bai(Bai::DRY));
         assert_eq!(
             c.normal,
-            Clearance::steel(0.010, 0.5e-3, 0.016).unwrap().normal
+            Clearance::steel_improved_liu(0.010, 0.5e-3, 0.016)
+                .unwrap()
+                .normal
         );
     }
 }

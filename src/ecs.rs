@@ -45,7 +45,7 @@
 //!     .spawn((
 //!         Hinge::new(base, arm, Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0)),
 //!         // Was: IdealHinge,
-//!         ClearanceHinge(Clearance::steel(0.010, 0.2e-3, 0.016)?),
+//!         ClearanceHinge(Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?),
 //!     ))
 //!     .id();
 //! let mut schedule = physics_schedule();
@@ -59,7 +59,7 @@
 //! ```
 
 use crate::angle::HingeAngle;
-use crate::convert::{Clearance, ClearanceModel, ConvertRevolute};
+use crate::convert::{BearingSide, Clearance, ClearanceModel, ConvertRevolute};
 use crate::drive::{DriveSet, TorsionSpring};
 use crate::error::{Error, Result, unit_vector};
 use crate::joint::{ClearanceJoint, ClearanceJointHandle, ClearanceJointSet};
@@ -361,7 +361,12 @@ impl Physics {
                 {
                     let h = self
                         .large_step
-                        .convert_revolute(j, named(c, entity), &mut self.world.impulse_joints)
+                        .convert_revolute(
+                            j,
+                            BearingSide::Body1,
+                            named(c, entity),
+                            &mut self.world.impulse_joints,
+                        )
                         .map_err(context)?;
                     let r = self.hinges.get_mut(&entity).expect("realised");
                     r.joint = HingeJoint::LargeStep(h);
@@ -386,7 +391,12 @@ impl Physics {
                 (HingeJoint::Ideal(j), Some(Some(c))) if same_place => {
                     let h = self
                         .clearance
-                        .convert_revolute(j, named(c, entity), &mut self.world.impulse_joints)
+                        .convert_revolute(
+                            j,
+                            BearingSide::Body1,
+                            named(c, entity),
+                            &mut self.world.impulse_joints,
+                        )
                         .map_err(context)?;
                     self.changed = true;
                     let r = self.hinges.get_mut(&entity).expect("realised");
@@ -653,7 +663,7 @@ pub struct IdealHinge;
 /// Makes a [`Hinge`] a clearance joint with these laws (takes precedence over [`IdealHinge`]).
 /// [`Clearance::model`] chooses the model: the compliant contact law (the default; it needs small
 /// steps and `num_solver_iterations = 1`, as [`Physics::new`] sets) or the large-step constraint,
-/// `ClearanceHinge(Clearance::steel(..)?.model(ClearanceModel::LargeStep))`, for 1/60 s or 1 kHz
+/// `ClearanceHinge(Clearance::steel_improved_liu(..)?.model(ClearanceModel::LargeStep))`, for 1/60 s or 1 kHz
 /// worlds with any number of solver iterations.
 #[derive(Component, Clone, Debug, PartialEq)]
 pub struct ClearanceHinge(pub Clearance);
@@ -1131,7 +1141,7 @@ mod tests {
     use rapier3d_f64::prelude::{MassProperties, RigidBodyBuilder};
 
     fn clearance() -> Clearance {
-        Clearance::steel(0.010, 0.2e-3, 0.016)
+        Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
             .unwrap()
             .friction(FrictionModel::Bai(Bai::DRY))
     }

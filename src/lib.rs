@@ -14,6 +14,7 @@ pub mod kinematics;
 pub mod large_step;
 pub mod laws;
 pub mod ledger;
+pub mod metrics;
 /// The model: the equations of every law and of the kinematics, the conventions, the
 /// interpretations and their parameters, the paper's scene, the time integration and the ideal
 /// reactions (`docs/MODEL.md`, the page the source code cites as "MODEL.md §N").
@@ -31,7 +32,7 @@ pub use error::{Error, Result};
 
 /// The types most users need.
 pub mod prelude {
-    pub use crate::convert::{Clearance, ConvertRevolute};
+    pub use crate::convert::{BearingSide, Clearance, ConvertRevolute};
     pub use crate::joint::{
         ClearanceJoint, ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet,
         OutOfPlaneLock,
@@ -40,7 +41,10 @@ pub mod prelude {
         LargeStepJoint, LargeStepJointBuilder, LargeStepJointHandle, LargeStepJointSet, Restitution,
     };
     pub use crate::laws::*;
-    pub use crate::reaction::{IdealRevolute, ReactionSolver};
+    pub use crate::metrics::{ContactObservation, ImpactRecorder};
+    pub use crate::reaction::{
+        IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, ReactionSolver,
+    };
     pub use crate::stepper::{ForceSource, StepControl, StepInfo, Stepper};
     pub use rapier3d_f64::math::Vector;
 }

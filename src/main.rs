@@ -269,11 +269,22 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     let result = result?;
     let summary = result.write(&out)?;
     println!("{}", comparison_table(&summary));
+    let mut files = vec!["ideal.csv".to_string(), "clearance.csv".to_string()];
+    for t in &result.twins {
+        for h in t.clearance_hinges() {
+            files.push(format!("{}_{h}_impacts.csv", t.kind.name()));
+            if scene.drive_period().is_some() {
+                files.push(format!("{}_{h}_turns.csv", t.kind.name()));
+            }
+        }
+    }
+    files.push("summary.json".into());
     println!(
-        "{} steps in {:.2} s wall; wrote {}/{{ideal.csv, clearance.csv, summary.json}}",
+        "{} steps in {:.2} s wall; wrote {}/{{{}}}",
         result.steps,
         result.wall_s,
-        out.display()
+        out.display(),
+        files.join(", ")
     );
     Ok(())
 }

@@ -358,7 +358,11 @@ impl MemoryEstimate {
         } else {
             u64::MAX / 1000
         };
-        let per_twin = 1 + 2 * scene.bodies.len() as u64 + 7 * scene.hinges.len() as u64;
+        let motion = if scene.run.body_motion { 9 } else { 0 };
+        let per_twin = 1
+            + (2 + motion) * scene.bodies.len() as u64
+            + 7 * scene.hinges.len() as u64
+            + scene.joints.len() as u64;
         let values_per_row = 2 * per_twin;
         let bytes = rows
             .saturating_mul(values_per_row)

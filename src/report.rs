@@ -118,12 +118,44 @@ impl RunResult {
         self.twins.iter().find(|t| t.kind == kind)
     }
 
-    /// Writes `<twin>.csv` for each twin and `summary.json` into `dir` as one set
+    /// Writes `<twin>.csv` for each twin, `<twin>_<joint>_impacts.csv` for each clearance joint
+    /// (its impact list, [`ImpactRecorder::impacts_table`](crate::metrics::ImpactRecorder::impacts_table)),
+    /// `<twin>_<joint>_turns.csv` when a body spins (per-turn statistics,
+    /// [`per_period`](crate::metrics::per_period))
+    /// and `summary.json` into `dir` as one set
     /// ([`write_set`]): the tables are streamed (and checked finite) into temporary files, then
     /// renamed into place, `summary.json` last.
     pub fn write(&self, dir: &Path) -> Result<Summary> {
         let summary = self.summary();
         let json = summary_json(&summary)?;
+        // One impact list per clearance joint, `<twin>_<joint>_impacts.csv`.
+        let impact_tables: Vec<(std::path::PathBuf, crate::output::Table)> = self
+            .twins
+            .iter()
+            .flat_map(|t| {
+                let recorders = t.hinge_recorders();
+                let period = self.scene.drive_period();
+                let end = self.scene.run.end_s;
+                t.clearance_hinges()
+                    .into_iter()
+                    .flat_map(|h| {
+                        let mut v = vec![(
+                            dir.join(format!("{}_{h}_impacts.csv", t.kind.name())),
+                            recorders[h].impacts_table(),
+                        )];
+                        // Per crank turn when a body spins.
+                        if let Some(p) = period {
+                            let turns = crate::metrics::per_period(recorders[h].impacts(), p, end);
+                            v.push((
+                                dir.join(format!("{}_{h}_turns.csv", t.kind.name())),
+                                crate::metrics::per_period_table(&turns),
+                            ));
+                        }
+                        v
+                    })
+                    .collect::<Vec<_>>()
+            })
+            .collect();
         let paths: Vec<std::path::PathBuf> = self
             .twins
             .iter()
@@ -147,6 +179,19 @@ impl RunResult {
                 (path.as_path(), render)
             })
             .collect();
+        for (path, table) in &impact_tables {
+            let render: Render = Box::new(move |w: &mut dyn std::io::Write| {
+                table.write_csv(w).map_err(|e| match e {
+                    Error::Io { action, source, .. } => Error::Io {
+                        action,
+                        path: path.clone(),
+                        source,
+                    },
+                    other => other,
+                })
+            });
+            files.push((path.as_path(), render));
+        }
         let summary_path = dir.join("summary.json");
         let json_path = summary_path.clone();
         files.push((
@@ -265,9 +310,14 @@ pub fn comparison_table(summary: &Summary) -> String {
         twins
             .iter()
             .map(|(_, t)| {
+                let none = if t.invariants.driven {
+                    "n/a (driven)"
+                } else {
+                    "n/a (at rest)"
+                };
                 t.invariants
                     .energy_growth
-                    .map_or("n/a (at rest)".to_string(), |g| format!("{g:.1e}"))
+                    .map_or(none.to_string(), |g| format!("{g:.1e}"))
             })
             .collect(),
     ));

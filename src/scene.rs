@@ -30,6 +30,10 @@ pub struct Scene {
     pub bodies: Vec<BodySpec>,
     /// Hinges between bodies.
     pub hinges: Vec<HingeSpec>,
+    /// Ideal joints of Rapier's other kinds (prismatic, fixed, spherical) between bodies;
+    /// revolutes, ideal or with clearance, are `hinges`.
+    #[serde(default)]
+    pub joints: Vec<JointSpec>,
     /// Torsion-spring drives on hinges.
     #[serde(default)]
     pub drives: Vec<DriveSpec>,
@@ -53,6 +57,72 @@ pub struct BodySpec {
     /// A fixed body (ground): it does not move; mass and inertia are then ignored.
     #[serde(default)]
     pub fixed: bool,
+    /// A prescribed motion: the body is kinematic (Rapier's velocity-based kinematic body) and
+    /// drives the mechanism; its mass and inertia are then ignored.
+    #[serde(default)]
+    pub motion: Option<MotionSpec>,
+    /// Initial velocity of the centre of mass, m/s (dynamic bodies; default at rest).
+    #[serde(default)]
+    pub velocity_m_s: [f64; 3],
+    /// Initial angular velocity, rad/s (dynamic bodies; default at rest).
+    #[serde(default)]
+    pub angular_velocity_rad_s: [f64; 3],
+}
+
+/// A prescribed motion of a kinematic body.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum MotionSpec {
+    /// Constant angular speed `rate_rad_s` about `axis` (unit, world) through `point_m` (world,
+    /// m) from t = 0 (a crank).
+    Spin {
+        /// Rotation axis (unit vector, world).
+        axis: [f64; 3],
+        /// A point of the axis, m.
+        point_m: [f64; 3],
+        /// Angular speed, rad/s (right-hand rule about `axis`).
+        rate_rad_s: f64,
+    },
+    /// Constant velocity `velocity_m_s` (m/s, world) without rotation.
+    Translate {
+        /// Velocity, m/s.
+        velocity_m_s: [f64; 3],
+    },
+}
+
+/// An ideal joint that is not a revolute (revolutes are `hinges`).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct JointSpec {
+    /// Unique name (CSV column prefix).
+    pub name: String,
+    /// First body (the guide of a prismatic joint).
+    pub body1: String,
+    /// Second body (the slider): the joint force reported is the force on it.
+    pub body2: String,
+    /// World position of the joint point at t = 0, m (the slider's point of a prismatic joint).
+    pub point_m: [f64; 3],
+    /// Which joint.
+    pub kind: JointKindSpec,
+}
+
+/// The kinds of [`JointSpec`].
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum JointKindSpec {
+    /// Body 2 slides along `axis` (unit, world at t = 0) without turning relative to body 1,
+    /// optionally between `limits_m` (displacement from the start, m).
+    Prismatic {
+        /// Slide axis (unit vector, world, t = 0).
+        axis: [f64; 3],
+        /// Travel limits `[min, max]` along the axis from the start position, m.
+        #[serde(default)]
+        limits_m: Option<[f64; 2]>,
+    },
+    /// The bodies move as one.
+    Fixed,
+    /// A ball joint: the joint points coincide, rotation is free.
+    Spherical,
 }
 
 /// A hinge: ideal (Rapier revolute joint) unless `clearance` is given.
@@ -299,6 +369,10 @@ pub struct RunSettings {
     /// at the floor) fails the run instead of being reported (`--strict`).
     #[serde(default)]
     pub strict: bool,
+    /// Writes each moving body's centre-of-mass position and velocity along the world axes
+    /// (`<body>_x_m`, ..., `<body>_vz_m_s`) in the rows.
+    #[serde(default)]
+    pub body_motion: bool,
 }
 
 pub use crate::stepper::StepMode;
@@ -353,6 +427,7 @@ impl Default for RunSettings {
             step: StepMode::default(),
             tolerance: default_tolerance(),
             strict: false,
+            body_motion: false,
         }
     }
 }
@@ -432,6 +507,27 @@ impl Scene {
         self.bodies.iter().position(|b| b.name == name)
     }
 
+    /// Where body `i`'s frame is at t = 0 (world, m): the spin axis point of a spinning body
+    /// (Rapier turns a kinematic body about its frame origin), its centre of mass otherwise.
+    pub fn body_origin(&self, i: usize) -> [f64; 3] {
+        let b = &self.bodies[i];
+        match &b.motion {
+            Some(MotionSpec::Spin { point_m, .. }) => *point_m,
+            _ => b.center_of_mass_m,
+        }
+    }
+
+    /// The period of the scene's drive, s: one turn of the first body spinning at a nonzero
+    /// rate (`None` without one). Per-turn statistics are taken over it.
+    pub fn drive_period(&self) -> Option<f64> {
+        self.bodies.iter().find_map(|b| match &b.motion {
+            Some(MotionSpec::Spin { rate_rad_s, .. }) if *rate_rad_s != 0.0 => {
+                Some(std::f64::consts::TAU / rate_rad_s.abs())
+            }
+            _ => None,
+        })
+    }
+
     /// Index of the hinge called `name`.
     pub fn hinge_index(&self, name: &str) -> Option<usize> {
         self.hinges.iter().position(|h| h.name == name)
@@ -470,8 +566,8 @@ impl Scene {
             if !names.insert(b.name.as_str()) {
                 return Err(Error::invalid(p, "duplicate name"));
             }
-            if b.fixed {
-                // A ground body does not move: its mass and inertia are ignored (0 is fine).
+            if b.fixed || b.motion.is_some() {
+                // A ground or driven body: its mass and inertia are ignored (0 is fine).
                 non_negative(&format!("{p}.mass_kg"), b.mass_kg)?;
                 for (i, j) in b.inertia_kg_m2.iter().enumerate() {
                     non_negative(&format!("{p}.inertia_kg_m2[{i}]"), *j)?;
@@ -493,6 +589,61 @@ impl Scene {
             }
             for (i, x) in b.center_of_mass_m.iter().enumerate() {
                 position(&format!("{p}.center_of_mass_m[{i}]"), *x)?;
+            }
+            for (i, v) in b.velocity_m_s.iter().enumerate() {
+                in_range(
+                    &format!("{p}.velocity_m_s[{i}]"),
+                    *v,
+                    -SPEED_MAX,
+                    SPEED_MAX,
+                    "m/s",
+                )?;
+            }
+            for (i, w) in b.angular_velocity_rad_s.iter().enumerate() {
+                in_range(
+                    &format!("{p}.angular_velocity_rad_s[{i}]"),
+                    *w,
+                    -RATE_MAX,
+                    RATE_MAX,
+                    "rad/s",
+                )?;
+            }
+            match &b.motion {
+                Some(_) if b.fixed => {
+                    return Err(Error::invalid(
+                        format!("{p}.motion"),
+                        "a fixed body cannot also have a prescribed motion: remove `fixed: true` or the motion",
+                    ));
+                }
+                Some(MotionSpec::Spin {
+                    axis,
+                    point_m,
+                    rate_rad_s,
+                }) => {
+                    unit(axis, &format!("{p}.motion.axis"))?;
+                    for (i, x) in point_m.iter().enumerate() {
+                        position(&format!("{p}.motion.point_m[{i}]"), *x)?;
+                    }
+                    in_range(
+                        &format!("{p}.motion.rate_rad_s"),
+                        *rate_rad_s,
+                        -RATE_MAX,
+                        RATE_MAX,
+                        "rad/s",
+                    )?;
+                }
+                Some(MotionSpec::Translate { velocity_m_s }) => {
+                    for (i, v) in velocity_m_s.iter().enumerate() {
+                        in_range(
+                            &format!("{p}.motion.velocity_m_s[{i}]"),
+                            *v,
+                            -SPEED_MAX,
+                            SPEED_MAX,
+                            "m/s",
+                        )?;
+                    }
+                }
+                None => {}
             }
         }
         for h in &self.hinges {
@@ -535,6 +686,53 @@ impl Scene {
                         "`None` leaves the axial translation and the tilts free, and a scene has no locked axes to \
                          hold them: use `Joint` (plain-API users may lock the bodies' axes themselves)",
                     ));
+                }
+            }
+        }
+        for j in &self.joints {
+            let p = format!("joints[{}]", j.name);
+            if !is_plain_name(&j.name) {
+                return Err(Error::invalid(
+                    p,
+                    "name must be letters, digits, `_` and `-` (it prefixes CSV columns)",
+                ));
+            }
+            if !names.insert(j.name.as_str()) {
+                return Err(Error::invalid(
+                    p,
+                    "duplicate name (bodies, hinges, joints and drives share one namespace)",
+                ));
+            }
+            for (field, body) in [("body1", &j.body1), ("body2", &j.body2)] {
+                if self.body_index(body).is_none() {
+                    return Err(Error::invalid(
+                        format!("{p}.{field}"),
+                        format!("no body named `{body}`"),
+                    ));
+                }
+            }
+            if j.body1 == j.body2 {
+                return Err(Error::invalid(
+                    format!("{p}.body2"),
+                    "must differ from body1",
+                ));
+            }
+            for (i, x) in j.point_m.iter().enumerate() {
+                position(&format!("{p}.point_m[{i}]"), *x)?;
+            }
+            if let JointKindSpec::Prismatic { axis, limits_m } = &j.kind {
+                unit(axis, &format!("{p}.kind.axis"))?;
+                if let Some([lo, hi]) = limits_m {
+                    position(&format!("{p}.kind.limits_m[0]"), *lo)?;
+                    position(&format!("{p}.kind.limits_m[1]"), *hi)?;
+                    if !(lo < hi) || *lo > 0.0 || *hi < 0.0 {
+                        return Err(Error::invalid(
+                            format!("{p}.kind.limits_m"),
+                            format!(
+                                "must be [min, max] with min <= 0 <= max and min < max (the start is 0; got [{lo}, {hi}])"
+                            ),
+                        ));
+                    }
                 }
             }
         }
@@ -671,6 +869,11 @@ impl Scene {
 const MAX_ROWS: f64 = 1e7;
 /// Most steps (`run.end_s / run.dt_s`) a run may take.
 const MAX_STEPS: f64 = 1e9;
+
+/// Largest initial or prescribed speed of a body, m/s (half Rapier's speed clamp of 400 m/s).
+pub const SPEED_MAX: f64 = 200.0;
+/// Largest initial or prescribed angular speed, rad/s (about 95,000 rpm).
+pub const RATE_MAX: f64 = 1e4;
 
 /// Physical range of a body's mass, kg (fixed bodies: ignored).
 pub const MASS_RANGE: (f64, f64) = (1e-6, 1e9);

@@ -7,9 +7,12 @@ use crate::drive::{DriveSet, TorsionSpring};
 use crate::error::Result;
 use crate::joint::{ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet};
 use crate::laws::NormalForceLaw;
+use crate::metrics::{ContactObservation, ImpactRecorder};
 use crate::output::Table;
-use crate::reaction::{IdealRevolute, ReactionSolver};
-use crate::scene::Scene;
+use crate::reaction::{
+    IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, ReactionSolver,
+};
+use crate::scene::{JointKindSpec, MotionSpec, Scene};
 use crate::stepper::{ForceSource, GuardReport, StepInfo, Stepper};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::*;
@@ -63,7 +66,12 @@ struct BodyTrack {
     name: String,
     handle: RigidBodyHandle,
     mass: f64,
+    /// Fixed or driven by a prescribed motion: outside the energy and momentum balances.
     fixed: bool,
+    /// Not a fixed body (driven bodies move).
+    moves: bool,
+    /// The centre of mass in the body's frame (not the origin for a spinning body), m.
+    local_com: Vector,
     angle: UnwrappedAngle,
     linvel_before: Vector,
     /// Angular velocity, centre of mass and rotation at the state before the current step.
@@ -93,7 +101,23 @@ struct HingeTrack {
     force: f64,
     /// The clearance contact at the state before the current step.
     sample: ContactSample,
-    metrics: HingeMetrics,
+    recorder: ImpactRecorder,
+}
+
+impl HingeTrack {
+    /// The state before the current step, for the recorder.
+    fn observation(&self) -> ContactObservation {
+        match self.joint {
+            HingeJoint::Ideal => ContactObservation::ideal(self.force),
+            HingeJoint::Clearance(_) => ContactObservation {
+                force: self.force,
+                onset: self.sample.onset,
+                impact: self.sample.impact,
+                penetration: self.sample.penetration,
+                rate: self.sample.rate,
+            },
+        }
+    }
 }
 
 /// What a clearance hinge's hook saw at one state (read before the step it drives).
@@ -110,46 +134,7 @@ struct ContactSample {
     friction_force: f64,
 }
 
-/// Per-hinge metrics over every internal step.
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct HingeMetrics {
-    /// Largest joint force, N.
-    pub peak_force_n: f64,
-    /// Number of contact onsets (issue 2's definition of impacts), chatter of a journal
-    /// following the wall included.
-    pub impacts: u64,
-    /// Contact onsets after a free flight that opened at least the joint's `min_separation`
-    /// (0.1 um by default; the first contact always counts): impacts without the chatter.
-    pub separated_impacts: u64,
-    /// Time of the first contact onset, s.
-    pub first_impact_t_s: Option<f64>,
-    /// Largest force during the first contact, N.
-    pub first_impact_peak_n: Option<f64>,
-    /// Largest penetration, um.
-    pub max_penetration_um: f64,
-    /// Steps spent in contact.
-    pub contact_steps: u64,
-    /// Fraction of simulated time in contact.
-    pub contact_fraction: f64,
-    /// Root-mean-square joint force over the run (time-weighted), N.
-    pub rms_force_n: f64,
-    #[serde(skip)]
-    force_sq_time: f64,
-    #[serde(skip)]
-    contact_time: f64,
-    /// Largest apparent restitution of an impact, the separation speed over the approach speed
-    /// (from the first state out of and into contact), over impacts that approached faster than
-    /// 1 mm/s; above 1 a contact gave back more than it took (0 without such an impact).
-    pub max_restitution: f64,
-    #[serde(skip)]
-    onset_rate: f64,
-    #[serde(skip)]
-    was_in_contact: bool,
-    /// Final relative angle, deg.
-    pub final_angle_deg: f64,
-    #[serde(skip)]
-    in_first_contact: bool,
-}
+pub use crate::metrics::HingeMetrics;
 
 /// One twin: its bodies, joints, drives and records.
 #[derive(Debug)]
@@ -162,9 +147,13 @@ pub struct Twin {
     pub clearance: ClearanceJointSet,
     /// The drives of this twin.
     pub drives: DriveSet,
-    /// The ideal revolute joints, and the hinge index of each.
-    ideal_joints: Vec<IdealRevolute>,
+    /// The ideal joints: the ideal hinges' revolutes (with the hinge index of each), then the
+    /// scene's other joints.
+    ideal_joints: Vec<IdealJoint>,
     ideal_hinges: Vec<usize>,
+    /// The scene's other joints: name and force on body 2 at the current state, N.
+    joints: Vec<(String, f64)>,
+    body_motion: bool,
     reactions: ReactionSolver,
     /// The drives' and clearance joints' wrenches at the current state (scratch).
     source_wrenches: Vec<crate::ledger::Wrench>,
@@ -185,6 +174,10 @@ pub struct Twin {
 /// Conservation checks over every step.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Invariants {
+    /// A prescribed motion drives the scene: it does work the balance does not know, so the
+    /// energy figures are null.
+    #[serde(skip)]
+    pub driven: bool,
     /// Largest `|P(t) - P(0)|` over the largest single-body linear momentum seen; null when the
     /// scene is not free-floating (gravity or a fixed body: momentum is not conserved).
     pub linear_momentum_drift: Option<f64>,
@@ -195,7 +188,8 @@ pub struct Invariants {
     /// contact elastic energy; D: the work dissipated so far by contact damping and friction) over
     /// the energy scale. Fixed supports and ideal joints do no work, so the balance holds with
     /// gravity and grounds too, and energy gained by the integration shows even in a run that
-    /// dissipates. Null when nothing moved (an energy scale below 1e-9 J: no scale to judge by).
+    /// dissipates. Null when nothing moved (an energy scale below 1e-9 J: no scale to judge by),
+    /// and when a prescribed motion drives the scene (its work is not in the balance).
     pub energy_growth: Option<f64>,
     /// Largest `|E(t) + D(t) - E(0)|` over the energy scale (null when nothing moved).
     pub energy_error: Option<f64>,
@@ -225,10 +219,6 @@ pub struct Invariants {
     #[serde(skip)]
     max_dpe: f64,
 }
-
-/// Impacts slower than this (m/s) are not judged by their apparent restitution: at a grazing
-/// approach the separation speed is set by the other forces, not by the contact.
-const RESTITUTION_MIN_SPEED: f64 = 1e-3;
 
 /// Below this energy scale (J) nothing moved enough for the energy balance to be judged.
 const MIN_ENERGY_SCALE_J: f64 = 1e-9;
@@ -314,7 +304,7 @@ impl ComparisonSums {
             let excess = hc.force - hi.force;
             // The band is the ideal peak at the end, at least the peak so far: an excess within
             // it can never be the answer, so it is not stored (memory stays bounded in practice).
-            if excess <= hi.metrics.peak_force_n {
+            if excess <= hi.recorder.metrics().peak_force_n {
                 continue;
             }
             let stack = &mut self.excess[k];
@@ -342,7 +332,7 @@ impl ComparisonSums {
             );
         }
         for (k, h) in ideal.hinges.iter().enumerate() {
-            let band = h.metrics.peak_force_n;
+            let band = h.recorder.metrics().peak_force_n;
             let last = self
                 .excess
                 .get(k)
@@ -537,8 +527,6 @@ impl Simulation {
         for twin in &mut self.twins {
             twin.before_step(&self.world.bodies, gravity, t, rows);
         }
-        self.write_rows(t);
-        self.t_prev = t;
         let target = self.target();
         let info = {
             let mut sources = sources(&mut self.twins);
@@ -548,7 +536,13 @@ impl Simulation {
         };
         for twin in &mut self.twins {
             twin.after_step(&self.world.bodies, &info, gravity);
+            if rows {
+                twin.complete_row_motion(&self.world.bodies, &info);
+            }
         }
+        // Rows up to this state, now that its step gave its velocities and accelerations.
+        self.write_rows(t);
+        self.t_prev = t;
         if let [ideal, clear] = self.twins.as_slice() {
             self.comparison
                 .record(ideal, clear, &self.world.bodies, info.t0, info.dt);
@@ -569,18 +563,32 @@ impl Simulation {
         for twin in &mut self.twins {
             twin.before_step(&self.world.bodies, gravity, t, rows);
         }
+        if rows && self.scene.run.body_motion {
+            // The final state's velocities and accelerations from one more step, taken and
+            // undone.
+            let mut twins = std::mem::take(&mut self.twins);
+            let peeked = {
+                let mut sources = sources(&mut twins);
+                let dt = self.scene.run.dt_s;
+                self.stepper
+                    .peek(&mut self.world, &mut sources, dt, |world, info| {
+                        (world.bodies.clone(), *info)
+                    })
+            };
+            self.twins = twins;
+            let (bodies, info) = peeked.map_err(|e| name_step_field(e, "run.dt_s"))?;
+            for twin in &mut self.twins {
+                twin.complete_row_motion(&bodies, &info);
+            }
+        }
         self.write_rows(t);
         let duration = self.time();
         for twin in &mut self.twins {
             // The final state counts for peaks and onsets (it carries no time).
-            twin.update_force_metrics(t, 0.0);
             for h in &mut twin.hinges {
-                let m = &mut h.metrics;
-                m.final_angle_deg = h.angle.value().to_degrees();
-                if duration > 0.0 {
-                    m.rms_force_n = (m.force_sq_time / duration).sqrt();
-                    m.contact_fraction = m.contact_time / duration;
-                }
+                let obs = h.observation();
+                h.recorder.finish(duration, &obs);
+                h.recorder.set_final_angle_deg(h.angle.value().to_degrees());
             }
         }
         Ok(())
@@ -608,28 +616,54 @@ fn name_step_field(mut e: crate::Error, name: &str) -> crate::Error {
 impl Twin {
     fn build(scene: &Scene, kind: TwinKind, world: &mut PhysicsWorld) -> Result<Twin> {
         let mut bodies = Vec::new();
-        for b in &scene.bodies {
+        for (i, b) in scene.bodies.iter().enumerate() {
             let com = Vector::from(b.center_of_mass_m);
-            let builder = if b.fixed {
-                RigidBodyBuilder::fixed()
-            } else {
-                RigidBodyBuilder::dynamic()
+            let origin = Vector::from(scene.body_origin(i));
+            let rb = match &b.motion {
+                // A driven body: no mass properties, so Rapier turns it about its frame origin.
+                Some(m) => {
+                    let (v, w) = match m {
+                        MotionSpec::Spin {
+                            axis, rate_rad_s, ..
+                        } => (Vector::ZERO, Vector::from(*axis).normalize() * *rate_rad_s),
+                        MotionSpec::Translate { velocity_m_s } => {
+                            (Vector::from(*velocity_m_s), Vector::ZERO)
+                        }
+                    };
+                    RigidBodyBuilder::kinematic_velocity_based()
+                        .translation(origin)
+                        .linvel(v)
+                        .angvel(w)
+                        .can_sleep(false)
+                        .build()
+                }
+                None => {
+                    let builder = if b.fixed {
+                        RigidBodyBuilder::fixed()
+                    } else {
+                        RigidBodyBuilder::dynamic()
+                            .linvel(Vector::from(b.velocity_m_s))
+                            .angvel(Vector::from(b.angular_velocity_rad_s))
+                    };
+                    builder
+                        .translation(com)
+                        .additional_mass_properties(MassProperties::new(
+                            Vector::ZERO,
+                            b.mass_kg,
+                            Vector::from(b.inertia_kg_m2),
+                        ))
+                        .can_sleep(false)
+                        .build()
+                }
             };
-            let rb = builder
-                .translation(com)
-                .additional_mass_properties(MassProperties::new(
-                    Vector::ZERO,
-                    b.mass_kg,
-                    Vector::from(b.inertia_kg_m2),
-                ))
-                .can_sleep(false)
-                .build();
             let handle = world.bodies.insert(rb);
             bodies.push(BodyTrack {
                 name: b.name.clone(),
                 handle,
                 mass: b.mass_kg,
-                fixed: b.fixed,
+                fixed: b.fixed || b.motion.is_some(),
+                moves: !b.fixed,
+                local_com: com - origin,
                 angle: UnwrappedAngle::default(),
                 linvel_before: Vector::ZERO,
                 angvel_before: Vector::ZERO,
@@ -646,9 +680,10 @@ impl Twin {
             );
             let point = Vector::from(h.point_m);
             let axis = Vector::from(h.axis).normalize();
-            // Bodies start unrotated with their frame at the centre of mass.
-            let a1 = point - Vector::from(scene.bodies[ib].center_of_mass_m);
-            let a2 = point - Vector::from(scene.bodies[ij].center_of_mass_m);
+            // Bodies start unrotated with their frame at their origin (the centre of mass, or
+            // a spinning body's axis point).
+            let a1 = point - Vector::from(scene.body_origin(ib));
+            let a2 = point - Vector::from(scene.body_origin(ij));
             let (b1, b2) = (bodies[ib].handle, bodies[ij].handle);
             let joint = match (&h.clearance, kind) {
                 (Some(spec), TwinKind::Clearance) => {
@@ -689,7 +724,7 @@ impl Twin {
                 angle: HingeAngle::default(),
                 force: 0.0,
                 sample: ContactSample::default(),
-                metrics: HingeMetrics::default(),
+                recorder: ImpactRecorder::new(),
             });
         }
         let mut drives = DriveSet::new();
@@ -712,22 +747,93 @@ impl Twin {
             if let HingeJoint::Ideal = h.joint {
                 let hs = &scene.hinges[i];
                 let point = Vector::from(hs.point_m);
-                let com = |k: usize| Vector::from(scene.bodies[k].center_of_mass_m);
-                ideal_joints.push(IdealRevolute {
+                let com = |k: usize| Vector::from(scene.body_origin(k));
+                ideal_joints.push(IdealJoint::Revolute(IdealRevolute {
                     body1: bodies[h.bearing].handle,
                     body2: bodies[h.journal].handle,
                     local_anchor1: point - com(h.bearing),
                     local_anchor2: point - com(h.journal),
                     local_axis1: h.local_axis1,
-                });
+                }));
                 ideal_hinges.push(i);
             }
+        }
+        let mut joints = Vec::new();
+        for j in &scene.joints {
+            let (i1, i2) = (
+                scene.body_index(&j.body1).unwrap(),
+                scene.body_index(&j.body2).unwrap(),
+            );
+            let point = Vector::from(j.point_m);
+            let a1 = point - Vector::from(scene.body_origin(i1));
+            let a2 = point - Vector::from(scene.body_origin(i2));
+            let (b1, b2) = (bodies[i1].handle, bodies[i2].handle);
+            let ideal = match &j.kind {
+                JointKindSpec::Prismatic { axis, limits_m } => {
+                    let axis = Vector::from(*axis).normalize();
+                    let mut rj = PrismaticJointBuilder::new(axis)
+                        .local_anchor1(a1)
+                        .local_anchor2(a2)
+                        .contacts_enabled(false);
+                    if let Some(l) = limits_m {
+                        rj = rj.limits(*l);
+                    }
+                    world.impulse_joints.insert(b1, b2, rj, true);
+                    IdealJoint::Prismatic(IdealPrismatic {
+                        body1: b1,
+                        body2: b2,
+                        local_anchor1: a1,
+                        local_anchor2: a2,
+                        local_axis1: axis,
+                    })
+                }
+                JointKindSpec::Fixed => {
+                    let rj = FixedJointBuilder::new()
+                        .local_anchor1(a1)
+                        .local_anchor2(a2)
+                        .contacts_enabled(false);
+                    world.impulse_joints.insert(b1, b2, rj, true);
+                    IdealJoint::Fixed(IdealFixed {
+                        body1: b1,
+                        body2: b2,
+                        local_anchor1: a1,
+                        local_anchor2: a2,
+                    })
+                }
+                JointKindSpec::Spherical => {
+                    let rj = SphericalJointBuilder::new()
+                        .local_anchor1(a1)
+                        .local_anchor2(a2)
+                        .contacts_enabled(false);
+                    world.impulse_joints.insert(b1, b2, rj, true);
+                    IdealJoint::Spherical(IdealSpherical {
+                        body1: b1,
+                        body2: b2,
+                        local_anchor1: a1,
+                        local_anchor2: a2,
+                    })
+                }
+            };
+            ideal_joints.push(ideal);
+            joints.push((j.name.clone(), 0.0));
         }
         let mut columns = vec!["t_s".to_string()];
         for b in &bodies {
             columns.push(format!("{}_angle_deg", b.name));
             columns.push(format!("{}_rate_deg_s", b.name));
         }
+        let body_motion = scene.run.body_motion;
+        if body_motion {
+            for b in bodies.iter().filter(|b| b.moves) {
+                for c in [
+                    "x_m", "y_m", "z_m", "vx_m_s", "vy_m_s", "vz_m_s", "ax_m_s2", "ay_m_s2",
+                    "az_m_s2",
+                ] {
+                    columns.push(format!("{}_{c}", b.name));
+                }
+            }
+        }
+
         for h in &hinges {
             for c in [
                 "angle_deg",
@@ -741,6 +847,9 @@ impl Twin {
                 columns.push(format!("{}_{c}", h.name));
             }
         }
+        for (name, _) in &joints {
+            columns.push(format!("{name}_force_n"));
+        }
         Ok(Twin {
             kind,
             bodies,
@@ -749,6 +858,8 @@ impl Twin {
             drives,
             ideal_joints,
             ideal_hinges,
+            joints,
+            body_motion,
             reactions: ReactionSolver::default(),
             source_wrenches: Vec::new(),
             source_energy_before: 0.0,
@@ -763,7 +874,9 @@ impl Twin {
             row_prev: Vec::new(),
             row_cur: Vec::new(),
             invariants: Invariants {
-                free_floating: scene.gravity == [0.0; 3] && scene.bodies.iter().all(|b| !b.fixed),
+                free_floating: scene.gravity == [0.0; 3]
+                    && scene.bodies.iter().all(|b| !b.fixed && b.motion.is_none()),
+                driven: scene.bodies.iter().any(|b| b.motion.is_some()),
                 ..Invariants::default()
             },
         })
@@ -842,6 +955,38 @@ impl Twin {
         }
     }
 
+    /// Completes the body motion of the current row from the step taken from its state:
+    /// a dynamic body's velocity at the state is the synchronous one,
+    /// `(h v[n-1/2] + h_prev v[n+1/2])/(h_prev + h)`, and its acceleration
+    /// `(v[n+1/2] - v[n-1/2])/kick`, what the step applied (the stored velocities live at half
+    /// steps); a driven body's are exact (`w x r` and `w x (w x r)` for a spin, 0 for a
+    /// translation).
+    fn complete_row_motion(&mut self, bodies_after: &RigidBodySet, info: &StepInfo) {
+        if !self.body_motion {
+            return;
+        }
+        let (h, h_prev) = (info.dt, (2.0 * info.kick - info.dt).max(0.0));
+        let mut col = 1 + 2 * self.bodies.len();
+        for b in self.bodies.iter().filter(|b| b.moves) {
+            let (vel, acc) = if b.fixed {
+                // Driven: the row's velocity is exact; the acceleration is the spin's.
+                let rb = &bodies_after[b.handle];
+                let w = rb.angvel();
+                let r = b.rotation_before * b.local_com;
+                (None, w.cross(w.cross(r)))
+            } else {
+                let after = bodies_after[b.handle].linvel();
+                let sync = (h * b.linvel_before + h_prev * after) / (h_prev + h);
+                (Some(sync), (after - b.linvel_before) / info.kick)
+            };
+            if let Some(v) = vel {
+                self.row_cur[col + 3..col + 6].copy_from_slice(&[v.x, v.y, v.z]);
+            }
+            self.row_cur[col + 6..col + 9].copy_from_slice(&[acc.x, acc.y, acc.z]);
+            col += 9;
+        }
+    }
+
     /// Ideal-joint reactions at the current state, exact: the constrained rigid-body equations
     /// solved for the joint forces ([`ReactionSolver`]), whatever the step control.
     fn solve_ideal_reactions(&mut self, bodies: &RigidBodySet, gravity: Vector) {
@@ -854,12 +999,18 @@ impl Twin {
             .extend_from_slice(self.drives.wrenches());
         self.source_wrenches
             .extend_from_slice(self.clearance.wrenches());
-        if let Some(forces) =
-            self.reactions
-                .solve_with(bodies, &self.ideal_joints, gravity, &self.source_wrenches)
-        {
+        if let Some(forces) = self.reactions.solve_joints_with(
+            bodies,
+            &self.ideal_joints,
+            gravity,
+            &self.source_wrenches,
+        ) {
+            let n = self.ideal_hinges.len();
             for (&hi, f) in self.ideal_hinges.iter().zip(forces) {
                 self.hinges[hi].force = f.length();
+            }
+            for (j, f) in self.joints.iter_mut().zip(&forces[n..]) {
+                j.1 = f.length();
             }
         }
     }
@@ -867,46 +1018,8 @@ impl Twin {
     /// Metrics of the state before the step (its sample and force), weighted by the step.
     fn update_force_metrics(&mut self, t: f64, dt: f64) {
         for h in &mut self.hinges {
-            let m = &mut h.metrics;
-            m.peak_force_n = m.peak_force_n.max(h.force);
-            m.force_sq_time += h.force * h.force * dt;
-            if let HingeJoint::Clearance(_) = h.joint {
-                let sample = h.sample;
-                let in_contact = sample.penetration > 0.0;
-                if sample.impact {
-                    m.separated_impacts += 1;
-                }
-                if sample.onset {
-                    m.onset_rate = sample.rate;
-                }
-                if m.was_in_contact && !in_contact && m.onset_rate > RESTITUTION_MIN_SPEED {
-                    m.max_restitution = m.max_restitution.max(-sample.rate / m.onset_rate);
-                }
-                m.was_in_contact = in_contact;
-                if sample.onset {
-                    m.impacts += 1;
-                    if m.first_impact_t_s.is_none() {
-                        m.first_impact_t_s = Some(t);
-                        m.first_impact_peak_n = Some(0.0);
-                        m.in_first_contact = true;
-                    }
-                }
-                if m.in_first_contact {
-                    if in_contact {
-                        m.first_impact_peak_n =
-                            Some(m.first_impact_peak_n.unwrap_or(0.0).max(h.force));
-                    } else {
-                        m.in_first_contact = false;
-                    }
-                }
-                if in_contact && dt > 0.0 {
-                    m.contact_steps += 1;
-                    m.contact_time += dt;
-                }
-                if in_contact {
-                    m.max_penetration_um = m.max_penetration_um.max(sample.penetration * 1e6);
-                }
-            }
+            let obs = h.observation();
+            h.recorder.record(t, dt, &obs);
         }
     }
 
@@ -955,7 +1068,7 @@ impl Twin {
             inv.linear_momentum_drift = Some(rel(inv.max_dp, inv.max_p));
             inv.angular_momentum_drift = Some(rel(inv.max_dl, inv.max_l));
         }
-        if inv.energy_scale_j >= MIN_ENERGY_SCALE_J {
+        if inv.energy_scale_j >= MIN_ENERGY_SCALE_J && !inv.driven {
             inv.energy_growth = Some(inv.max_de / inv.energy_scale_j);
             inv.energy_error = Some(inv.max_abs_de / inv.energy_scale_j);
         }
@@ -971,6 +1084,18 @@ impl Twin {
             let rb = &bodies[b.handle];
             v.push(b.angle.value().to_degrees());
             v.push(rb.angvel().dot(axis_ref).to_degrees());
+        }
+        if self.body_motion {
+            for b in self.bodies.iter().filter(|b| b.moves) {
+                let rb = &bodies[b.handle];
+                let p = *rb.position() * b.local_com;
+                // The velocity of the centre of mass (a driven body's frame turns about its
+                // origin, so its centre of mass moves with `w x r`).
+                let vel = rb.linvel() + rb.angvel().cross(p - rb.translation());
+                // Velocity and acceleration are completed by the step from this state
+                // (`complete_row_motion`).
+                v.extend_from_slice(&[p.x, p.y, p.z, vel.x, vel.y, vel.z, 0.0, 0.0, 0.0]);
+            }
         }
         for h in &self.hinges {
             let (r1, r2) = (
@@ -992,6 +1117,9 @@ impl Twin {
                 }
                 HingeJoint::Ideal => v.extend_from_slice(&[0.0, 0.0, 0.0, 0.0]),
             }
+        }
+        for (_, f) in &self.joints {
+            v.push(*f);
         }
     }
 
@@ -1020,7 +1148,24 @@ impl Twin {
     pub fn hinge_metrics(&self) -> BTreeMap<String, HingeMetrics> {
         self.hinges
             .iter()
-            .map(|h| (h.name.clone(), h.metrics.clone()))
+            .map(|h| (h.name.clone(), h.recorder.metrics().clone()))
+            .collect()
+    }
+
+    /// The impact recorder of every hinge, by hinge name (ideal hinges record no impacts).
+    pub fn hinge_recorders(&self) -> BTreeMap<String, &ImpactRecorder> {
+        self.hinges
+            .iter()
+            .map(|h| (h.name.clone(), &h.recorder))
+            .collect()
+    }
+
+    /// Names of the hinges that are clearance joints in this twin, in scene order.
+    pub fn clearance_hinges(&self) -> Vec<&str> {
+        self.hinges
+            .iter()
+            .filter(|h| matches!(h.joint, HingeJoint::Clearance(_)))
+            .map(|h| h.name.as_str())
             .collect()
     }
 

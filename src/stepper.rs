@@ -45,7 +45,7 @@
 //! );
 //! let mut joints = ClearanceJointSet::new();
 //! // Improved Liu law, steel on steel: bearing radius 10 mm, clearance 0.2 mm, width 16 mm.
-//! let pin = Clearance::steel(0.010, 0.2e-3, 0.016)?.joint(
+//! let pin = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?.joint(
 //!     Vector::ZERO,
 //!     Vector::new(-0.3, 0.0, 0.0),
 //!     Vector::Z,
@@ -593,6 +593,59 @@ impl Stepper {
                 }
             }
         }
+    }
+
+    /// Takes a step of the last step's size (or `dt` if none), lets `read` look at the world and
+    /// the step, then restores the state before it exactly: e.g. an ideal joint's reaction at
+    /// the final time, which only the step after it determines.
+    pub fn peek<R>(
+        &mut self,
+        world: &mut PhysicsWorld,
+        sources: &mut [&mut dyn ForceSource],
+        dt: f64,
+        read: impl FnOnce(&PhysicsWorld, &StepInfo) -> R,
+    ) -> Result<R> {
+        self.prepare(world, sources)?;
+        let (t, last, steps, guards, control) = (
+            self.t,
+            self.last_dt,
+            self.steps,
+            self.guards.clone(),
+            self.control,
+        );
+        let h = if last > 0.0 { last } else { dt };
+        // A fixed step of `h` with the sources saved, then everything put back.
+        for s in sources.iter_mut() {
+            s.save_state();
+        }
+        let mut probe = control;
+        probe.mode = StepMode::Fixed;
+        probe.max_dt = h;
+        self.control = probe;
+        let mut saved_bodies = Vec::new();
+        for (handle, rb) in world.bodies.iter() {
+            if !rb.is_fixed() {
+                saved_bodies.push(BodySnapshot {
+                    handle,
+                    position: *rb.position(),
+                    next_position: *rb.next_position(),
+                    linvel: rb.linvel(),
+                    angvel: rb.angvel(),
+                    force: rb.user_force(),
+                    torque: rb.user_torque(),
+                });
+            }
+        }
+        let result = self.step(world, sources, t + h);
+        let out = result.map(|info| read(world, &info));
+        self.saved = saved_bodies;
+        self.restore(world, sources);
+        self.t = t;
+        self.last_dt = last;
+        self.steps = steps;
+        self.guards = guards;
+        self.control = control;
+        out
     }
 
     fn restore_forces(&self, world: &mut PhysicsWorld) {

@@ -247,6 +247,8 @@ fn example_binaries_run_headless_and_print_the_comparison() {
             "game_rate",
             "--example",
             "robot_backlash",
+            "--example",
+            "slider_crank",
         ])
         .output()
         .unwrap();
@@ -266,6 +268,10 @@ fn example_binaries_run_headless_and_print_the_comparison() {
         (
             "robot_backlash",
             &["ideal", "play", "hand off the ideal arm's"][..],
+        ),
+        (
+            "slider_crank",
+            &["ideal slider acceleration", "closed form", "first impact"][..],
         ),
     ] {
         let exe = dir.join(format!("{name}{}", std::env::consts::EXE_SUFFIX));

@@ -670,6 +670,7 @@ fn stale_temporaries_are_cleaned() {
         [
             format!(".clearance.csv.tmp-{}", std::process::id()),
             "clearance.csv".into(),
+            "clearance_hinge_impacts.csv".into(),
             "ideal.csv".into(),
             "notes.tmp-1".into(),
             "summary.json".into()
@@ -728,7 +729,12 @@ fn concurrent_runs_and_interrupts() {
     assert!(o.status.success(), "{}", stderr(&o));
     assert_eq!(
         files_in(&dir),
-        ["clearance.csv", "ideal.csv", "summary.json"]
+        [
+            "clearance.csv",
+            "clearance_hinge_impacts.csv",
+            "ideal.csv",
+            "summary.json"
+        ]
     );
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -279,7 +279,8 @@ struct CrankRun {
 }
 
 fn crank_run(control: StepControl, end: f64) -> clearance_joint::Result<CrankRun> {
-    let (mut world, mut joints, _) = crank_mechanism(Clearance::steel(0.010, 0.5e-3, 0.016)?);
+    let (mut world, mut joints, _) =
+        crank_mechanism(Clearance::steel_improved_liu(0.010, 0.5e-3, 0.016)?);
     let mut stepper = Stepper::new(control);
     let (mut first, mut contacts, mut onset_ratio) = (0.0f64, 0u32, 0.0f64);
     let (mut onset_depth, mut peak, mut fast) = (0.0, 0.0f64, false);

@@ -8,7 +8,9 @@ use crate::kinematics::{
 use crate::laws::{
     BearingGeometry, FrictionLaw, FrictionModel, NormalContact, NormalForceLaw, NormalModel,
 };
-use crate::ledger::{ForceLedger, Wrench, ensure_mass_properties, world_center_of_mass};
+use crate::ledger::{
+    ForceLedger, Wrench, ensure_mass_properties, inverse_mass_along, world_center_of_mass,
+};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, IntegrationParameters, JointAxesMask,
@@ -579,17 +581,6 @@ fn motion(rb: &RigidBody) -> BodyMotion {
         linvel: rb.linvel(),
         angvel: rb.angvel(),
     }
-}
-
-/// `1/m + (r x n) . I^-1 (r x n)` of a dynamic body for a unit force along `n` at `point`;
-/// 0 for fixed and kinematic bodies.
-fn inverse_mass_along(rb: &RigidBody, point: Vector, n: Vector) -> f64 {
-    if !rb.is_dynamic() {
-        return 0.0;
-    }
-    let mp = &rb.mass_properties().local_mprops;
-    let rn = (point - world_center_of_mass(rb)).cross(n);
-    mp.inv_mass + rn.dot(mp.world_inv_inertia(rb.rotation()) * rn)
 }
 
 /// Handle of a joint in a [`ClearanceJointSet`].

@@ -69,3 +69,18 @@ pub(crate) fn ensure_mass_properties(
         rb.recompute_mass_properties_from_colliders(colliders.unwrap_or(&empty));
     }
 }
+
+/// `1/m + (r x n) . I^-1 (r x n)` of a dynamic body for a unit force along `n` at `point`: the
+/// inverse of its effective mass there; 0 for fixed and kinematic bodies.
+pub(crate) fn inverse_mass_along(
+    rb: &rapier3d_f64::prelude::RigidBody,
+    point: Vector,
+    n: Vector,
+) -> f64 {
+    if !rb.is_dynamic() {
+        return 0.0;
+    }
+    let mp = &rb.mass_properties().local_mprops;
+    let rn = (point - world_center_of_mass(rb)).cross(n);
+    mp.inv_mass + rn.dot(mp.world_inv_inertia(rb.rotation()) * rn)
+}

@@ -76,7 +76,7 @@ pub mod resolution;
 
 use crate::error::{Error, Result, non_negative, positive, unit_vector};
 use crate::laws::{BearingGeometry, NormalModel, impact_restitution};
-use crate::ledger::{ensure_mass_properties, world_center_of_mass};
+use crate::ledger::{ensure_mass_properties, inverse_mass_along, world_center_of_mass};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     GenericJoint, GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, IntegrationParameters,
@@ -588,17 +588,6 @@ impl LargeStepJoint {
         self.state.last_onset = onset;
         self.report = report;
     }
-}
-
-/// `1/m + (r x n) . I^-1 (r x n)` of a dynamic body for a unit force along `n` at `point`;
-/// 0 for fixed and kinematic bodies.
-fn inverse_mass_along(rb: &RigidBody, point: Vector, n: Vector) -> f64 {
-    if !rb.is_dynamic() {
-        return 0.0;
-    }
-    let mp = &rb.mass_properties().local_mprops;
-    let rn = (point - world_center_of_mass(rb)).cross(n);
-    mp.inv_mass + rn.dot(mp.world_inv_inertia(rb.rotation()) * rn)
 }
 
 /// Handle of a joint in a [`LargeStepJointSet`]. Handles stay valid (and are never reused) when

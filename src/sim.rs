@@ -12,7 +12,7 @@ use crate::output::Table;
 use crate::reaction::{
     IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, ReactionSolver,
 };
-use crate::scene::{JointKindSpec, MotionSpec, Scene};
+use crate::scene::{JointKindSpec, MotionSpec, MotorSpec, Scene};
 use crate::stepper::{ForceSource, GuardReport, StepInfo, Stepper};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::*;
@@ -174,8 +174,8 @@ pub struct Twin {
 /// Conservation checks over every step.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Invariants {
-    /// A prescribed motion drives the scene: it does work the balance does not know, so the
-    /// energy figures are null.
+    /// A prescribed motion or a motor drives the scene: it does work the balance does not know,
+    /// so the energy figures are null.
     #[serde(skip)]
     pub driven: bool,
     /// Largest `|P(t) - P(0)|` over the largest single-body linear momentum seen; null when the
@@ -783,6 +783,34 @@ impl Twin {
                         local_axis1: axis,
                     })
                 }
+                JointKindSpec::Revolute { axis } => {
+                    let axis = Vector::from(*axis).normalize();
+                    let mut rj = RevoluteJointBuilder::new(axis)
+                        .local_anchor1(a1)
+                        .local_anchor2(a2)
+                        .contacts_enabled(false);
+                    let ideal = IdealRevolute {
+                        body1: b1,
+                        body2: b2,
+                        local_anchor1: a1,
+                        local_anchor2: a2,
+                        local_axis1: axis,
+                    };
+                    match &j.motor {
+                        Some(MotorSpec::Velocity {
+                            target_rad_s,
+                            factor,
+                        }) => {
+                            rj = rj.motor_velocity(*target_rad_s, *factor);
+                            world.impulse_joints.insert(b1, b2, rj, true);
+                            IdealJoint::MotorRevolute(ideal)
+                        }
+                        None => {
+                            world.impulse_joints.insert(b1, b2, rj, true);
+                            IdealJoint::Revolute(ideal)
+                        }
+                    }
+                }
                 JointKindSpec::Fixed => {
                     let rj = FixedJointBuilder::new()
                         .local_anchor1(a1)
@@ -871,7 +899,8 @@ impl Twin {
             invariants: Invariants {
                 free_floating: scene.gravity == [0.0; 3]
                     && scene.bodies.iter().all(|b| !b.fixed && b.motion.is_none()),
-                driven: scene.bodies.iter().any(|b| b.motion.is_some()),
+                driven: scene.bodies.iter().any(|b| b.motion.is_some())
+                    || scene.joints.iter().any(|j| j.motor.is_some()),
                 ..Invariants::default()
             },
         })

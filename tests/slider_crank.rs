@@ -161,6 +161,15 @@ fn mechanism_fields_are_validated_with_their_paths() {
         "joints[guide].kind.axis",
     );
     check(&|s| s.joints[0].name = "rod".into(), "duplicate name");
+    check(
+        &|s| {
+            s.joints[0].motor = Some(clearance_joint::scene::MotorSpec::Velocity {
+                target_rad_s: 1.0,
+                factor: 1e6,
+            })
+        },
+        "joints[guide].motor",
+    );
     check(&|s| s.bodies[1].fixed = true, "bodies[crank].motion");
     check(
         &|s| {

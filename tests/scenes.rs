@@ -433,3 +433,49 @@ fn four_bar_linkage_runs_with_a_clearance_joint() {
     assert!(clear.impacts > 2 && clear.peak_force_n > 10.0 * m["rocker_pin"].peak_force_n);
     assert!(clear.contact_fraction > 0.5 && clear.contact_fraction < 1.0);
 }
+
+/// Issue 10: fixed and spherical joints in a scene: a bob hanging at rest from a ball joint with
+/// a weight welded below it. The ball carries both weights, the weld the lower one, exactly
+/// (the reactions are solved, not read from Rapier's impulses).
+#[test]
+fn ball_joint_and_weld_carry_their_weights() {
+    let text = r#"Scene(
+        name: "ball",
+        gravity: (0.0, -9.81, 0.0),
+        reference_axis: (0.0, 0.0, 1.0),
+        bodies: [
+            (name: "ground", mass_kg: 0.0, inertia_kg_m2: (0.0, 0.0, 0.0), center_of_mass_m: (0.0, 0.0, 0.0), fixed: true),
+            (name: "bob", mass_kg: 2.0, inertia_kg_m2: (0.01, 0.01, 0.01), center_of_mass_m: (0.0, -0.5, 0.0)),
+            (name: "weight", mass_kg: 1.0, inertia_kg_m2: (0.01, 0.01, 0.01), center_of_mass_m: (0.0, -0.7, 0.0)),
+        ],
+        hinges: [],
+        joints: [
+            (name: "ball", body1: "ground", body2: "bob", point_m: (0.0, 0.0, 0.0), kind: Spherical),
+            (name: "weld", body1: "bob", body2: "weight", point_m: (0.0, -0.6, 0.0), kind: Fixed),
+        ],
+        run: (dt_s: 1e-3, end_s: 0.1, output_interval_s: 0.01, step: Fixed, body_motion: true),
+    )"#;
+    let scene = Scene::from_ron(text, "test").unwrap();
+    let result = Simulation::new(&scene, RunOptions::default())
+        .unwrap()
+        .run()
+        .unwrap();
+    let table = &result.twin(TwinKind::Ideal).unwrap().table;
+    let (ball, weld) = (
+        table.column("ball_force_n").unwrap(),
+        table.column("weld_force_n").unwrap(),
+    );
+    for (b, w) in ball.iter().zip(&weld) {
+        assert!((b - 3.0 * 9.81).abs() < 1e-6, "ball {b}");
+        assert!((w - 9.81).abs() < 1e-6, "weld {w}");
+    }
+    // At rest: the rows' accelerations are zero after the first state (where Rapier's one
+    // solver iteration, not yet warm-started, leaves the chain sagging for a step), the
+    // positions the start's.
+    let ay = table.column("weight_ay_m_s2").unwrap();
+    assert!(ay[0] < -1.0, "{ay:?}");
+    assert!(ay[2..].iter().all(|a| a.abs() < 1e-6), "{ay:?}");
+    // Rapier's joints, solved with one iteration, sag 14.7 um under the two weights.
+    let y = table.column("weight_y_m").unwrap();
+    assert!(y.iter().all(|v| (v + 0.7).abs() < 2e-5), "{y:?}");
+}

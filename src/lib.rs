@@ -15,6 +15,7 @@ pub mod laws;
 pub mod ledger;
 pub mod metrics;
 pub mod output;
+pub mod prescribed;
 pub mod progress;
 pub mod reaction;
 pub mod report;
@@ -34,7 +35,8 @@ pub mod prelude {
     pub use crate::laws::*;
     pub use crate::metrics::{ContactObservation, ImpactRecorder};
     pub use crate::reaction::{
-        IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, ReactionSolver,
+        IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, KinematicState,
+        ReactionSolver,
     };
     pub use crate::stepper::{ForceSource, StepControl, StepInfo, Stepper};
     pub use rapier3d_f64::math::Vector;

@@ -88,6 +88,28 @@ pub enum MotionSpec {
         /// Velocity, m/s.
         velocity_m_s: [f64; 3],
     },
+    /// A tabulated angle `angle_rad` at times `t_s` about `axis` through `point_m`, interpolated
+    /// smoothly (cubic Hermite; rate continuous), relative to its value at t = 0.
+    TableAngle {
+        /// Rotation axis (unit vector, world).
+        axis: [f64; 3],
+        /// A point of the axis, m.
+        point_m: [f64; 3],
+        /// Times, s, strictly increasing.
+        t_s: Vec<f64>,
+        /// Angles at those times, rad.
+        angle_rad: Vec<f64>,
+    },
+    /// A tabulated position `position_m` at times `t_s` along `direction`, interpolated as
+    /// [`TableAngle`](Self::TableAngle), relative to its value at t = 0.
+    TablePosition {
+        /// Direction (unit vector, world).
+        direction: [f64; 3],
+        /// Times, s, strictly increasing.
+        t_s: Vec<f64>,
+        /// Positions at those times, m.
+        position_m: Vec<f64>,
+    },
 }
 
 /// An ideal joint that is not a revolute (revolutes are `hinges`).
@@ -536,7 +558,8 @@ impl Scene {
     pub fn body_origin(&self, i: usize) -> [f64; 3] {
         let b = &self.bodies[i];
         match &b.motion {
-            Some(MotionSpec::Spin { point_m, .. }) => *point_m,
+            Some(MotionSpec::Spin { point_m, .. })
+            | Some(MotionSpec::TableAngle { point_m, .. }) => *point_m,
             _ => b.center_of_mass_m,
         }
     }
@@ -663,6 +686,28 @@ impl Scene {
                         RATE_MAX,
                         "rad/s",
                     )?;
+                }
+                Some(MotionSpec::TableAngle {
+                    axis,
+                    point_m,
+                    t_s,
+                    angle_rad,
+                }) => {
+                    unit(axis, &format!("{p}.motion.axis"))?;
+                    for (i, x) in point_m.iter().enumerate() {
+                        position(&format!("{p}.motion.point_m[{i}]"), *x)?;
+                    }
+                    crate::prescribed::Table::new(t_s, angle_rad)
+                        .map_err(|e| table_error(e, &p, "angle_rad"))?;
+                }
+                Some(MotionSpec::TablePosition {
+                    direction,
+                    t_s,
+                    position_m,
+                }) => {
+                    unit(direction, &format!("{p}.motion.direction"))?;
+                    crate::prescribed::Table::new(t_s, position_m)
+                        .map_err(|e| table_error(e, &p, "position_m"))?;
                 }
                 Some(MotionSpec::Translate { velocity_m_s }) => {
                     for (i, v) in velocity_m_s.iter().enumerate() {
@@ -921,6 +966,22 @@ impl Scene {
             }
         }
         Ok(())
+    }
+}
+
+/// A table's error with the scene's field names (`t_s` and the value list's name).
+fn table_error(e: Error, body: &str, values: &str) -> Error {
+    match e {
+        Error::Invalid { field, reason } => Error::invalid(
+            format!(
+                "{body}.motion.{}",
+                field
+                    .replacen("values", values, 1)
+                    .replacen("times", "t_s", 1)
+            ),
+            reason,
+        ),
+        other => other,
     }
 }
 

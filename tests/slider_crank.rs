@@ -185,6 +185,27 @@ fn mechanism_fields_are_validated_with_their_paths() {
         &|s| s.bodies[2].velocity_m_s[1] = 1e6,
         "bodies[rod].velocity_m_s[1]",
     );
+    check(
+        &|s| {
+            s.bodies[1].motion = Some(MotionSpec::TableAngle {
+                axis: [0.0, 0.0, 1.0],
+                point_m: [0.0; 3],
+                t_s: vec![0.0, 0.0],
+                angle_rad: vec![0.0, 1.0],
+            })
+        },
+        "bodies[crank].motion.t_s[1]",
+    );
+    check(
+        &|s| {
+            s.bodies[1].motion = Some(MotionSpec::TablePosition {
+                direction: [1.0, 0.0, 0.0],
+                t_s: vec![0.0, 1.0],
+                position_m: vec![0.0],
+            })
+        },
+        "bodies[crank].motion.position_m",
+    );
     // The scene format stays backward compatible: no `joints`, no motion, no velocities.
     assert!(
         Scene::load(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/pendulum.ron"))

@@ -223,6 +223,10 @@ struct RunArgs {
     progress: String,
     #[command(flatten)]
     memory: MemoryArgs,
+    /// Also draw the figures of the first clearance hinge (angles and rates, joint force, journal
+    /// orbit; PNG and SVG) into the output folder, after the result set.
+    #[arg(long)]
+    figures: bool,
 }
 
 impl RunArgs {
@@ -286,6 +290,38 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
         out.display(),
         files.join(", ")
     );
+    if args.figures {
+        use clearance_joint::sim::TwinKind;
+        use clearance_joint::study::plot::{Figure, FigureKind};
+        use clearance_joint::study::series::CaseSeries;
+        let (Some(ideal), Some(clear)) = (
+            result.twin(TwinKind::Ideal),
+            result.twin(TwinKind::Clearance),
+        ) else {
+            return Err(clearance_joint::Error::invalid(
+                "--figures",
+                "needs both twins",
+            ));
+        };
+        let series = [CaseSeries::from_tables(
+            scene.name.clone(),
+            &scene,
+            &ideal.table,
+            &clear.table,
+        )?];
+        for kind in FigureKind::ALL {
+            let title = format!("{}: {}", scene.name, kind.stem().replace('_', " "));
+            let paths = Figure {
+                kind,
+                title: &title,
+                cases: &series,
+            }
+            .write(&out, kind.stem())?;
+            for p in paths {
+                println!("wrote {}", p.display());
+            }
+        }
+    }
     Ok(())
 }
 

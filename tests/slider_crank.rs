@@ -300,3 +300,44 @@ fn per_turn_statistics_add_up() {
     assert!(!dir.join("ideal_slider_pin_turns.csv").exists());
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The scene runs from the command line with `--scene`, writing the result set, the impact and
+/// per-turn lists, and with `--figures` the joint-force and journal-orbit figures.
+#[test]
+fn the_scene_runs_from_the_command_line_with_figures() {
+    let dir = std::env::temp_dir().join(format!("cj_sc_cli_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/slider_crank.ron");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
+        .arg("--scene")
+        .arg(&scene)
+        .args([
+            "--set",
+            "run.end_s=0.002",
+            "--figures",
+            "--progress",
+            "quiet",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "ideal.csv",
+        "clearance.csv",
+        "clearance_slider_pin_impacts.csv",
+        "clearance_slider_pin_turns.csv",
+        "summary.json",
+        "joint_force.png",
+        "trajectory.png",
+        "angles_rates.svg",
+    ] {
+        assert!(dir.join(f).is_file(), "no {f}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -313,7 +313,7 @@ fn the_scene_runs_from_the_command_line_with_figures() {
         .arg(&scene)
         .args([
             "--set",
-            "run.end_s=0.002",
+            "run.end_s=0.013",
             "--figures",
             "--progress",
             "quiet",
@@ -335,6 +335,7 @@ fn the_scene_runs_from_the_command_line_with_figures() {
         "summary.json",
         "joint_force.png",
         "trajectory.png",
+        "slider_acceleration.png",
         "angles_rates.svg",
     ] {
         assert!(dir.join(f).is_file(), "no {f}");

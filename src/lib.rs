@@ -21,6 +21,7 @@ pub mod metrics;
 #[doc = include_str!("../docs/MODEL.md")]
 pub mod model {}
 pub mod output;
+pub mod prescribed;
 pub mod progress;
 pub mod reaction;
 pub mod report;
@@ -43,7 +44,8 @@ pub mod prelude {
     pub use crate::laws::*;
     pub use crate::metrics::{ContactObservation, ImpactRecorder};
     pub use crate::reaction::{
-        IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, ReactionSolver,
+        IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, KinematicState,
+        ReactionSolver,
     };
     pub use crate::stepper::{ForceSource, StepControl, StepInfo, Stepper};
     pub use rapier3d_f64::math::Vector;

@@ -182,6 +182,26 @@ pub struct ReactionSolver {
     forces: Vec<Vector>,
     joints: Vec<IdealJoint>,
     extra: Vec<Wrench>,
+    /// Bodies whose motion is prescribed with a nonzero acceleration (a tabulated drive): their
+    /// velocities and accelerations at the state. Other kinematic bodies are taken to move at
+    /// constant velocity.
+    pub kinematic: Vec<KinematicState>,
+}
+
+/// The prescribed state of a kinematic body at the state solved: velocity and acceleration of
+/// its centre of mass (its frame origin when it has no mass), angular velocity and acceleration.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KinematicState {
+    /// The body.
+    pub body: RigidBodyHandle,
+    /// Velocity of the centre of mass, m/s.
+    pub linvel: Vector,
+    /// Angular velocity, rad/s.
+    pub angvel: Vector,
+    /// Acceleration of the centre of mass, m/s^2.
+    pub linacc: Vector,
+    /// Angular acceleration, rad/s^2.
+    pub angacc: Vector,
 }
 
 /// What the solver needs of one body.
@@ -333,13 +353,23 @@ impl ReactionSolver {
             self.starts.push(self.rows.len());
             let (h1, h2) = j.bodies();
             let (rb1, rb2) = (bodies.get(h1)?, bodies.get(h2)?);
-            let (t1, t2) = (
+            let (mut t1, mut t2) = (
                 terms(rb1, h1, gravity, &self.extra),
                 terms(rb2, h2, gravity, &self.extra),
             );
+            let (mut a1f, mut a1t) = t1.apply_inv_mass(rb1, t1.force, t1.torque);
+            let (mut a2f, mut a2t) = t2.apply_inv_mass(rb2, t2.force, t2.torque);
+            // A driven body's state and accelerations are prescribed.
+            let (mut v1, mut v2) = (rb1.linvel(), rb2.linvel());
+            for k in &self.kinematic {
+                if k.body == h1 {
+                    (v1, t1.angvel, a1f, a1t) = (k.linvel, k.angvel, k.linacc, k.angacc);
+                }
+                if k.body == h2 {
+                    (v2, t2.angvel, a2f, a2t) = (k.linvel, k.angvel, k.linacc, k.angacc);
+                }
+            }
             let (w1, w2) = (t1.angvel, t2.angvel);
-            let (a1f, a1t) = t1.apply_inv_mass(rb1, t1.force, t1.torque);
-            let (a2f, a2t) = t2.apply_inv_mass(rb2, t2.force, t2.torque);
             match j {
                 IdealJoint::Revolute(j) | IdealJoint::MotorRevolute(j) => {
                     let r1 = *rb1.position() * j.local_anchor1 - t1.com;
@@ -375,7 +405,7 @@ impl ReactionSolver {
                     // body 1. g'' = (a_p2 - a_p1).t + 2 (v_p2 - v_p1).(w1 x t)
                     //   + d.(alpha1 x t + w1 x (w1 x t)); the alpha1 term moves body 1's angular
                     // block to the lever of p2 (the reaction acts at the slider's point).
-                    let v_rel = (rb2.linvel() + w2.cross(r2)) - (rb1.linvel() + w1.cross(r1));
+                    let v_rel = (v2 + w2.cross(r2)) - (v1 + w1.cross(r1));
                     let c_pts = w2.cross(w2.cross(r2)) - w1.cross(w1.cross(r1));
                     let free_pts = a2f + a2t.cross(r2) - a1f - a1t.cross(r1);
                     for t in [u1, u2] {
@@ -782,5 +812,43 @@ mod tests {
         let f = solver.solve(&bodies, &[j], g).unwrap()[0];
         let expected = 19.62 * (1.0 - 2.0 * 0.09 / 0.21);
         assert!((f.y - expected).abs() < 1e-9, "{f:?} against {expected}");
+    }
+
+    #[test]
+    fn weld_on_an_accelerating_driven_base() {
+        // A base turning up from rest with a prescribed 10 rad/s^2 about z; a 2 kg block welded
+        // 0.3 m out along x: the weld pushes it along +y with m alpha r = 6 N.
+        let mut bodies = RigidBodySet::new();
+        let base = bodies.insert(RigidBodyBuilder::kinematic_position_based());
+        let b = slider(
+            &mut bodies,
+            Vector::new(0.3, 0.0, 0.0),
+            Vector::ZERO,
+            Vector::ZERO,
+        );
+        prepare_mass_properties(&mut bodies);
+        let j = IdealFixed {
+            body1: base,
+            body2: b,
+            local_anchor1: Vector::new(0.3, 0.0, 0.0),
+            local_anchor2: Vector::ZERO,
+        };
+        let mut solver = ReactionSolver::default();
+        // Without the prescribed acceleration the base would be taken to move steadily.
+        let f = solver
+            .solve_joints(&bodies, &[j.into()], Vector::ZERO)
+            .unwrap()[0];
+        assert!(f.length() < 1e-12);
+        solver.kinematic.push(KinematicState {
+            body: base,
+            linvel: Vector::ZERO,
+            angvel: Vector::ZERO,
+            linacc: Vector::ZERO,
+            angacc: Vector::new(0.0, 0.0, 10.0),
+        });
+        let f = solver
+            .solve_joints(&bodies, &[j.into()], Vector::ZERO)
+            .unwrap()[0];
+        assert!((f - Vector::new(0.0, 6.0, 0.0)).length() < 1e-9, "{f:?}");
     }
 }

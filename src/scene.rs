@@ -88,6 +88,28 @@ pub enum MotionSpec {
         /// Velocity, m/s.
         velocity_m_s: [f64; 3],
     },
+    /// A tabulated angle `angle_rad` at times `t_s` about `axis` through `point_m`, interpolated
+    /// smoothly (cubic Hermite; rate continuous), relative to its value at t = 0.
+    TableAngle {
+        /// Rotation axis (unit vector, world).
+        axis: [f64; 3],
+        /// A point of the axis, m.
+        point_m: [f64; 3],
+        /// Times, s, strictly increasing.
+        t_s: Vec<f64>,
+        /// Angles at those times, rad.
+        angle_rad: Vec<f64>,
+    },
+    /// A tabulated position `position_m` at times `t_s` along `direction`, interpolated as
+    /// [`TableAngle`](Self::TableAngle), relative to its value at t = 0.
+    TablePosition {
+        /// Direction (unit vector, world).
+        direction: [f64; 3],
+        /// Times, s, strictly increasing.
+        t_s: Vec<f64>,
+        /// Positions at those times, m.
+        position_m: Vec<f64>,
+    },
 }
 
 /// An ideal joint that is not a revolute (revolutes are `hinges`).
@@ -104,6 +126,24 @@ pub struct JointSpec {
     pub point_m: [f64; 3],
     /// Which joint.
     pub kind: JointKindSpec,
+    /// A motor on the joint's free axis (revolute joints).
+    #[serde(default)]
+    pub motor: Option<MotorSpec>,
+}
+
+/// A joint motor (Rapier's, acceleration-based model).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum MotorSpec {
+    /// Drives the relative angular speed to `target_rad_s` with Rapier's damping `factor` (1/s,
+    /// higher holds the speed more stiffly). The joint forces reported are those of a motor that
+    /// holds its speed exactly.
+    Velocity {
+        /// Target relative angular speed of body 2 about the axis, rad/s.
+        target_rad_s: f64,
+        /// Rapier's motor damping factor, 1/s.
+        factor: f64,
+    },
 }
 
 /// The kinds of [`JointSpec`].
@@ -118,6 +158,12 @@ pub enum JointKindSpec {
         /// Travel limits `[min, max]` along the axis from the start position, m.
         #[serde(default)]
         limits_m: Option<[f64; 2]>,
+    },
+    /// An ideal revolute about `axis` (unit, world at t = 0) that may carry a `motor` (a
+    /// revolute without motor is better written as a hinge, which may also take a clearance).
+    Revolute {
+        /// Hinge axis (unit vector, world, t = 0).
+        axis: [f64; 3],
     },
     /// The bodies move as one.
     Fixed,
@@ -512,20 +558,29 @@ impl Scene {
     pub fn body_origin(&self, i: usize) -> [f64; 3] {
         let b = &self.bodies[i];
         match &b.motion {
-            Some(MotionSpec::Spin { point_m, .. }) => *point_m,
+            Some(MotionSpec::Spin { point_m, .. })
+            | Some(MotionSpec::TableAngle { point_m, .. }) => *point_m,
             _ => b.center_of_mass_m,
         }
     }
 
     /// The period of the scene's drive, s: one turn of the first body spinning at a nonzero
-    /// rate (`None` without one). Per-turn statistics are taken over it.
+    /// rate, or else of the first velocity motor's target (`None` without either). Per-turn statistics are taken over it.
     pub fn drive_period(&self) -> Option<f64> {
-        self.bodies.iter().find_map(|b| match &b.motion {
-            Some(MotionSpec::Spin { rate_rad_s, .. }) if *rate_rad_s != 0.0 => {
-                Some(std::f64::consts::TAU / rate_rad_s.abs())
-            }
+        let spin = self.bodies.iter().find_map(|b| match &b.motion {
+            Some(MotionSpec::Spin { rate_rad_s, .. }) if *rate_rad_s != 0.0 => Some(*rate_rad_s),
             _ => None,
-        })
+        });
+        let motor = || {
+            self.joints.iter().find_map(|j| match &j.motor {
+                Some(MotorSpec::Velocity { target_rad_s, .. }) if *target_rad_s != 0.0 => {
+                    Some(*target_rad_s)
+                }
+                _ => None,
+            })
+        };
+        spin.or_else(motor)
+            .map(|rate| std::f64::consts::TAU / rate.abs())
     }
 
     /// Index of the hinge called `name`.
@@ -632,6 +687,28 @@ impl Scene {
                         "rad/s",
                     )?;
                 }
+                Some(MotionSpec::TableAngle {
+                    axis,
+                    point_m,
+                    t_s,
+                    angle_rad,
+                }) => {
+                    unit(axis, &format!("{p}.motion.axis"))?;
+                    for (i, x) in point_m.iter().enumerate() {
+                        position(&format!("{p}.motion.point_m[{i}]"), *x)?;
+                    }
+                    crate::prescribed::Table::new(t_s, angle_rad)
+                        .map_err(|e| table_error(e, &p, "angle_rad"))?;
+                }
+                Some(MotionSpec::TablePosition {
+                    direction,
+                    t_s,
+                    position_m,
+                }) => {
+                    unit(direction, &format!("{p}.motion.direction"))?;
+                    crate::prescribed::Table::new(t_s, position_m)
+                        .map_err(|e| table_error(e, &p, "position_m"))?;
+                }
                 Some(MotionSpec::Translate { velocity_m_s }) => {
                     for (i, v) in velocity_m_s.iter().enumerate() {
                         in_range(
@@ -719,6 +796,34 @@ impl Scene {
             }
             for (i, x) in j.point_m.iter().enumerate() {
                 position(&format!("{p}.point_m[{i}]"), *x)?;
+            }
+            if let JointKindSpec::Revolute { axis } = &j.kind {
+                unit(axis, &format!("{p}.kind.axis"))?;
+            }
+            match (&j.motor, &j.kind) {
+                (
+                    Some(MotorSpec::Velocity {
+                        target_rad_s,
+                        factor,
+                    }),
+                    JointKindSpec::Revolute { .. },
+                ) => {
+                    in_range(
+                        &format!("{p}.motor.target_rad_s"),
+                        *target_rad_s,
+                        -RATE_MAX,
+                        RATE_MAX,
+                        "rad/s",
+                    )?;
+                    in_range(&format!("{p}.motor.factor"), *factor, 1e-6, 1e12, "1/s")?;
+                }
+                (Some(_), _) => {
+                    return Err(Error::invalid(
+                        format!("{p}.motor"),
+                        "a motor is supported on a `Revolute` joint only (prismatic motors are not in the scene format yet)",
+                    ));
+                }
+                (None, _) => {}
             }
             if let JointKindSpec::Prismatic { axis, limits_m } = &j.kind {
                 unit(axis, &format!("{p}.kind.axis"))?;
@@ -861,6 +966,22 @@ impl Scene {
             }
         }
         Ok(())
+    }
+}
+
+/// A table's error with the scene's field names (`t_s` and the value list's name).
+fn table_error(e: Error, body: &str, values: &str) -> Error {
+    match e {
+        Error::Invalid { field, reason } => Error::invalid(
+            format!(
+                "{body}.motion.{}",
+                field
+                    .replacen("values", values, 1)
+                    .replacen("times", "t_s", 1)
+            ),
+            reason,
+        ),
+        other => other,
     }
 }
 
@@ -1241,8 +1362,8 @@ enum Step {
 }
 
 /// Finds the JSON slot an override path names (see [`Scene::with_overrides`]). The first
-/// segment is a top-level field, the name of a body, hinge or drive, or `bodies[name]`,
-/// `hinges[name]`, `drives[name]` (the form error messages use). A name that is also a
+/// segment is a top-level field, the name of a body, hinge, joint or drive, or `bodies[name]`,
+/// `hinges[name]`, `joints[name]`, `drives[name]` (the form error messages use). A name that is also a
 /// top-level field (a body called `run`) is taken where the rest of the path exists.
 fn locate<'a>(root: &'a mut serde_json::Value, path: &str) -> Result<&'a mut serde_json::Value> {
     let unknown = |reason: String| Error::invalid(path, reason);
@@ -1266,12 +1387,13 @@ fn locate<'a>(root: &'a mut serde_json::Value, path: &str) -> Result<&'a mut ser
     if let Some((list, name)) = first
         .strip_suffix(']')
         .and_then(|f| f.split_once('['))
-        .filter(|(l, _)| ["bodies", "hinges", "drives"].contains(l))
+        .filter(|(l, _)| ["bodies", "hinges", "joints", "drives"].contains(l))
     {
         let start = item(list, name).ok_or_else(|| {
             let what = match list {
                 "bodies" => "body",
                 "hinges" => "hinge",
+                "joints" => "joint",
                 _ => "drive",
             };
             unknown(format!("no {what} named `{name}`"))
@@ -1284,7 +1406,12 @@ fn locate<'a>(root: &'a mut serde_json::Value, path: &str) -> Result<&'a mut ser
                 vec![Step::Key(first.to_string())],
             ));
         }
-        for (list, what) in [("bodies", "body"), ("hinges", "hinge"), ("drives", "drive")] {
+        for (list, what) in [
+            ("bodies", "body"),
+            ("hinges", "hinge"),
+            ("joints", "joint"),
+            ("drives", "drive"),
+        ] {
             if let Some(start) = item(list, first) {
                 starts.push((format!("the {what} `{first}` ({list}[{first}])"), start));
             }
@@ -1292,7 +1419,7 @@ fn locate<'a>(root: &'a mut serde_json::Value, path: &str) -> Result<&'a mut ser
     }
     if starts.is_empty() {
         return Err(unknown(format!(
-            "`{first}` is neither a top-level field nor the name of a body, hinge or drive"
+            "`{first}` is neither a top-level field nor the name of a body, hinge, joint or drive"
         )));
     }
     let resolved: Vec<(String, std::result::Result<Vec<Step>, String>)> = starts

@@ -9,10 +9,12 @@ use crate::joint::{ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSe
 use crate::laws::NormalForceLaw;
 use crate::metrics::{ContactObservation, ImpactRecorder};
 use crate::output::Table;
+use crate::prescribed::{PrescribedMotion, PrescribedPath, PrescribedSet, Table as MotionTable};
 use crate::reaction::{
-    IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, ReactionSolver,
+    IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, KinematicState,
+    ReactionSolver,
 };
-use crate::scene::{JointKindSpec, MotionSpec, Scene};
+use crate::scene::{JointKindSpec, MotionSpec, MotorSpec, Scene};
 use crate::stepper::{ForceSource, GuardReport, StepInfo, Stepper};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::*;
@@ -70,6 +72,8 @@ struct BodyTrack {
     fixed: bool,
     /// Not a fixed body (driven bodies move).
     moves: bool,
+    /// The body's tabulated motion (index in the twin's prescribed set).
+    table: Option<usize>,
     /// The centre of mass in the body's frame (not the origin for a spinning body), m.
     local_com: Vector,
     angle: UnwrappedAngle,
@@ -147,6 +151,8 @@ pub struct Twin {
     pub clearance: ClearanceJointSet,
     /// The drives of this twin.
     pub drives: DriveSet,
+    /// The tabulated motions of this twin's driven bodies.
+    pub prescribed: PrescribedSet,
     /// The ideal joints: the ideal hinges' revolutes (with the hinge index of each), then the
     /// scene's other joints.
     ideal_joints: Vec<IdealJoint>,
@@ -174,8 +180,8 @@ pub struct Twin {
 /// Conservation checks over every step.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Invariants {
-    /// A prescribed motion drives the scene: it does work the balance does not know, so the
-    /// energy figures are null.
+    /// A prescribed motion or a motor drives the scene: it does work the balance does not know,
+    /// so the energy figures are null.
     #[serde(skip)]
     pub driven: bool,
     /// Largest `|P(t) - P(0)|` over the largest single-body linear momentum seen; null when the
@@ -597,10 +603,13 @@ impl Simulation {
 
 /// The force sources of all twins, for the stepper.
 fn sources(twins: &mut [Twin]) -> Vec<&mut dyn ForceSource> {
-    let mut v: Vec<&mut dyn ForceSource> = Vec::with_capacity(2 * twins.len());
+    let mut v: Vec<&mut dyn ForceSource> = Vec::with_capacity(3 * twins.len());
     for t in twins.iter_mut() {
         v.push(&mut t.drives);
         v.push(&mut t.clearance);
+        if !t.prescribed.motions.is_empty() {
+            v.push(&mut t.prescribed);
+        }
     }
     v
 }
@@ -616,10 +625,56 @@ fn name_step_field(mut e: crate::Error, name: &str) -> crate::Error {
 impl Twin {
     fn build(scene: &Scene, kind: TwinKind, world: &mut PhysicsWorld) -> Result<Twin> {
         let mut bodies = Vec::new();
+        let mut prescribed = PrescribedSet::default();
         for (i, b) in scene.bodies.iter().enumerate() {
             let com = Vector::from(b.center_of_mass_m);
             let origin = Vector::from(scene.body_origin(i));
+            let mut table = None;
             let rb = match &b.motion {
+                // A tabulated drive: a position-based kinematic body whose next pose the
+                // prescribed set gives before each step.
+                Some(m @ (MotionSpec::TableAngle { .. } | MotionSpec::TablePosition { .. })) => {
+                    let (path, t, v) = match m {
+                        MotionSpec::TableAngle {
+                            axis,
+                            t_s,
+                            angle_rad,
+                            ..
+                        } => (
+                            PrescribedPath::Angle {
+                                axis: Vector::from(*axis).normalize(),
+                            },
+                            t_s,
+                            angle_rad,
+                        ),
+                        MotionSpec::TablePosition {
+                            direction,
+                            t_s,
+                            position_m,
+                        } => (
+                            PrescribedPath::Position {
+                                direction: Vector::from(*direction).normalize(),
+                            },
+                            t_s,
+                            position_m,
+                        ),
+                        _ => unreachable!("matched above"),
+                    };
+                    let rb = RigidBodyBuilder::kinematic_position_based()
+                        .translation(origin)
+                        .can_sleep(false)
+                        .build();
+                    let start = *rb.position();
+                    table = Some(prescribed.motions.len());
+                    prescribed.motions.push(PrescribedMotion {
+                        body: RigidBodyHandle::invalid(),
+                        start,
+                        path,
+                        table: MotionTable::new(t, v)
+                            .map_err(|e| e.within(&format!("bodies[{}].motion", b.name)))?,
+                    });
+                    rb
+                }
                 // A driven body: no mass properties, so Rapier turns it about its frame origin.
                 Some(m) => {
                     let (v, w) = match m {
@@ -629,6 +684,7 @@ impl Twin {
                         MotionSpec::Translate { velocity_m_s } => {
                             (Vector::from(*velocity_m_s), Vector::ZERO)
                         }
+                        _ => unreachable!("tables are matched above"),
                     };
                     RigidBodyBuilder::kinematic_velocity_based()
                         .translation(origin)
@@ -657,7 +713,11 @@ impl Twin {
                 }
             };
             let handle = world.bodies.insert(rb);
+            if let Some(k) = table {
+                prescribed.motions[k].body = handle;
+            }
             bodies.push(BodyTrack {
+                table,
                 name: b.name.clone(),
                 handle,
                 mass: b.mass_kg,
@@ -787,6 +847,34 @@ impl Twin {
                         local_axis1: axis,
                     })
                 }
+                JointKindSpec::Revolute { axis } => {
+                    let axis = Vector::from(*axis).normalize();
+                    let mut rj = RevoluteJointBuilder::new(axis)
+                        .local_anchor1(a1)
+                        .local_anchor2(a2)
+                        .contacts_enabled(false);
+                    let ideal = IdealRevolute {
+                        body1: b1,
+                        body2: b2,
+                        local_anchor1: a1,
+                        local_anchor2: a2,
+                        local_axis1: axis,
+                    };
+                    match &j.motor {
+                        Some(MotorSpec::Velocity {
+                            target_rad_s,
+                            factor,
+                        }) => {
+                            rj = rj.motor_velocity(*target_rad_s, *factor);
+                            world.impulse_joints.insert(b1, b2, rj, true);
+                            IdealJoint::MotorRevolute(ideal)
+                        }
+                        None => {
+                            world.impulse_joints.insert(b1, b2, rj, true);
+                            IdealJoint::Revolute(ideal)
+                        }
+                    }
+                }
                 JointKindSpec::Fixed => {
                     let rj = FixedJointBuilder::new()
                         .local_anchor1(a1)
@@ -860,6 +948,7 @@ impl Twin {
             ideal_hinges,
             joints,
             body_motion,
+            prescribed,
             reactions: ReactionSolver::default(),
             source_wrenches: Vec::new(),
             source_energy_before: 0.0,
@@ -876,7 +965,8 @@ impl Twin {
             invariants: Invariants {
                 free_floating: scene.gravity == [0.0; 3]
                     && scene.bodies.iter().all(|b| !b.fixed && b.motion.is_none()),
-                driven: scene.bodies.iter().any(|b| b.motion.is_some()),
+                driven: scene.bodies.iter().any(|b| b.motion.is_some())
+                    || scene.joints.iter().any(|j| j.motor.is_some()),
                 ..Invariants::default()
             },
         })
@@ -922,7 +1012,7 @@ impl Twin {
                 };
             }
         }
-        self.solve_ideal_reactions(bodies, gravity);
+        self.solve_ideal_reactions(bodies, gravity, t);
         self.source_energy_before = self.drives.potential_energy()
             + self
                 .clearance
@@ -968,7 +1058,12 @@ impl Twin {
         let (h, h_prev) = (info.dt, (2.0 * info.kick - info.dt).max(0.0));
         let mut col = 1 + 2 * self.bodies.len();
         for b in self.bodies.iter().filter(|b| b.moves) {
-            let (vel, acc) = if b.fixed {
+            let (vel, acc) = if let Some(k) = b.table {
+                // A tabulated drive: the table's acceleration at the state.
+                let (_, a, w, alpha) = self.prescribed.motions[k].rates(info.t0);
+                let r = b.rotation_before * b.local_com;
+                (None, a + alpha.cross(r) + w.cross(w.cross(r)))
+            } else if b.fixed {
                 // Driven: the row's velocity is exact; the acceleration is the spin's.
                 let rb = &bodies_after[b.handle];
                 let w = rb.angvel();
@@ -989,9 +1084,24 @@ impl Twin {
 
     /// Ideal-joint reactions at the current state, exact: the constrained rigid-body equations
     /// solved for the joint forces ([`ReactionSolver`]), whatever the step control.
-    fn solve_ideal_reactions(&mut self, bodies: &RigidBodySet, gravity: Vector) {
+    fn solve_ideal_reactions(&mut self, bodies: &RigidBodySet, gravity: Vector, t: f64) {
         if self.ideal_joints.is_empty() {
             return;
+        }
+        // Tabulated drives at this state: their velocities and accelerations.
+        self.reactions.kinematic.clear();
+        for b in &self.bodies {
+            if let Some(k) = b.table {
+                let m = &self.prescribed.motions[k];
+                let (v, a, w, alpha) = m.rates(t);
+                self.reactions.kinematic.push(KinematicState {
+                    body: b.handle,
+                    linvel: v,
+                    angvel: w,
+                    linacc: a,
+                    angacc: alpha,
+                });
+            }
         }
         // The sources' wrenches act during the steps only: the solver gets them explicitly.
         self.source_wrenches.clear();
@@ -1090,8 +1200,16 @@ impl Twin {
                 let rb = &bodies[b.handle];
                 let p = *rb.position() * b.local_com;
                 // The velocity of the centre of mass (a driven body's frame turns about its
-                // origin, so its centre of mass moves with `w x r`).
-                let vel = rb.linvel() + rb.angvel().cross(p - rb.translation());
+                // origin, so its centre of mass moves with `w x r`; a tabulated drive's
+                // velocities at the state are the table's, Rapier's the last step's mean).
+                let (v0, w) = match b.table {
+                    Some(k) => {
+                        let (v, _, w, _) = self.prescribed.motions[k].rates(t);
+                        (v, w)
+                    }
+                    None => (rb.linvel(), rb.angvel()),
+                };
+                let vel = v0 + w.cross(p - rb.translation());
                 // Velocity and acceleration are completed by the step from this state
                 // (`complete_row_motion`).
                 v.extend_from_slice(&[p.x, p.y, p.z, vel.x, vel.y, vel.z, 0.0, 0.0, 0.0]);

@@ -88,6 +88,16 @@ pub trait ForceSource {
     fn clearance_joints(&self) -> Option<&ClearanceJointSet> {
         None
     }
+    /// Called right before each Rapier step (a retried step included) with its start `t0` and
+    /// length `dt`, s: a source that prescribes kinematic motion sets the bodies' next poses here
+    /// ([`PrescribedSet`](crate::prescribed::PrescribedSet)). Default: nothing.
+    fn before_rapier_step(
+        &mut self,
+        _bodies: &mut rapier3d_f64::prelude::RigidBodySet,
+        _t0: f64,
+        _dt: f64,
+    ) {
+    }
 }
 
 impl ForceSource for ClearanceJointSet {
@@ -528,6 +538,9 @@ impl Stepper {
             }
             world.gravity = gravity * scale;
             world.integration_parameters.dt = dt;
+            for s in sources.iter_mut() {
+                s.before_rapier_step(&mut world.bodies, self.t, dt);
+            }
             world.step();
             world.gravity = gravity;
             self.restore_forces(world);

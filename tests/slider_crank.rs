@@ -161,6 +161,15 @@ fn mechanism_fields_are_validated_with_their_paths() {
         "joints[guide].kind.axis",
     );
     check(&|s| s.joints[0].name = "rod".into(), "duplicate name");
+    check(
+        &|s| {
+            s.joints[0].motor = Some(clearance_joint::scene::MotorSpec::Velocity {
+                target_rad_s: 1.0,
+                factor: 1e6,
+            })
+        },
+        "joints[guide].motor",
+    );
     check(&|s| s.bodies[1].fixed = true, "bodies[crank].motion");
     check(
         &|s| {
@@ -175,6 +184,27 @@ fn mechanism_fields_are_validated_with_their_paths() {
     check(
         &|s| s.bodies[2].velocity_m_s[1] = 1e6,
         "bodies[rod].velocity_m_s[1]",
+    );
+    check(
+        &|s| {
+            s.bodies[1].motion = Some(MotionSpec::TableAngle {
+                axis: [0.0, 0.0, 1.0],
+                point_m: [0.0; 3],
+                t_s: vec![0.0, 0.0],
+                angle_rad: vec![0.0, 1.0],
+            })
+        },
+        "bodies[crank].motion.t_s[1]",
+    );
+    check(
+        &|s| {
+            s.bodies[1].motion = Some(MotionSpec::TablePosition {
+                direction: [1.0, 0.0, 0.0],
+                t_s: vec![0.0, 1.0],
+                position_m: vec![0.0],
+            })
+        },
+        "bodies[crank].motion.position_m",
     );
     // The scene format stays backward compatible: no `joints`, no motion, no velocities.
     assert!(
@@ -268,5 +298,47 @@ fn per_turn_statistics_add_up() {
     let contact = rows[0][5] * turn + rows[1][5] * (0.018 - turn);
     assert!((contact / 0.018 - m.contact_fraction).abs() < 1e-9);
     assert!(!dir.join("ideal_slider_pin_turns.csv").exists());
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The scene runs from the command line with `--scene`, writing the result set, the impact and
+/// per-turn lists, and with `--figures` the joint-force and journal-orbit figures.
+#[test]
+fn the_scene_runs_from_the_command_line_with_figures() {
+    let dir = std::env::temp_dir().join(format!("cj_sc_cli_{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/slider_crank.ron");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
+        .arg("--scene")
+        .arg(&scene)
+        .args([
+            "--set",
+            "run.end_s=0.013",
+            "--figures",
+            "--progress",
+            "quiet",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "ideal.csv",
+        "clearance.csv",
+        "clearance_slider_pin_impacts.csv",
+        "clearance_slider_pin_turns.csv",
+        "summary.json",
+        "joint_force.png",
+        "trajectory.png",
+        "slider_acceleration.png",
+        "angles_rates.svg",
+    ] {
+        assert!(dir.join(f).is_file(), "no {f}");
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }

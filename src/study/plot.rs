@@ -106,49 +106,17 @@ impl Figure<'_> {
 
     /// Renders the figure into a PNG image (RGB, 8 bit), in memory.
     pub fn png(&self) -> Result<Vec<u8>> {
-        fonts()?;
-        let (w, h) = self.size();
-        let mut rgb = vec![0u8; w as usize * h as usize * 3];
-        {
-            let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
-            self.draw(&root).map_err(|e| self.error("PNG", e))?;
-            root.present()
-                .map_err(|e| self.error("PNG", e.to_string().into()))?;
-        }
-        let mut bytes = Vec::new();
-        let mut enc = png::Encoder::new(&mut bytes, w, h);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        let encode =
-            |enc: png::Encoder<'_, &mut Vec<u8>>| -> std::result::Result<(), png::EncodingError> {
-                let mut writer = enc.write_header()?;
-                writer.write_image_data(&rgb)?;
-                writer.finish()
-            };
-        encode(enc).map_err(|e| self.error("PNG", e.to_string().into()))?;
-        Ok(bytes)
+        render_png(self)
     }
 
     /// Renders the figure as SVG text.
     pub fn svg(&self) -> Result<String> {
-        fonts()?;
-        let mut text = String::new();
-        {
-            let root = SVGBackend::with_string(&mut text, self.size()).into_drawing_area();
-            self.draw(&root).map_err(|e| self.error("SVG", e))?;
-            root.present()
-                .map_err(|e| self.error("SVG", e.to_string().into()))?;
-        }
-        Ok(text)
+        render_svg(self)
     }
 
     /// Writes `<dir>/<stem>.png` and `<dir>/<stem>.svg` (each whole or not at all); returns both paths.
     pub fn write(&self, dir: &Path, stem: &str) -> Result<[PathBuf; 2]> {
-        let png_path = dir.join(format!("{stem}.png"));
-        let svg_path = dir.join(format!("{stem}.svg"));
-        write_atomic(&png_path, &self.png()?)?;
-        write_atomic(&svg_path, self.svg()?.as_bytes())?;
-        Ok([png_path, svg_path])
+        write_both(self, dir, stem)
     }
 
     fn error(&self, format: &str, e: Box<dyn std::error::Error>) -> Error {
@@ -172,6 +140,154 @@ impl Figure<'_> {
             FigureKind::Force => draw_force(&body, self.cases),
             FigureKind::Trajectory => draw_trajectory(&body, self.cases),
         }
+    }
+}
+
+/// What the renderers need of a figure.
+trait Drawable {
+    fn pixels(&self) -> (u32, u32);
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult
+    where
+        DB::ErrorType: 'static;
+    fn fail(&self, format: &str, e: Box<dyn std::error::Error>) -> Error;
+}
+
+impl Drawable for Figure<'_> {
+    fn pixels(&self) -> (u32, u32) {
+        self.size()
+    }
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult
+    where
+        DB::ErrorType: 'static,
+    {
+        self.draw(root)
+    }
+    fn fail(&self, format: &str, e: Box<dyn std::error::Error>) -> Error {
+        self.error(format, e)
+    }
+}
+
+fn render_png(f: &impl Drawable) -> Result<Vec<u8>> {
+    fonts()?;
+    let (w, h) = f.pixels();
+    let mut rgb = vec![0u8; w as usize * h as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
+        f.draw_on(&root).map_err(|e| f.fail("PNG", e))?;
+        root.present()
+            .map_err(|e| f.fail("PNG", e.to_string().into()))?;
+    }
+    let mut bytes = Vec::new();
+    let mut enc = png::Encoder::new(&mut bytes, w, h);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let encode =
+        |enc: png::Encoder<'_, &mut Vec<u8>>| -> std::result::Result<(), png::EncodingError> {
+            let mut writer = enc.write_header()?;
+            writer.write_image_data(&rgb)?;
+            writer.finish()
+        };
+    encode(enc).map_err(|e| f.fail("PNG", e.to_string().into()))?;
+    Ok(bytes)
+}
+
+fn render_svg(f: &impl Drawable) -> Result<String> {
+    fonts()?;
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, f.pixels()).into_drawing_area();
+        f.draw_on(&root).map_err(|e| f.fail("SVG", e))?;
+        root.present()
+            .map_err(|e| f.fail("SVG", e.to_string().into()))?;
+    }
+    Ok(text)
+}
+
+fn write_both(f: &impl Drawable, dir: &Path, stem: &str) -> Result<[PathBuf; 2]> {
+    let png_path = dir.join(format!("{stem}.png"));
+    let svg_path = dir.join(format!("{stem}.svg"));
+    write_atomic(&png_path, &render_png(f)?)?;
+    write_atomic(&svg_path, render_svg(f)?.as_bytes())?;
+    Ok([png_path, svg_path])
+}
+
+/// A plain figure of curves `y` against `x` (e.g. a slider's acceleration against the crank
+/// angle), each curve a label and its points in drawing order.
+#[derive(Clone, Copy, Debug)]
+pub struct XyFigure<'a> {
+    /// Title line at the top.
+    pub title: &'a str,
+    /// Axis descriptions.
+    pub x_label: &'a str,
+    /// Axis descriptions.
+    pub y_label: &'a str,
+    /// The curves: label and points.
+    pub curves: &'a [(String, Vec<(f64, f64)>)],
+}
+
+impl XyFigure<'_> {
+    /// Writes `<dir>/<stem>.png` and `<dir>/<stem>.svg`; returns both paths.
+    pub fn write(&self, dir: &Path, stem: &str) -> Result<[PathBuf; 2]> {
+        write_both(self, dir, stem)
+    }
+}
+
+impl Drawable for XyFigure<'_> {
+    fn pixels(&self) -> (u32, u32) {
+        (1200, 700)
+    }
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult
+    where
+        DB::ErrorType: 'static,
+    {
+        root.fill(&WHITE)?;
+        let body = root.titled(self.title, (FAMILY, 26).into_font().color(&BLACK))?;
+        let pts = || self.curves.iter().flat_map(|(_, p)| p.iter()).copied();
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for (x, y) in pts().filter(|(x, y)| x.is_finite() && y.is_finite()) {
+            (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+        }
+        if !(x1 > x0) || !(y1 >= y0) {
+            return Ok(());
+        }
+        let pad = 0.05 * (y1 - y0).max(1e-12);
+        let mut chart = ChartBuilder::on(&body)
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(90)
+            .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))?;
+        chart
+            .configure_mesh()
+            .x_desc(self.x_label)
+            .y_desc(self.y_label)
+            .label_style((FAMILY, 15))
+            .axis_desc_style((FAMILY, 17))
+            .light_line_style(RGBColor(246, 246, 246))
+            .draw()?;
+        for (i, (label, points)) in self.curves.iter().enumerate() {
+            let color = if i == 0 { BLACK } else { case_color(i - 1) };
+            chart
+                .draw_series(LineSeries::new(
+                    points.iter().copied(),
+                    color.stroke_width(1),
+                ))?
+                .label(label.as_str())
+                .legend(legend_line(color));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font((FAMILY, 15))
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(160, 160, 160))
+            .draw()?;
+        Ok(())
+    }
+    fn fail(&self, format: &str, e: Box<dyn std::error::Error>) -> Error {
+        Error::invalid(
+            format!("figure `{}` ({format})", self.title),
+            format!("cannot be drawn: {e}"),
+        )
     }
 }
 

@@ -322,6 +322,27 @@ struct BodySnapshot {
     torque: Vector,
 }
 
+/// Replaces `into` with the state of every movable body: pose (and kinematic target),
+/// velocities, and the user forces on it.
+fn snapshot_bodies(world: &PhysicsWorld, into: &mut Vec<BodySnapshot>) {
+    into.clear();
+    into.extend(
+        world
+            .bodies
+            .iter()
+            .filter(|(_, rb)| !rb.is_fixed())
+            .map(|(handle, rb)| BodySnapshot {
+                handle,
+                position: *rb.position(),
+                next_position: *rb.next_position(),
+                linvel: rb.linvel(),
+                angvel: rb.angvel(),
+                force: rb.user_force(),
+                torque: rb.user_torque(),
+            }),
+    );
+}
+
 /// The step control of a world with clearance joints: see the module docs.
 #[derive(Clone, Debug)]
 pub struct Stepper {
@@ -486,23 +507,7 @@ impl Stepper {
         }
         // Save the state: bodies (always: their forces are restored after the scaled step) and,
         // when a step may be rejected, the sources.
-        self.saved.clear();
-        self.saved
-            .extend(
-                world
-                    .bodies
-                    .iter()
-                    .filter(|(_, rb)| !rb.is_fixed())
-                    .map(|(handle, rb)| BodySnapshot {
-                        handle,
-                        position: *rb.position(),
-                        next_position: *rb.next_position(),
-                        linvel: rb.linvel(),
-                        angvel: rb.angvel(),
-                        force: rb.user_force(),
-                        torque: rb.user_torque(),
-                    }),
-            );
+        snapshot_bodies(world, &mut self.saved);
         if adaptive {
             for s in sources.iter_mut() {
                 s.save_state();
@@ -636,19 +641,7 @@ impl Stepper {
         probe.max_dt = h;
         self.control = probe;
         let mut saved_bodies = Vec::new();
-        for (handle, rb) in world.bodies.iter() {
-            if !rb.is_fixed() {
-                saved_bodies.push(BodySnapshot {
-                    handle,
-                    position: *rb.position(),
-                    next_position: *rb.next_position(),
-                    linvel: rb.linvel(),
-                    angvel: rb.angvel(),
-                    force: rb.user_force(),
-                    torque: rb.user_torque(),
-                });
-            }
-        }
+        snapshot_bodies(world, &mut saved_bodies);
         let result = self.step(world, sources, t + h);
         let out = result.map(|info| read(world, &info));
         self.saved = saved_bodies;

@@ -223,10 +223,14 @@ struct RunArgs {
     progress: String,
     #[command(flatten)]
     memory: MemoryArgs,
-    /// Also draw the figures of the first clearance hinge (angles and rates, joint force, journal
-    /// orbit; PNG and SVG) into the output folder, after the result set.
-    #[arg(long)]
+    /// Draw the figures (the default): angles and rates, joint force, journal orbit of the first
+    /// clearance hinge, PNG and SVG, into the output folder after the result set. With this flag a
+    /// scene that cannot have them is an error; without it such a scene just has none.
+    #[arg(long, conflicts_with = "no_figures")]
     figures: bool,
+    /// Skip the figures.
+    #[arg(long)]
+    no_figures: bool,
 }
 
 impl RunArgs {
@@ -290,103 +294,110 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
         out.display(),
         files.join(", ")
     );
-    if args.figures {
-        use clearance_joint::sim::TwinKind;
-        use clearance_joint::study::plot::{Figure, FigureKind};
-        use clearance_joint::study::series::CaseSeries;
-        let (Some(ideal), Some(clear)) = (
-            result.twin(TwinKind::Ideal),
-            result.twin(TwinKind::Clearance),
-        ) else {
-            return Err(clearance_joint::Error::invalid(
-                "--figures",
-                "needs both twins",
-            ));
-        };
-        let series = [CaseSeries::from_tables(
-            scene.name.clone(),
-            &scene,
-            &ideal.table,
-            &clear.table,
-        )?];
-        // Driven mechanisms: each moving body's x acceleration against the driver's angle over
-        // the last turn, ideal against clearance.
-        if let (Some(period), true) = (scene.drive_period(), scene.run.body_motion) {
-            use clearance_joint::scene::MotionSpec;
-            let driver = scene
-                .bodies
-                .iter()
-                .find(|b| matches!(b.motion, Some(MotionSpec::Spin { .. })))
-                .map(|b| b.name.clone())
-                .or_else(|| {
-                    scene
-                        .joints
-                        .iter()
-                        .find(|j| j.motor.is_some())
-                        .map(|j| j.body2.clone())
-                });
-            let end = scene.run.end_s;
-            for b in scene
-                .bodies
-                .iter()
-                .filter(|b| !b.fixed && b.motion.is_none())
-            {
-                let (Some(driver), true) = (&driver, end >= period * (1.0 - 1e-9)) else {
-                    continue;
-                };
-                let column = format!("{}_ax_m_s2", b.name);
-                let curve = |label: &str, t: &clearance_joint::output::Table| {
-                    let (Some(ts), Some(angle), Some(a)) = (
-                        t.column("t_s"),
-                        t.column(&format!("{driver}_angle_deg")),
-                        t.column(&column),
-                    ) else {
-                        return None;
+    if !args.no_figures {
+        let drawn = (|| -> clearance_joint::Result<()> {
+            use clearance_joint::sim::TwinKind;
+            use clearance_joint::study::plot::{Figure, FigureKind};
+            use clearance_joint::study::series::CaseSeries;
+            let (Some(ideal), Some(clear)) = (
+                result.twin(TwinKind::Ideal),
+                result.twin(TwinKind::Clearance),
+            ) else {
+                return Err(clearance_joint::Error::invalid(
+                    "--figures",
+                    "needs both twins",
+                ));
+            };
+            let series = [CaseSeries::from_tables(
+                scene.name.clone(),
+                &scene,
+                &ideal.table,
+                &clear.table,
+            )?];
+            // Driven mechanisms: each moving body's x acceleration against the driver's angle over
+            // the last turn, ideal against clearance.
+            if let (Some(period), true) = (scene.drive_period(), scene.run.body_motion) {
+                use clearance_joint::scene::MotionSpec;
+                let driver = scene
+                    .bodies
+                    .iter()
+                    .find(|b| matches!(b.motion, Some(MotionSpec::Spin { .. })))
+                    .map(|b| b.name.clone())
+                    .or_else(|| {
+                        scene
+                            .joints
+                            .iter()
+                            .find(|j| j.motor.is_some())
+                            .map(|j| j.body2.clone())
+                    });
+                let end = scene.run.end_s;
+                for b in scene
+                    .bodies
+                    .iter()
+                    .filter(|b| !b.fixed && b.motion.is_none())
+                {
+                    let (Some(driver), true) = (&driver, end >= period * (1.0 - 1e-9)) else {
+                        continue;
                     };
-                    let first = ts.iter().position(|&x| x >= end - period)?;
-                    let points = (first..ts.len())
-                        .map(|i| (angle[i] - angle[first], a[i]))
-                        .collect();
-                    Some((label.to_string(), points))
-                };
-                let curves: Vec<(String, Vec<(f64, f64)>)> = [
-                    curve("ideal", &ideal.table),
-                    curve("clearance", &clear.table),
-                ]
-                .into_iter()
-                .flatten()
-                .collect();
-                if curves.is_empty() {
-                    continue;
+                    let column = format!("{}_ax_m_s2", b.name);
+                    let curve = |label: &str, t: &clearance_joint::output::Table| {
+                        let (Some(ts), Some(angle), Some(a)) = (
+                            t.column("t_s"),
+                            t.column(&format!("{driver}_angle_deg")),
+                            t.column(&column),
+                        ) else {
+                            return None;
+                        };
+                        let first = ts.iter().position(|&x| x >= end - period)?;
+                        let points = (first..ts.len())
+                            .map(|i| (angle[i] - angle[first], a[i]))
+                            .collect();
+                        Some((label.to_string(), points))
+                    };
+                    let curves: Vec<(String, Vec<(f64, f64)>)> = [
+                        curve("ideal", &ideal.table),
+                        curve("clearance", &clear.table),
+                    ]
+                    .into_iter()
+                    .flatten()
+                    .collect();
+                    if curves.is_empty() {
+                        continue;
+                    }
+                    let title = format!(
+                        "{}: {} acceleration along x over the last turn of {driver}",
+                        scene.name, b.name
+                    );
+                    let x_label = format!("{driver} angle from the turn's start (deg)");
+                    let paths = clearance_joint::study::plot::XyFigure {
+                        title: &title,
+                        x_label: &x_label,
+                        y_label: "acceleration along x (m/s^2)",
+                        curves: &curves,
+                    }
+                    .write(&out, &format!("{}_acceleration", b.name))?;
+                    for p in paths {
+                        println!("wrote {}", p.display());
+                    }
                 }
-                let title = format!(
-                    "{}: {} acceleration along x over the last turn of {driver}",
-                    scene.name, b.name
-                );
-                let x_label = format!("{driver} angle from the turn's start (deg)");
-                let paths = clearance_joint::study::plot::XyFigure {
+            }
+            for kind in FigureKind::ALL {
+                let title = format!("{}: {}", scene.name, kind.stem().replace('_', " "));
+                let paths = Figure {
+                    kind,
                     title: &title,
-                    x_label: &x_label,
-                    y_label: "acceleration along x (m/s^2)",
-                    curves: &curves,
+                    cases: &series,
                 }
-                .write(&out, &format!("{}_acceleration", b.name))?;
+                .write(&out, kind.stem())?;
                 for p in paths {
                     println!("wrote {}", p.display());
                 }
             }
-        }
-        for kind in FigureKind::ALL {
-            let title = format!("{}: {}", scene.name, kind.stem().replace('_', " "));
-            let paths = Figure {
-                kind,
-                title: &title,
-                cases: &series,
-            }
-            .write(&out, kind.stem())?;
-            for p in paths {
-                println!("wrote {}", p.display());
-            }
+            Ok(())
+        })();
+        match drawn {
+            Err(e) if !args.figures => eprintln!("no figures: {e}"),
+            other => other?,
         }
     }
     Ok(())

@@ -658,7 +658,7 @@ fn stale_temporaries_are_cleaned() {
         std::fs::write(f, b"x").unwrap();
     }
     let o = bin()
-        .args(["--end", "0.01", "--out"])
+        .args(["--end", "0.01", "--no-figures", "--out"])
         .arg(&dir)
         .output()
         .unwrap();
@@ -686,7 +686,7 @@ fn stale_temporaries_are_cleaned() {
 fn concurrent_runs_and_interrupts() {
     let dir = scratch("lock");
     let mut first = bin()
-        .args(["--end", "100", "--output-interval", "0.01", "--out"])
+        .args(["--end", "100", "--output-interval", "0.01", "--no-figures", "--out"])
         .arg(&dir)
         .stderr(Stdio::piped())
         .stdout(Stdio::null())
@@ -700,7 +700,7 @@ fn concurrent_runs_and_interrupts() {
         std::thread::sleep(Duration::from_millis(20));
     }
     let second = bin()
-        .args(["--end", "0.01", "--out"])
+        .args(["--end", "0.01", "--no-figures", "--out"])
         .arg(&dir)
         .output()
         .unwrap();
@@ -722,7 +722,7 @@ fn concurrent_runs_and_interrupts() {
     assert!(files_in(&dir).is_empty(), "left {:?}", files_in(&dir));
     // The folder is free again.
     let o = bin()
-        .args(["--end", "0.01", "--out"])
+        .args(["--end", "0.01", "--no-figures", "--out"])
         .arg(&dir)
         .output()
         .unwrap();

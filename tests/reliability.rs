@@ -686,7 +686,14 @@ fn stale_temporaries_are_cleaned() {
 fn concurrent_runs_and_interrupts() {
     let dir = scratch("lock");
     let mut first = bin()
-        .args(["--end", "100", "--output-interval", "0.01", "--no-figures", "--out"])
+        .args([
+            "--end",
+            "100",
+            "--output-interval",
+            "0.01",
+            "--no-figures",
+            "--out",
+        ])
         .arg(&dir)
         .stderr(Stdio::piped())
         .stdout(Stdio::null())

@@ -450,7 +450,7 @@ impl RunSettings {
         c.strict(self.strict)
     }
 
-    /// The step control in words, e.g. "adaptive steps of at most 1e-4 s (tolerance 0.02 of a
+    /// The step control in words, e.g. "adaptive steps of at most 1e-3 s (tolerance 0.0075 of a
     /// contact period)".
     pub fn stepping(&self) -> String {
         match self.step {

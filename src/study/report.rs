@@ -85,7 +85,7 @@ pub const PAPER: [&str; 4] = [
 pub struct Setup {
     /// Step, s (the largest step with adaptive stepping).
     pub dt_s: f64,
-    /// The step control in words, e.g. "adaptive steps of at most 1e-4 s (tolerance 0.02)".
+    /// The step control in words, e.g. "adaptive steps of at most 1e-3 s (tolerance 0.0075 of a contact period)".
     pub stepping: String,
     /// Interval between rows, s.
     pub output_interval_s: f64,

@@ -430,6 +430,19 @@ fn revolute_with([anchor1, anchor2, axis1, axis2]: [Vector; 4]) -> RevoluteJoint
     RevoluteJoint { data }
 }
 
+/// The joint behind `revolute`, or an error naming the handle.
+fn revolute_of(
+    impulse_joints: &ImpulseJointSet,
+    revolute: ImpulseJointHandle,
+) -> Result<&rapier3d_f64::prelude::ImpulseJoint> {
+    impulse_joints.get(revolute).ok_or_else(|| {
+        Error::invalid(
+            "revolute",
+            format!("no joint with handle {revolute:?} in the ImpulseJointSet"),
+        )
+    })
+}
+
 /// Replaces the revolute joint `revolute` of `impulse_joints` by a clearance joint in `set`
 /// between the same bodies, the bearing on the body `bearing` says, with the same anchors and
 /// axes and the laws of `clearance`. The clearance joint's body 1 is the bearing's body.
@@ -441,12 +454,7 @@ pub fn revolute_to_clearance(
     clearance: Clearance,
     impulse_joints: &mut ImpulseJointSet,
 ) -> Result<ClearanceJointHandle> {
-    let ij = impulse_joints.get(revolute).ok_or_else(|| {
-        Error::invalid(
-            "revolute",
-            format!("no joint with handle {revolute:?} in the ImpulseJointSet"),
-        )
-    })?;
+    let ij = revolute_of(impulse_joints, revolute)?;
     let (body1, body2) = (ij.body1(), ij.body2());
     let joint = clearance_joint_from_revolute(&ij.data, &clearance)?;
     let (body1, body2, joint) = match bearing {
@@ -504,12 +512,7 @@ pub fn revolute_to_large_step(
     clearance: Clearance,
     impulse_joints: &mut ImpulseJointSet,
 ) -> Result<LargeStepJointHandle> {
-    let ij = impulse_joints.get(revolute).ok_or_else(|| {
-        Error::invalid(
-            "revolute",
-            format!("no joint with handle {revolute:?} in the ImpulseJointSet"),
-        )
-    })?;
+    let ij = revolute_of(impulse_joints, revolute)?;
     let (body1, body2) = (ij.body1(), ij.body2());
     let joint = large_step_joint_from_revolute(&ij.data, &clearance)?;
     impulse_joints.remove(revolute, true);

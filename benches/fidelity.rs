@@ -26,12 +26,12 @@
 //! force (the limit's impulse over the substep), which measures an impact's impulse over one
 //! substep, not the contact's force history.
 
-use clearance_joint::angle::HingeAngle;
-use clearance_joint::convert::Clearance;
-use clearance_joint::drive::{DriveSet, TorsionSpring};
-use clearance_joint::joint::ClearanceJointSet;
-use clearance_joint::large_step::LargeStepJointSet;
-use clearance_joint::laws::{Bai, FrictionModel};
+use clearance_joint::model::angle::HingeAngle;
+use clearance_joint::model::laws::{Bai, FrictionModel};
+use clearance_joint::rapier::convert::Clearance;
+use clearance_joint::rapier::drive::{DriveSet, TorsionSpring};
+use clearance_joint::rapier::joint::ClearanceJointSet;
+use clearance_joint::rapier::large_step::LargeStepJointSet;
 use rapier3d_f64::math::{Pose, Rotation, Vector};
 use rapier3d_f64::prelude::{
     IntegrationParameters, MassProperties, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder,
@@ -409,9 +409,9 @@ fn resolution(clearance: f64, cap: Option<usize>) -> (f64, f64, u64) {
     let anchor = Vector::new(-0.3, 0.0, 0.0);
     let mut play = LargeStepJointSet::new();
     let pin = cap.map(|cap| {
-        let joint = clearance_joint::large_step::LargeStepJointBuilder::new(
+        let joint = clearance_joint::rapier::large_step::LargeStepJointBuilder::new(
             Vector::Z,
-            clearance_joint::laws::BearingGeometry::from_clearance(0.010, clearance, 0.016)
+            clearance_joint::model::laws::BearingGeometry::from_clearance(0.010, clearance, 0.016)
                 .expect("valid geometry"),
         )
         .local_anchor2(anchor)

@@ -11,10 +11,12 @@
 //!
 //! `cargo bench --bench scale`. Medians of 5 runs; ratios within one run of the bench.
 
-use clearance_joint::convert::Clearance;
-use clearance_joint::joint::ClearanceJointSet;
-use clearance_joint::large_step::{DEFAULT_MAX_SUBSTEPS, LargeStepJointBuilder, LargeStepJointSet};
-use clearance_joint::laws::{Bai, FrictionModel};
+use clearance_joint::model::laws::{Bai, FrictionModel};
+use clearance_joint::rapier::convert::Clearance;
+use clearance_joint::rapier::joint::ClearanceJointSet;
+use clearance_joint::rapier::large_step::{
+    DEFAULT_MAX_SUBSTEPS, LargeStepJointBuilder, LargeStepJointSet,
+};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     IntegrationParameters, MassProperties, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder,

@@ -3,7 +3,7 @@
 //! Medians of 5 runs of the paper's 5-s scene at dt = 1e-4 s; ratios are measured in one run.
 
 use clearance_joint::scene::Scene;
-use clearance_joint::sim::{RunOptions, Simulation, Twins};
+use clearance_joint::scene::runner::{RunOptions, Simulation, Twins};
 use rapier3d_f64::prelude::LockedAxes;
 use std::time::Instant;
 

@@ -7,11 +7,11 @@
 //! `cargo run --release --example drop_in`
 
 use clearance_joint::Result;
-use clearance_joint::angle::{UnwrappedAngle, twist_angle};
-use clearance_joint::convert::{BearingSide, Clearance, ConvertRevolute};
-use clearance_joint::joint::ClearanceJointSet;
-use clearance_joint::laws::{Bai, FrictionModel};
-use clearance_joint::stepper::{StepControl, Stepper};
+use clearance_joint::model::angle::{UnwrappedAngle, twist_angle};
+use clearance_joint::model::laws::{Bai, FrictionModel};
+use clearance_joint::rapier::convert::{BearingSide, Clearance, ConvertRevolute};
+use clearance_joint::rapier::joint::ClearanceJointSet;
+use clearance_joint::rapier::stepper::{StepControl, Stepper};
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::{
     ImpulseJointHandle, MassProperties, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder,

@@ -10,12 +10,12 @@
 
 use bevy_ecs::prelude::*;
 use clearance_joint::Result;
-use clearance_joint::convert::Clearance;
 use clearance_joint::ecs::{
     Body, ClearanceHinge, Hinge, HingeMode, HingeState, IdealHinge, Physics, physics_schedule,
     run_step,
 };
-use clearance_joint::laws::{Bai, FrictionModel};
+use clearance_joint::model::laws::{Bai, FrictionModel};
+use clearance_joint::rapier::convert::Clearance;
 use rapier3d_f64::math::{Pose, Rotation, Vector};
 use rapier3d_f64::prelude::{MassProperties, RigidBodyBuilder};
 use std::process::ExitCode;

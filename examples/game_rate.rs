@@ -11,9 +11,11 @@
 //! `cargo run --release --example game_rate`
 
 use clearance_joint::Result;
-use clearance_joint::angle::HingeAngle;
-use clearance_joint::large_step::{DEFAULT_MAX_SUBSTEPS, LargeStepJointBuilder, LargeStepJointSet};
-use clearance_joint::laws::BearingGeometry;
+use clearance_joint::model::angle::HingeAngle;
+use clearance_joint::model::laws::BearingGeometry;
+use clearance_joint::rapier::large_step::{
+    DEFAULT_MAX_SUBSTEPS, LargeStepJointBuilder, LargeStepJointSet,
+};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     IntegrationParameters, MassProperties, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder,

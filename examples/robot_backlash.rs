@@ -13,9 +13,11 @@
 //! `cargo run --release --example robot_backlash`
 
 use clearance_joint::Result;
-use clearance_joint::angle::HingeAngle;
-use clearance_joint::large_step::{LargeStepJointBuilder, LargeStepJointHandle, LargeStepJointSet};
-use clearance_joint::laws::BearingGeometry;
+use clearance_joint::model::angle::HingeAngle;
+use clearance_joint::model::laws::BearingGeometry;
+use clearance_joint::rapier::large_step::{
+    LargeStepJointBuilder, LargeStepJointHandle, LargeStepJointSet,
+};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     IntegrationParameters, MassProperties, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder,

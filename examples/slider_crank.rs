@@ -17,14 +17,14 @@
 //! the prismatic guide); the clearance pin force is the contact and friction force.
 
 use clearance_joint::Result;
-use clearance_joint::angle::twist_angle;
-use clearance_joint::convert::{BearingSide, Clearance, ConvertRevolute};
-use clearance_joint::joint::{ClearanceJointHandle, ClearanceJointSet};
-use clearance_joint::metrics::{ContactObservation, HingeMetrics, ImpactRecorder};
-use clearance_joint::reaction::{
+use clearance_joint::model::angle::twist_angle;
+use clearance_joint::rapier::convert::{BearingSide, Clearance, ConvertRevolute};
+use clearance_joint::rapier::joint::{ClearanceJointHandle, ClearanceJointSet};
+use clearance_joint::rapier::metrics::{ContactObservation, HingeMetrics, ImpactRecorder};
+use clearance_joint::rapier::reaction::{
     IdealJoint, IdealPrismatic, IdealRevolute, ReactionSolver, prepare_mass_properties,
 };
-use clearance_joint::stepper::{StepControl, Stepper};
+use clearance_joint::rapier::stepper::{StepControl, Stepper};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::*;
 use std::f64::consts::TAU;
@@ -241,7 +241,7 @@ pub fn simulate(clearance: Option<Clearance>, dt: f64, end: f64) -> Result<Run> 
         force: Vec::new(),
         recorder: ImpactRecorder::new(),
     };
-    let mut theta = clearance_joint::angle::UnwrappedAngle::default();
+    let mut theta = clearance_joint::model::angle::UnwrappedAngle::default();
     loop {
         // The state before the step: its pin force and contact, its positions.
         let obs = match m.pin {

@@ -7,15 +7,17 @@
 //! `cargo run --release --example solar_panel`
 
 use clearance_joint::Result;
-use clearance_joint::angle::{UnwrappedAngle, twist_angle};
-use clearance_joint::drive::{DriveSet, TorsionSpring};
-use clearance_joint::joint::{ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet};
-use clearance_joint::laws::{
+use clearance_joint::model::angle::{UnwrappedAngle, twist_angle};
+use clearance_joint::model::laws::{
     Bai, BearingGeometry, FrictionModel, ImprovedLiu, Material, MaxDamping, NormalModel,
     effective_modulus,
 };
-use clearance_joint::reaction::{IdealRevolute, ReactionSolver, prepare_mass_properties};
-use clearance_joint::stepper::{StepControl, Stepper};
+use clearance_joint::rapier::drive::{DriveSet, TorsionSpring};
+use clearance_joint::rapier::joint::{
+    ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet,
+};
+use clearance_joint::rapier::reaction::{IdealRevolute, ReactionSolver, prepare_mass_properties};
+use clearance_joint::rapier::stepper::{StepControl, Stepper};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     MassProperties, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder, RigidBodyHandle,

@@ -51,7 +51,7 @@ pub enum Error {
         /// Linearised damping ratio of the contact.
         zeta: f64,
         /// The contact law: it tells which parameter sets the stiffness and the damping.
-        law: crate::laws::LawKind,
+        law: crate::model::laws::LawKind,
         /// Whether the step was adaptive (`Some(true)`), fixed (`Some(false)`) or unknown to the
         /// code that raised the error (`None`); see [`Error::with_step_mode`].
         adaptive: Option<bool>,
@@ -292,8 +292,8 @@ pub fn sig4(x: f64) -> String {
 
 /// The contact parameter that sets a contact's stiffness (or, when it is over-damped, its
 /// damping), as a scene path under `hinges[<hinge>].clearance`.
-fn stiff_field(hinge: &str, law: crate::laws::LawKind, zeta: f64) -> String {
-    use crate::laws::LawKind as L;
+fn stiff_field(hinge: &str, law: crate::model::laws::LawKind, zeta: f64) -> String {
+    use crate::model::laws::LawKind as L;
     let p = format!("hinges[{hinge}].clearance");
     let damped = zeta > 1.0;
     match law {
@@ -316,7 +316,7 @@ fn stiff_field(hinge: &str, law: crate::laws::LawKind, zeta: f64) -> String {
 fn step_advice(
     field: &str,
     hinge: &str,
-    law: crate::laws::LawKind,
+    law: crate::model::laws::LawKind,
     dt_max: f64,
     zeta: f64,
     adaptive: Option<bool>,

@@ -2,7 +2,7 @@
 //! this test and their numbers checked, and their binaries are run as a user would run them.
 
 use clearance_joint::scene::Scene;
-use clearance_joint::sim::{RunOptions, Simulation, TwinKind, Twins};
+use clearance_joint::scene::runner::{RunOptions, Simulation, TwinKind, Twins};
 use std::path::PathBuf;
 use std::process::Command;
 

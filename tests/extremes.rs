@@ -4,9 +4,9 @@
 //! so energy and momentum are what is checked.
 
 use clearance_joint::Error;
-use clearance_joint::report::TwinSummary;
 use clearance_joint::scene::Scene;
-use clearance_joint::sim::{RunOptions, Simulation, Twins};
+use clearance_joint::scene::report::TwinSummary;
+use clearance_joint::scene::runner::{RunOptions, Simulation, Twins};
 
 /// The energy balance may not grow by more than this fraction of the energy scale (the
 /// integrator's own error, first order in the contact step).

@@ -1,13 +1,13 @@
-//! The large-step clearance joint (`clearance_joint::large_step`): bounded eccentricity, no energy
+//! The large-step clearance joint (`clearance_joint::rapier::large_step`): bounded eccentricity, no energy
 //! gain, stability over clearances and masses at game rate, restitution, friction, the force
 //! readout, and what it says when it cannot resolve a step. Release profile (`cargo test
 //! --release`); every scene is at most a minute of simulated time at 1/60 s.
 
-use clearance_joint::large_step::{
-    LargeStepJointBuilder, LargeStepJointHandle, LargeStepJointSet, LargeStepReport,
-};
-use clearance_joint::laws::{
+use clearance_joint::model::laws::{
     BearingGeometry, ImprovedLiu, MaxDamping, NormalModel, impact_restitution,
+};
+use clearance_joint::rapier::large_step::{
+    LargeStepJointBuilder, LargeStepJointHandle, LargeStepJointSet, LargeStepReport,
 };
 use rapier3d_f64::prelude::*;
 

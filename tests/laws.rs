@@ -4,8 +4,8 @@
 //! and recomputed in the test from the formula as written in MODEL.md, never through the crate's
 //! own helpers (`step`, `sigma`, `effective_modulus`, `hysteresis_factor`, ...).
 
-use clearance_joint::kinematics::*;
-use clearance_joint::laws::*;
+use clearance_joint::model::kinematics::*;
+use clearance_joint::model::laws::*;
 use proptest::prelude::*;
 use rapier3d_f64::math::Vector;
 use std::f64::consts::PI;

@@ -3,7 +3,7 @@
 
 use clearance_joint::prelude::*;
 use clearance_joint::scene::Scene;
-use clearance_joint::sim::{RunOptions, RunResult, Simulation, TwinKind, Twins};
+use clearance_joint::scene::runner::{RunOptions, RunResult, Simulation, TwinKind, Twins};
 use rapier3d_f64::prelude::*;
 
 fn run(overrides: &[&str], twins: Twins) -> RunResult {
@@ -22,7 +22,7 @@ fn run(overrides: &[&str], twins: Twins) -> RunResult {
     .unwrap()
 }
 
-fn clearance_summary(r: &RunResult) -> clearance_joint::report::TwinSummary {
+fn clearance_summary(r: &RunResult) -> clearance_joint::scene::report::TwinSummary {
     r.summary().twins["clearance"].clone()
 }
 
@@ -240,7 +240,7 @@ fn identical_runs_are_bit_identical() {
         for t in s.twins.values_mut() {
             t.wall_s = 0.0;
         }
-        clearance_joint::report::summary_json(&s).unwrap()
+        clearance_joint::scene::report::summary_json(&s).unwrap()
     };
     assert_eq!(strip(&a), strip(&b));
 }

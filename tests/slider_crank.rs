@@ -84,7 +84,7 @@ fn clearance_pin_impacts_and_its_first_impact_converges() {
 #[test]
 fn the_scene_run_is_the_plain_api_run_bit_for_bit() {
     use clearance_joint::scene::Scene;
-    use clearance_joint::sim::{RunOptions, Simulation, TwinKind};
+    use clearance_joint::scene::runner::{RunOptions, Simulation, TwinKind};
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/slider_crank.ron");
     let mut scene = Scene::load(&path).unwrap();
     let end = 0.004;
@@ -219,7 +219,7 @@ fn mechanism_fields_are_validated_with_their_paths() {
 #[test]
 fn scene_rows_carry_the_slider_acceleration() {
     use clearance_joint::scene::Scene;
-    use clearance_joint::sim::{RunOptions, Simulation, TwinKind};
+    use clearance_joint::scene::runner::{RunOptions, Simulation, TwinKind};
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/slider_crank.ron");
     let scene = Scene::load(&path).unwrap();
     let result = Simulation::new(&scene, RunOptions::default())
@@ -268,7 +268,7 @@ fn scene_rows_carry_the_slider_acceleration() {
 #[test]
 fn per_turn_statistics_add_up() {
     use clearance_joint::scene::Scene;
-    use clearance_joint::sim::{RunOptions, Simulation};
+    use clearance_joint::scene::runner::{RunOptions, Simulation};
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/slider_crank.ron");
     let mut scene = Scene::load(&path).unwrap();
     scene.run.end_s = 0.018; // a turn and a half
@@ -298,47 +298,5 @@ fn per_turn_statistics_add_up() {
     let contact = rows[0][5] * turn + rows[1][5] * (0.018 - turn);
     assert!((contact / 0.018 - m.contact_fraction).abs() < 1e-9);
     assert!(!dir.join("ideal_slider_pin_turns.csv").exists());
-    let _ = std::fs::remove_dir_all(&dir);
-}
-
-/// The scene runs from the command line with `--scene`, writing the result set, the impact and
-/// per-turn lists, and with `--figures` the joint-force and journal-orbit figures.
-#[test]
-fn the_scene_runs_from_the_command_line_with_figures() {
-    let dir = std::env::temp_dir().join(format!("cj_sc_cli_{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/slider_crank.ron");
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
-        .arg("--scene")
-        .arg(&scene)
-        .args([
-            "--set",
-            "run.end_s=0.013",
-            "--figures",
-            "--progress",
-            "quiet",
-            "--out",
-        ])
-        .arg(&dir)
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    for f in [
-        "ideal.csv",
-        "clearance.csv",
-        "clearance_slider_pin_impacts.csv",
-        "clearance_slider_pin_turns.csv",
-        "summary.json",
-        "joint_force.png",
-        "trajectory.png",
-        "slider_acceleration.png",
-        "angles_rates.svg",
-    ] {
-        assert!(dir.join(f).is_file(), "no {f}");
-    }
     let _ = std::fs::remove_dir_all(&dir);
 }

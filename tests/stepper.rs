@@ -2,14 +2,14 @@
 //! make trustworthy (agreement with converged fixed steps, independence of the output interval,
 //! exact ideal reactions), on the paper's scene and on a kinematically driven mechanism.
 
-use clearance_joint::convert::Clearance;
 use clearance_joint::error::Error;
-use clearance_joint::joint::ClearanceJointSet;
-use clearance_joint::laws::{BearingGeometry, Hertz, NormalModel};
-use clearance_joint::reaction::{IdealRevolute, ReactionSolver, prepare_mass_properties};
+use clearance_joint::model::laws::{BearingGeometry, Hertz, NormalModel};
+use clearance_joint::rapier::convert::Clearance;
+use clearance_joint::rapier::joint::ClearanceJointSet;
+use clearance_joint::rapier::reaction::{IdealRevolute, ReactionSolver, prepare_mass_properties};
+use clearance_joint::rapier::stepper::{StepControl, Stepper};
 use clearance_joint::scene::Scene;
-use clearance_joint::sim::{RunOptions, RunResult, Simulation, TwinKind, Twins};
-use clearance_joint::stepper::{StepControl, Stepper};
+use clearance_joint::scene::runner::{RunOptions, RunResult, Simulation, TwinKind, Twins};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::*;
 

@@ -1,0 +1,686 @@
+//! Figures of a study, one per figure kind of the paper, as PNG and SVG (plotters):
+//! - angles and rates of every movable body vs time, each case with its ideal curve
+//!   (the paper's figs 3, 6, 9);
+//! - joint force vs time, ideal and clearance joint, one row per case (figs 4, 7, 10);
+//! - journal-centre trajectory inside the clearance circle, to scale, one panel per case
+//!   (figs 5, 8, 11).
+//!
+//! Long series are decimated for drawing: time series keep the minimum and the maximum of
+//! every pixel column ([`minmax_decimate`]), so impact peaks survive; trajectories drop points
+//! closer than a fraction of a pixel to the last kept one ([`decimate_path`]). PNG text is drawn
+//! with DejaVu Sans embedded in the binary (`assets/fonts/`), so nothing depends on the fonts of
+//! the machine.
+
+pub mod series;
+
+use clearance_joint::error::{Error, Result};
+use clearance_joint::scene::output::write_atomic;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use series::CaseSeries;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+type DrawResult = std::result::Result<(), Box<dyn std::error::Error>>;
+
+/// DejaVu Sans (Bitstream Vera licence, `assets/fonts/LICENSE-DejaVu.txt`).
+static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+const FAMILY: &str = "sans-serif";
+
+/// Case colours (Okabe-Ito, readable by colour-blind readers).
+pub const PALETTE: [RGBColor; 6] = [
+    RGBColor(0, 114, 178),
+    RGBColor(213, 94, 0),
+    RGBColor(0, 158, 115),
+    RGBColor(204, 121, 167),
+    RGBColor(230, 159, 0),
+    RGBColor(86, 180, 233),
+];
+
+/// Registers the embedded font with plotters once per process.
+fn fonts() -> Result<()> {
+    static OK: OnceLock<bool> = OnceLock::new();
+    let ok =
+        *OK.get_or_init(|| plotters::style::register_font(FAMILY, FontStyle::Normal, FONT).is_ok());
+    if ok {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            "assets/fonts/DejaVuSans.ttf",
+            "is not a usable TrueType font",
+        ))
+    }
+}
+
+/// The kinds of figure.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FigureKind {
+    /// Angles and rates vs time (figs 3, 6, 9).
+    AnglesRates,
+    /// Joint force vs time (figs 4, 7, 10).
+    Force,
+    /// Journal-centre trajectory (figs 5, 8, 11).
+    Trajectory,
+}
+
+impl FigureKind {
+    /// All kinds, in the paper's order.
+    pub const ALL: [FigureKind; 3] = [
+        FigureKind::AnglesRates,
+        FigureKind::Force,
+        FigureKind::Trajectory,
+    ];
+
+    /// File stem: `angles_rates`, `joint_force`, `trajectory`.
+    pub fn stem(self) -> &'static str {
+        match self {
+            FigureKind::AnglesRates => "angles_rates",
+            FigureKind::Force => "joint_force",
+            FigureKind::Trajectory => "trajectory",
+        }
+    }
+}
+
+/// A figure to draw: its kind, title and cases.
+#[derive(Clone, Copy, Debug)]
+pub struct Figure<'a> {
+    /// What is drawn.
+    pub kind: FigureKind,
+    /// Title line at the top.
+    pub title: &'a str,
+    /// The cases, in legend order.
+    pub cases: &'a [CaseSeries],
+}
+
+impl Figure<'_> {
+    /// Pixel size of the figure.
+    pub fn size(&self) -> (u32, u32) {
+        let n = self.cases.len().max(1) as u32;
+        match self.kind {
+            FigureKind::AnglesRates => {
+                let rows = self.cases.first().map_or(1, |c| c.bodies.len().max(1)) as u32;
+                (1400, 90 + 420 * rows)
+            }
+            FigureKind::Force => (1400, 90 + 300 * n),
+            FigureKind::Trajectory => ((520 * n).max(700), 640),
+        }
+    }
+
+    /// Renders the figure into a PNG image (RGB, 8 bit), in memory.
+    pub fn png(&self) -> Result<Vec<u8>> {
+        render_png(self)
+    }
+
+    /// Renders the figure as SVG text.
+    pub fn svg(&self) -> Result<String> {
+        render_svg(self)
+    }
+
+    /// Writes `<dir>/<stem>.png` and `<dir>/<stem>.svg` (each whole or not at all); returns both paths.
+    pub fn write(&self, dir: &Path, stem: &str) -> Result<[PathBuf; 2]> {
+        write_both(self, dir, stem)
+    }
+
+    fn error(&self, format: &str, e: Box<dyn std::error::Error>) -> Error {
+        Error::invalid(
+            format!("figure `{}` ({format})", self.kind.stem()),
+            format!("cannot be drawn: {e}"),
+        )
+    }
+
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult
+    where
+        DB::ErrorType: 'static,
+    {
+        root.fill(&WHITE)?;
+        let body = root.titled(self.title, (FAMILY, 26).into_font().color(&BLACK))?;
+        if self.cases.is_empty() {
+            return Ok(());
+        }
+        match self.kind {
+            FigureKind::AnglesRates => draw_angles_rates(&body, self.cases),
+            FigureKind::Force => draw_force(&body, self.cases),
+            FigureKind::Trajectory => draw_trajectory(&body, self.cases),
+        }
+    }
+}
+
+/// What the renderers need of a figure.
+trait Drawable {
+    fn pixels(&self) -> (u32, u32);
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult
+    where
+        DB::ErrorType: 'static;
+    fn fail(&self, format: &str, e: Box<dyn std::error::Error>) -> Error;
+}
+
+impl Drawable for Figure<'_> {
+    fn pixels(&self) -> (u32, u32) {
+        self.size()
+    }
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult
+    where
+        DB::ErrorType: 'static,
+    {
+        self.draw(root)
+    }
+    fn fail(&self, format: &str, e: Box<dyn std::error::Error>) -> Error {
+        self.error(format, e)
+    }
+}
+
+fn render_png(f: &impl Drawable) -> Result<Vec<u8>> {
+    fonts()?;
+    let (w, h) = f.pixels();
+    let mut rgb = vec![0u8; w as usize * h as usize * 3];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
+        f.draw_on(&root).map_err(|e| f.fail("PNG", e))?;
+        root.present()
+            .map_err(|e| f.fail("PNG", e.to_string().into()))?;
+    }
+    let mut bytes = Vec::new();
+    let mut enc = png::Encoder::new(&mut bytes, w, h);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    let encode =
+        |enc: png::Encoder<'_, &mut Vec<u8>>| -> std::result::Result<(), png::EncodingError> {
+            let mut writer = enc.write_header()?;
+            writer.write_image_data(&rgb)?;
+            writer.finish()
+        };
+    encode(enc).map_err(|e| f.fail("PNG", e.to_string().into()))?;
+    Ok(bytes)
+}
+
+fn render_svg(f: &impl Drawable) -> Result<String> {
+    fonts()?;
+    let mut text = String::new();
+    {
+        let root = SVGBackend::with_string(&mut text, f.pixels()).into_drawing_area();
+        f.draw_on(&root).map_err(|e| f.fail("SVG", e))?;
+        root.present()
+            .map_err(|e| f.fail("SVG", e.to_string().into()))?;
+    }
+    Ok(text)
+}
+
+fn write_both(f: &impl Drawable, dir: &Path, stem: &str) -> Result<[PathBuf; 2]> {
+    let png_path = dir.join(format!("{stem}.png"));
+    let svg_path = dir.join(format!("{stem}.svg"));
+    write_atomic(&png_path, &render_png(f)?)?;
+    write_atomic(&svg_path, render_svg(f)?.as_bytes())?;
+    Ok([png_path, svg_path])
+}
+
+/// A plain figure of curves `y` against `x` (e.g. a slider's acceleration against the crank
+/// angle), each curve a label and its points in drawing order.
+#[derive(Clone, Copy, Debug)]
+pub struct XyFigure<'a> {
+    /// Title line at the top.
+    pub title: &'a str,
+    /// Axis descriptions.
+    pub x_label: &'a str,
+    /// Axis descriptions.
+    pub y_label: &'a str,
+    /// The curves: label and points.
+    pub curves: &'a [(String, Vec<(f64, f64)>)],
+}
+
+impl XyFigure<'_> {
+    /// Writes `<dir>/<stem>.png` and `<dir>/<stem>.svg`; returns both paths.
+    pub fn write(&self, dir: &Path, stem: &str) -> Result<[PathBuf; 2]> {
+        write_both(self, dir, stem)
+    }
+}
+
+impl Drawable for XyFigure<'_> {
+    fn pixels(&self) -> (u32, u32) {
+        (1200, 700)
+    }
+    fn draw_on<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> DrawResult
+    where
+        DB::ErrorType: 'static,
+    {
+        root.fill(&WHITE)?;
+        let body = root.titled(self.title, (FAMILY, 26).into_font().color(&BLACK))?;
+        let pts = || self.curves.iter().flat_map(|(_, p)| p.iter()).copied();
+        let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+        for (x, y) in pts().filter(|(x, y)| x.is_finite() && y.is_finite()) {
+            (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+        }
+        if !(x1 > x0) || !(y1 >= y0) {
+            return Ok(());
+        }
+        let pad = 0.05 * (y1 - y0).max(1e-12);
+        let mut chart = ChartBuilder::on(&body)
+            .margin(15)
+            .x_label_area_size(45)
+            .y_label_area_size(90)
+            .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))?;
+        chart
+            .configure_mesh()
+            .x_desc(self.x_label)
+            .y_desc(self.y_label)
+            .label_style((FAMILY, 15))
+            .axis_desc_style((FAMILY, 17))
+            .light_line_style(RGBColor(246, 246, 246))
+            .draw()?;
+        for (i, (label, points)) in self.curves.iter().enumerate() {
+            let color = if i == 0 { BLACK } else { case_color(i - 1) };
+            chart
+                .draw_series(LineSeries::new(
+                    points.iter().copied(),
+                    color.stroke_width(1),
+                ))?
+                .label(label.as_str())
+                .legend(legend_line(color));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font((FAMILY, 15))
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(160, 160, 160))
+            .draw()?;
+        Ok(())
+    }
+    fn fail(&self, format: &str, e: Box<dyn std::error::Error>) -> Error {
+        Error::invalid(
+            format!("figure `{}` ({format})", self.title),
+            format!("cannot be drawn: {e}"),
+        )
+    }
+}
+
+/// Keeps, for each of `bins` equal time columns over `[t0, t1]`, the minimum and the maximum of
+/// `y` (in time order), so a line through the result has the envelope of the full series and
+/// every peak. Points outside `[t0, t1]` are dropped. At most `2 * bins` points.
+pub fn minmax_decimate(t: &[f64], y: &[f64], t0: f64, t1: f64, bins: usize) -> Vec<(f64, f64)> {
+    let n = t.len().min(y.len());
+    if n <= 2 * bins || bins == 0 || t1 <= t0 {
+        return (0..n)
+            .filter(|&i| t[i] >= t0 && t[i] <= t1)
+            .map(|i| (t[i], y[i]))
+            .collect();
+    }
+    let mut out = Vec::with_capacity(2 * bins);
+    let mut current: Option<(usize, usize, usize)> = None; // (bin, index of min, index of max)
+    let flush = |out: &mut Vec<(f64, f64)>, c: Option<(usize, usize, usize)>| {
+        if let Some((_, lo, hi)) = c {
+            let (a, b) = if lo <= hi { (lo, hi) } else { (hi, lo) };
+            out.push((t[a], y[a]));
+            if b != a {
+                out.push((t[b], y[b]));
+            }
+        }
+    };
+    for i in 0..n {
+        if t[i] < t0 || t[i] > t1 || !y[i].is_finite() {
+            continue;
+        }
+        let bin = (((t[i] - t0) / (t1 - t0) * bins as f64) as usize).min(bins - 1);
+        match &mut current {
+            Some((b, lo, hi)) if *b == bin => {
+                if y[i] < y[*lo] {
+                    *lo = i;
+                }
+                if y[i] > y[*hi] {
+                    *hi = i;
+                }
+            }
+            _ => {
+                flush(&mut out, current);
+                current = Some((bin, i, i));
+            }
+        }
+    }
+    flush(&mut out, current);
+    out
+}
+
+/// Keeps the first point, then every point farther than `min_step` from the last kept one, and
+/// the last point: a path drawn through the result differs from the full path by less than
+/// `min_step`.
+pub fn decimate_path(u: &[f64], v: &[f64], min_step: f64) -> Vec<(f64, f64)> {
+    let n = u.len().min(v.len());
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    for i in 0..n {
+        let p = (u[i], v[i]);
+        match out.last() {
+            Some(&(a, b)) if (p.0 - a).hypot(p.1 - b) < min_step && i + 1 < n => {}
+            _ => out.push(p),
+        }
+    }
+    out
+}
+
+/// The corner of the plotting area (`x` and `y` ranges) where a legend box of `(fw, fh)`
+/// (fractions of width and height) covers the fewest of `points`; upper corners win ties.
+fn emptiest_corner(
+    points: impl Iterator<Item = (f64, f64)>,
+    (x0, x1): (f64, f64),
+    (y0, y1): (f64, f64),
+    (fw, fh): (f64, f64),
+) -> SeriesLabelPosition {
+    let mut counts = [0usize; 4]; // upper left, upper right, lower left, lower right
+    let (w, h) = ((x1 - x0).max(1e-300), (y1 - y0).max(1e-300));
+    for (x, y) in points {
+        let (fx, fy) = ((x - x0) / w, (y - y0) / h);
+        let left = fx <= fw;
+        let right = fx >= 1.0 - fw;
+        let upper = fy >= 1.0 - fh;
+        let lower = fy <= fh;
+        for (k, hit) in [upper && left, upper && right, lower && left, lower && right]
+            .into_iter()
+            .enumerate()
+        {
+            if hit {
+                counts[k] += 1;
+            }
+        }
+    }
+    match (0..4).min_by_key(|&k| (counts[k], k)) {
+        Some(1) => SeriesLabelPosition::UpperRight,
+        Some(2) => SeriesLabelPosition::LowerLeft,
+        Some(3) => SeriesLabelPosition::LowerRight,
+        _ => SeriesLabelPosition::UpperLeft,
+    }
+}
+
+/// `[lo, hi]` of the values with 5 % padding (a unit span around a constant).
+fn range_of<'a>(values: impl IntoIterator<Item = &'a f64>) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for &v in values {
+        if v.is_finite() {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+    }
+    if !lo.is_finite() {
+        return (0.0, 1.0);
+    }
+    if hi - lo < 1e-12 * hi.abs().max(1.0) {
+        return (lo - 0.5, hi + 0.5);
+    }
+    let pad = 0.05 * (hi - lo);
+    (lo - pad, hi + pad)
+}
+
+fn time_range(cases: &[CaseSeries]) -> (f64, f64) {
+    let t1 = cases
+        .iter()
+        .filter_map(|c| c.t_s.last().copied())
+        .fold(0.0, f64::max);
+    (0.0, if t1 > 0.0 { t1 } else { 1.0 })
+}
+
+const DECIMATE_BINS: usize = 900;
+
+/// Which cases draw their own ideal curve: a case whose ideal series equals an earlier case's
+/// (e.g. clearance and friction do not change the ideal twin) does not draw it again.
+fn distinct_ideals(cases: &[CaseSeries]) -> Vec<bool> {
+    (0..cases.len())
+        .map(|i| {
+            !cases[..i].iter().any(|c| {
+                c.t_s == cases[i].t_s
+                    && c.force_ideal_n == cases[i].force_ideal_n
+                    && c.bodies.iter().zip(&cases[i].bodies).all(|(a, b)| {
+                        a.angle_ideal_deg == b.angle_ideal_deg
+                            && a.rate_ideal_deg_s == b.rate_ideal_deg_s
+                    })
+            })
+        })
+        .collect()
+}
+
+/// A line to draw: label, colour, dashed (ideal) or solid, points.
+type Curve = (String, RGBColor, bool, Vec<(f64, f64)>);
+
+fn case_color(i: usize) -> RGBColor {
+    PALETTE[i % PALETTE.len()]
+}
+
+fn legend_line(color: RGBColor) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
+    move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+}
+
+fn draw_angles_rates<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    cases: &[CaseSeries],
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    let rows = cases[0].bodies.len().max(1);
+    let panels = area.split_evenly((rows, 2));
+    let (t0, t1) = time_range(cases);
+    let own_ideal = distinct_ideals(cases);
+    let single_ideal = own_ideal.iter().filter(|&&b| b).count() == 1;
+    for (r, body) in cases[0].bodies.iter().enumerate() {
+        for (c, is_rate) in [(0, false), (1, true)] {
+            let panel = &panels[r * 2 + c];
+            let pick = |b: &series::BodySeries, ideal: bool| -> Vec<f64> {
+                match (is_rate, ideal) {
+                    (false, false) => b.angle_deg.clone(),
+                    (false, true) => b.angle_ideal_deg.clone(),
+                    (true, false) => b.rate_deg_s.clone(),
+                    (true, true) => b.rate_ideal_deg_s.clone(),
+                }
+            };
+            let mut curves: Vec<Curve> = Vec::new();
+            for (i, case) in cases.iter().enumerate() {
+                let Some(b) = case.bodies.iter().find(|b| b.name == body.name) else {
+                    continue;
+                };
+                curves.push((
+                    case.label.clone(),
+                    case_color(i),
+                    false,
+                    minmax_decimate(&case.t_s, &pick(b, false), t0, t1, DECIMATE_BINS),
+                ));
+            }
+            for (i, case) in cases.iter().enumerate() {
+                let Some(b) = case.bodies.iter().find(|b| b.name == body.name) else {
+                    continue;
+                };
+                if own_ideal[i] {
+                    let (label, color) = if single_ideal {
+                        ("ideal joint".to_string(), BLACK)
+                    } else {
+                        (format!("ideal, {}", case.label), case_color(i))
+                    };
+                    curves.push((
+                        label,
+                        color,
+                        true,
+                        minmax_decimate(&case.t_s, &pick(b, true), t0, t1, DECIMATE_BINS),
+                    ));
+                }
+            }
+            let (y0, y1) = range_of(curves.iter().flat_map(|c| c.3.iter().map(|p| &p.1)));
+            let corner = emptiest_corner(
+                curves.iter().flat_map(|c| c.3.iter().copied()),
+                (t0, t1),
+                (y0, y1),
+                (0.3, 0.1 + 0.07 * curves.len() as f64),
+            );
+            let what = if is_rate { "angular rate" } else { "angle" };
+            let unit = if is_rate { "deg/s" } else { "deg" };
+            let mut chart = ChartBuilder::on(panel)
+                .caption(format!("{} {what}", body.name), (FAMILY, 22))
+                .margin(12)
+                .x_label_area_size(50)
+                .y_label_area_size(80)
+                .build_cartesian_2d(t0..t1, y0..y1)?;
+            chart
+                .configure_mesh()
+                .x_desc("time (s)")
+                .y_desc(format!("{what} ({unit})"))
+                .label_style((FAMILY, 16))
+                .axis_desc_style((FAMILY, 18))
+                .light_line_style(RGBColor(246, 246, 246))
+                .draw()?;
+            for (label, color, dashed, points) in curves {
+                let style = color.stroke_width(if dashed { 2 } else { 1 });
+                if dashed {
+                    chart
+                        .draw_series(DashedLineSeries::new(points, 8, 5, style))?
+                        .label(label)
+                        .legend(move |(x, y)| {
+                            EmptyElement::at((x, y))
+                                + PathElement::new(vec![(0, 0), (8, 0)], color.stroke_width(2))
+                                + PathElement::new(vec![(12, 0), (20, 0)], color.stroke_width(2))
+                        });
+                } else {
+                    chart
+                        .draw_series(LineSeries::new(points, style))?
+                        .label(label)
+                        .legend(legend_line(color));
+                }
+            }
+            chart
+                .configure_series_labels()
+                .position(corner)
+                .label_font((FAMILY, 16))
+                .background_style(WHITE.mix(0.85))
+                .border_style(RGBColor(160, 160, 160))
+                .draw()?;
+        }
+    }
+    Ok(())
+}
+
+fn draw_force<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, cases: &[CaseSeries]) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    let panels = area.split_evenly((cases.len(), 2));
+    let (t0, t1) = time_range(cases);
+    let top = |f: fn(&CaseSeries) -> &Vec<f64>| {
+        let m = cases
+            .iter()
+            .flat_map(|c| f(c).iter())
+            .copied()
+            .filter(|v| v.is_finite())
+            .fold(0.0, f64::max);
+        if m > 0.0 { 1.05 * m } else { 1.0 }
+    };
+    let ideal_top = top(|c| &c.force_ideal_n);
+    let clear_top = top(|c| &c.force_n);
+    for (i, case) in cases.iter().enumerate() {
+        for (col, (name, series, y1, color)) in [
+            ("ideal joint", &case.force_ideal_n, ideal_top, BLACK),
+            ("clearance joint", &case.force_n, clear_top, case_color(i)),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let panel = &panels[i * 2 + col];
+            let mut chart = ChartBuilder::on(panel)
+                .caption(format!("{}: {name}", case.label), (FAMILY, 20))
+                .margin(10)
+                .x_label_area_size(45)
+                .y_label_area_size(80)
+                .build_cartesian_2d(t0..t1, 0.0..y1)?;
+            chart
+                .configure_mesh()
+                .x_desc("time (s)")
+                .y_desc("joint force (N)")
+                .label_style((FAMILY, 15))
+                .axis_desc_style((FAMILY, 17))
+                .light_line_style(RGBColor(246, 246, 246))
+                .draw()?;
+            let points = minmax_decimate(&case.t_s, series, t0, t1, DECIMATE_BINS);
+            let peak = series.iter().copied().fold(0.0, f64::max);
+            let corner = emptiest_corner(points.iter().copied(), (t0, t1), (0.0, y1), (0.45, 0.2));
+            chart
+                .draw_series(LineSeries::new(points, color.stroke_width(1)))?
+                .label(format!("{name}, highest row {peak:.4} N"))
+                .legend(legend_line(color));
+            chart
+                .configure_series_labels()
+                .position(corner)
+                .label_font((FAMILY, 15))
+                .background_style(WHITE.mix(0.85))
+                .border_style(RGBColor(160, 160, 160))
+                .draw()?;
+        }
+    }
+    Ok(())
+}
+
+fn draw_trajectory<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    cases: &[CaseSeries],
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    let panels = area.split_evenly((1, cases.len()));
+    for (i, case) in cases.iter().enumerate() {
+        let c = if case.clearance_mm > 0.0 {
+            case.clearance_mm
+        } else {
+            1.0
+        };
+        let lim = 1.15 * c;
+        // A square plotting area keeps the circle round: same span on both axes.
+        let (w, h) = panels[i].dim_in_pixel();
+        let side = w.min(h.saturating_sub(40));
+        let (pad_x, pad_y) = ((w - side) / 2, (h - side) / 2);
+        let panel = panels[i].margin(pad_y, pad_y, pad_x, pad_x);
+        let mut chart = ChartBuilder::on(&panel)
+            .caption(
+                if case.label.starts_with("c =") {
+                    case.label.clone()
+                } else {
+                    format!("{} (c = {:.2} mm)", case.label, case.clearance_mm)
+                },
+                (FAMILY, 20),
+            )
+            .margin(10)
+            .x_label_area_size(50)
+            .y_label_area_size(70)
+            .build_cartesian_2d(-lim..lim, -lim..lim)?;
+        chart
+            .configure_mesh()
+            .x_desc("eccentricity u (mm)")
+            .y_desc("eccentricity v (mm)")
+            .label_style((FAMILY, 15))
+            .axis_desc_style((FAMILY, 17))
+            .light_line_style(RGBColor(246, 246, 246))
+            .draw()?;
+        let circle: Vec<(f64, f64)> = (0..=720)
+            .map(|k| {
+                let a = k as f64 * std::f64::consts::PI / 360.0;
+                (c * a.cos(), c * a.sin())
+            })
+            .collect();
+        chart
+            .draw_series(LineSeries::new(circle, BLACK.stroke_width(2)))?
+            .label("clearance circle |e| = c")
+            .legend(legend_line(BLACK));
+        // A pixel is about 2 lim / 400 here; keep steps of a quarter pixel.
+        let path = decimate_path(&case.ecc_u_mm, &case.ecc_v_mm, lim / 800.0);
+        let color = case_color(i);
+        chart
+            .draw_series(LineSeries::new(path, color.stroke_width(1)))?
+            .label("journal centre")
+            .legend(legend_line(color));
+        if let (Some(&u), Some(&v)) = (case.ecc_u_mm.first(), case.ecc_v_mm.first()) {
+            chart
+                .draw_series(std::iter::once(Circle::new((u, v), 4, BLACK.filled())))?
+                .label("start")
+                .legend(|(x, y)| Circle::new((x + 10, y), 4, BLACK.filled()));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .label_font((FAMILY, 14))
+            .background_style(WHITE.mix(0.85))
+            .border_style(RGBColor(160, 160, 160))
+            .draw()?;
+    }
+    Ok(())
+}

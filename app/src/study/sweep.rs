@@ -1,0 +1,697 @@
+//! Running a grid of scenes: one ideal-vs-clearance run per point in its own folder, in
+//! parallel (rayon), resumable, shardable, and summarised in one metrics table.
+//!
+//! Layout of a sweep folder `OUT`:
+//! - `OUT/points/<dir>/{ideal.csv, clearance.csv, summary.json, point.json}` per point.
+//!   `point.json` (the manifest: the point, its scene, its metrics and the sizes of the other
+//!   files) is written last, atomically: a point is finished exactly when its manifest exists,
+//!   describes the same scene, and every file it lists has the size it records.
+//! - `OUT/metrics.csv` and `OUT/metrics.json` (whole grid), or
+//!   `OUT/metrics.shard-K-of-N.{csv,json}` for a shard; `merge` gathers shard tables.
+
+use super::grid::{Axis, Grid, Point, Shard};
+use super::metrics::RunMetrics;
+use clearance_joint::error::{Error, Result};
+use clearance_joint::scene::Scene;
+use clearance_joint::scene::output::{DirLock, MemoryEstimate, write_all_atomic, write_atomic};
+use clearance_joint::scene::runner::{RunOptions, Simulation};
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Version of the manifest and table formats.
+pub const FORMAT_VERSION: u32 = 1;
+/// Name of a point's manifest, written last.
+pub const MANIFEST: &str = "point.json";
+
+/// A grid of scenes: a base scene with fixed overrides, and the swept axes.
+#[derive(Clone, Debug)]
+pub struct Sweep {
+    /// Name of the sweep (table header, progress messages).
+    pub name: String,
+    /// The scene before any override.
+    pub base: Scene,
+    /// Overrides applied to every point before the point's own.
+    pub base_overrides: Vec<String>,
+    /// The swept axes.
+    pub grid: Grid,
+}
+
+/// One point ready to run: its scene and its folder.
+#[derive(Clone, Debug)]
+pub struct Job {
+    /// The grid point.
+    pub point: Point,
+    /// The scene with the base and point overrides applied (validated).
+    pub scene: Scene,
+    /// The point's folder.
+    pub dir: PathBuf,
+    /// The sweep's fixed overrides (recorded in the manifest).
+    pub base_overrides: Vec<String>,
+}
+
+/// A size-checked file of a finished point.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FileEntry {
+    /// File name inside the point's folder.
+    pub name: String,
+    /// Its size, bytes.
+    pub bytes: u64,
+}
+
+/// `point.json`: what a finished point holds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Manifest {
+    /// [`FORMAT_VERSION`].
+    pub format: u32,
+    /// The grid point.
+    pub point: Point,
+    /// The fixed overrides of the sweep.
+    pub base_overrides: Vec<String>,
+    /// The scene that ran, as RON: a rerun reuses the point only if its scene is identical.
+    pub scene_ron: String,
+    /// The result files and their sizes.
+    pub files: Vec<FileEntry>,
+    /// The run's metrics.
+    pub metrics: RunMetrics,
+}
+
+/// A finished point, just run or reused.
+#[derive(Clone, Debug)]
+pub struct PointOutcome {
+    /// Its manifest.
+    pub manifest: Manifest,
+    /// Its folder.
+    pub dir: PathBuf,
+    /// True when an earlier run's complete files were reused.
+    pub reused: bool,
+}
+
+/// How to show progress.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Progress {
+    /// A bar when standard error is a terminal, plain lines otherwise.
+    #[default]
+    Auto,
+    /// Always a bar.
+    Bar,
+    /// One line per finished point.
+    Lines,
+    /// Nothing.
+    Quiet,
+}
+
+/// Execution options of a sweep.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct ExecOptions {
+    /// Progress display.
+    pub progress: Progress,
+    /// Worker threads (`None`: one per core).
+    pub threads: Option<usize>,
+    /// Recompute finished points instead of reusing them.
+    pub rerun: bool,
+    /// Memory the parallel runs may hold, bytes (`None`: 80 % of what the system reports
+    /// available, see [`clearance_joint::scene::output::available_memory`]).
+    pub max_memory: Option<u64>,
+}
+
+/// The number of worker threads for `requested` (`None`: one per core), at most one per core:
+/// more threads than cores only add memory and switching. Returns the count and, when the
+/// request was cut, a message saying so.
+pub fn thread_count(requested: Option<usize>) -> Result<(usize, Option<String>)> {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    match requested {
+        Some(0) => Err(Error::invalid("--jobs", "must be at least 1 (got 0)")),
+        Some(n) if n > cores => Ok((
+            cores,
+            Some(format!(
+                "--jobs {n} capped at {cores}: this machine has {cores} core(s)"
+            )),
+        )),
+        Some(n) => Ok((n, None)),
+        None => Ok((cores, None)),
+    }
+}
+
+/// A point that failed, with the reason.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Failure {
+    /// The grid point.
+    pub point: Point,
+    /// The error message.
+    pub error: String,
+}
+
+impl Sweep {
+    /// A sweep of `grid` over `base` with fixed `base_overrides`.
+    pub fn new(
+        name: impl Into<String>,
+        base: Scene,
+        base_overrides: Vec<String>,
+        grid: Grid,
+    ) -> Sweep {
+        Sweep {
+            name: name.into(),
+            base,
+            base_overrides,
+            grid,
+        }
+    }
+
+    /// The jobs of `shard` with folders under `out/points/`. Every point's scene is built and
+    /// validated first, so a bad value fails before anything runs, naming the point.
+    pub fn jobs(&self, out: &Path, shard: Shard) -> Result<Vec<Job>> {
+        let base = self.base.with_overrides(&self.base_overrides)?;
+        shard
+            .points(&self.grid)
+            .into_iter()
+            .map(|point| {
+                let scene = base
+                    .with_overrides(&point.overrides())
+                    .map_err(|e| match e {
+                        Error::Invalid { field, reason } => Error::Invalid {
+                            field,
+                            reason: format!("{reason} (sweep point `{}`)", point.dir),
+                        },
+                        Error::Parse { what, reason } => Error::Parse {
+                            what: format!("{what} (sweep point `{}`)", point.dir),
+                            reason,
+                        },
+                        other => other,
+                    })?;
+                Ok(Job {
+                    dir: out.join("points").join(&point.dir),
+                    base_overrides: self.base_overrides.clone(),
+                    point,
+                    scene,
+                })
+            })
+            .collect()
+    }
+
+    /// The table header describing this sweep.
+    pub fn info(&self) -> SweepInfo {
+        SweepInfo {
+            format: FORMAT_VERSION,
+            name: self.name.clone(),
+            scene: self.base.name.clone(),
+            base_overrides: self.base_overrides.clone(),
+            axes: self.grid.axes.clone(),
+            points: self.grid.len(),
+        }
+    }
+
+    /// Runs `shard` of the sweep into `out` and writes its table (see the module docs). Points
+    /// that fail are listed in the table's `failures` and returned with the outcome; the error
+    /// is only for problems that stop the whole sweep (bad overrides, unwritable folder).
+    pub fn run(&self, out: &Path, shard: Shard, options: ExecOptions) -> Result<SweepOutcome> {
+        let jobs = self.jobs(out, shard)?;
+        let results = execute(&jobs, options)?;
+        let mut rows = Vec::new();
+        let mut failures = Vec::new();
+        let mut outcomes = Vec::new();
+        for (job, r) in jobs.iter().zip(results) {
+            match r {
+                Ok(o) => {
+                    rows.push(TableRow::of(&o.manifest, &job.dir, out));
+                    outcomes.push(o);
+                }
+                Err(e) => failures.push(Failure {
+                    point: job.point.clone(),
+                    error: e.to_string(),
+                }),
+            }
+        }
+        let table = MetricsTable {
+            sweep: self.info(),
+            shard: (!shard.is_all()).then_some(shard),
+            rows,
+            failures,
+            missing: Vec::new(),
+        };
+        table.write(out)?;
+        Ok(SweepOutcome {
+            points: outcomes,
+            table,
+        })
+    }
+}
+
+/// What a sweep run produced.
+#[derive(Clone, Debug)]
+pub struct SweepOutcome {
+    /// Finished points, in grid order.
+    pub points: Vec<PointOutcome>,
+    /// The table written (with the failures).
+    pub table: MetricsTable,
+}
+
+impl Job {
+    /// The point's manifest if the point is finished: manifest readable, same format and scene,
+    /// and every listed file present with its recorded size. Anything else means unfinished.
+    pub fn finished(&self) -> Option<Manifest> {
+        let text = std::fs::read_to_string(self.dir.join(MANIFEST)).ok()?;
+        let m: Manifest = serde_json::from_str(&text).ok()?;
+        if m.format != FORMAT_VERSION || m.scene_ron != self.scene.to_ron() {
+            return None;
+        }
+        for f in &m.files {
+            let meta = std::fs::metadata(self.dir.join(&f.name)).ok()?;
+            if !meta.is_file() || meta.len() != f.bytes {
+                return None;
+            }
+        }
+        Some(m)
+    }
+
+    /// Runs the point and writes its files, the manifest last. An old manifest is removed
+    /// first, so an interrupted rerun never looks finished.
+    pub fn run(&self) -> Result<Manifest> {
+        // One process per point folder: a second sweep running the same point is refused
+        // rather than mixing its files with ours.
+        let _lock = DirLock::acquire(&self.dir)?;
+        remove_if_present(&self.dir.join(MANIFEST))?;
+        let adaptive = self.scene.run.step == clearance_joint::scene::StepMode::Adaptive;
+        let result = Simulation::new(&self.scene, RunOptions::default())?
+            .run()
+            .map_err(|e| e.with_step_mode(adaptive))?;
+        let metrics = RunMetrics::of(&result)?;
+        result.write(&self.dir)?;
+        let mut files = Vec::new();
+        for twin in &result.twins {
+            files.push(format!("{}.csv", twin.kind.name()));
+        }
+        files.push("summary.json".into());
+        let files = files
+            .into_iter()
+            .map(|name| {
+                let path = self.dir.join(&name);
+                let bytes = std::fs::metadata(&path)
+                    .map_err(|source| Error::Io {
+                        action: "cannot read the size of",
+                        path,
+                        source,
+                    })?
+                    .len();
+                Ok(FileEntry { name, bytes })
+            })
+            .collect::<Result<Vec<_>>>()?;
+        let manifest = Manifest {
+            format: FORMAT_VERSION,
+            point: self.point.clone(),
+            base_overrides: self.base_overrides.clone(),
+            scene_ron: self.scene.to_ron(),
+            files,
+            metrics,
+        };
+        write_atomic(
+            &self.dir.join(MANIFEST),
+            &json_bytes(&manifest, "manifest")?,
+        )?;
+        Ok(manifest)
+    }
+}
+
+fn remove_if_present(path: &Path) -> Result<()> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(Error::Io {
+            action: "cannot remove",
+            path: path.to_path_buf(),
+            source: e,
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// Pretty JSON of a serialisable value (refusing non-finite numbers, which JSON cannot hold).
+pub(crate) fn json_bytes<T: Serialize>(value: &T, what: &str) -> Result<Vec<u8>> {
+    let v = serde_json::to_value(value).map_err(|e| Error::invalid(what, e.to_string()))?;
+    serde_json::to_vec_pretty(&v).map_err(|e| Error::invalid(what, e.to_string()))
+}
+
+/// Runs `jobs` (reusing finished ones unless `rerun`) in parallel; results in job order.
+/// Fails only if the thread pool cannot be built; each job has its own result.
+pub fn execute(jobs: &[Job], options: ExecOptions) -> Result<Vec<Result<PointOutcome>>> {
+    let (threads, _) = thread_count(options.threads)?;
+    check_memory(jobs, threads, options.max_memory)?;
+    let progress = Reporter::new(jobs.len(), options.progress);
+    let work = || -> Vec<Result<PointOutcome>> {
+        jobs.par_iter()
+            .map(|job| {
+                let start = Instant::now();
+                let outcome = match (!options.rerun).then(|| job.finished()).flatten() {
+                    Some(manifest) => Ok(PointOutcome {
+                        manifest,
+                        dir: job.dir.clone(),
+                        reused: true,
+                    }),
+                    None => job.run().map(|manifest| PointOutcome {
+                        manifest,
+                        dir: job.dir.clone(),
+                        reused: false,
+                    }),
+                };
+                progress.done(job, &outcome, start.elapsed().as_secs_f64());
+                outcome
+            })
+            .collect()
+    };
+    let results = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| Error::invalid("--jobs", e.to_string()))?
+        .install(work);
+    progress.finish();
+    Ok(results)
+}
+
+/// Refuses, before any point runs, a batch whose parallel runs would hold more memory than
+/// `budget` (default: what the system has available): the largest point's estimate times the
+/// runs in flight at once.
+pub fn check_memory(jobs: &[Job], threads: usize, budget: Option<u64>) -> Result<()> {
+    let Some(budget) = budget.or_else(clearance_joint::scene::output::available_memory) else {
+        return Ok(());
+    };
+    let Some((job, estimate)) = jobs
+        .iter()
+        .map(|j| (j, MemoryEstimate::of(&j.scene)))
+        .max_by_key(|(_, e)| e.bytes)
+    else {
+        return Ok(());
+    };
+    let concurrent = threads.min(jobs.len()).max(1) as u64;
+    estimate
+        .check(&job.scene, concurrent, budget)
+        .map_err(|e| match e {
+            Error::Invalid { field, reason } => Error::Invalid {
+                field,
+                reason: format!("{reason} (sweep point `{}`)", job.point.dir),
+            },
+            other => other,
+        })
+}
+
+/// Progress display: an indicatif bar or plain lines on standard error.
+struct Reporter {
+    bar: Option<ProgressBar>,
+    lines: bool,
+    total: usize,
+    done: std::sync::atomic::AtomicUsize,
+}
+
+impl Reporter {
+    fn new(total: usize, mode: Progress) -> Reporter {
+        let mode = match mode {
+            Progress::Auto if std::io::stderr().is_terminal() => Progress::Bar,
+            Progress::Auto => Progress::Lines,
+            m => m,
+        };
+        let bar = (mode == Progress::Bar).then(|| {
+            let b = ProgressBar::new(total as u64);
+            if let Ok(style) = ProgressStyle::with_template(
+                "{elapsed_precise} [{bar:30}] {pos}/{len} points {msg}",
+            ) {
+                b.set_style(style.progress_chars("=> "));
+            }
+            b
+        });
+        Reporter {
+            bar,
+            lines: mode == Progress::Lines,
+            total,
+            done: std::sync::atomic::AtomicUsize::new(0),
+        }
+    }
+
+    fn done(&self, job: &Job, outcome: &Result<PointOutcome>, seconds: f64) {
+        let n = self.done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        let what = match outcome {
+            Ok(o) if o.reused => "reused (finished earlier)".to_string(),
+            Ok(_) => format!("done in {seconds:.2} s"),
+            Err(e) => format!("FAILED: {e}"),
+        };
+        let line = format!("[{n}/{}] {}: {what}", self.total, job.point.dir);
+        if let Some(bar) = &self.bar {
+            if outcome.is_err() {
+                bar.println(&line);
+            }
+            bar.set_message(job.point.dir.clone());
+            bar.inc(1);
+        } else if self.lines {
+            eprintln!("{line}");
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+/// Header of a metrics table: which sweep it belongs to.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct SweepInfo {
+    /// [`FORMAT_VERSION`].
+    pub format: u32,
+    /// Sweep name.
+    pub name: String,
+    /// Base scene name.
+    pub scene: String,
+    /// Fixed overrides.
+    pub base_overrides: Vec<String>,
+    /// Swept axes.
+    pub axes: Vec<Axis>,
+    /// Number of points of the whole grid.
+    pub points: usize,
+}
+
+/// One row of the metrics table: a finished point.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TableRow {
+    /// The grid point.
+    pub point: Point,
+    /// Its folder, relative to the sweep folder (`points/<dir>`).
+    pub dir: String,
+    /// Its metrics.
+    pub metrics: RunMetrics,
+}
+
+impl TableRow {
+    fn of(manifest: &Manifest, dir: &Path, out: &Path) -> TableRow {
+        TableRow {
+            point: manifest.point.clone(),
+            dir: dir
+                .strip_prefix(out)
+                .unwrap_or(dir)
+                .to_string_lossy()
+                .replace('\\', "/"),
+            metrics: manifest.metrics.clone(),
+        }
+    }
+}
+
+/// The per-run metrics of a sweep (or of one shard of it).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MetricsTable {
+    /// The sweep.
+    pub sweep: SweepInfo,
+    /// The shard this table covers (`None`: the whole grid or a merge).
+    pub shard: Option<Shard>,
+    /// Finished points, in grid order.
+    pub rows: Vec<TableRow>,
+    /// Points that failed.
+    pub failures: Vec<Failure>,
+    /// Indices of grid points with neither a row nor a failure (after a merge of incomplete shards).
+    #[serde(default)]
+    pub missing: Vec<usize>,
+}
+
+impl MetricsTable {
+    /// File stem of this table: `metrics` or `metrics.shard-K-of-N`.
+    pub fn stem(&self) -> String {
+        match self.shard {
+            Some(s) => format!("metrics.shard-{}-of-{}", s.index(), s.count()),
+            None => "metrics".into(),
+        }
+    }
+
+    /// CSV text: `index, dir`, one column per axis (its value as written), then the metrics
+    /// columns of [`RunMetrics::columns`]; an optional metric without value is an empty cell.
+    pub fn to_csv(&self) -> Result<String> {
+        let mut header: Vec<String> = vec!["index".into(), "dir".into()];
+        header.extend(self.sweep.axes.iter().map(|a| csv_cell(&a.path)));
+        let metric_names: Vec<String> = self
+            .rows
+            .first()
+            .map(|r| r.metrics.columns().into_iter().map(|c| c.0).collect())
+            .unwrap_or_default();
+        header.extend(metric_names.iter().cloned());
+        let mut s = header.join(",");
+        s.push('\n');
+        for r in &self.rows {
+            let cols = r.metrics.columns();
+            if cols.len() != metric_names.len()
+                || cols.iter().zip(&metric_names).any(|(c, n)| &c.0 != n)
+            {
+                return Err(Error::invalid(
+                    "metrics table",
+                    format!(
+                        "point `{}` has other metric columns than the first point (different bodies or hinges)",
+                        r.point.dir
+                    ),
+                ));
+            }
+            let mut cells = vec![r.point.index.to_string(), csv_cell(&r.dir)];
+            cells.extend(r.point.assignments.iter().map(|(_, v)| csv_cell(v)));
+            for (name, v) in cols {
+                cells.push(match v {
+                    Some(x) if x.is_finite() => format!("{x}"),
+                    Some(x) => {
+                        return Err(Error::Diverged {
+                            t: r.metrics.end_s,
+                            reason: format!("metric `{name}` of `{}` is {x}", r.point.dir),
+                        });
+                    }
+                    None => String::new(),
+                });
+            }
+            s.push_str(&cells.join(","));
+            s.push('\n');
+        }
+        Ok(s)
+    }
+
+    /// Writes `<stem>.csv` and `<stem>.json` into `out` as one set (see [`MetricsTable::stem`]).
+    pub fn write(&self, out: &Path) -> Result<()> {
+        self.write_named(out, &self.stem())
+    }
+
+    /// Writes `<stem>.csv` and `<stem>.json` into `out` as one set, the JSON last.
+    pub fn write_named(&self, out: &Path, stem: &str) -> Result<()> {
+        for r in &self.rows {
+            r.metrics.check_finite()?;
+        }
+        let csv = self.to_csv()?;
+        let json = json_bytes(self, "metrics table")?;
+        // One set, the JSON (which `merge` reads) last.
+        write_all_atomic(&[
+            (&out.join(format!("{stem}.csv")), csv.as_bytes()),
+            (&out.join(format!("{stem}.json")), &json),
+        ])
+    }
+
+    /// Reads a table written by [`MetricsTable::write`] (its JSON file).
+    pub fn load(path: &Path) -> Result<MetricsTable> {
+        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+            action: "cannot read metrics table",
+            path: path.to_path_buf(),
+            source,
+        })?;
+        serde_json::from_str(&text).map_err(|e| Error::Parse {
+            what: path.display().to_string(),
+            reason: e.to_string(),
+        })
+    }
+}
+
+/// A CSV cell: quoted when it holds a comma, quote or newline.
+fn csv_cell(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// The shard tables (`metrics.shard-*.json`) in `dir`, sorted by name.
+pub fn shard_tables_in(dir: &Path) -> Result<Vec<PathBuf>> {
+    let entries = std::fs::read_dir(dir).map_err(|source| Error::Io {
+        action: "cannot list",
+        path: dir.to_path_buf(),
+        source,
+    })?;
+    let mut found: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            p.file_name()
+                .and_then(|n| n.to_str())
+                .is_some_and(|n| n.starts_with("metrics.shard-") && n.ends_with(".json"))
+        })
+        .collect();
+    found.sort();
+    Ok(found)
+}
+
+/// Gathers shard tables of one sweep into one table for the whole grid. Every table must
+/// describe the same sweep; a point in two tables must have identical metrics. A point failed
+/// in one shard but finished in another counts as finished. Grid points in no table are listed
+/// in `missing` (the caller decides whether that is an error).
+pub fn merge(tables: &[MetricsTable]) -> Result<MetricsTable> {
+    let first = tables
+        .first()
+        .ok_or_else(|| Error::invalid("merge", "no shard table given"))?;
+    let info = first.sweep.clone();
+    let mut rows: std::collections::BTreeMap<usize, TableRow> = Default::default();
+    let mut failures: std::collections::BTreeMap<usize, Failure> = Default::default();
+    for (i, t) in tables.iter().enumerate() {
+        if t.sweep != info {
+            return Err(Error::invalid(
+                format!("merge: table {}", i + 1),
+                format!(
+                    "belongs to another sweep (`{}` with {} points, {:?}) than table 1 (`{}` with {} points, {:?})",
+                    t.sweep.name, t.sweep.points, t.sweep.axes, info.name, info.points, info.axes
+                ),
+            ));
+        }
+        for r in &t.rows {
+            if r.point.index >= info.points {
+                return Err(Error::invalid(
+                    format!("merge: table {}", i + 1),
+                    format!(
+                        "has point {} outside the grid of {}",
+                        r.point.index, info.points
+                    ),
+                ));
+            }
+            match rows.get(&r.point.index) {
+                // Wall time is a measurement of the machine, not of the physics: a point
+                // recomputed in two shards agrees in everything else.
+                Some(old) if !same_physics(&old.metrics, &r.metrics) => {
+                    return Err(Error::invalid(
+                        format!("merge: point `{}`", r.point.dir),
+                        "appears in two tables with different metrics",
+                    ));
+                }
+                Some(_) => {}
+                None => {
+                    rows.insert(r.point.index, r.clone());
+                }
+            }
+        }
+        for f in &t.failures {
+            failures.entry(f.point.index).or_insert_with(|| f.clone());
+        }
+    }
+    failures.retain(|k, _| !rows.contains_key(k));
+    let missing = (0..info.points)
+        .filter(|i| !rows.contains_key(i) && !failures.contains_key(i))
+        .collect();
+    Ok(MetricsTable {
+        sweep: info,
+        shard: None,
+        rows: rows.into_values().collect(),
+        failures: failures.into_values().collect(),
+        missing,
+    })
+}
+
+/// Two runs' metrics equal in everything but the wall time.
+fn same_physics(a: &super::metrics::RunMetrics, b: &super::metrics::RunMetrics) -> bool {
+    let mut b = b.clone();
+    b.wall_s = a.wall_s;
+    *a == b
+}

@@ -1,0 +1,234 @@
+//! Every invalid input named in DEVELOPERS.md gets a clear error naming the field, never a panic,
+//! and a failed run leaves no result file behind.
+
+use clearance_joint::Error;
+use clearance_joint::scene::runner::{RunOptions, Simulation};
+use clearance_joint::scene::{SOLAR_PANEL_RON, Scene};
+use std::process::Command;
+
+fn override_err(set: &[&str]) -> String {
+    Scene::solar_panel()
+        .with_overrides(set)
+        .expect_err("must be refused")
+        .to_string()
+}
+
+#[test]
+fn non_positive_clearance() {
+    for c in ["0", "-0.1"] {
+        let e = override_err(&[&format!("hinge.clearance_mm={c}")]);
+        assert!(
+            e.contains("hinges[hinge].clearance.clearance_mm") && e.contains("> 0"),
+            "{e}"
+        );
+    }
+}
+
+#[test]
+fn journal_larger_than_bearing() {
+    let e = override_err(&["hinge.clearance_mm=12"]);
+    assert!(
+        e.contains("clearance_mm") && e.contains("bearing radius"),
+        "{e}"
+    );
+}
+
+#[test]
+fn nan_in_a_scene_file() {
+    let text = SOLAR_PANEL_RON.replace("mass_kg: 7.68", "mass_kg: NaN");
+    let e = Scene::from_ron(&text, "nan.ron").unwrap_err().to_string();
+    assert!(
+        e.contains("bodies[panel].mass_kg") && e.contains("NaN"),
+        "{e}"
+    );
+}
+
+#[test]
+fn unknown_model_name() {
+    let text = SOLAR_PANEL_RON.replace("contact: ImprovedLiu(", "contact: Improved(");
+    let e = Scene::from_ron(&text, "bad.ron").unwrap_err().to_string();
+    assert!(
+        e.contains("bad.ron") && e.contains("Improved") && e.contains("ImprovedLiu"),
+        "{e}"
+    );
+    let e = override_err(&["hinge.friction=Sticky"]);
+    assert!(e.contains("Sticky") && e.contains("Lubricated"), "{e}");
+}
+
+#[test]
+fn malformed_scene_file_names_the_position() {
+    let text = SOLAR_PANEL_RON.replace("bodies: [", "bodies: [[");
+    let e = Scene::from_ron(&text, "broken.ron").unwrap_err();
+    assert!(matches!(e, Error::Parse { .. }));
+    let e = e.to_string();
+    assert!(
+        e.contains("broken.ron") && e.chars().any(|c| c.is_ascii_digit()),
+        "{e}"
+    );
+}
+
+#[test]
+fn unknown_override_path() {
+    let e = override_err(&["hinge.clearence_mm=0.2"]);
+    assert!(e.contains("clearence_mm"), "{e}");
+    let e = override_err(&["wing.clearance_mm=0.2"]);
+    assert!(e.contains("wing"), "{e}");
+}
+
+#[test]
+fn bad_laws_parameters_are_named() {
+    let e = override_err(&[r#"hinge.contact={"HuntCrossley":{"restitution":1.5}}"#]);
+    assert!(
+        e.contains("hinges[hinge].clearance.contact.restitution"),
+        "{e}"
+    );
+    let e = override_err(&[
+        r#"hinge.friction={"Bai":{"mu_s":0.3,"mu_d":0.25,"v_s_mm_s":10,"v_d_mm_s":0.1}}"#,
+    ]);
+    assert!(e.contains("hinges[hinge].clearance.friction.v_d"), "{e}");
+    let e = override_err(&["run.dt_s=-1e-4"]);
+    assert!(e.contains("run.dt_s"), "{e}");
+}
+
+#[test]
+fn step_too_large_for_the_contact_stiffness() {
+    let scene = Scene::solar_panel()
+        .with_overrides(&["run.step=Fixed", "run.dt_s=5e-4"])
+        .unwrap();
+    let e = Simulation::new(&scene, RunOptions::default())
+        .unwrap()
+        .run()
+        .unwrap_err();
+    match &e {
+        Error::StepTooLarge { field, dt_max, .. } => {
+            assert_eq!(field, "run.dt_s");
+            assert!(*dt_max < 5e-4 && *dt_max > 1e-5, "{dt_max}");
+        }
+        other => panic!("expected StepTooLarge, got {other}"),
+    }
+}
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
+}
+
+#[test]
+fn cli_refuses_without_writing_anything() {
+    let dir = std::env::temp_dir().join(format!("cj-refused-{}", std::process::id()));
+    let out = bin()
+        .args(["--set", "run.step=Fixed", "--dt", "1e-3", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("run.dt_s") && err.contains("too large"),
+        "{err}"
+    );
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(
+        !dir.exists() || std::fs::read_dir(&dir).unwrap().next().is_none(),
+        "files left in {}",
+        dir.display()
+    );
+}
+
+#[test]
+fn cli_writes_the_specified_files() {
+    let dir = std::env::temp_dir().join(format!("cj-ok-{}", std::process::id()));
+    let out = bin()
+        .args(["--end", "0.2", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let header = "t_s,satellite_angle_deg,satellite_rate_deg_s,panel_angle_deg,panel_rate_deg_s,hinge_angle_deg,\
+                  hinge_rate_deg_s,hinge_force_n,hinge_ecc_u_mm,hinge_ecc_v_mm,hinge_penetration_um,hinge_contact";
+    for twin in ["ideal", "clearance"] {
+        let csv = std::fs::read_to_string(dir.join(format!("{twin}.csv"))).unwrap();
+        let mut lines = csv.lines();
+        assert_eq!(lines.next().unwrap(), header);
+        let rows: Vec<&str> = lines.collect();
+        assert_eq!(rows.len(), 2001, "one row per 0.1 ms from 0 to 0.2 s");
+        assert!(!csv.contains("NaN") && !csv.contains("inf"));
+    }
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    for key in [
+        "steps",
+        "wall_s",
+        "final_angles_deg",
+        "peak_joint_force_n",
+        "impacts",
+        "first_impact_t_s",
+        "first_impact_peak_n",
+        "max_penetration_um",
+        "linear_momentum_drift",
+        "angular_momentum_drift",
+    ] {
+        let v = &summary["twins"]["clearance"][key];
+        assert!(v.is_number() || v.is_object(), "`{key}` is {v}");
+    }
+    // The first impact of the paper's scene comes at 0.0875 s, within the 0.2 s run.
+    let t = summary["twins"]["clearance"]["first_impact_t_s"]
+        .as_f64()
+        .unwrap();
+    assert!((t - 0.0875).abs() < 1e-3, "{t}");
+    assert!(summary["twins"]["ideal"]["first_impact_t_s"].is_null());
+    // No temporary files left behind.
+    assert!(
+        std::fs::read_dir(&dir).unwrap().all(|e| !e
+            .unwrap()
+            .file_name()
+            .to_string_lossy()
+            .starts_with('.'))
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn names_that_would_break_outputs() {
+    let text = SOLAR_PANEL_RON.replace("name: \"hinge\"", "name: \"hin,ge\"");
+    let e = Scene::from_ron(&text, "names.ron").unwrap_err().to_string();
+    assert!(e.contains("hinges[hin,ge]") && e.contains("letters"), "{e}");
+    let e = override_err(&["name=\"..\""]);
+    assert!(e.contains("`name`"), "{e}");
+}
+
+#[test]
+fn too_many_rows() {
+    let e = override_err(&["run.end_s=1e4", "run.output_interval_s=1e-6"]);
+    assert!(
+        e.contains("run.output_interval_s") && e.contains("rows"),
+        "{e}"
+    );
+}
+
+#[test]
+fn geometric_stiffness_only_for_exponent_one_and_a_half() {
+    let e = override_err(&[r#"hinge.contact={"HuntCrossley":{"restitution":0.8,"exponent":1.0}}"#]);
+    assert!(
+        e.contains("hinges[hinge].clearance.contact.stiffness") && e.contains("1.5"),
+        "{e}"
+    );
+    // With n = 1.5 the default applies; with an explicit stiffness any n is fine.
+    Scene::solar_panel()
+        .with_overrides(&[r#"hinge.contact={"HuntCrossley":{"restitution":0.8}}"#])
+        .unwrap();
+    Scene::solar_panel()
+        .with_overrides(&[
+            r#"hinge.contact={"HuntCrossley":{"restitution":0.8,"exponent":1.0,"stiffness":1e9}}"#,
+        ])
+        .unwrap();
+}
+
+#[test]
+fn unlocked_out_of_plane_motion_in_a_scene() {
+    let e = override_err(&["hinge.lock=None"]);
+    assert!(e.contains("hinges[hinge].clearance.lock"), "{e}");
+}

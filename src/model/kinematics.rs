@@ -1,0 +1,251 @@
+//! Journal-bearing kinematics and the contact force pair (MODEL.md §1): pure functions of
+//! poses and velocities, no Rapier state.
+
+use crate::model::laws::{BearingGeometry, FrictionLaw, NormalContact, NormalForceLaw};
+use rapier3d_f64::math::Vector;
+
+/// Position of the centre of mass and velocities of one rigid body, in world coordinates.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BodyMotion {
+    /// World position of the centre of mass, m.
+    pub center_of_mass: Vector,
+    /// Linear velocity of the centre of mass, m/s.
+    pub linvel: Vector,
+    /// Angular velocity, rad/s.
+    pub angvel: Vector,
+}
+
+impl BodyMotion {
+    /// Velocity of the material point at world position `point`.
+    #[inline]
+    pub fn velocity_at(&self, point: Vector) -> Vector {
+        self.linvel + self.angvel.cross(point - self.center_of_mass)
+    }
+}
+
+/// Journal motion mode (paper Fig. 1b).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub enum ContactMode {
+    /// No contact: `delta <= 0`.
+    #[default]
+    FreeFlight,
+    /// A contact that has just begun, from onset until the end of its compression phase
+    /// (the first step at which the penetration stops growing).
+    Impact,
+    /// The rest of a contact: restitution, or the journal following the bearing wall.
+    Continuous,
+}
+
+/// Geometric and kinematic state of one journal in its bearing (MODEL.md §1).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct JournalState {
+    /// Eccentricity `e`: the part of `P_j - P_i` normal to the axis, m.
+    pub eccentricity: Vector,
+    /// Unit normal `n = e/|e|` (bearing centre towards journal centre); an arbitrary
+    /// in-plane unit vector when `e = 0`.
+    pub normal: Vector,
+    /// Penetration `delta = |e| - c`, m (negative: free gap).
+    pub penetration: f64,
+    /// Penetration rate `delta_dot = v_rel . n`, m/s.
+    pub penetration_rate: f64,
+    /// In-plane tangential slip velocity `v_t`, m/s.
+    pub slip: Vector,
+    /// The common application point of the force pair: midpoint of `Q_i` and `Q_j`.
+    pub contact_point: Vector,
+}
+
+/// Computes [`JournalState`] from the bearing centre `p_i`, journal centre `p_j`, the unit
+/// bearing axis `axis` (world), and both bodies' motion.
+pub fn journal_state(
+    geometry: &BearingGeometry,
+    p_i: Vector,
+    p_j: Vector,
+    axis: Vector,
+    bearing: &BodyMotion,
+    journal: &BodyMotion,
+) -> JournalState {
+    let d = p_j - p_i;
+    let eccentricity = d - d.dot(axis) * axis;
+    let e = eccentricity.length();
+    let normal = if e > 0.0 {
+        eccentricity / e
+    } else {
+        axis.any_orthonormal_vector()
+    };
+    let q_i = p_i + geometry.bearing_radius() * normal;
+    let q_j = p_j + geometry.journal_radius() * normal;
+    let v_rel = journal.velocity_at(q_j) - bearing.velocity_at(q_i);
+    let penetration_rate = v_rel.dot(normal);
+    let slip = v_rel - penetration_rate * normal - v_rel.dot(axis) * axis;
+    JournalState {
+        eccentricity,
+        normal,
+        penetration: e - geometry.clearance(),
+        penetration_rate,
+        slip,
+        contact_point: 0.5 * (q_i + q_j),
+    }
+}
+
+/// The equal-and-opposite contact force pair of one joint.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ForcePair {
+    /// Force on the journal body, N; the bearing body receives its negative at the same point.
+    pub on_journal: Vector,
+    /// World point where both forces act, so the pair has no net moment.
+    pub point: Vector,
+    /// Normal force magnitude `F_N >= 0`, N.
+    pub normal_force: f64,
+    /// Friction force magnitude, N.
+    pub friction_force: f64,
+}
+
+/// Evaluates the laws at `state`: `F = -F_N n - mu(|v_t|) F_N v_t/|v_t|` on the journal (MODEL.md §1).
+/// `impact_rate` is `delta_dot0` of the current contact (already floored positive).
+pub fn contact_force(
+    state: &JournalState,
+    impact_rate: f64,
+    normal: &impl NormalForceLaw,
+    friction: &impl FrictionLaw,
+) -> ForcePair {
+    let normal_force = normal.normal_force(&NormalContact {
+        penetration: state.penetration,
+        penetration_rate: state.penetration_rate,
+        impact_rate,
+    });
+    if normal_force <= 0.0 {
+        return ForcePair {
+            point: state.contact_point,
+            ..ForcePair::default()
+        };
+    }
+    let slip_speed = state.slip.length();
+    let (friction_force, friction) = if slip_speed > 0.0 {
+        let f = friction.coefficient(slip_speed) * normal_force;
+        (f, -f / slip_speed * state.slip)
+    } else {
+        (0.0, Vector::ZERO)
+    };
+    ForcePair {
+        on_journal: -normal_force * state.normal + friction,
+        point: state.contact_point,
+        normal_force,
+        friction_force,
+    }
+}
+
+/// Largest stable step of symplectic Euler for the contact linearised at `state`:
+/// `m x'' = -k x - d x'` is stable for `omega dt <= 2 (sqrt(1 + zeta^2) - zeta)`,
+/// `omega = sqrt(k/m)`, `zeta = d/(2 m omega)` (the eigenvalues of the one-step map).
+/// Returns `(dt_max, omega, zeta)`. Without stiffness (`k <= 0`) damping alone limits the step to
+/// `2 m/d` (reported with `omega = 0`, `zeta` infinite); without either `dt_max` is infinite.
+pub fn stable_step(stiffness: f64, damping: f64, effective_mass: f64) -> (f64, f64, f64) {
+    if !(effective_mass > 0.0) || !effective_mass.is_finite() {
+        return (f64::INFINITY, 0.0, 0.0);
+    }
+    if !(stiffness > 0.0) {
+        // Pure damping `m x'' = -d x'`: `v (1 - dt d/m)` per step, stable for `dt <= 2 m/d`.
+        return if damping > 0.0 {
+            (2.0 * effective_mass / damping, 0.0, f64::INFINITY)
+        } else {
+            (f64::INFINITY, 0.0, 0.0)
+        };
+    }
+    let omega = (stiffness / effective_mass).sqrt();
+    let zeta = damping.max(0.0) / (2.0 * effective_mass * omega);
+    (
+        2.0 * ((1.0 + zeta * zeta).sqrt() - zeta) / omega,
+        omega,
+        zeta,
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::laws::{Bai, FrictionModel, Hertz};
+
+    fn geometry() -> BearingGeometry {
+        BearingGeometry::new(0.010, 0.0095, 0.016).unwrap()
+    }
+
+    #[test]
+    fn eccentricity_penetration_and_rates_by_hand() {
+        let axis = Vector::new(0.0, -1.0, 0.0);
+        let p_i = Vector::new(0.4, 0.0, 0.4);
+        // journal centre 0.6 mm along +x, plus an axial offset that must be ignored
+        let p_j = p_i + Vector::new(0.6e-3, 0.003, 0.0);
+        let bearing = BodyMotion::default();
+        let journal = BodyMotion {
+            center_of_mass: Vector::new(0.4, 0.0, 0.0),
+            linvel: Vector::new(0.01, 0.0, 0.02),
+            angvel: Vector::ZERO,
+        };
+        let s = journal_state(&geometry(), p_i, p_j, axis, &bearing, &journal);
+        assert!((s.eccentricity - Vector::new(0.6e-3, 0.0, 0.0)).length() < 1e-15);
+        assert!((s.penetration - 0.1e-3).abs() < 1e-15);
+        assert!((s.normal - Vector::X).length() < 1e-15);
+        assert!((s.penetration_rate - 0.01).abs() < 1e-15);
+        assert!((s.slip - Vector::new(0.0, 0.0, 0.02)).length() < 1e-15);
+        // Q_i = P_i + 10 mm x, Q_j = P_j + 9.5 mm x (axial offset kept): midpoint
+        let expected = 0.5 * ((p_i + 0.010 * Vector::X) + (p_j + 0.0095 * Vector::X));
+        assert!((s.contact_point - expected).length() < 1e-15);
+    }
+
+    #[test]
+    fn rotation_adds_surface_velocity() {
+        // Bearing spinning about the axis at w: its surface point Q_i moves at w x (Q_i - com).
+        let axis = Vector::Z;
+        let bearing = BodyMotion {
+            center_of_mass: Vector::ZERO,
+            linvel: Vector::ZERO,
+            angvel: Vector::new(0.0, 0.0, 2.0),
+        };
+        let journal = BodyMotion::default();
+        let s = journal_state(
+            &geometry(),
+            Vector::ZERO,
+            Vector::new(1e-3, 0.0, 0.0),
+            axis,
+            &bearing,
+            &journal,
+        );
+        // Q_i = (0.010, 0, 0) moves at (0, 0.02, 0); v_rel = -(0, 0.02, 0): pure slip
+        assert!(s.penetration_rate.abs() < 1e-15);
+        assert!((s.slip - Vector::new(0.0, -0.02, 0.0)).length() < 1e-15);
+    }
+
+    #[test]
+    fn force_pair_opposes_penetration_and_slip() {
+        let s = JournalState {
+            eccentricity: Vector::X * 0.5001e-3,
+            normal: Vector::X,
+            penetration: 1e-7,
+            penetration_rate: 0.0,
+            slip: Vector::new(0.0, 0.0, 1.0),
+            contact_point: Vector::ZERO,
+        };
+        let law = Hertz::new(1e12, 1.5).unwrap();
+        let f = contact_force(&s, 1.0, &law, &FrictionModel::Bai(Bai::DRY));
+        // F_N = 1e12 * 1e-7^1.5 = 1e12 * 3.1623e-11 = 31.623 N, friction 0.25 F_N along -z
+        assert!((f.normal_force - 31.622776601683793).abs() < 1e-9);
+        assert!(
+            (f.on_journal - Vector::new(-f.normal_force, 0.0, -0.25 * f.normal_force)).length()
+                < 1e-9
+        );
+    }
+
+    #[test]
+    fn stable_step_by_hand() {
+        // undamped: 2/omega; omega = sqrt(4e8/4) = 1e4
+        let (dt, omega, zeta) = stable_step(4e8, 0.0, 4.0);
+        assert!((omega - 1e4).abs() < 1e-9 && zeta == 0.0 && (dt - 2e-4).abs() < 1e-15);
+        // zeta = 1: 2 (sqrt 2 - 1)/omega
+        let (dt, _, zeta) = stable_step(4e8, 2.0 * 4.0 * 1e4, 4.0);
+        assert!((zeta - 1.0).abs() < 1e-15 && (dt - 2.0 * (2f64.sqrt() - 1.0) / 1e4).abs() < 1e-15);
+        assert!(stable_step(0.0, 0.0, 1.0).0.is_infinite());
+        // pure damping: 2 m/d
+        assert!((stable_step(0.0, 4.0, 2.0).0 - 1.0).abs() < 1e-15);
+        assert!((stable_step(-5.0, 8.0, 2.0).0 - 0.5).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,169 @@
+//! Torsion-spring drive between two bodies (MODEL.md §4, eq. 20): `T = T0 - k theta`.
+
+use crate::error::{Result, finite, non_negative, unit_vector};
+use crate::model::angle::HingeAngle;
+use crate::rapier::ledger::{ForceLedger, Wrench};
+use rapier3d_f64::math::Vector;
+use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
+
+/// A torsion spring about a hinge axis: torque `+T a` on body 2, `-T a` on body 1 (a pure couple,
+/// so total momentum is unchanged). `theta` is body 2's rotation relative to body 1 about the
+/// axis, zero when the drive is created.
+#[derive(Clone, Debug)]
+pub struct TorsionSpring {
+    body1: RigidBodyHandle,
+    body2: RigidBodyHandle,
+    local_axis1: Vector,
+    torque0: f64,
+    stiffness: f64,
+    angle: HingeAngle,
+    last_torque: f64,
+}
+
+impl TorsionSpring {
+    /// Preload `torque0` (N m) and stiffness (N m/rad), about `local_axis1` (body 1's frame).
+    pub fn new(
+        body1: RigidBodyHandle,
+        body2: RigidBodyHandle,
+        local_axis1: Vector,
+        torque0: f64,
+        stiffness: f64,
+    ) -> Result<Self> {
+        finite("torque0_nm", torque0)?;
+        non_negative("stiffness_nm_per_deg", stiffness)?;
+        Ok(TorsionSpring {
+            body1,
+            body2,
+            local_axis1: unit_vector("axis", local_axis1)?,
+            torque0,
+            stiffness,
+            angle: HingeAngle::default(),
+            last_torque: 0.0,
+        })
+    }
+
+    /// The torque law `T(theta) = T0 - k theta`, N m.
+    pub fn torque_at(&self, theta: f64) -> f64 {
+        self.torque0 - self.stiffness * theta
+    }
+
+    /// Potential energy `-(T0 theta - k theta^2/2)` of the spring at `theta`, J (so that kinetic
+    /// plus potential energy is conserved by an ideal mechanism).
+    pub fn potential_energy(&self, theta: f64) -> f64 {
+        -(self.torque0 * theta - 0.5 * self.stiffness * theta * theta)
+    }
+
+    /// The relative angle at the last application, rad.
+    pub fn angle(&self) -> f64 {
+        self.angle.value()
+    }
+
+    /// The torque applied at the last application, N m.
+    pub fn torque(&self) -> f64 {
+        self.last_torque
+    }
+
+    /// Measures the relative angle and returns the couple to apply.
+    fn evaluate(&mut self, bodies: &RigidBodySet) -> Option<(Wrench, Wrench)> {
+        let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
+        let theta = self
+            .angle
+            .update(rb1.rotation(), rb2.rotation(), self.local_axis1);
+        let torque = self.torque_at(theta);
+        self.last_torque = torque;
+        let t = torque * (*rb1.rotation() * self.local_axis1);
+        Some((
+            Wrench {
+                body: self.body1,
+                force: Vector::ZERO,
+                torque: -t,
+            },
+            Wrench {
+                body: self.body2,
+                force: Vector::ZERO,
+                torque: t,
+            },
+        ))
+    }
+}
+
+/// All drives of a world; [`DriveSet::apply`] is called before every step.
+#[derive(Clone, Debug, Default)]
+pub struct DriveSet {
+    drives: Vec<TorsionSpring>,
+    ledger: ForceLedger,
+    wrenches: Vec<Wrench>,
+    saved: Vec<(HingeAngle, f64)>,
+    saved_wrenches: Vec<Wrench>,
+}
+
+impl DriveSet {
+    /// An empty set.
+    pub fn new() -> Self {
+        Self::default()
+    }
+    /// Adds a drive; returns its index.
+    pub fn insert(&mut self, drive: TorsionSpring) -> usize {
+        self.drives.push(drive);
+        self.drives.len() - 1
+    }
+    /// The drives.
+    pub fn drives(&self) -> &[TorsionSpring] {
+        &self.drives
+    }
+    /// Replaces the torques applied at the previous call by the current ones (for a loop that
+    /// calls `world.step()` itself; the [`Stepper`](crate::rapier::stepper::Stepper) uses
+    /// [`evaluate`](Self::evaluate) and adds the torques for its step only).
+    pub fn apply(&mut self, bodies: &mut RigidBodySet) {
+        self.evaluate(bodies);
+        self.ledger.replace(bodies, self.wrenches.iter().copied());
+    }
+
+    /// Measures the angles and computes the torques of [`wrenches`](Self::wrenches), without
+    /// touching the bodies' forces.
+    pub fn evaluate(&mut self, bodies: &RigidBodySet) {
+        self.wrenches.clear();
+        for d in &mut self.drives {
+            if let Some((w1, w2)) = d.evaluate(bodies) {
+                self.wrenches.push(w1);
+                self.wrenches.push(w2);
+            }
+        }
+    }
+
+    /// The torques of the last evaluation, two per drive.
+    pub fn wrenches(&self) -> &[Wrench] {
+        &self.wrenches
+    }
+    /// Takes back, exactly, every torque this set applied at its last [`apply`](Self::apply)
+    /// (for a drive removed from the world).
+    pub fn take_back(&mut self, bodies: &mut RigidBodySet) {
+        self.wrenches.clear();
+        self.ledger.replace(bodies, std::iter::empty());
+    }
+
+    /// Saves the angle trackers and applied torques (before a step that may be rejected).
+    pub fn save_state(&mut self) {
+        self.saved.clear();
+        self.saved
+            .extend(self.drives.iter().map(|d| (d.angle, d.last_torque)));
+        self.saved_wrenches.clone_from(&self.wrenches);
+    }
+
+    /// Restores what [`save_state`](Self::save_state) saved.
+    pub fn restore_state(&mut self) {
+        for (d, &(angle, torque)) in self.drives.iter_mut().zip(&self.saved) {
+            d.angle = angle;
+            d.last_torque = torque;
+        }
+        self.wrenches.clone_from(&self.saved_wrenches);
+    }
+
+    /// Total potential energy of the springs at their last measured angles, J.
+    pub fn potential_energy(&self) -> f64 {
+        self.drives
+            .iter()
+            .map(|d| d.potential_energy(d.angle()))
+            .sum()
+    }
+}

@@ -1,0 +1,820 @@
+//! The clearance joint in a Rapier world: a revolute hinge whose radial play is left to the
+//! contact law. [`ClearanceJointSet::apply`] is the per-step force hook.
+
+use crate::error::{Error, Result};
+use crate::model::kinematics::{
+    BodyMotion, ContactMode, ForcePair, JournalState, contact_force, journal_state, stable_step,
+};
+use crate::model::laws::{
+    BearingGeometry, FrictionLaw, FrictionModel, NormalContact, NormalForceLaw, NormalModel,
+};
+use crate::rapier::ledger::{
+    ForceLedger, Wrench, ensure_mass_properties, inverse_mass_along, world_center_of_mass,
+};
+use rapier3d_f64::math::Vector;
+use rapier3d_f64::prelude::{
+    GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, IntegrationParameters, JointAxesMask,
+    RigidBody, RigidBodyHandle, RigidBodySet,
+};
+
+/// What holds the degrees of freedom the contact law does not (axial translation and the two tilts).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum OutOfPlaneLock {
+    /// A Rapier `GenericJoint` locking the axial translation and the two tilts, relative to the
+    /// bodies (works for any axis and any body motion). The default.
+    #[default]
+    Joint,
+    /// Nothing: the caller guarantees planar motion (e.g. with `LockedAxes` on the bodies).
+    None,
+}
+
+/// Builds a [`ClearanceJoint`] with chained setters, like Rapier's `RevoluteJointBuilder`.
+/// Body 1 carries the bearing (hole), body 2 the journal (pin).
+///
+/// ```
+/// use clearance_joint::prelude::*;
+/// let geometry = BearingGeometry::from_clearance(0.010, 0.5e-3, 0.016).unwrap();
+/// let law = ImprovedLiu::new(1.137e11, 0.016, 0.5e-3, 1.0, 1e-4, MaxDamping::Eta(0.01)).unwrap();
+/// let joint = ClearanceJointBuilder::new(Vector::new(0.0, -1.0, 0.0), geometry, NormalModel::ImprovedLiu(law))
+///     .local_anchor1(Vector::new(0.4, 0.0, 0.4))
+///     .local_anchor2(Vector::new(0.0, 0.0, 0.4))
+///     .friction(FrictionModel::Bai(Bai::DRY))
+///     .build()
+///     .unwrap();
+/// assert!((joint.geometry().clearance() - 0.5e-3).abs() < 1e-15);
+/// ```
+#[derive(Clone, Debug)]
+pub struct ClearanceJointBuilder {
+    joint: ClearanceJoint,
+}
+
+impl ClearanceJointBuilder {
+    /// A joint about `axis` (in body 1's frame; also used for body 2 unless
+    /// [`local_axis2`](Self::local_axis2) is set) with the given geometry and normal law,
+    /// frictionless, anchors at both bodies' origins.
+    pub fn new(axis: Vector, geometry: BearingGeometry, normal_law: NormalModel) -> Self {
+        ClearanceJointBuilder {
+            joint: ClearanceJoint {
+                name: String::from("clearance joint"),
+                local_axis1: axis,
+                local_axis2: axis,
+                local_anchor1: Vector::ZERO,
+                local_anchor2: Vector::ZERO,
+                geometry,
+                normal_law,
+                friction_law: FrictionModel::None,
+                min_impact_speed: DEFAULT_MIN_IMPACT_SPEED,
+                min_separation: DEFAULT_MIN_SEPARATION,
+                max_valid_penetration: None,
+                lock: OutOfPlaneLock::Joint,
+                body1: RigidBodyHandle::invalid(),
+                body2: RigidBodyHandle::invalid(),
+                lock_handle: None,
+                contact: ContactHistory::default(),
+                report: ClearanceReport::default(),
+                previous_rate: None,
+                last_wrenches: None,
+                prepared: false,
+            },
+        }
+    }
+    /// Bearing centre in body 1's frame.
+    pub fn local_anchor1(mut self, anchor: Vector) -> Self {
+        self.joint.local_anchor1 = anchor;
+        self
+    }
+    /// Journal centre in body 2's frame.
+    pub fn local_anchor2(mut self, anchor: Vector) -> Self {
+        self.joint.local_anchor2 = anchor;
+        self
+    }
+    /// Hinge axis in body 2's frame (defaults to the axis given to [`new`](Self::new)).
+    pub fn local_axis2(mut self, axis: Vector) -> Self {
+        self.joint.local_axis2 = axis;
+        self
+    }
+    /// The friction law (default: none).
+    pub fn friction(mut self, friction: FrictionModel) -> Self {
+        self.joint.friction_law = friction;
+        self
+    }
+    /// Floor on the impact velocity `delta_dot0` of the hysteresis laws, m/s (default 1e-4): a
+    /// contact that begins at a vanishing speed would otherwise get unbounded damping.
+    pub fn min_impact_speed(mut self, speed: f64) -> Self {
+        self.joint.min_impact_speed = speed;
+        self
+    }
+    /// The gap a free flight must open for the next contact to count as a new impact, m
+    /// (default 0.1 um, about 8 times the resting penetration of the paper's hinge load): smaller
+    /// separations are the chatter of a journal following the wall.
+    pub fn min_separation(mut self, gap: f64) -> Self {
+        self.joint.min_separation = gap;
+        self
+    }
+    /// The deepest penetration at which the contact law is still trusted, m (default: a tenth
+    /// of the radial clearance). Compliant laws assume a contact small against the bodies'
+    /// curvature: a journal pressed deeper is outside the model. The steppers report it as a
+    /// guard violation ([`crate::rapier::stepper::GuardReport`]); it is not a force limit.
+    pub fn max_valid_penetration(mut self, depth: f64) -> Self {
+        self.joint.max_valid_penetration = Some(depth);
+        self
+    }
+    /// What locks the out-of-plane degrees of freedom (default [`OutOfPlaneLock::Joint`]).
+    pub fn lock(mut self, lock: OutOfPlaneLock) -> Self {
+        self.joint.lock = lock;
+        self
+    }
+    /// A name used in error messages and outputs.
+    pub fn name(mut self, name: impl Into<String>) -> Self {
+        self.joint.name = name.into();
+        self
+    }
+    /// Validates and returns the joint.
+    pub fn build(mut self) -> Result<ClearanceJoint> {
+        let j = &mut self.joint;
+        j.local_axis1 = crate::error::unit_vector("local_axis1", j.local_axis1)?;
+        j.local_axis2 = crate::error::unit_vector("local_axis2", j.local_axis2)?;
+        for (field, v) in [
+            ("local_anchor1", j.local_anchor1),
+            ("local_anchor2", j.local_anchor2),
+        ] {
+            if !v.is_finite() {
+                return Err(Error::invalid(field, format!("must be finite (got {v:?})")));
+            }
+        }
+        crate::error::positive("min_impact_speed", j.min_impact_speed)?;
+        crate::error::non_negative("min_separation", j.min_separation)?;
+        if let Some(d) = j.max_valid_penetration {
+            crate::error::positive("max_valid_penetration", d)?;
+        }
+        Ok(self.joint)
+    }
+}
+
+/// State carried between steps: whether a contact is on, and its impact velocity.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ContactHistory {
+    in_contact: bool,
+    /// Largest gap of the current free flight (infinite before the first contact), m.
+    max_gap: f64,
+    compressing: bool,
+    impact_rate: f64,
+}
+
+impl Default for ContactHistory {
+    fn default() -> Self {
+        ContactHistory {
+            in_contact: false,
+            max_gap: f64::INFINITY,
+            compressing: false,
+            impact_rate: 0.0,
+        }
+    }
+}
+
+/// What the hook computed for one joint at its last application.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ClearanceReport {
+    /// Journal state (eccentricity, penetration, rates).
+    pub state: JournalState,
+    /// Motion mode.
+    pub mode: ContactMode,
+    /// Whether a contact began at this application (any onset, chatter included).
+    pub onset: bool,
+    /// Whether this onset is an impact: the first contact, or one after a free flight that opened
+    /// a gap of at least the joint's `min_separation`. Re-contacts after smaller separations are
+    /// chatter of a journal following the wall, not new impacts.
+    pub impact: bool,
+    /// `delta_dot0` of the current contact (0 in free flight), m/s.
+    pub impact_rate: f64,
+    /// The force pair applied.
+    pub force: ForcePair,
+    /// Largest stable step for the contact as linearised now (infinite in free flight), s:
+    /// stiffness and damping along the normal. Beyond it the explicit step blows up.
+    pub max_stable_dt: f64,
+    /// Largest step that resolves friction as linearised now, `2 m_t/(F_N dmu/dv)` (infinite
+    /// without contact), s: a friction law whose coefficient rises steeply with slip, like Bai's
+    /// near zero slip, acts as a stiff tangential damper. Friction is bounded by `mu_s F_N`, so a
+    /// longer step does not blow up; it turns stiction into a numerical chatter of the slip.
+    pub friction_stable_dt: f64,
+    /// Linearised natural frequency of the contact, rad/s.
+    pub omega: f64,
+    /// Linearised damping ratio of the contact.
+    pub zeta: f64,
+    /// Effective mass of the two bodies along the contact normal, kg.
+    pub effective_mass: f64,
+}
+
+/// A revolute hinge with radial clearance between two Rapier rigid bodies.
+#[derive(Clone, Debug)]
+pub struct ClearanceJoint {
+    name: String,
+    local_axis1: Vector,
+    local_axis2: Vector,
+    local_anchor1: Vector,
+    local_anchor2: Vector,
+    geometry: BearingGeometry,
+    normal_law: NormalModel,
+    friction_law: FrictionModel,
+    min_impact_speed: f64,
+    min_separation: f64,
+    max_valid_penetration: Option<f64>,
+    lock: OutOfPlaneLock,
+    body1: RigidBodyHandle,
+    body2: RigidBodyHandle,
+    lock_handle: Option<ImpulseJointHandle>,
+    contact: ContactHistory,
+    report: ClearanceReport,
+    previous_rate: Option<f64>,
+    /// The wrenches on body 1 and body 2 at the last application.
+    last_wrenches: Option<[Wrench; 2]>,
+    prepared: bool,
+}
+
+/// Default of [`ClearanceJointBuilder::min_impact_speed`], m/s.
+pub const DEFAULT_MIN_IMPACT_SPEED: f64 = 1e-4;
+
+/// Default of [`ClearanceJointBuilder::min_separation`], m.
+pub const DEFAULT_MIN_SEPARATION: f64 = 1e-7;
+
+/// Fraction of the predicted time to contact that one free-flight step may cover, so that a
+/// contact is approached in shrinking steps and starts near a step boundary.
+const APPROACH_FRACTION: f64 = 0.5;
+/// Margin on the damped stability limit used by the adaptive step.
+const STABILITY_SAFETY: f64 = 0.8;
+
+/// The dynamic state of a joint between steps (what a rejected step must restore).
+#[derive(Clone, Copy, Debug)]
+struct JointDynamics {
+    contact: ContactHistory,
+    report: ClearanceReport,
+    previous_rate: Option<f64>,
+    last_wrenches: Option<[Wrench; 2]>,
+    prepared: bool,
+}
+
+/// Slope `dmu/dv` of a friction law at slip speed `v` (one-sided difference at 0, where the
+/// regularised laws are steepest).
+fn friction_slope(law: &impl FrictionLaw, v: f64) -> f64 {
+    let h = (1e-4 * v).max(1e-9);
+    let lo = (v - h).max(0.0);
+    let hi = v + h;
+    (law.coefficient(hi) - law.coefficient(lo)) / (hi - lo)
+}
+
+impl ClearanceJoint {
+    /// The joint's name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+    /// Bearing body.
+    pub fn body1(&self) -> RigidBodyHandle {
+        self.body1
+    }
+    /// Journal body.
+    pub fn body2(&self) -> RigidBodyHandle {
+        self.body2
+    }
+    /// Radial geometry.
+    pub fn geometry(&self) -> &BearingGeometry {
+        &self.geometry
+    }
+    /// Normal law.
+    pub fn normal_law(&self) -> &NormalModel {
+        &self.normal_law
+    }
+    /// Friction law.
+    pub fn friction_law(&self) -> &FrictionModel {
+        &self.friction_law
+    }
+    /// Hinge axis in body 1's frame (unit).
+    pub fn local_axis1(&self) -> Vector {
+        self.local_axis1
+    }
+    /// Hinge axis in body 2's frame (unit).
+    pub fn local_axis2(&self) -> Vector {
+        self.local_axis2
+    }
+    /// Bearing centre in body 1's frame.
+    pub fn local_anchor1(&self) -> Vector {
+        self.local_anchor1
+    }
+    /// Journal centre in body 2's frame.
+    pub fn local_anchor2(&self) -> Vector {
+        self.local_anchor2
+    }
+    /// The Rapier joint locking the out-of-plane motion, if any.
+    pub fn lock_handle(&self) -> Option<ImpulseJointHandle> {
+        self.lock_handle
+    }
+    /// What the hook computed at its last application.
+    pub fn report(&self) -> &ClearanceReport {
+        &self.report
+    }
+    /// The deepest penetration at which the contact law is trusted, m
+    /// ([`ClearanceJointBuilder::max_valid_penetration`]; default a tenth of the clearance).
+    pub fn max_valid_penetration(&self) -> f64 {
+        self.max_valid_penetration
+            .unwrap_or(0.1 * self.geometry.clearance())
+    }
+    /// Whether the joint was in contact at its last application.
+    pub fn in_contact(&self) -> bool {
+        self.contact.in_contact
+    }
+    /// Elastic energy stored in the contact at the last application, J.
+    pub fn elastic_energy(&self) -> f64 {
+        self.normal_law
+            .elastic_energy(self.report.state.penetration)
+    }
+
+    /// The largest step that resolves this joint's contact dynamics to `tolerance`, the fraction of
+    /// a contact's natural period `2 pi/omega` one step may cover, from the state of the last
+    /// application. `last_dt` is the step taken before it (to estimate the gap's acceleration).
+    ///
+    /// - In contact: `omega` at the deepest point the contact can reach (its elastic energy plus
+    ///   the kinetic energy of the approach), and within the damped stability limit there.
+    /// - In free flight: the contact ahead is predicted from the gap, closing speed and
+    ///   acceleration; a step covers at most half the time to it, and no less than the step that
+    ///   contact will need. Separating without acceleration towards the wall: unbounded.
+    pub fn adaptive_step(&self, tolerance: f64, last_dt: f64) -> f64 {
+        let r = &self.report;
+        let m = r.effective_mass;
+        if !(m > 0.0 && m.is_finite()) {
+            return f64::INFINITY;
+        }
+        let delta = r.state.penetration;
+        let rate = r.state.penetration_rate;
+        let contact_step =
+            |approach_speed: f64, depth: f64| self.contact_step(approach_speed, depth, tolerance);
+        if delta > 0.0 {
+            return contact_step(rate.max(0.0), delta)
+                .min(STABILITY_SAFETY * r.max_stable_dt.min(r.friction_stable_dt));
+        }
+        let gap = -delta;
+        let accel = match self.previous_rate {
+            Some(prev) if last_dt > 0.0 => (rate - prev) / last_dt,
+            _ => 0.0,
+        };
+        // Smallest positive t with gap = rate t + accel t^2/2.
+        let time_to_contact = if accel.abs() < 1e-300 {
+            if rate > 0.0 {
+                gap / rate
+            } else {
+                f64::INFINITY
+            }
+        } else {
+            let disc = rate * rate + 2.0 * accel * gap;
+            if disc < 0.0 {
+                f64::INFINITY
+            } else {
+                (-rate + disc.sqrt()) / accel
+            }
+        };
+        if !(time_to_contact > 0.0 && time_to_contact.is_finite()) {
+            return f64::INFINITY;
+        }
+        let speed_at_contact = (rate + accel * time_to_contact).max(0.0);
+        (APPROACH_FRACTION * time_to_contact).max(contact_step(speed_at_contact, 0.0))
+    }
+
+    /// The step that resolves a contact entered at `approach_speed` (m/s) and now `depth` deep
+    /// (m) to `tolerance` of its natural period, taken at the deepest point the contact can reach
+    /// (its elastic energy plus the kinetic energy of the approach), and within the damped
+    /// stability limit there.
+    fn contact_step(&self, approach_speed: f64, depth: f64, tolerance: f64) -> f64 {
+        let m = self.report.effective_mass;
+        let energy =
+            0.5 * m * approach_speed * approach_speed + self.normal_law.elastic_energy(depth);
+        let peak =
+            crate::model::laws::penetration_for_energy(&self.normal_law, energy, 1e-6).max(depth);
+        let stiffness = self.normal_law.tangent_stiffness(peak);
+        if !(stiffness > 0.0) {
+            return f64::INFINITY;
+        }
+        let impact_rate = if self.contact.in_contact {
+            self.contact.impact_rate
+        } else {
+            approach_speed.max(self.min_impact_speed)
+        };
+        let c = NormalContact {
+            penetration: peak,
+            penetration_rate: approach_speed,
+            impact_rate,
+        };
+        let (stable, omega, _) = stable_step(stiffness, self.normal_law.damping_coefficient(&c), m);
+        (tolerance * std::f64::consts::TAU / omega).min(STABILITY_SAFETY * stable)
+    }
+
+    /// Judges a step of `dt` that ended in the state of the last application, for a joint that
+    /// was (`was_in_contact`) or was not in contact when the step began. `None` when the step
+    /// resolved the contact; otherwise the shorter step to retry with:
+    /// - the step went beyond the stability limit of the contact it ended in;
+    /// - a contact began inside the step and got deeper than a step of the contact's own size
+    ///   (`tolerance` of its period) would have let it: the step crossed the onset blind;
+    /// - the step was longer than friction's limit ([`ClearanceReport::friction_stable_dt`]).
+    pub fn judge_step(&self, dt: f64, tolerance: f64, was_in_contact: bool) -> Option<f64> {
+        let r = &self.report;
+        let delta = r.state.penetration;
+        if !(delta > 0.0) {
+            return None;
+        }
+        let limit = r.max_stable_dt.min(r.friction_stable_dt);
+        if dt > limit {
+            return Some((STABILITY_SAFETY * limit).min(0.5 * dt));
+        }
+        if was_in_contact {
+            return None;
+        }
+        let rate = r.state.penetration_rate.max(0.0);
+        let h_c = self.contact_step(rate, delta, tolerance);
+        if dt <= h_c || delta <= rate * h_c {
+            return None;
+        }
+        // Retry with a step that ends shortly before the onset (then the approach shrinks the
+        // steps to the contact's own), or with the contact's own step.
+        let inside = if rate > 0.0 { delta / rate } else { dt };
+        let before = (dt - inside).max(0.0);
+        Some(h_c.max(0.9 * before).min(0.5 * dt))
+    }
+
+    fn dynamics(&self) -> JointDynamics {
+        JointDynamics {
+            contact: self.contact,
+            report: self.report,
+            previous_rate: self.previous_rate,
+            last_wrenches: self.last_wrenches,
+            prepared: self.prepared,
+        }
+    }
+
+    fn set_dynamics(&mut self, d: JointDynamics) {
+        self.contact = d.contact;
+        self.report = d.report;
+        self.previous_rate = d.previous_rate;
+        self.last_wrenches = d.last_wrenches;
+        self.prepared = d.prepared;
+    }
+
+    fn evaluate(&mut self, bodies: &RigidBodySet) -> Option<(Wrench, Wrench)> {
+        let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
+        let (m1, m2) = (motion(rb1), motion(rb2));
+        let axis = *rb1.rotation() * self.local_axis1;
+        let p_i = *rb1.position() * self.local_anchor1;
+        let p_j = *rb2.position() * self.local_anchor2;
+        let state = journal_state(&self.geometry, p_i, p_j, axis, &m1, &m2);
+
+        // Contact history: record delta_dot0 at onset (MODEL.md §2), classify the mode.
+        let onset = state.penetration > 0.0 && !self.contact.in_contact;
+        let impact = onset && self.contact.max_gap >= self.min_separation;
+        if state.penetration > 0.0 {
+            if onset {
+                self.contact = ContactHistory {
+                    in_contact: true,
+                    max_gap: 0.0,
+                    compressing: true,
+                    impact_rate: state.penetration_rate.max(self.min_impact_speed),
+                };
+            } else if state.penetration_rate <= 0.0 {
+                self.contact.compressing = false;
+            }
+        } else {
+            let gap = -state.penetration;
+            let max_gap = if self.contact.in_contact {
+                gap
+            } else {
+                self.contact.max_gap.max(gap)
+            };
+            self.contact = ContactHistory {
+                max_gap,
+                ..ContactHistory::default()
+            };
+        }
+        let mode = match (self.contact.in_contact, self.contact.compressing) {
+            (false, _) => ContactMode::FreeFlight,
+            (true, true) => ContactMode::Impact,
+            (true, false) => ContactMode::Continuous,
+        };
+        let force = contact_force(
+            &state,
+            self.contact.impact_rate,
+            &self.normal_law,
+            &self.friction_law,
+        );
+
+        // Linearised contact for the step-size limit.
+        let effective_mass = 1.0
+            / (inverse_mass_along(rb1, state.contact_point, state.normal)
+                + inverse_mass_along(rb2, state.contact_point, state.normal));
+        let (max_stable_dt, omega, zeta) = if state.penetration > 0.0 {
+            let c = NormalContact {
+                penetration: state.penetration,
+                penetration_rate: state.penetration_rate,
+                impact_rate: self.contact.impact_rate,
+            };
+            // dF/d delta = K_tangent + (dD/d delta) delta_dot (MODEL.md §2 laws, linearised).
+            let stiffness = self.normal_law.tangent_stiffness(state.penetration)
+                + self.normal_law.damping_slope(&c) * state.penetration_rate;
+            stable_step(
+                stiffness,
+                self.normal_law.damping_coefficient(&c),
+                effective_mass,
+            )
+        } else {
+            (f64::INFINITY, 0.0, 0.0)
+        };
+        // Friction as a tangential damper: `d(mu F_N)/dv = F_N dmu/dv` along the slip.
+        let mut friction_stable_dt = f64::INFINITY;
+        if force.normal_force > 0.0 {
+            let v = state.slip.length();
+            let slope = friction_slope(&self.friction_law, v);
+            if slope > 0.0 {
+                let t = if v > 0.0 {
+                    state.slip / v
+                } else {
+                    state.normal.cross(axis)
+                };
+                let inv_m = inverse_mass_along(rb1, state.contact_point, t)
+                    + inverse_mass_along(rb2, state.contact_point, t);
+                friction_stable_dt = 2.0 / (inv_m * force.normal_force * slope);
+            }
+        }
+        if self.prepared_report() {
+            self.previous_rate = Some(self.report.state.penetration_rate);
+        }
+        self.report = ClearanceReport {
+            state,
+            mode,
+            onset,
+            impact,
+            impact_rate: self.contact.impact_rate,
+            force,
+            max_stable_dt,
+            friction_stable_dt,
+            omega,
+            zeta,
+            effective_mass,
+        };
+        let f = force.on_journal;
+        let w2 = Wrench {
+            body: self.body2,
+            force: f,
+            torque: (force.point - m2.center_of_mass).cross(f),
+        };
+        let w1 = Wrench {
+            body: self.body1,
+            force: -f,
+            torque: (force.point - m1.center_of_mass).cross(-f),
+        };
+        Some((w1, w2))
+    }
+}
+
+impl ClearanceJoint {
+    /// Whether a report from an earlier application exists.
+    fn prepared_report(&self) -> bool {
+        self.report.effective_mass > 0.0
+    }
+}
+
+fn motion(rb: &RigidBody) -> BodyMotion {
+    BodyMotion {
+        center_of_mass: world_center_of_mass(rb),
+        linvel: rb.linvel(),
+        angvel: rb.angvel(),
+    }
+}
+
+/// Handle of a joint in a [`ClearanceJointSet`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct ClearanceJointHandle(pub usize);
+
+/// All clearance joints of a world, and the per-step force hook.
+#[derive(Clone, Debug, Default)]
+pub struct ClearanceJointSet {
+    joints: Vec<ClearanceJoint>,
+    ledger: ForceLedger,
+    wrenches: Vec<Wrench>,
+    saved: Vec<JointDynamics>,
+    saved_wrenches: Vec<Wrench>,
+}
+
+impl ClearanceJointSet {
+    /// An empty set.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Adds `joint` between `body1` (bearing) and `body2` (journal). With
+    /// [`OutOfPlaneLock::Joint`] it also inserts into `impulse_joints` the Rapier joint that locks
+    /// the axial translation and the two tilts.
+    pub fn insert(
+        &mut self,
+        body1: RigidBodyHandle,
+        body2: RigidBodyHandle,
+        mut joint: ClearanceJoint,
+        impulse_joints: &mut ImpulseJointSet,
+    ) -> ClearanceJointHandle {
+        joint.body1 = body1;
+        joint.body2 = body2;
+        if joint.lock == OutOfPlaneLock::Joint {
+            let lock = GenericJointBuilder::new(
+                JointAxesMask::LIN_X | JointAxesMask::ANG_Y | JointAxesMask::ANG_Z,
+            )
+            .local_axis1(joint.local_axis1)
+            .local_axis2(joint.local_axis2)
+            .local_anchor1(joint.local_anchor1)
+            .local_anchor2(joint.local_anchor2)
+            .contacts_enabled(false)
+            .build();
+            joint.lock_handle = Some(impulse_joints.insert(body1, body2, lock, true));
+        }
+        self.joints.push(joint);
+        ClearanceJointHandle(self.joints.len() - 1)
+    }
+
+    /// Removes the joint's forces from its bodies (and its lock joint from `impulse_joints`) and
+    /// returns it. Handles of the joints after it shift down by one.
+    pub fn remove(
+        &mut self,
+        handle: ClearanceJointHandle,
+        bodies: &mut RigidBodySet,
+        impulse_joints: &mut ImpulseJointSet,
+    ) -> Option<ClearanceJoint> {
+        if handle.0 >= self.joints.len() {
+            return None;
+        }
+        let mut joint = self.joints.remove(handle.0);
+        if let Some(lock) = joint.lock_handle.take() {
+            impulse_joints.remove(lock, true);
+        }
+        // Take back the removed joint's last forces only: the others' stay as last applied.
+        self.wrenches.clear();
+        self.wrenches
+            .extend(self.joints.iter().filter_map(|j| j.last_wrenches).flatten());
+        self.ledger.replace(bodies, self.wrenches.iter().copied());
+        Some(joint)
+    }
+
+    /// The joint behind `handle`.
+    pub fn get(&self, handle: ClearanceJointHandle) -> Option<&ClearanceJoint> {
+        self.joints.get(handle.0)
+    }
+
+    /// All joints with their handles.
+    pub fn iter(&self) -> impl Iterator<Item = (ClearanceJointHandle, &ClearanceJoint)> {
+        self.joints
+            .iter()
+            .enumerate()
+            .map(|(i, j)| (ClearanceJointHandle(i), j))
+    }
+
+    /// Number of joints.
+    pub fn len(&self) -> usize {
+        self.joints.len()
+    }
+
+    /// Whether the set is empty.
+    pub fn is_empty(&self) -> bool {
+        self.joints.is_empty()
+    }
+
+    /// The force hook: call before every `PhysicsPipeline::step`. It evaluates every joint from
+    /// the bodies' current poses and velocities and replaces the forces it applied at the
+    /// previous call with the new contact and friction forces (your own user forces are left
+    /// alone).
+    ///
+    /// Errors (after applying the forces):
+    /// - `num_solver_iterations` is not 1: Rapier's substeps hold the hook's force constant
+    ///   across substeps and the scheme then gains energy at every impact.
+    /// - [`Error::StepTooLarge`]: `dt` exceeds the stability limit of a contact as linearised now.
+    pub fn apply(
+        &mut self,
+        bodies: &mut RigidBodySet,
+        params: &IntegrationParameters,
+    ) -> Result<()> {
+        self.apply_forces(bodies);
+        self.check_substeps(params)?;
+        self.check_step(params.dt)
+    }
+
+    /// The force evaluation of [`apply`](Self::apply) without its checks, for callers that choose
+    /// the step after seeing the contact state (adaptive stepping) and then call
+    /// [`check_step`](Self::check_step) themselves.
+    pub fn apply_forces(&mut self, bodies: &mut RigidBodySet) {
+        self.evaluate(bodies);
+        self.ledger.replace(bodies, self.wrenches.iter().copied());
+    }
+
+    /// Evaluates every joint at the bodies' current state (contact history, report, the
+    /// wrenches of [`wrenches`](Self::wrenches)) without touching the bodies' forces: the
+    /// [`Stepper`](crate::rapier::stepper::Stepper) adds the wrenches for the duration of its step only,
+    /// so the bodies carry nothing but the user's own forces between steps. A joint whose body is
+    /// gone reports free flight and applies nothing.
+    pub fn evaluate(&mut self, bodies: &mut RigidBodySet) {
+        self.wrenches.clear();
+        for joint in &mut self.joints {
+            if !joint.prepared {
+                ensure_mass_properties(bodies, None, joint.body1);
+                ensure_mass_properties(bodies, None, joint.body2);
+                joint.prepared = true;
+            }
+            joint.last_wrenches = joint.evaluate(bodies).map(|(w1, w2)| [w1, w2]);
+            if joint.last_wrenches.is_none() {
+                joint.contact = ContactHistory::default();
+                joint.report = ClearanceReport::default();
+                joint.previous_rate = None;
+            }
+            self.wrenches
+                .extend(joint.last_wrenches.into_iter().flatten());
+        }
+    }
+
+    /// The force and torque on each body from the last evaluation (two per joint: bearing,
+    /// journal).
+    pub fn wrenches(&self) -> &[Wrench] {
+        &self.wrenches
+    }
+
+    /// Refuses Rapier substeps (`num_solver_iterations != 1`) when the set holds joints.
+    pub fn check_substeps(&self, params: &IntegrationParameters) -> Result<()> {
+        if params.num_solver_iterations != 1 && !self.joints.is_empty() {
+            return Err(Error::invalid(
+                "num_solver_iterations",
+                format!(
+                    "must be 1 with clearance joints (got {}): Rapier's substeps hold the hook's force \
+                     constant over the whole step and the scheme gains energy at every impact",
+                    params.num_solver_iterations
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// Checks `dt` against every joint's current stability limit.
+    pub fn check_step(&self, dt: f64) -> Result<()> {
+        for j in &self.joints {
+            let r = &j.report;
+            if dt > r.max_stable_dt {
+                return Err(Error::StepTooLarge {
+                    field: "dt".into(),
+                    hinge: j.name.clone(),
+                    dt,
+                    dt_max: r.max_stable_dt,
+                    t: None,
+                    penetration_um: r.state.penetration * 1e6,
+                    omega: r.omega,
+                    zeta: r.zeta,
+                    law: j.normal_law.kind(),
+                    adaptive: None,
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Saves every joint's contact history and report and its last wrenches (before a step that
+    /// may be rejected; no allocation after the first call).
+    pub fn save_state(&mut self) {
+        self.saved.clear();
+        self.saved.extend(self.joints.iter().map(|j| j.dynamics()));
+        self.saved_wrenches.clone_from(&self.wrenches);
+    }
+
+    /// Restores what [`save_state`](Self::save_state) saved.
+    pub fn restore_state(&mut self) {
+        for (j, d) in self.joints.iter_mut().zip(&self.saved) {
+            j.set_dynamics(*d);
+        }
+        self.wrenches.clone_from(&self.saved_wrenches);
+    }
+
+    /// [`ClearanceJoint::judge_step`] over all joints, with their contact state saved by the last
+    /// [`save_state`](Self::save_state): the shortest retry step asked for, if any.
+    pub fn judge_step(&self, dt: f64, tolerance: f64) -> Option<f64> {
+        self.joints
+            .iter()
+            .enumerate()
+            .filter_map(|(i, j)| {
+                let was = self.saved.get(i).is_some_and(|d| d.contact.in_contact);
+                j.judge_step(dt, tolerance, was)
+            })
+            .reduce(f64::min)
+    }
+
+    /// Smallest [`ClearanceJoint::adaptive_step`] over all joints (infinite without joints).
+    pub fn adaptive_step(&self, tolerance: f64, last_dt: f64) -> f64 {
+        self.joints
+            .iter()
+            .map(|j| j.adaptive_step(tolerance, last_dt))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Smallest stability limit over all joints at the last application (infinite when no
+    /// joint is in contact), s.
+    pub fn max_stable_dt(&self) -> f64 {
+        self.joints
+            .iter()
+            .map(|j| j.report.max_stable_dt)
+            .fold(f64::INFINITY, f64::min)
+    }
+}

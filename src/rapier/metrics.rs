@@ -1,0 +1,462 @@
+//! Joint metrics a loop of your own can record: the impact list of a clearance joint (onset,
+//! approach speed, peak force, deepest penetration, duration of every contact), the fraction of
+//! time in contact, peak, RMS and first-impact figures.
+//!
+//! The scene runner records its hinges with the same [`ImpactRecorder`], so a plain-Rapier loop
+//! that records the same states gets the same numbers. A state is recorded with the step that
+//! follows it: read the joint (a [`ContactObservation`]) before a step, record it with that
+//! step's start and length once the step is taken, and finish with the final state.
+//!
+//! ```
+//! use clearance_joint::rapier::metrics::{ContactObservation, ImpactRecorder};
+//! use clearance_joint::prelude::*;
+//! use rapier3d_f64::prelude::*;
+//!
+//! let mut world = PhysicsWorld::new(); // gravity along -y
+//! world.integration_parameters.num_solver_iterations = 1;
+//! let base = world.bodies.insert(RigidBodyBuilder::fixed());
+//! let arm = world.bodies.insert(
+//!     RigidBodyBuilder::dynamic()
+//!         .translation(Vector::new(0.0, -0.3, 0.0))
+//!         .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02)))
+//!         .can_sleep(false),
+//! );
+//! let revolute = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0));
+//! let pivot = world.impulse_joints.insert(base, arm, revolute, true);
+//! let mut clearance = ClearanceJointSet::new();
+//! let clear = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?;
+//! let pivot = clearance.convert_revolute(pivot, BearingSide::Body1, clear, &mut world.impulse_joints)?;
+//!
+//! let mut stepper = Stepper::new(StepControl::fixed(2e-5));
+//! stepper.prepare(&mut world, &mut [&mut clearance])?;
+//! let mut recorder = ImpactRecorder::new();
+//! while stepper.time() < 0.1 {
+//!     let before = ContactObservation::of(clearance.get(pivot).unwrap());
+//!     let info = stepper.step(&mut world, &mut [&mut clearance], 0.1)?;
+//!     recorder.record(info.t0, info.dt, &before);
+//! }
+//! recorder.finish(stepper.time(), &ContactObservation::of(clearance.get(pivot).unwrap()));
+//! // The journal drops through the 0.2 mm gap and bounces on the bearing's floor.
+//! let first = &recorder.impacts()[0];
+//! assert!(first.approach_speed_m_s > 0.01 && first.peak_force_n > 100.0);
+//! assert_eq!(recorder.metrics().impacts as usize, recorder.impacts().len());
+//! # Ok::<(), clearance_joint::Error>(())
+//! ```
+
+use crate::rapier::joint::ClearanceJoint;
+use crate::table::Table;
+use serde::Serialize;
+
+/// Impacts slower than this (m/s) are not judged by their apparent restitution: at a grazing
+/// approach the separation speed is set by the other forces, not by the contact.
+pub const RESTITUTION_MIN_SPEED: f64 = 1e-3;
+
+/// What a clearance joint's force hook saw at one state: the joint force and the contact.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ContactObservation {
+    /// Joint force magnitude, N (the contact and friction force on the journal; for an ideal
+    /// joint, its reaction).
+    pub force: f64,
+    /// Whether a contact began at this state (any onset, chatter included).
+    pub onset: bool,
+    /// Whether this onset is an impact after a real separation (see
+    /// [`ClearanceReport::impact`](crate::rapier::joint::ClearanceReport::impact)).
+    pub impact: bool,
+    /// Penetration, m (negative: the gap).
+    pub penetration: f64,
+    /// Penetration rate, m/s (positive approaching).
+    pub rate: f64,
+}
+
+impl ContactObservation {
+    /// The joint's state at its last force evaluation (the stepper evaluates the joints at
+    /// every accepted state).
+    pub fn of(joint: &ClearanceJoint) -> Self {
+        let r = joint.report();
+        ContactObservation {
+            force: r.force.on_journal.length(),
+            onset: r.onset,
+            impact: r.impact,
+            penetration: r.state.penetration,
+            rate: r.state.penetration_rate,
+        }
+    }
+
+    /// An ideal joint's state: its reaction force, never in contact.
+    pub fn ideal(force: f64) -> Self {
+        ContactObservation {
+            force,
+            penetration: f64::NEG_INFINITY,
+            ..Default::default()
+        }
+    }
+
+    /// Whether the surfaces are in contact (penetration above 0).
+    pub fn in_contact(&self) -> bool {
+        self.penetration > 0.0
+    }
+}
+
+/// One contact of a clearance joint, from its onset to the first state out of contact.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct Impact {
+    /// Time of the first state in contact, s.
+    pub onset_t_s: f64,
+    /// Penetration rate at that state, m/s (positive approaching).
+    pub approach_speed_m_s: f64,
+    /// Largest joint force during the contact, N.
+    pub peak_force_n: f64,
+    /// Deepest penetration during the contact, um.
+    pub max_penetration_um: f64,
+    /// Time in contact, s (up to the end of the run for a contact still closed there).
+    pub duration_s: f64,
+    /// Whether the onset came after a free flight that opened at least the joint's
+    /// `min_separation` (an impact; otherwise chatter of a journal following the wall).
+    pub separated: bool,
+}
+
+/// Per-joint metrics over every recorded state.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct HingeMetrics {
+    /// Largest joint force, N.
+    pub peak_force_n: f64,
+    /// Number of contact onsets, chatter of a journal following the wall included.
+    pub impacts: u64,
+    /// Contact onsets after a free flight that opened at least the joint's `min_separation`
+    /// (0.1 um by default; the first contact always counts): impacts without the chatter.
+    pub separated_impacts: u64,
+    /// Time of the first contact onset, s.
+    pub first_impact_t_s: Option<f64>,
+    /// Largest force during the first contact, N.
+    pub first_impact_peak_n: Option<f64>,
+    /// Largest penetration, um.
+    pub max_penetration_um: f64,
+    /// Steps spent in contact.
+    pub contact_steps: u64,
+    /// Fraction of recorded time in contact.
+    pub contact_fraction: f64,
+    /// Root-mean-square joint force over the run (time-weighted), N.
+    pub rms_force_n: f64,
+    /// Largest apparent restitution of an impact, the separation speed over the approach speed
+    /// (from the first state out of and into contact), over impacts that approached faster than
+    /// [`RESTITUTION_MIN_SPEED`]; above 1 a contact gave back more than it took (0 without such
+    /// an impact).
+    pub max_restitution: f64,
+    /// Final relative angle, deg (set by the scene runner; 0 from a bare recorder).
+    pub final_angle_deg: f64,
+}
+
+/// Records a joint's states, one per step, into [`HingeMetrics`] and an impact list. The
+/// scene runner's hinges are recorded by it; see the module docs for a loop of your own.
+#[derive(Clone, Debug, Default)]
+pub struct ImpactRecorder {
+    metrics: HingeMetrics,
+    impacts: Vec<Impact>,
+    force_sq_time: f64,
+    contact_time: f64,
+    onset_rate: f64,
+    was_in_contact: bool,
+    in_first_contact: bool,
+    /// Whether the last impact of the list is still open.
+    open: bool,
+    finished: bool,
+}
+
+impl ImpactRecorder {
+    /// An empty recorder.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Records the state at time `t` (s), which held for the step `dt` (s) that followed it:
+    /// the state before the step, with the step's start and length.
+    pub fn record(&mut self, t: f64, dt: f64, obs: &ContactObservation) {
+        let m = &mut self.metrics;
+        m.peak_force_n = m.peak_force_n.max(obs.force);
+        self.force_sq_time += obs.force * obs.force * dt;
+        let in_contact = obs.in_contact();
+        if obs.impact {
+            m.separated_impacts += 1;
+        }
+        if obs.onset {
+            self.onset_rate = obs.rate;
+        }
+        if self.was_in_contact && !in_contact && self.onset_rate > RESTITUTION_MIN_SPEED {
+            m.max_restitution = m.max_restitution.max(-obs.rate / self.onset_rate);
+        }
+        self.was_in_contact = in_contact;
+        if self.open && (!in_contact || obs.onset) {
+            self.open = false;
+        }
+        if obs.onset {
+            m.impacts += 1;
+            if m.first_impact_t_s.is_none() {
+                m.first_impact_t_s = Some(t);
+                m.first_impact_peak_n = Some(0.0);
+                self.in_first_contact = true;
+            }
+            self.impacts.push(Impact {
+                onset_t_s: t,
+                approach_speed_m_s: obs.rate,
+                separated: obs.impact,
+                ..Impact::default()
+            });
+            self.open = true;
+        }
+        if self.in_first_contact {
+            if in_contact {
+                m.first_impact_peak_n = Some(m.first_impact_peak_n.unwrap_or(0.0).max(obs.force));
+            } else {
+                self.in_first_contact = false;
+            }
+        }
+        if in_contact {
+            if dt > 0.0 {
+                m.contact_steps += 1;
+                self.contact_time += dt;
+            }
+            m.max_penetration_um = m.max_penetration_um.max(obs.penetration * 1e6);
+        }
+        if self.open
+            && let Some(i) = self.impacts.last_mut()
+        {
+            i.peak_force_n = i.peak_force_n.max(obs.force);
+            i.max_penetration_um = i.max_penetration_um.max(obs.penetration * 1e6);
+            i.duration_s += dt;
+        }
+    }
+
+    /// Records the final state at time `t` (it carries no time) and completes the time-weighted
+    /// figures over the recorded time `t` (from 0). Recording after it is not meaningful.
+    pub fn finish(&mut self, t: f64, last: &ContactObservation) {
+        if self.finished {
+            return;
+        }
+        self.record(t, 0.0, last);
+        self.finished = true;
+        if t > 0.0 {
+            self.metrics.rms_force_n = (self.force_sq_time / t).sqrt();
+            self.metrics.contact_fraction = self.contact_time / t;
+        }
+    }
+
+    /// The figures so far (RMS force and contact fraction once [`finish`](Self::finish)ed).
+    pub fn metrics(&self) -> &HingeMetrics {
+        &self.metrics
+    }
+
+    /// Sets the final relative angle reported with the metrics, deg.
+    pub fn set_final_angle_deg(&mut self, angle: f64) {
+        self.metrics.final_angle_deg = angle;
+    }
+
+    /// Every contact so far, in order of onset.
+    pub fn impacts(&self) -> &[Impact] {
+        &self.impacts
+    }
+
+    /// Time in contact so far, s.
+    pub fn contact_time(&self) -> f64 {
+        self.contact_time
+    }
+
+    /// The impact list as a table: `onset_t_s, approach_speed_mm_s, peak_force_n,
+    /// max_penetration_um, duration_s, separated` (1 or 0).
+    pub fn impacts_table(&self) -> Table {
+        let mut t = Table::new(
+            [
+                "onset_t_s",
+                "approach_speed_mm_s",
+                "peak_force_n",
+                "max_penetration_um",
+                "duration_s",
+                "separated",
+            ]
+            .map(String::from)
+            .to_vec(),
+        );
+        for i in &self.impacts {
+            t.values.extend_from_slice(&[
+                i.onset_t_s,
+                i.approach_speed_m_s * 1e3,
+                i.peak_force_n,
+                i.max_penetration_um,
+                i.duration_s,
+                if i.separated { 1.0 } else { 0.0 },
+            ]);
+        }
+        t
+    }
+}
+
+/// One period (a crank turn) of a driven mechanism's clearance joint.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct PeriodStats {
+    /// Start of the period, s.
+    pub start_s: f64,
+    /// Its length, s (the last period may be cut short by the end of the run).
+    pub length_s: f64,
+    /// Contacts that began in it.
+    pub impacts: u64,
+    /// Contacts that began in it after a real separation.
+    pub separated_impacts: u64,
+    /// Largest peak force of the contacts that began in it, N (0 without one).
+    pub peak_force_n: f64,
+    /// Time in contact within it, s (contacts are split at the period's bounds).
+    pub contact_s: f64,
+}
+
+/// Per-period statistics of an impact list over `[0, end)` in periods of `period` (s): impacts,
+/// peak force and time in contact per crank turn. A contact's duration is the contiguous span
+/// from its onset, so the time in contact is split exactly at the bounds; its peak counts in the
+/// period of its onset. Empty for a non-positive period or end.
+pub fn per_period(impacts: &[Impact], period: f64, end: f64) -> Vec<PeriodStats> {
+    if !(period > 0.0) || !(end > 0.0) {
+        return Vec::new();
+    }
+    let n = (end / period).ceil().max(1.0) as usize;
+    let mut out: Vec<PeriodStats> = (0..n)
+        .map(|k| {
+            let start = k as f64 * period;
+            PeriodStats {
+                start_s: start,
+                length_s: ((k + 1) as f64 * period).min(end) - start,
+                ..Default::default()
+            }
+        })
+        .collect();
+    for i in impacts {
+        let k = ((i.onset_t_s / period) as usize).min(n - 1);
+        let p = &mut out[k];
+        p.impacts += 1;
+        p.separated_impacts += u64::from(i.separated);
+        p.peak_force_n = p.peak_force_n.max(i.peak_force_n);
+        let (a, b) = (i.onset_t_s, i.onset_t_s + i.duration_s);
+        for p in out.iter_mut().skip(k) {
+            let (lo, hi) = (p.start_s, p.start_s + p.length_s);
+            if lo >= b {
+                break;
+            }
+            p.contact_s += (b.min(hi) - a.max(lo)).max(0.0);
+        }
+    }
+    out
+}
+
+/// The per-period statistics as a table: `turn, start_s, impacts, separated_impacts,
+/// peak_force_n, contact_fraction`.
+pub fn per_period_table(periods: &[PeriodStats]) -> Table {
+    let mut t = Table::new(
+        [
+            "turn",
+            "start_s",
+            "impacts",
+            "separated_impacts",
+            "peak_force_n",
+            "contact_fraction",
+        ]
+        .map(String::from)
+        .to_vec(),
+    );
+    for (k, p) in periods.iter().enumerate() {
+        t.values.extend_from_slice(&[
+            k as f64,
+            p.start_s,
+            p.impacts as f64,
+            p.separated_impacts as f64,
+            p.peak_force_n,
+            if p.length_s > 0.0 {
+                p.contact_s / p.length_s
+            } else {
+                0.0
+            },
+        ]);
+    }
+    t
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn obs(force: f64, pen_um: f64, rate: f64, onset: bool) -> ContactObservation {
+        ContactObservation {
+            force,
+            onset,
+            impact: onset,
+            penetration: pen_um * 1e-6,
+            rate,
+        }
+    }
+
+    #[test]
+    fn two_contacts_by_hand() {
+        let mut r = ImpactRecorder::new();
+        // Free, contact over two steps, free, a second contact still closed at the end.
+        let states = [
+            (0.0, 0.1, obs(0.0, -1.0, 0.01, false)),
+            (0.1, 0.1, obs(10.0, 2.0, 0.02, true)),
+            (0.2, 0.1, obs(30.0, 3.0, 0.0, false)),
+            (0.3, 0.2, obs(0.0, -0.5, -0.01, false)),
+            (0.5, 0.5, obs(5.0, 1.0, 0.004, true)),
+        ];
+        for (t, dt, o) in &states {
+            r.record(*t, *dt, o);
+        }
+        r.finish(1.0, &obs(6.0, 1.5, 0.0, false));
+        let i = r.impacts();
+        assert_eq!(i.len(), 2);
+        assert_eq!(i[0].onset_t_s, 0.1);
+        assert_eq!(i[0].approach_speed_m_s, 0.02);
+        assert_eq!(i[0].peak_force_n, 30.0);
+        assert_eq!(i[0].max_penetration_um, 3.0);
+        assert!((i[0].duration_s - 0.2).abs() < 1e-15);
+        assert_eq!(i[1].peak_force_n, 6.0);
+        assert_eq!(i[1].duration_s, 0.5);
+        let m = r.metrics();
+        assert_eq!((m.impacts, m.separated_impacts), (2, 2));
+        assert_eq!(m.first_impact_t_s, Some(0.1));
+        assert_eq!(m.first_impact_peak_n, Some(30.0));
+        assert_eq!(m.peak_force_n, 30.0);
+        assert!((m.contact_fraction - 0.7).abs() < 1e-15);
+        // Sum of F^2 dt = 100*0.1 + 900*0.1 + 25*0.5 = 112.5 over 1 s.
+        assert!((m.rms_force_n - 112.5f64.sqrt()).abs() < 1e-12);
+        // Restitution: left at 0.01 m/s after approaching at 0.02.
+        assert!((m.max_restitution - 0.5).abs() < 1e-15);
+        assert_eq!(r.impacts_table().rows(), 2);
+    }
+
+    #[test]
+    fn ideal_joint_has_no_impacts() {
+        let mut r = ImpactRecorder::new();
+        r.record(0.0, 0.5, &ContactObservation::ideal(2.0));
+        r.finish(0.5, &ContactObservation::ideal(4.0));
+        assert!(r.impacts().is_empty());
+        assert_eq!(r.metrics().peak_force_n, 4.0);
+        assert_eq!(r.metrics().contact_fraction, 0.0);
+        assert_eq!(r.metrics().rms_force_n, 2.0);
+    }
+
+    #[test]
+    fn per_turn_statistics_by_hand() {
+        let imp = |t: f64, d: f64, f: f64| Impact {
+            onset_t_s: t,
+            duration_s: d,
+            peak_force_n: f,
+            separated: true,
+            ..Impact::default()
+        };
+        // Turns of 1 s over 2.5 s; a contact from 0.5 to 1.25 s spans the first bound.
+        let list = [imp(0.2, 0.1, 5.0), imp(0.5, 0.75, 9.0), imp(2.1, 0.2, 3.0)];
+        let p = per_period(&list, 1.0, 2.5);
+        assert_eq!(p.len(), 3);
+        assert_eq!((p[0].impacts, p[1].impacts, p[2].impacts), (2, 0, 1));
+        assert_eq!((p[0].peak_force_n, p[1].peak_force_n), (9.0, 0.0));
+        assert!((p[0].contact_s - 0.6).abs() < 1e-12);
+        assert!((p[1].contact_s - 0.25).abs() < 1e-12);
+        assert!((p[2].contact_s - 0.2).abs() < 1e-12 && p[2].length_s == 0.5);
+        let t = per_period_table(&p);
+        assert!((t.row(2)[5] - 0.4).abs() < 1e-12);
+        assert!(per_period(&list, 0.0, 1.0).is_empty());
+    }
+}

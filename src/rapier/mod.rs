@@ -1,0 +1,23 @@
+//! The Rapier layer: the model's forces applied to a Rapier world, and what a step loop needs
+//! around them.
+//!
+//! - [`joint`]: the clearance joint (compliant contact and friction as a per-step force), its set.
+//! - [`large_step`]: the same play as a constraint inside Rapier's solver, for 1/60 s and 1 kHz.
+//! - [`convert`]: a clearance joint from a Rapier revolute joint, with the bearing side chosen.
+//! - [`stepper`]: the one step control (variable-step Störmer-Verlet, acceptance, guards).
+//! - [`drive`]: torsion springs and torques; [`prescribed`]: prescribed (kinematic) motions.
+//! - [`reaction`]: exact ideal-joint reactions from the constrained equations.
+//! - [`metrics`]: impact lists, contact fraction and per-turn statistics.
+//! - [`ledger`]: the forces and torques each source applied in a step.
+//!
+//! Depends on [`crate::model`] only (and on Rapier); knows nothing of scenes or the ECS.
+
+pub mod convert;
+pub mod drive;
+pub mod joint;
+pub mod large_step;
+pub mod ledger;
+pub mod metrics;
+pub mod prescribed;
+pub mod reaction;
+pub mod stepper;

@@ -1,0 +1,207 @@
+//! Prescribed motion from a table: a kinematic body turned by a tabulated angle about an axis
+//! through a point, or moved by a tabulated position along a direction, interpolated smoothly
+//! (cubic Hermite, continuous slope: [`Table`]).
+//!
+//! A [`PrescribedSet`] is a [`ForceSource`] that applies no force:
+//! before each Rapier step the [`Stepper`](crate::rapier::stepper::Stepper) hands it the step's start and
+//! length, and it sets each body's next pose at the step's end (Rapier's position-based kinematic
+//! bodies then move there, their velocity being the step's mean). Poses are exact at every
+//! state, whatever the step.
+
+use crate::error::{Error, Result};
+use crate::rapier::stepper::ForceSource;
+use rapier3d_f64::math::{Pose, Rotation, Vector};
+use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
+
+/// A value against time, interpolated by cubic Hermite segments with slopes from the neighbours
+/// (`(v[i+1] - v[i-1]) / (t[i+1] - t[i-1])`, one-sided at the ends): the value and its rate are
+/// continuous, the second derivative is piecewise linear. Outside the table the value goes on
+/// along the end slope (rate constant, no acceleration).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Table {
+    t: Vec<f64>,
+    v: Vec<f64>,
+    m: Vec<f64>,
+}
+
+impl Table {
+    /// A table of `values` at strictly increasing `times` (s); at least two finite points.
+    pub fn new(times: &[f64], values: &[f64]) -> Result<Table> {
+        if times.len() != values.len() {
+            return Err(Error::invalid(
+                "values",
+                format!("{} values for {} times", values.len(), times.len()),
+            ));
+        }
+        if times.len() < 2 {
+            return Err(Error::invalid("times", "needs at least two points"));
+        }
+        for (i, (t, v)) in times.iter().zip(values).enumerate() {
+            if !t.is_finite() {
+                return Err(Error::invalid(format!("times[{i}]"), "must be finite"));
+            }
+            if !v.is_finite() {
+                return Err(Error::invalid(format!("values[{i}]"), "must be finite"));
+            }
+            if i > 0 && !(times[i] > times[i - 1]) {
+                return Err(Error::invalid(
+                    format!("times[{i}]"),
+                    "times must increase strictly",
+                ));
+            }
+        }
+        let n = times.len();
+        let m = (0..n)
+            .map(|i| {
+                let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
+                (values[b] - values[a]) / (times[b] - times[a])
+            })
+            .collect();
+        Ok(Table {
+            t: times.to_vec(),
+            v: values.to_vec(),
+            m,
+        })
+    }
+
+    /// Value, rate and second derivative at `t`.
+    pub fn eval(&self, t: f64) -> (f64, f64, f64) {
+        let n = self.t.len();
+        if t <= self.t[0] {
+            return (self.v[0] + self.m[0] * (t - self.t[0]), self.m[0], 0.0);
+        }
+        if t >= self.t[n - 1] {
+            return (
+                self.v[n - 1] + self.m[n - 1] * (t - self.t[n - 1]),
+                self.m[n - 1],
+                0.0,
+            );
+        }
+        let i = self.t.partition_point(|&x| x <= t) - 1;
+        let h = self.t[i + 1] - self.t[i];
+        let s = (t - self.t[i]) / h;
+        let (p0, p1, m0, m1) = (self.v[i], self.v[i + 1], self.m[i] * h, self.m[i + 1] * h);
+        // Hermite basis and its derivatives in s.
+        let (s2, s3) = (s * s, s * s * s);
+        let v = (2.0 * s3 - 3.0 * s2 + 1.0) * p0
+            + (s3 - 2.0 * s2 + s) * m0
+            + (-2.0 * s3 + 3.0 * s2) * p1
+            + (s3 - s2) * m1;
+        let d = (6.0 * s2 - 6.0 * s) * p0
+            + (3.0 * s2 - 4.0 * s + 1.0) * m0
+            + (-6.0 * s2 + 6.0 * s) * p1
+            + (3.0 * s2 - 2.0 * s) * m1;
+        let dd = (12.0 * s - 6.0) * p0
+            + (6.0 * s - 4.0) * m0
+            + (-12.0 * s + 6.0) * p1
+            + (6.0 * s - 2.0) * m1;
+        (v, d / h, dd / (h * h))
+    }
+}
+
+/// What a table drives.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PrescribedPath {
+    /// Rotation by the table's angle (rad, relative to its value at t = 0) about the unit `axis`
+    /// through the body's frame origin.
+    Angle {
+        /// Unit axis, world.
+        axis: Vector,
+    },
+    /// Translation by the table's position (m, relative to its value at t = 0) along the unit
+    /// `direction`.
+    Position {
+        /// Unit direction, world.
+        direction: Vector,
+    },
+}
+
+/// One kinematic (position-based) body on a table.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PrescribedMotion {
+    /// The body.
+    pub body: RigidBodyHandle,
+    /// Its pose at t = 0.
+    pub start: Pose,
+    /// Angle or position.
+    pub path: PrescribedPath,
+    /// The table.
+    pub table: Table,
+}
+
+impl PrescribedMotion {
+    /// The body's pose at `t`.
+    pub fn pose(&self, t: f64) -> Pose {
+        let (x, _, _) = self.table.eval(t);
+        let x0 = self.table.eval(0.0).0;
+        match self.path {
+            PrescribedPath::Angle { axis } => {
+                let r = Rotation::from_axis_angle(axis, x - x0);
+                Pose::from_parts(self.start.translation, r * self.start.rotation)
+            }
+            PrescribedPath::Position { direction } => Pose::from_parts(
+                self.start.translation + direction * (x - x0),
+                self.start.rotation,
+            ),
+        }
+    }
+
+    /// Velocity and acceleration of the frame origin and angular velocity and acceleration at
+    /// `t`: `(v, a, w, alpha)`.
+    pub fn rates(&self, t: f64) -> (Vector, Vector, Vector, Vector) {
+        let (_, d, dd) = self.table.eval(t);
+        match self.path {
+            PrescribedPath::Angle { axis } => (Vector::ZERO, Vector::ZERO, axis * d, axis * dd),
+            PrescribedPath::Position { direction } => {
+                (direction * d, direction * dd, Vector::ZERO, Vector::ZERO)
+            }
+        }
+    }
+}
+
+/// The tabulated motions of a world, as a force source for the stepper (it sets poses, not
+/// forces).
+#[derive(Clone, Debug, Default)]
+pub struct PrescribedSet {
+    /// The motions.
+    pub motions: Vec<PrescribedMotion>,
+}
+
+impl ForceSource for PrescribedSet {
+    fn evaluate(&mut self, _bodies: &mut RigidBodySet) {}
+    fn wrenches(&self) -> &[crate::rapier::ledger::Wrench] {
+        &[]
+    }
+    fn save_state(&mut self) {}
+    fn restore_state(&mut self) {}
+    fn before_rapier_step(&mut self, bodies: &mut RigidBodySet, t0: f64, dt: f64) {
+        for m in &self.motions {
+            if let Some(rb) = bodies.get_mut(m.body) {
+                rb.set_next_kinematic_position(m.pose(t0 + dt));
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hermite_table_by_hand() {
+        // A parabola sampled at 0, 1, 2, 3: v = t^2. Interior slopes are the central
+        // differences 2, 4 (exact for a parabola); the ends are one-sided, 1 and 5.
+        let t = Table::new(&[0.0, 1.0, 2.0, 3.0], &[0.0, 1.0, 4.0, 9.0]).unwrap();
+        let (v, d, dd) = t.eval(1.5);
+        // Between exact slopes 2 and 4 the Hermite cubic is the parabola itself.
+        assert!((v - 2.25).abs() < 1e-12 && (d - 3.0).abs() < 1e-12 && (dd - 2.0).abs() < 1e-12);
+        // Knots are hit exactly, with continuous slope.
+        let (v, d, _) = t.eval(2.0);
+        assert!((v - 4.0).abs() < 1e-12 && (d - 4.0).abs() < 1e-12);
+        // Beyond the end: along the end slope (5), no acceleration.
+        assert_eq!(t.eval(4.0), (14.0, 5.0, 0.0));
+        assert!(Table::new(&[0.0, 0.0], &[1.0, 2.0]).is_err());
+        assert!(Table::new(&[0.0], &[1.0]).is_err());
+        assert!(Table::new(&[0.0, 1.0], &[1.0]).is_err());
+    }
+}

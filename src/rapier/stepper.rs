@@ -1,0 +1,811 @@
+//! The step control, public: one [`Stepper`] chooses, takes, judges and (when needed) retries
+//! every Rapier step of a world that holds clearance joints. The scene runner and the bevy_ecs
+//! layer use it; a plain-Rapier user calls it in their own loop in place of `world.step()`.
+//!
+//! What it adds to `PhysicsWorld::step`:
+//! - **Consistent variable steps.** With one solver iteration a Rapier step is symplectic Euler
+//!   (`v += h F/m`, then `x += h v`), which is second order only while `h` is constant. The
+//!   stepper makes it variable-step Störmer-Verlet: the velocity kick of a step `h` after a step
+//!   `h_prev` spans `(h_prev + h)/2`, so every user force and torque (the hooks' and your own) and
+//!   gravity are scaled by `(h_prev + h)/(2 h)` for the step and restored after it. The first
+//!   step from a given state is a half kick (`h_prev = 0`): velocities then live at half steps,
+//!   and positions are second-order accurate from the start.
+//! - **Step choice** ([`StepControl`]): fixed, or adaptive from the contacts (the joints'
+//!   [`adaptive_step`](crate::rapier::joint::ClearanceJoint::adaptive_step)), growing by at most
+//!   [`StepControl::max_growth`] per step and landing exactly on the time given to
+//!   [`Stepper::step`].
+//! - **Step acceptance.** After the step the force sources are evaluated at the new state (the
+//!   forces of the next step) and every clearance joint judges it
+//!   ([`judge_step`](crate::rapier::joint::ClearanceJoint::judge_step)): a contact that began deeper than
+//!   the contact's own step allows, or a step beyond the stability limit of the contact it ended
+//!   in, is rejected; the world is restored from the state saved before the step and the step is
+//!   retried shorter. With fixed steps nothing is retried: a step beyond the stability limit is an
+//!   [`Error::StepTooLarge`], before (from the state at the step's start) or after it.
+//! - **Guards** ([`GuardReport`]): a body that left the physical range is an error
+//!   ([`Error::Diverged`]); a contact deeper than its law's validity and runs of steps at the step
+//!   floor are recorded (and fail the run under [`StepControl::strict`]); a step control that
+//!   cannot make progress (no accepted step above the floor for [`STALL_STEPS`] steps) is an
+//!   [`Error::Stalled`].
+//!
+//! ```
+//! use clearance_joint::prelude::*;
+//! use clearance_joint::rapier::stepper::{StepControl, Stepper};
+//! use rapier3d_f64::prelude::*;
+//!
+//! // A 2 kg arm on a steel pin with 0.2 mm of play, released horizontal under gravity.
+//! let mut world = PhysicsWorld::new();
+//! world.gravity = Vector::new(0.0, -9.81, 0.0);
+//! world.integration_parameters.num_solver_iterations = 1;
+//! let base = world.bodies.insert(RigidBodyBuilder::fixed());
+//! let arm = world.bodies.insert(
+//!     RigidBodyBuilder::dynamic()
+//!         .translation(Vector::new(0.3, 0.0, 0.0))
+//!         .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02)))
+//!         .can_sleep(false),
+//! );
+//! let mut joints = ClearanceJointSet::new();
+//! // Improved Liu law, steel on steel: bearing radius 10 mm, clearance 0.2 mm, width 16 mm.
+//! let pin = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?.joint(
+//!     Vector::ZERO,
+//!     Vector::new(-0.3, 0.0, 0.0),
+//!     Vector::Z,
+//!     Vector::Z,
+//! )?;
+//! let pin = joints.insert(base, arm, pin, &mut world.impulse_joints);
+//! let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.02));
+//! let mut peak: f64 = 0.0;
+//! while stepper.time() < 0.2 {
+//!     stepper.step(&mut world, &mut [&mut joints], 0.2)?;
+//!     peak = peak.max(joints.get(pin).unwrap().report().force.normal_force);
+//! }
+//! assert!(stepper.guards().is_clean(), "{:?}", stepper.guards());
+//! assert!(peak > 19.62, "the first impact exceeds the static load: {peak} N");
+//! # Ok::<(), clearance_joint::Error>(())
+//! ```
+
+use crate::error::{Error, Result};
+use crate::rapier::drive::DriveSet;
+use crate::rapier::joint::ClearanceJointSet;
+use crate::rapier::ledger::Wrench;
+use rapier3d_f64::math::{Pose, Vector};
+use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle};
+use serde::{Deserialize, Serialize};
+
+/// Something that exerts forces on the bodies of a world, computed from their state:
+/// [`ClearanceJointSet`] and [`DriveSet`] are ones. The [`Stepper`] evaluates it at the state
+/// before each step and adds its wrenches to the bodies for the duration of that step only, so
+/// between steps the bodies carry nothing but your own forces (reset or replace them as you like).
+pub trait ForceSource {
+    /// Evaluates at the bodies' current state (without touching their forces).
+    fn evaluate(&mut self, bodies: &mut rapier3d_f64::prelude::RigidBodySet);
+    /// The wrenches of the last evaluation.
+    fn wrenches(&self) -> &[Wrench];
+    /// Saves the internal state (before a step that may be rejected).
+    fn save_state(&mut self);
+    /// Restores the state saved last (the stepper restores the bodies).
+    fn restore_state(&mut self);
+    /// The clearance joints of this source, for the step choice and acceptance.
+    fn clearance_joints(&self) -> Option<&ClearanceJointSet> {
+        None
+    }
+    /// Called right before each Rapier step (a retried step included) with its start `t0` and
+    /// length `dt`, s: a source that prescribes kinematic motion sets the bodies' next poses here
+    /// ([`PrescribedSet`](crate::rapier::prescribed::PrescribedSet)). Default: nothing.
+    fn before_rapier_step(
+        &mut self,
+        _bodies: &mut rapier3d_f64::prelude::RigidBodySet,
+        _t0: f64,
+        _dt: f64,
+    ) {
+    }
+}
+
+impl ForceSource for ClearanceJointSet {
+    fn evaluate(&mut self, bodies: &mut rapier3d_f64::prelude::RigidBodySet) {
+        ClearanceJointSet::evaluate(self, bodies);
+    }
+    fn wrenches(&self) -> &[Wrench] {
+        ClearanceJointSet::wrenches(self)
+    }
+    fn save_state(&mut self) {
+        ClearanceJointSet::save_state(self);
+    }
+    fn restore_state(&mut self) {
+        ClearanceJointSet::restore_state(self);
+    }
+    fn clearance_joints(&self) -> Option<&ClearanceJointSet> {
+        Some(self)
+    }
+}
+
+impl ForceSource for DriveSet {
+    fn evaluate(&mut self, bodies: &mut rapier3d_f64::prelude::RigidBodySet) {
+        DriveSet::evaluate(self, bodies);
+    }
+    fn wrenches(&self) -> &[Wrench] {
+        DriveSet::wrenches(self)
+    }
+    fn save_state(&mut self) {
+        DriveSet::save_state(self);
+    }
+    fn restore_state(&mut self) {
+        DriveSet::restore_state(self);
+    }
+}
+
+/// How the step is chosen (`run.step` in scene files).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum StepMode {
+    /// A constant step (the paper's way); the last step is shortened to land on the end.
+    Fixed,
+    /// The step changes between Rapier steps: at most the largest step in free flight, shorter as
+    /// a contact approaches and inside it (`tolerance` of the contact's natural period, within
+    /// its damped and friction stability limits), with rejected steps retried. The default.
+    #[default]
+    Adaptive,
+}
+
+/// Steps at or below this many floors in a row, with no progress in simulated time, stop the
+/// run with [`Error::Stalled`].
+pub const STALL_STEPS: u64 = 100_000;
+
+/// Rejections of one step after which the step control gives up ([`Error::Stalled`]).
+const MAX_REJECTIONS: u32 = 60;
+
+/// The step control of a [`Stepper`], built with chained setters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepControl {
+    /// Fixed or adaptive.
+    pub mode: StepMode,
+    /// The fixed step, or the largest adaptive step, s.
+    pub max_dt: f64,
+    /// Adaptive: the fraction of a contact's natural period one step may cover.
+    pub tolerance: f64,
+    /// Adaptive: the smallest step, s (the floor; see [`STALL_STEPS`]).
+    pub min_dt: f64,
+    /// Adaptive: the largest ratio of a step to the one before it. Steps that change abruptly
+    /// make Rapier's constrained velocities (which it evaluates at the step's start) disagree
+    /// with the half-step velocities of the kicked bodies; a bounded ratio keeps that error
+    /// first order in the change.
+    pub max_growth: f64,
+    /// Whether a guard violation ([`GuardReport::is_clean`] false) fails the step with
+    /// [`Error::Guard`] instead of only being recorded.
+    pub strict: bool,
+}
+
+impl StepControl {
+    /// Constant steps of `dt` seconds.
+    pub fn fixed(dt: f64) -> Self {
+        StepControl {
+            mode: StepMode::Fixed,
+            max_dt: dt,
+            ..Self::adaptive(dt, 0.02)
+        }
+    }
+
+    /// Adaptive steps of at most `max_dt` seconds, `tolerance` of a contact period inside
+    /// contacts; floor 1e-10 s, growth at most 2 per step, not strict.
+    pub fn adaptive(max_dt: f64, tolerance: f64) -> Self {
+        StepControl {
+            mode: StepMode::Adaptive,
+            max_dt,
+            tolerance,
+            min_dt: 1e-10,
+            max_growth: 2.0,
+            strict: false,
+        }
+    }
+
+    /// Sets the adaptive tolerance, the fraction of a contact period one step may cover.
+    pub fn with_tolerance(mut self, tolerance: f64) -> Self {
+        self.tolerance = tolerance;
+        self
+    }
+
+    /// Sets the floor of the adaptive step, s.
+    pub fn min_dt(mut self, dt: f64) -> Self {
+        self.min_dt = dt;
+        self
+    }
+
+    /// Sets the largest growth ratio of one step over the previous.
+    pub fn max_growth(mut self, ratio: f64) -> Self {
+        self.max_growth = ratio;
+        self
+    }
+
+    /// Makes guard violations errors.
+    pub fn strict(mut self, strict: bool) -> Self {
+        self.strict = strict;
+        self
+    }
+
+    /// Checks the fields: positive finite steps, a tolerance in (0, 1], growth above 1.
+    pub fn validate(&self) -> Result<()> {
+        let ok = |v: f64| v.is_finite() && v > 0.0;
+        if !ok(self.max_dt) {
+            return Err(Error::invalid(
+                "dt_s",
+                format!(
+                    "must be a positive finite step in seconds (got {})",
+                    self.max_dt
+                ),
+            ));
+        }
+        if self.mode == StepMode::Adaptive {
+            if !(ok(self.tolerance) && self.tolerance <= 1.0) {
+                return Err(Error::invalid(
+                    "tolerance",
+                    format!(
+                        "must be in (0, 1], a fraction of a contact period (got {})",
+                        self.tolerance
+                    ),
+                ));
+            }
+            if !(ok(self.min_dt) && self.min_dt <= self.max_dt) {
+                return Err(Error::invalid(
+                    "min_dt",
+                    format!(
+                        "must be positive and at most the largest step {} s (got {})",
+                        self.max_dt, self.min_dt
+                    ),
+                ));
+            }
+            if !(self.max_growth.is_finite() && self.max_growth > 1.0) {
+                return Err(Error::invalid(
+                    "max_growth",
+                    format!("must be a finite ratio above 1 (got {})", self.max_growth),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What the guards saw over all steps so far.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct GuardReport {
+    /// Steps rejected and retried shorter.
+    pub rejected_steps: u64,
+    /// Deepest penetration over its joint's validity limit seen, as a ratio (0 when none
+    /// exceeded it; above 1 is a violation).
+    pub worst_penetration_ratio: f64,
+    /// Joint and time of the first penetration beyond the validity limit.
+    pub first_invalid_penetration: Option<(String, f64)>,
+    /// Steps taken at the floor `min_dt`.
+    pub floor_steps: u64,
+    /// Violations in words, in the order they were first seen (the first of each kind and
+    /// joint).
+    pub violations: Vec<String>,
+    #[serde(skip)]
+    keys: Vec<String>,
+}
+
+impl GuardReport {
+    /// No violation recorded.
+    pub fn is_clean(&self) -> bool {
+        self.violations.is_empty()
+    }
+
+    /// Records `text` unless a violation with the same `key` was recorded.
+    pub fn violation(&mut self, key: &str, text: impl FnOnce() -> String) {
+        if !self.keys.iter().any(|k| k == key) {
+            self.keys.push(key.to_string());
+            self.violations.push(text());
+        }
+    }
+}
+
+/// What one accepted step did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepInfo {
+    /// Time at the step's start, s.
+    pub t0: f64,
+    /// The step, s.
+    pub dt: f64,
+    /// The span of the velocity kick, `(h_prev + h)/2` (`h/2` for the first step), s: applied
+    /// forces and gravity acted for this long, so a momentum change over the step divided by it
+    /// is the mean force at the step's start (an ideal joint's reaction, say).
+    pub kick: f64,
+    /// Steps rejected before this one was accepted.
+    pub rejected: u32,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct BodySnapshot {
+    handle: RigidBodyHandle,
+    position: Pose,
+    next_position: Pose,
+    linvel: Vector,
+    angvel: Vector,
+    force: Vector,
+    torque: Vector,
+}
+
+/// Replaces `into` with the state of every movable body: pose (and kinematic target),
+/// velocities, and the user forces on it.
+fn snapshot_bodies(world: &PhysicsWorld, into: &mut Vec<BodySnapshot>) {
+    into.clear();
+    into.extend(
+        world
+            .bodies
+            .iter()
+            .filter(|(_, rb)| !rb.is_fixed())
+            .map(|(handle, rb)| BodySnapshot {
+                handle,
+                position: *rb.position(),
+                next_position: *rb.next_position(),
+                linvel: rb.linvel(),
+                angvel: rb.angvel(),
+                force: rb.user_force(),
+                torque: rb.user_torque(),
+            }),
+    );
+}
+
+/// The step control of a world with clearance joints: see the module docs.
+#[derive(Clone, Debug)]
+pub struct Stepper {
+    control: StepControl,
+    t: f64,
+    last_dt: f64,
+    steps: u64,
+    prepared: bool,
+    floor_run: u64,
+    saved: Vec<BodySnapshot>,
+    guards: GuardReport,
+}
+
+impl Stepper {
+    /// A stepper at time 0 that has not evaluated its force sources yet.
+    pub fn new(control: StepControl) -> Self {
+        Stepper {
+            control,
+            t: 0.0,
+            last_dt: 0.0,
+            steps: 0,
+            prepared: false,
+            floor_run: 0,
+            saved: Vec::new(),
+            guards: GuardReport::default(),
+        }
+    }
+
+    /// The step control.
+    pub fn control(&self) -> &StepControl {
+        &self.control
+    }
+
+    /// Changes the step control (e.g. the ECS layer follows `integration_parameters.dt`).
+    pub fn set_control(&mut self, control: StepControl) {
+        self.control = control;
+    }
+
+    /// Simulated time, s: the sum of the accepted steps.
+    pub fn time(&self) -> f64 {
+        self.t
+    }
+
+    /// Accepted steps.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// The last accepted step (0 before the first), s.
+    pub fn last_dt(&self) -> f64 {
+        self.last_dt
+    }
+
+    /// What the guards recorded.
+    pub fn guards(&self) -> &GuardReport {
+        &self.guards
+    }
+
+    /// Forgets the force sources' evaluation: the next step evaluates them again first. Call it
+    /// after changing the world between steps (bodies moved by hand, joints or drives added or
+    /// removed). With `restart_kick` the next step is a half kick again, as from a new initial
+    /// state (after setting velocities by hand).
+    pub fn invalidate(&mut self, restart_kick: bool) {
+        self.prepared = false;
+        if restart_kick {
+            self.last_dt = 0.0;
+        }
+    }
+
+    /// Evaluates every source at the current state (once, before the first step; the stepper
+    /// re-evaluates after every step by itself). Also checks the solver iterations.
+    pub fn prepare(
+        &mut self,
+        world: &mut PhysicsWorld,
+        sources: &mut [&mut dyn ForceSource],
+    ) -> Result<()> {
+        if self.prepared {
+            return Ok(());
+        }
+        self.control.validate()?;
+        for s in sources.iter_mut() {
+            s.evaluate(&mut world.bodies);
+            if let Some(j) = s.clearance_joints() {
+                j.check_substeps(&world.integration_parameters)?;
+            }
+        }
+        self.prepared = true;
+        Ok(())
+    }
+
+    /// The step the control would take now, before landing on `until`.
+    fn choose(&self, sources: &[&mut dyn ForceSource]) -> f64 {
+        let c = &self.control;
+        match c.mode {
+            StepMode::Fixed => c.max_dt,
+            StepMode::Adaptive => {
+                let mut dt = c.max_dt;
+                for s in sources {
+                    if let Some(j) = s.clearance_joints() {
+                        dt = dt.min(j.adaptive_step(c.tolerance, self.last_dt));
+                    }
+                }
+                if self.last_dt > 0.0 {
+                    dt = dt.min(c.max_growth * self.last_dt);
+                }
+                dt.max(c.min_dt)
+            }
+        }
+    }
+
+    /// Takes one accepted step towards `until` (s; the step lands on it exactly, a fixed step
+    /// being taken whole when the remainder is within 1e-6 of it; an infinite `until` is no
+    /// target), with `sources` evaluated at the state before it (done by the previous call, or by
+    /// [`prepare`](Self::prepare) on the first) and again at the state after it. Returns what the
+    /// step did. `until` at or before the current time is refused. An error after the step (a
+    /// fixed step beyond a contact's stability limit, a guard under `strict`, a diverged body)
+    /// leaves the world and the clock at the state the step reached.
+    ///
+    /// Between steps the bodies carry only your own forces: the sources' wrenches are added for
+    /// the step and taken away after it. Kinematic position targets
+    /// (`set_next_kinematic_position`) are reached within one step whatever its length: move such
+    /// bodies with velocities (velocity-based kinematic bodies) when the step is adaptive.
+    pub fn step(
+        &mut self,
+        world: &mut PhysicsWorld,
+        sources: &mut [&mut dyn ForceSource],
+        until: f64,
+    ) -> Result<StepInfo> {
+        // Cheap, and `set_control` may have changed it since the last step.
+        self.control.validate()?;
+        self.prepare(world, sources)?;
+        let left = until - self.t;
+        if !(left > 0.0) {
+            return Err(Error::invalid(
+                "until",
+                format!(
+                    "must be after the current time {} s (got {until} s)",
+                    self.t
+                ),
+            ));
+        }
+        let adaptive = self.control.mode == StepMode::Adaptive;
+        let mut dt = self.choose(sources);
+        if adaptive {
+            // Divide what is left into equal steps no larger than dt: no sliver step before the
+            // target (a 1e-8 s step after a 1e-4 s one would break the growth bound). An
+            // infinite `until` is no target.
+            if left.is_finite() {
+                dt = left / (left / dt).ceil();
+            }
+        } else {
+            // The last step lands on `until`: a full step when `left` is one step up to rounding
+            // (no sliver after it), else shortened.
+            if left < dt * (1.0 - 1e-6) {
+                dt = left;
+            }
+            for s in sources.iter() {
+                if let Some(j) = s.clearance_joints() {
+                    j.check_step(dt).map_err(|e| self.locate(e))?;
+                }
+            }
+        }
+        // Save the state: bodies (always: their forces are restored after the scaled step) and,
+        // when a step may be rejected, the sources.
+        snapshot_bodies(world, &mut self.saved);
+        if adaptive {
+            for s in sources.iter_mut() {
+                s.save_state();
+            }
+        }
+        let gravity = world.gravity;
+        let mut rejected = 0u32;
+        loop {
+            let kick = 0.5 * (self.last_dt + dt);
+            let scale = kick / dt;
+            // For this step only: your forces and the sources' wrenches, scaled to the kick.
+            for b in &self.saved {
+                if let Some(rb) = world.bodies.get_mut(b.handle)
+                    && rb.is_dynamic()
+                    && scale != 1.0
+                {
+                    rb.reset_forces(false);
+                    rb.reset_torques(false);
+                    rb.add_force(b.force * scale, false);
+                    rb.add_torque(b.torque * scale, false);
+                }
+            }
+            for s in sources.iter() {
+                for w in s.wrenches() {
+                    if let Some(rb) = world.bodies.get_mut(w.body)
+                        && rb.is_dynamic()
+                    {
+                        let wake = w.force != Vector::ZERO || w.torque != Vector::ZERO;
+                        rb.add_force(w.force * scale, wake);
+                        rb.add_torque(w.torque * scale, wake);
+                    }
+                }
+            }
+            world.gravity = gravity * scale;
+            world.integration_parameters.dt = dt;
+            for s in sources.iter_mut() {
+                s.before_rapier_step(&mut world.bodies, self.t, dt);
+            }
+            world.step();
+            world.gravity = gravity;
+            self.restore_forces(world);
+            for s in sources.iter_mut() {
+                s.evaluate(&mut world.bodies);
+            }
+            let retry = if adaptive {
+                sources
+                    .iter()
+                    .filter_map(|s| s.clearance_joints())
+                    .filter_map(|j| j.judge_step(dt, self.control.tolerance))
+                    .reduce(f64::min)
+            } else {
+                None
+            };
+            match retry {
+                None => {
+                    // The step is taken: the clock follows the world before any check can fail,
+                    // so an error leaves both at the state the step reached.
+                    let info = StepInfo {
+                        t0: self.t,
+                        dt,
+                        kick,
+                        rejected,
+                    };
+                    self.t = if dt >= left * (1.0 - 1e-6) {
+                        until
+                    } else {
+                        self.t + dt
+                    };
+                    self.last_dt = dt;
+                    self.steps += 1;
+                    self.guards.rejected_steps += u64::from(rejected);
+                    if !adaptive {
+                        // The last step is checked too: the contact it ended in.
+                        for s in sources.iter() {
+                            if let Some(j) = s.clearance_joints() {
+                                j.check_step(dt).map_err(|e| self.locate(e))?;
+                            }
+                        }
+                    }
+                    self.check_health(world, sources, dt)?;
+                    self.count_floor(dt)?;
+                    return Ok(info);
+                }
+                Some(shorter) => {
+                    rejected += 1;
+                    self.restore(world, sources);
+                    let next = shorter.min(0.5 * dt).max(self.control.min_dt);
+                    if rejected > MAX_REJECTIONS || next >= dt {
+                        return Err(Error::Stalled {
+                            t: self.t,
+                            reason: format!(
+                                "the step was rejected {rejected} times down to {} s: no step \
+                                 resolves the contact (a contact law parameter out of its physical \
+                                 range, a step floor `min_dt` too high, or a body moved by hand or \
+                                 by a kinematic position target, which any step reaches at once)",
+                                crate::error::sig4(dt)
+                            ),
+                        });
+                    }
+                    dt = next;
+                }
+            }
+        }
+    }
+
+    /// Takes a step of the last step's size (or `dt` if none), lets `read` look at the world and
+    /// the step, then restores the state before it exactly: e.g. an ideal joint's reaction at
+    /// the final time, which only the step after it determines.
+    pub fn peek<R>(
+        &mut self,
+        world: &mut PhysicsWorld,
+        sources: &mut [&mut dyn ForceSource],
+        dt: f64,
+        read: impl FnOnce(&PhysicsWorld, &StepInfo) -> R,
+    ) -> Result<R> {
+        self.prepare(world, sources)?;
+        let (t, last, steps, guards, control) = (
+            self.t,
+            self.last_dt,
+            self.steps,
+            self.guards.clone(),
+            self.control,
+        );
+        let h = if last > 0.0 { last } else { dt };
+        // A fixed step of `h` with the sources saved, then everything put back.
+        for s in sources.iter_mut() {
+            s.save_state();
+        }
+        let mut probe = control;
+        probe.mode = StepMode::Fixed;
+        probe.max_dt = h;
+        self.control = probe;
+        let mut saved_bodies = Vec::new();
+        snapshot_bodies(world, &mut saved_bodies);
+        let result = self.step(world, sources, t + h);
+        let out = result.map(|info| read(world, &info));
+        self.saved = saved_bodies;
+        self.restore(world, sources);
+        self.t = t;
+        self.last_dt = last;
+        self.steps = steps;
+        self.guards = guards;
+        self.control = control;
+        out
+    }
+
+    fn restore_forces(&self, world: &mut PhysicsWorld) {
+        for b in &self.saved {
+            if let Some(rb) = world.bodies.get_mut(b.handle)
+                && rb.is_dynamic()
+            {
+                rb.reset_forces(false);
+                rb.reset_torques(false);
+                rb.add_force(b.force, false);
+                rb.add_torque(b.torque, false);
+            }
+        }
+    }
+
+    /// Puts the bodies and the sources back as they were before the step.
+    fn restore(&self, world: &mut PhysicsWorld, sources: &mut [&mut dyn ForceSource]) {
+        for b in &self.saved {
+            if let Some(rb) = world.bodies.get_mut(b.handle) {
+                rb.set_position(b.position, false);
+                if rb.is_kinematic() {
+                    rb.set_next_kinematic_position(b.next_position);
+                }
+                rb.set_linvel(b.linvel, false);
+                rb.set_angvel(b.angvel, false);
+            }
+        }
+        self.restore_forces(world);
+        for s in sources.iter_mut() {
+            s.restore_state();
+        }
+    }
+
+    fn count_floor(&mut self, dt: f64) -> Result<()> {
+        if self.control.mode == StepMode::Adaptive && dt <= self.control.min_dt * (1.0 + 1e-9) {
+            self.guards.floor_steps += 1;
+            self.floor_run += 1;
+            let (floor, t) = (self.control.min_dt, self.t);
+            self.guards.violation("floor", || {
+                format!(
+                    "steps at the floor {} s (first at t = {} s): contacts resolved no better \
+                     than the floor allows",
+                    crate::error::sig4(floor),
+                    crate::error::sig4(t)
+                )
+            });
+            if self.floor_run >= STALL_STEPS {
+                return Err(Error::Stalled {
+                    t: self.t,
+                    reason: format!(
+                        "{} steps in a row at the floor {} s: the contact is too stiff or too \
+                         damped for any step (a contact law parameter out of its physical range?)",
+                        self.floor_run,
+                        crate::error::sig4(self.control.min_dt)
+                    ),
+                });
+            }
+        } else {
+            self.floor_run = 0;
+        }
+        Ok(())
+    }
+
+    /// Non-physical bodies are errors; penetrations beyond validity are recorded.
+    fn check_health(
+        &mut self,
+        world: &PhysicsWorld,
+        sources: &[&mut dyn ForceSource],
+        dt: f64,
+    ) -> Result<()> {
+        for b in &self.saved {
+            if let Some(rb) = world.bodies.get(b.handle)
+                && let Some(speed) = left_physical_range(rb, &world.integration_parameters)
+            {
+                return Err(Error::Diverged {
+                    t: self.t,
+                    reason: format!(
+                        "body {:?} left the physical range (speed {} m/s)",
+                        b.handle.into_raw_parts(),
+                        crate::error::sig4(speed)
+                    ),
+                });
+            }
+        }
+        let t = self.t;
+        let fixed = self.control.mode == StepMode::Fixed;
+        for s in sources {
+            let Some(set) = s.clearance_joints() else {
+                continue;
+            };
+            for (_, j) in set.iter() {
+                let limit = j.report().friction_stable_dt;
+                if fixed && dt > limit {
+                    self.guards
+                        .violation(&format!("friction:{}", j.name()), || {
+                            format!(
+                                "joint `{}`: the fixed step {} s is longer than friction's limit \
+                                 {} s near zero slip (first at t = {} s): stiction is a numerical \
+                                 chatter there; adaptive steps resolve it",
+                                j.name(),
+                                crate::error::sig4(dt),
+                                crate::error::sig4(limit),
+                                crate::error::sig4(t)
+                            )
+                        });
+                }
+                let ratio = j.report().state.penetration / j.max_valid_penetration();
+                if ratio > self.guards.worst_penetration_ratio {
+                    self.guards.worst_penetration_ratio = ratio;
+                }
+                if ratio > 1.0 {
+                    if self.guards.first_invalid_penetration.is_none() {
+                        self.guards.first_invalid_penetration = Some((j.name().to_string(), t));
+                    }
+                    self.guards
+                        .violation(&format!("penetration:{}", j.name()), || {
+                            format!(
+                                "joint `{}` penetrated beyond its law's validity ({} um > {} um, \
+                                 first at t = {} s)",
+                                j.name(),
+                                crate::error::sig4(j.report().state.penetration * 1e6),
+                                crate::error::sig4(j.max_valid_penetration() * 1e6),
+                                crate::error::sig4(t)
+                            )
+                        });
+                }
+            }
+        }
+        if self.control.strict && !self.guards.is_clean() {
+            return Err(Error::Guard {
+                t: self.t,
+                violations: self.guards.violations.join("; "),
+            });
+        }
+        Ok(())
+    }
+
+    /// Adds the time and the step mode to a step-limit error (the joints know neither).
+    fn locate(&self, mut e: Error) -> Error {
+        if let Error::StepTooLarge { t, .. } = &mut e {
+            *t = Some(self.t);
+        }
+        e.with_step_mode(self.control.mode == StepMode::Adaptive)
+    }
+}
+
+/// `Some(speed)` when `rb` has left the physical range: disabled by Rapier's quarantine,
+/// non-finite, or faster than half Rapier's speed clamp (Rapier clamps a blown-up body instead of
+/// producing NaN, so a clamped speed is the sign of a silent blow-up).
+pub fn left_physical_range(
+    rb: &rapier3d_f64::prelude::RigidBody,
+    params: &rapier3d_f64::prelude::IntegrationParameters,
+) -> Option<f64> {
+    let (v, w) = (rb.linvel(), rb.angvel());
+    let bad = !rb.is_enabled() || !rb.translation().is_finite() || !v.is_finite() || !w.is_finite();
+    (bad || v.length() > 0.5 * params.max_linear_velocity()).then(|| v.length())
+}

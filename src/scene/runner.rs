@@ -1,0 +1,1316 @@
+//! The runner: builds a scene twice in one Rapier world, an ideal twin (every hinge a Rapier
+//! revolute joint) and a clearance twin (hinges with clearance become [`ClearanceJoint`](crate::rapier::joint::ClearanceJoint)s), steps
+//! both together, and records both.
+
+use crate::error::Result;
+use crate::model::angle::{HingeAngle, UnwrappedAngle, twist_angle};
+use crate::model::laws::NormalForceLaw;
+use crate::rapier::drive::{DriveSet, TorsionSpring};
+use crate::rapier::joint::{ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet};
+use crate::rapier::metrics::{ContactObservation, ImpactRecorder};
+use crate::rapier::prescribed::{
+    PrescribedMotion, PrescribedPath, PrescribedSet, Table as MotionTable,
+};
+use crate::rapier::reaction::{
+    IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, KinematicState,
+    ReactionSolver,
+};
+use crate::rapier::stepper::{ForceSource, GuardReport, StepInfo, Stepper};
+use crate::scene::{JointKindSpec, MotionSpec, MotorSpec, Scene};
+use crate::table::Table;
+use rapier3d_f64::math::Vector;
+use rapier3d_f64::prelude::*;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// Which hinges a twin models with clearance.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TwinKind {
+    /// Every hinge is Rapier's ideal revolute joint.
+    Ideal,
+    /// Hinges with a clearance spec are clearance joints.
+    Clearance,
+}
+
+impl TwinKind {
+    /// `"ideal"` or `"clearance"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            TwinKind::Ideal => "ideal",
+            TwinKind::Clearance => "clearance",
+        }
+    }
+}
+
+/// Which twins to build.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Twins {
+    /// Both, side by side in one world (the default).
+    #[default]
+    Both,
+    /// Only the ideal twin (for cost measurements).
+    IdealOnly,
+    /// Only the clearance twin (for cost measurements).
+    ClearanceOnly,
+}
+
+/// Run options beyond the scene.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RunOptions {
+    /// Which twins to build.
+    pub twins: Twins,
+    /// Keep output rows (off for benchmarks: metrics are still computed every step).
+    pub skip_rows: bool,
+}
+
+#[derive(Clone, Debug)]
+struct BodyTrack {
+    name: String,
+    handle: RigidBodyHandle,
+    mass: f64,
+    /// Fixed or driven by a prescribed motion: outside the energy and momentum balances.
+    fixed: bool,
+    /// Not a fixed body (driven bodies move).
+    moves: bool,
+    /// The body's tabulated motion (index in the twin's prescribed set).
+    table: Option<usize>,
+    /// The centre of mass in the body's frame (not the origin for a spinning body), m.
+    local_com: Vector,
+    angle: UnwrappedAngle,
+    linvel_before: Vector,
+    /// Angular velocity, centre of mass and rotation at the state before the current step.
+    angvel_before: Vector,
+    com_before: Vector,
+    rotation_before: rapier3d_f64::math::Rotation,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum HingeJoint {
+    Ideal,
+    Clearance(ClearanceJointHandle),
+}
+
+#[derive(Clone, Debug)]
+struct HingeTrack {
+    name: String,
+    joint: HingeJoint,
+    bearing: usize,
+    journal: usize,
+    local_axis1: Vector,
+    local_u1: Vector,
+    local_v1: Vector,
+    angle: HingeAngle,
+    /// Force magnitude at the state before the current step (the clearance hook's force, or the
+    /// ideal reaction once the step determined it), N.
+    force: f64,
+    /// The clearance contact at the state before the current step.
+    sample: ContactSample,
+    recorder: ImpactRecorder,
+}
+
+impl HingeTrack {
+    /// The state before the current step, for the recorder.
+    fn observation(&self) -> ContactObservation {
+        match self.joint {
+            HingeJoint::Ideal => ContactObservation::ideal(self.force),
+            HingeJoint::Clearance(_) => ContactObservation {
+                force: self.force,
+                onset: self.sample.onset,
+                impact: self.sample.impact,
+                penetration: self.sample.penetration,
+                rate: self.sample.rate,
+            },
+        }
+    }
+}
+
+/// What a clearance hinge's hook saw at one state (read before the step it drives).
+#[derive(Clone, Copy, Debug, Default)]
+struct ContactSample {
+    onset: bool,
+    impact: bool,
+    penetration: f64,
+    /// Penetration rate, m/s (positive approaching).
+    rate: f64,
+    /// The damping part of the normal force (total minus elastic), N.
+    damping_force: f64,
+    /// Friction force magnitude, N.
+    friction_force: f64,
+}
+
+pub use crate::rapier::metrics::HingeMetrics;
+
+/// One twin: its bodies, joints, drives and records.
+#[derive(Debug)]
+pub struct Twin {
+    /// Ideal or clearance.
+    pub kind: TwinKind,
+    bodies: Vec<BodyTrack>,
+    hinges: Vec<HingeTrack>,
+    /// The clearance joints of this twin.
+    pub clearance: ClearanceJointSet,
+    /// The drives of this twin.
+    pub drives: DriveSet,
+    /// The tabulated motions of this twin's driven bodies.
+    pub prescribed: PrescribedSet,
+    /// The ideal joints: the ideal hinges' revolutes (with the hinge index of each), then the
+    /// scene's other joints.
+    ideal_joints: Vec<IdealJoint>,
+    ideal_hinges: Vec<usize>,
+    /// The scene's other joints: name and force on body 2 at the current state, N.
+    joints: Vec<(String, f64)>,
+    body_motion: bool,
+    reactions: ReactionSolver,
+    /// The drives' and clearance joints' wrenches at the current state (scratch).
+    source_wrenches: Vec<crate::rapier::ledger::Wrench>,
+    /// Spring and contact elastic energy at the state before the current step, J.
+    source_energy_before: f64,
+    reference_axis: Vector,
+    /// Output rows.
+    pub table: Table,
+    /// Row values at the previous and the current state.
+    row_prev: Vec<f64>,
+    row_cur: Vec<f64>,
+    /// Columns holding a contact flag (taken from the nearer state, not interpolated).
+    contact_columns: Vec<usize>,
+    /// Invariants and energy over every step.
+    pub invariants: Invariants,
+}
+
+/// Conservation checks over every step.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Invariants {
+    /// A prescribed motion or a motor drives the scene: it does work the balance does not know,
+    /// so the energy figures are null.
+    #[serde(skip)]
+    pub driven: bool,
+    /// Largest `|P(t) - P(0)|` over the largest single-body linear momentum seen; null when the
+    /// scene is not free-floating (gravity or a fixed body: momentum is not conserved).
+    pub linear_momentum_drift: Option<f64>,
+    /// Largest `|L(t) - L(0)|` (about the origin) over the largest single-body angular momentum
+    /// seen; null when the scene is not free-floating.
+    pub angular_momentum_drift: Option<f64>,
+    /// Largest growth of the energy balance `E(t) + D(t) - E(0)` (E: kinetic, gravity, spring and
+    /// contact elastic energy; D: the work dissipated so far by contact damping and friction) over
+    /// the energy scale. Fixed supports and ideal joints do no work, so the balance holds with
+    /// gravity and grounds too, and energy gained by the integration shows even in a run that
+    /// dissipates. Null when nothing moved (an energy scale below 1e-9 J: no scale to judge by),
+    /// and when a prescribed motion drives the scene (its work is not in the balance).
+    pub energy_growth: Option<f64>,
+    /// Largest `|E(t) + D(t) - E(0)|` over the energy scale (null when nothing moved).
+    pub energy_error: Option<f64>,
+    /// The energy scale: the larger of the peak kinetic energy and the largest change of the
+    /// potential energy, J.
+    pub energy_scale_j: f64,
+    /// Peak kinetic energy, J.
+    pub peak_kinetic_energy_j: f64,
+    /// Work dissipated by contact damping and friction over the run, J.
+    pub dissipated_j: f64,
+    #[serde(skip)]
+    free_floating: bool,
+    #[serde(skip)]
+    p0: Option<(Vector, Vector, f64, f64)>,
+    #[serde(skip)]
+    max_p: f64,
+    #[serde(skip)]
+    max_l: f64,
+    #[serde(skip)]
+    max_dp: f64,
+    #[serde(skip)]
+    max_dl: f64,
+    #[serde(skip)]
+    max_de: f64,
+    #[serde(skip)]
+    max_abs_de: f64,
+    #[serde(skip)]
+    max_dpe: f64,
+}
+
+/// Below this energy scale (J) nothing moved enough for the energy balance to be judged.
+const MIN_ENERGY_SCALE_J: f64 = 1e-9;
+
+/// Energy growth above this fraction of the energy scale is a guard violation.
+pub const ENERGY_GROWTH_LIMIT: f64 = 1e-2;
+
+/// A scene built in a Rapier world, ready to step.
+pub struct Simulation {
+    /// The Rapier world holding both twins.
+    pub world: PhysicsWorld,
+    /// The twins, ideal first.
+    pub twins: Vec<Twin>,
+    /// The step control (the same public piece a plain-Rapier loop uses).
+    pub stepper: Stepper,
+    scene: Scene,
+    /// Index of the next output row (row `k` is at `k * output_interval_s`, the last at `end_s`).
+    next_row: u64,
+    /// Time of the previous state (rows between it and the current one are interpolated).
+    t_prev: f64,
+    /// The row at `end_s` is written.
+    rows_done: bool,
+    skip_rows: bool,
+    comparison: ComparisonSums,
+}
+
+pub use crate::rapier::stepper::left_physical_range;
+
+/// The clearance twin against the ideal twin, from every internal step (both twins built).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Comparison {
+    /// Per body: deviation of its angular rate (about the reference axis) from the ideal twin's.
+    pub bodies: BTreeMap<String, RateDeviation>,
+    /// Per hinge: settling of the joint force.
+    pub hinges: BTreeMap<String, Settling>,
+}
+
+/// Rate deviation of one body, clearance twin minus ideal twin.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct RateDeviation {
+    /// Root-mean-square over the run (time-weighted), deg/s.
+    pub rms_deg_s: f64,
+    /// Largest absolute deviation, deg/s.
+    pub max_deg_s: f64,
+}
+
+/// When the joint force of a hinge settles.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Settling {
+    /// The last time at which the clearance joint force exceeded the ideal joint force by more
+    /// than `band_n`: after it the force stays within one ideal peak of the rigid hinge's load.
+    /// 0 when it never did.
+    pub settling_time_s: f64,
+    /// The band: the ideal twin's peak joint force on this hinge, N.
+    pub band_n: f64,
+}
+
+/// Running sums behind [`Comparison`].
+#[derive(Clone, Debug, Default)]
+struct ComparisonSums {
+    rate_sq_time: Vec<f64>,
+    rate_max: Vec<f64>,
+    /// Per hinge, a stack of `(t, excess)` with decreasing excess and increasing time: for any band
+    /// `b`, the last time the excess exceeded `b` is the latest entry above `b`.
+    excess: Vec<Vec<(f64, f64)>>,
+}
+
+impl ComparisonSums {
+    fn record(&mut self, ideal: &Twin, clear: &Twin, bodies: &RigidBodySet, t: f64, dt: f64) {
+        let n = ideal.bodies.len();
+        self.rate_sq_time.resize(n, 0.0);
+        self.rate_max.resize(n, 0.0);
+        self.excess.resize(ideal.hinges.len(), Vec::new());
+        let axis = ideal.reference_axis;
+        for (i, (bi, bc)) in ideal.bodies.iter().zip(&clear.bodies).enumerate() {
+            let d = (bodies[bc.handle].angvel() - bodies[bi.handle].angvel())
+                .dot(axis)
+                .to_degrees();
+            self.rate_sq_time[i] += d * d * dt;
+            self.rate_max[i] = self.rate_max[i].max(d.abs());
+        }
+        for (k, (hi, hc)) in ideal.hinges.iter().zip(&clear.hinges).enumerate() {
+            let excess = hc.force - hi.force;
+            // The band is the ideal peak at the end, at least the peak so far: an excess within
+            // it can never be the answer, so it is not stored (memory stays bounded in practice).
+            if excess <= hi.recorder.metrics().peak_force_n {
+                continue;
+            }
+            let stack = &mut self.excess[k];
+            while stack.last().is_some_and(|&(_, e)| e <= excess) {
+                stack.pop();
+            }
+            stack.push((t, excess));
+        }
+    }
+
+    fn finish(&self, ideal: &Twin, duration: f64) -> Comparison {
+        let mut c = Comparison::default();
+        for (i, b) in ideal.bodies.iter().enumerate() {
+            let rms = if duration > 0.0 {
+                (self.rate_sq_time.get(i).copied().unwrap_or(0.0) / duration).sqrt()
+            } else {
+                0.0
+            };
+            c.bodies.insert(
+                b.name.clone(),
+                RateDeviation {
+                    rms_deg_s: rms,
+                    max_deg_s: self.rate_max.get(i).copied().unwrap_or(0.0),
+                },
+            );
+        }
+        for (k, h) in ideal.hinges.iter().enumerate() {
+            let band = h.recorder.metrics().peak_force_n;
+            let last = self
+                .excess
+                .get(k)
+                .and_then(|s| s.iter().rev().find(|&&(_, e)| e > band))
+                .map_or(0.0, |&(t, _)| t);
+            c.hinges.insert(
+                h.name.clone(),
+                Settling {
+                    settling_time_s: last,
+                    band_n: band,
+                },
+            );
+        }
+        c
+    }
+}
+
+/// Where a run is, passed to the callback of [`Simulation::run_with_progress`].
+#[derive(Clone, Copy, Debug)]
+pub struct Progress {
+    /// Simulated time reached, s.
+    pub t: f64,
+    /// Simulated time at the end of the run, s.
+    pub end: f64,
+    /// Internal steps taken so far.
+    pub steps: u64,
+}
+
+/// The result of a whole run.
+#[derive(Debug)]
+pub struct RunResult {
+    /// The scene that ran (after overrides).
+    pub scene: Scene,
+    /// Twins with their tables and invariants.
+    pub twins: Vec<Twin>,
+    /// Internal steps taken.
+    pub steps: u64,
+    /// Wall time of the whole run (both twins share one world), s.
+    pub wall_s: f64,
+    /// Clearance twin against ideal twin (when both were built).
+    pub comparison: Option<Comparison>,
+    /// What the run-time guards saw (the stepper's, plus energy growth).
+    pub guards: GuardReport,
+}
+
+impl Simulation {
+    /// Builds the world for `scene`.
+    pub fn new(scene: &Scene, options: RunOptions) -> Result<Simulation> {
+        scene.validate()?;
+        let control = scene.run.step_control();
+        control.validate().map_err(|e| e.within("run"))?;
+        let mut world = PhysicsWorld::new();
+        world.gravity = Vector::from(scene.gravity);
+        world.integration_parameters.dt = scene.run.dt_s;
+        // One substep: the hook's force is constant over the step (substeps gain energy).
+        world.integration_parameters.num_solver_iterations = 1;
+        let kinds: &[TwinKind] = match options.twins {
+            Twins::Both => &[TwinKind::Ideal, TwinKind::Clearance],
+            Twins::IdealOnly => &[TwinKind::Ideal],
+            Twins::ClearanceOnly => &[TwinKind::Clearance],
+        };
+        let mut twins = Vec::new();
+        for &kind in kinds {
+            twins.push(Twin::build(scene, kind, &mut world)?);
+        }
+        // Mass properties before the first step (Rapier computes them in it; the reactions and
+        // the hooks need them at the initial state).
+        crate::rapier::reaction::prepare_mass_properties(&mut world.bodies);
+        Ok(Simulation {
+            world,
+            twins,
+            stepper: Stepper::new(control),
+            scene: scene.clone(),
+            next_row: 0,
+            t_prev: 0.0,
+            rows_done: false,
+            skip_rows: options.skip_rows,
+            comparison: ComparisonSums::default(),
+        })
+    }
+
+    /// Simulated time, s.
+    pub fn time(&self) -> f64 {
+        self.stepper.time()
+    }
+
+    fn done(&self) -> bool {
+        self.time() >= self.scene.run.end_s
+    }
+
+    /// Writes the rows whose times lie in `(t_prev, t]` (and the row at 0 at the first state),
+    /// interpolated between the previous state and the current one: rows sit exactly at
+    /// multiples of `output_interval_s` (and at `end_s`) whatever the steps, and never change them.
+    fn write_rows(&mut self, t: f64) {
+        if self.skip_rows {
+            return;
+        }
+        let run = &self.scene.run;
+        let (oi, end) = (run.output_interval_s, run.end_s);
+        // Rounding of summed steps: a row within a billionth of a step counts as reached.
+        let slack = 1e-9 * run.max_dt_s.max(run.dt_s);
+        while !self.rows_done {
+            let grid = self.next_row as f64 * oi;
+            let last = grid >= end - slack;
+            let r = if last { end } else { grid };
+            if r > t + slack {
+                return;
+            }
+            let w = if t > self.t_prev {
+                ((r - self.t_prev) / (t - self.t_prev)).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            for twin in &mut self.twins {
+                twin.write_row(r, w);
+            }
+            self.next_row += 1;
+            self.rows_done = last;
+        }
+    }
+
+    /// Where the next step may go at most: the end. Rows never shorten a step (a row is the
+    /// first state at or after its time), so the physics is the same for any output interval.
+    fn target(&self) -> f64 {
+        self.scene.run.end_s
+    }
+
+    /// Runs to `run.end_s`.
+    pub fn run(self) -> Result<RunResult> {
+        self.run_with_progress(|_| {})
+    }
+
+    /// Runs to `run.end_s`, calling `progress` after every internal step (e.g. to show simulated
+    /// time, steps per second and an ETA on a terminal; the call should be cheap).
+    pub fn run_with_progress(mut self, mut progress: impl FnMut(&Progress)) -> Result<RunResult> {
+        let start = Instant::now();
+        while !self.done() {
+            self.step()?;
+            progress(&Progress {
+                t: self.time(),
+                end: self.scene.run.end_s,
+                steps: self.stepper.steps(),
+            });
+        }
+        self.finish()?;
+        let comparison = match self.twins.as_slice() {
+            [ideal, _] => Some(self.comparison.finish(ideal, self.time())),
+            _ => None,
+        };
+        let mut guards = self.stepper.guards().clone();
+        for twin in &self.twins {
+            let g = twin.invariants.energy_growth.unwrap_or(0.0);
+            if g > ENERGY_GROWTH_LIMIT {
+                guards.violation(&format!("energy:{}", twin.kind.name()), || {
+                    format!(
+                        "the {} twin gained energy: {} of its energy scale (limit {})",
+                        twin.kind.name(),
+                        crate::error::sig4(g),
+                        ENERGY_GROWTH_LIMIT
+                    )
+                });
+            }
+        }
+        if self.scene.run.strict && !guards.is_clean() {
+            return Err(crate::Error::Guard {
+                t: self.time(),
+                violations: guards.violations.join("; "),
+            });
+        }
+        Ok(RunResult {
+            comparison,
+            scene: self.scene,
+            twins: self.twins,
+            steps: self.stepper.steps(),
+            wall_s: start.elapsed().as_secs_f64(),
+            guards,
+        })
+    }
+
+    /// Advances one accepted internal step: records the state before it (invariants, a row when
+    /// due, the contact samples), lets the stepper take it, then completes what only the step
+    /// determines (ideal reactions, metrics).
+    pub fn step(&mut self) -> Result<()> {
+        {
+            // The sources' forces at the first state, before it is read.
+            let mut sources = sources(&mut self.twins);
+            self.stepper.prepare(&mut self.world, &mut sources)?;
+        }
+        let t = self.time();
+        let gravity = self.world.gravity;
+        let rows = !self.skip_rows;
+        for twin in &mut self.twins {
+            twin.before_step(&self.world.bodies, gravity, t, rows);
+        }
+        let target = self.target();
+        let info = {
+            let mut sources = sources(&mut self.twins);
+            self.stepper
+                .step(&mut self.world, &mut sources, target)
+                .map_err(|e| name_step_field(e, "run.dt_s"))?
+        };
+        for twin in &mut self.twins {
+            twin.after_step(&self.world.bodies, &info, gravity);
+            if rows {
+                twin.complete_row_motion(&self.world.bodies, &info);
+            }
+        }
+        // Rows up to this state, now that its step gave its velocities and accelerations.
+        self.write_rows(t);
+        self.t_prev = t;
+        if let [ideal, clear] = self.twins.as_slice() {
+            self.comparison
+                .record(ideal, clear, &self.world.bodies, info.t0, info.dt);
+        }
+        Ok(())
+    }
+
+    /// Records the final state: invariants, a last row at `end_s` whose forces are those at that
+    /// state (ideal reactions from one more step, taken and undone), final metrics.
+    fn finish(&mut self) -> Result<()> {
+        {
+            let mut sources = sources(&mut self.twins);
+            self.stepper.prepare(&mut self.world, &mut sources)?;
+        }
+        let t = self.time();
+        let gravity = self.world.gravity;
+        let rows = !self.skip_rows;
+        for twin in &mut self.twins {
+            twin.before_step(&self.world.bodies, gravity, t, rows);
+        }
+        if rows && self.scene.run.body_motion {
+            // The final state's velocities and accelerations from one more step, taken and
+            // undone.
+            let mut twins = std::mem::take(&mut self.twins);
+            let peeked = {
+                let mut sources = sources(&mut twins);
+                let dt = self.scene.run.dt_s;
+                self.stepper
+                    .peek(&mut self.world, &mut sources, dt, |world, info| {
+                        (world.bodies.clone(), *info)
+                    })
+            };
+            self.twins = twins;
+            let (bodies, info) = peeked.map_err(|e| name_step_field(e, "run.dt_s"))?;
+            for twin in &mut self.twins {
+                twin.complete_row_motion(&bodies, &info);
+            }
+        }
+        self.write_rows(t);
+        let duration = self.time();
+        for twin in &mut self.twins {
+            // The final state counts for peaks and onsets (it carries no time).
+            for h in &mut twin.hinges {
+                let obs = h.observation();
+                h.recorder.finish(duration, &obs);
+                h.recorder.set_final_angle_deg(h.angle.value().to_degrees());
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The force sources of all twins, for the stepper.
+fn sources(twins: &mut [Twin]) -> Vec<&mut dyn ForceSource> {
+    let mut v: Vec<&mut dyn ForceSource> = Vec::with_capacity(3 * twins.len());
+    for t in twins.iter_mut() {
+        v.push(&mut t.drives);
+        v.push(&mut t.clearance);
+        if !t.prescribed.motions.is_empty() {
+            v.push(&mut t.prescribed);
+        }
+    }
+    v
+}
+
+/// Names the scene's step field in a step-limit error (the stepper knows only `dt`).
+fn name_step_field(mut e: crate::Error, name: &str) -> crate::Error {
+    if let crate::Error::StepTooLarge { field, .. } = &mut e {
+        *field = name.into();
+    }
+    e
+}
+
+impl Twin {
+    fn build(scene: &Scene, kind: TwinKind, world: &mut PhysicsWorld) -> Result<Twin> {
+        let mut bodies = Vec::new();
+        let mut prescribed = PrescribedSet::default();
+        for (i, b) in scene.bodies.iter().enumerate() {
+            let com = Vector::from(b.center_of_mass_m);
+            let origin = Vector::from(scene.body_origin(i));
+            let mut table = None;
+            let rb = match &b.motion {
+                // A tabulated drive: a position-based kinematic body whose next pose the
+                // prescribed set gives before each step.
+                Some(m @ (MotionSpec::TableAngle { .. } | MotionSpec::TablePosition { .. })) => {
+                    let (path, t, v) = match m {
+                        MotionSpec::TableAngle {
+                            axis,
+                            t_s,
+                            angle_rad,
+                            ..
+                        } => (
+                            PrescribedPath::Angle {
+                                axis: Vector::from(*axis).normalize(),
+                            },
+                            t_s,
+                            angle_rad,
+                        ),
+                        MotionSpec::TablePosition {
+                            direction,
+                            t_s,
+                            position_m,
+                        } => (
+                            PrescribedPath::Position {
+                                direction: Vector::from(*direction).normalize(),
+                            },
+                            t_s,
+                            position_m,
+                        ),
+                        _ => unreachable!("matched above"),
+                    };
+                    let rb = RigidBodyBuilder::kinematic_position_based()
+                        .translation(origin)
+                        .can_sleep(false)
+                        .build();
+                    let start = *rb.position();
+                    table = Some(prescribed.motions.len());
+                    prescribed.motions.push(PrescribedMotion {
+                        body: RigidBodyHandle::invalid(),
+                        start,
+                        path,
+                        table: MotionTable::new(t, v)
+                            .map_err(|e| e.within(&format!("bodies[{}].motion", b.name)))?,
+                    });
+                    rb
+                }
+                // A driven body: no mass properties, so Rapier turns it about its frame origin.
+                Some(m) => {
+                    let (v, w) = match m {
+                        MotionSpec::Spin {
+                            axis, rate_rad_s, ..
+                        } => (Vector::ZERO, Vector::from(*axis).normalize() * *rate_rad_s),
+                        MotionSpec::Translate { velocity_m_s } => {
+                            (Vector::from(*velocity_m_s), Vector::ZERO)
+                        }
+                        _ => unreachable!("tables are matched above"),
+                    };
+                    RigidBodyBuilder::kinematic_velocity_based()
+                        .translation(origin)
+                        .linvel(v)
+                        .angvel(w)
+                        .can_sleep(false)
+                        .build()
+                }
+                None => {
+                    let builder = if b.fixed {
+                        RigidBodyBuilder::fixed()
+                    } else {
+                        RigidBodyBuilder::dynamic()
+                            .linvel(Vector::from(b.velocity_m_s))
+                            .angvel(Vector::from(b.angular_velocity_rad_s))
+                    };
+                    builder
+                        .translation(com)
+                        .additional_mass_properties(MassProperties::new(
+                            Vector::ZERO,
+                            b.mass_kg,
+                            Vector::from(b.inertia_kg_m2),
+                        ))
+                        .can_sleep(false)
+                        .build()
+                }
+            };
+            let handle = world.bodies.insert(rb);
+            if let Some(k) = table {
+                prescribed.motions[k].body = handle;
+            }
+            bodies.push(BodyTrack {
+                table,
+                name: b.name.clone(),
+                handle,
+                mass: b.mass_kg,
+                fixed: b.fixed || b.motion.is_some(),
+                moves: !b.fixed,
+                local_com: com - origin,
+                angle: UnwrappedAngle::default(),
+                linvel_before: Vector::ZERO,
+                angvel_before: Vector::ZERO,
+                com_before: com,
+                rotation_before: rapier3d_f64::math::Rotation::IDENTITY,
+            });
+        }
+        let mut clearance = ClearanceJointSet::new();
+        let mut hinges = Vec::new();
+        for h in &scene.hinges {
+            let (ib, ij) = (
+                scene.body_index(&h.bearing).unwrap(),
+                scene.body_index(&h.journal).unwrap(),
+            );
+            let point = Vector::from(h.point_m);
+            let axis = Vector::from(h.axis).normalize();
+            // Bodies start unrotated with their frame at their origin (the centre of mass, or
+            // a spinning body's axis point).
+            let a1 = point - Vector::from(scene.body_origin(ib));
+            let a2 = point - Vector::from(scene.body_origin(ij));
+            let (b1, b2) = (bodies[ib].handle, bodies[ij].handle);
+            let joint = match (&h.clearance, kind) {
+                (Some(spec), TwinKind::Clearance) => {
+                    let p = spec
+                        .build()
+                        .map_err(|e| e.within(&format!("hinges[{}].clearance", h.name)))?;
+                    let j = ClearanceJointBuilder::new(axis, p.geometry, p.normal)
+                        .local_anchor1(a1)
+                        .local_anchor2(a2)
+                        .friction(p.friction)
+                        .min_impact_speed(p.min_impact_speed)
+                        .min_separation(p.min_separation)
+                        .lock(spec.lock)
+                        .name(h.name.clone())
+                        .build()?;
+                    HingeJoint::Clearance(clearance.insert(b1, b2, j, &mut world.impulse_joints))
+                }
+                _ => {
+                    let j = RevoluteJointBuilder::new(axis)
+                        .local_anchor1(a1)
+                        .local_anchor2(a2)
+                        .contacts_enabled(false);
+                    {
+                        world.impulse_joints.insert(b1, b2, j, true);
+                        HingeJoint::Ideal
+                    }
+                }
+            };
+            let u = in_plane_u(axis);
+            hinges.push(HingeTrack {
+                name: h.name.clone(),
+                joint,
+                bearing: ib,
+                journal: ij,
+                local_axis1: axis,
+                local_u1: u,
+                local_v1: axis.cross(u),
+                angle: HingeAngle::default(),
+                force: 0.0,
+                sample: ContactSample::default(),
+                recorder: ImpactRecorder::new(),
+            });
+        }
+        let mut drives = DriveSet::new();
+        for d in &scene.drives {
+            let hi = scene.hinge_index(&d.hinge).unwrap();
+            let h = &hinges[hi];
+            let per_rad = d.stiffness_nm_per_deg.to_degrees();
+            let spring = TorsionSpring::new(
+                bodies[h.bearing].handle,
+                bodies[h.journal].handle,
+                h.local_axis1,
+                d.torque_scale * d.torque0_nm,
+                d.torque_scale * per_rad,
+            )
+            .map_err(|e| e.within(&format!("drives[{}]", d.name)))?;
+            drives.insert(spring);
+        }
+        let (mut ideal_joints, mut ideal_hinges) = (Vec::new(), Vec::new());
+        for (i, h) in hinges.iter().enumerate() {
+            if let HingeJoint::Ideal = h.joint {
+                let hs = &scene.hinges[i];
+                let point = Vector::from(hs.point_m);
+                let com = |k: usize| Vector::from(scene.body_origin(k));
+                ideal_joints.push(IdealJoint::Revolute(IdealRevolute {
+                    body1: bodies[h.bearing].handle,
+                    body2: bodies[h.journal].handle,
+                    local_anchor1: point - com(h.bearing),
+                    local_anchor2: point - com(h.journal),
+                    local_axis1: h.local_axis1,
+                }));
+                ideal_hinges.push(i);
+            }
+        }
+        let mut joints = Vec::new();
+        for j in &scene.joints {
+            let (i1, i2) = (
+                scene.body_index(&j.body1).unwrap(),
+                scene.body_index(&j.body2).unwrap(),
+            );
+            let point = Vector::from(j.point_m);
+            let a1 = point - Vector::from(scene.body_origin(i1));
+            let a2 = point - Vector::from(scene.body_origin(i2));
+            let (b1, b2) = (bodies[i1].handle, bodies[i2].handle);
+            let ideal = match &j.kind {
+                JointKindSpec::Prismatic { axis, limits_m } => {
+                    let axis = Vector::from(*axis).normalize();
+                    let mut rj = PrismaticJointBuilder::new(axis)
+                        .local_anchor1(a1)
+                        .local_anchor2(a2)
+                        .contacts_enabled(false);
+                    if let Some(l) = limits_m {
+                        rj = rj.limits(*l);
+                    }
+                    world.impulse_joints.insert(b1, b2, rj, true);
+                    IdealJoint::Prismatic(IdealPrismatic {
+                        body1: b1,
+                        body2: b2,
+                        local_anchor1: a1,
+                        local_anchor2: a2,
+                        local_axis1: axis,
+                    })
+                }
+                JointKindSpec::Revolute { axis } => {
+                    let axis = Vector::from(*axis).normalize();
+                    let mut rj = RevoluteJointBuilder::new(axis)
+                        .local_anchor1(a1)
+                        .local_anchor2(a2)
+                        .contacts_enabled(false);
+                    let ideal = IdealRevolute {
+                        body1: b1,
+                        body2: b2,
+                        local_anchor1: a1,
+                        local_anchor2: a2,
+                        local_axis1: axis,
+                    };
+                    match &j.motor {
+                        Some(MotorSpec::Velocity {
+                            target_rad_s,
+                            factor,
+                        }) => {
+                            rj = rj.motor_velocity(*target_rad_s, *factor);
+                            world.impulse_joints.insert(b1, b2, rj, true);
+                            IdealJoint::MotorRevolute(ideal)
+                        }
+                        None => {
+                            world.impulse_joints.insert(b1, b2, rj, true);
+                            IdealJoint::Revolute(ideal)
+                        }
+                    }
+                }
+                JointKindSpec::Fixed => {
+                    let rj = FixedJointBuilder::new()
+                        .local_anchor1(a1)
+                        .local_anchor2(a2)
+                        .contacts_enabled(false);
+                    world.impulse_joints.insert(b1, b2, rj, true);
+                    IdealJoint::Fixed(IdealFixed {
+                        body1: b1,
+                        body2: b2,
+                        local_anchor1: a1,
+                        local_anchor2: a2,
+                    })
+                }
+                JointKindSpec::Spherical => {
+                    let rj = SphericalJointBuilder::new()
+                        .local_anchor1(a1)
+                        .local_anchor2(a2)
+                        .contacts_enabled(false);
+                    world.impulse_joints.insert(b1, b2, rj, true);
+                    IdealJoint::Spherical(IdealSpherical {
+                        body1: b1,
+                        body2: b2,
+                        local_anchor1: a1,
+                        local_anchor2: a2,
+                    })
+                }
+            };
+            ideal_joints.push(ideal);
+            joints.push((j.name.clone(), 0.0));
+        }
+        let mut columns = vec!["t_s".to_string()];
+        for b in &bodies {
+            columns.push(format!("{}_angle_deg", b.name));
+            columns.push(format!("{}_rate_deg_s", b.name));
+        }
+        let body_motion = scene.run.body_motion;
+        if body_motion {
+            for b in bodies.iter().filter(|b| b.moves) {
+                for c in [
+                    "x_m", "y_m", "z_m", "vx_m_s", "vy_m_s", "vz_m_s", "ax_m_s2", "ay_m_s2",
+                    "az_m_s2",
+                ] {
+                    columns.push(format!("{}_{c}", b.name));
+                }
+            }
+        }
+
+        for h in &hinges {
+            for c in [
+                "angle_deg",
+                "rate_deg_s",
+                "force_n",
+                "ecc_u_mm",
+                "ecc_v_mm",
+                "penetration_um",
+                "contact",
+            ] {
+                columns.push(format!("{}_{c}", h.name));
+            }
+        }
+        for (name, _) in &joints {
+            columns.push(format!("{name}_force_n"));
+        }
+        Ok(Twin {
+            kind,
+            bodies,
+            hinges,
+            clearance,
+            drives,
+            ideal_joints,
+            ideal_hinges,
+            joints,
+            body_motion,
+            prescribed,
+            reactions: ReactionSolver::default(),
+            source_wrenches: Vec::new(),
+            source_energy_before: 0.0,
+            reference_axis: Vector::from(scene.reference_axis).normalize(),
+            contact_columns: columns
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| c.ends_with("_contact"))
+                .map(|(i, _)| i)
+                .collect(),
+            table: Table::new(columns),
+            row_prev: Vec::new(),
+            row_cur: Vec::new(),
+            invariants: Invariants {
+                free_floating: scene.gravity == [0.0; 3]
+                    && scene.bodies.iter().all(|b| !b.fixed && b.motion.is_none()),
+                driven: scene.bodies.iter().any(|b| b.motion.is_some())
+                    || scene.joints.iter().any(|j| j.motor.is_some()),
+                ..Invariants::default()
+            },
+        })
+    }
+
+    /// Reads the state before a step (from the sources' evaluation at it): invariants, the
+    /// clearance samples and forces, the angles, and (with `rows`) the row values of the state.
+    fn before_step(&mut self, bodies: &RigidBodySet, gravity: Vector, t: f64, rows: bool) {
+        let axis_ref = self.reference_axis;
+        for b in &mut self.bodies {
+            let rb = &bodies[b.handle];
+            b.linvel_before = rb.linvel();
+            b.angvel_before = rb.angvel();
+            b.com_before = crate::rapier::ledger::world_center_of_mass(rb);
+            b.rotation_before = *rb.rotation();
+            // Bodies start unrotated: the body's rotation is its rotation since t = 0.
+            b.angle.update(twist_angle(rb.rotation(), axis_ref));
+        }
+        for h in &mut self.hinges {
+            let (r1, r2) = (
+                &bodies[self.bodies[h.bearing].handle],
+                &bodies[self.bodies[h.journal].handle],
+            );
+            // Every state, so the unwrapped angle never aliases whatever the output interval.
+            h.angle.update(r1.rotation(), r2.rotation(), h.local_axis1);
+            if let HingeJoint::Clearance(c) = h.joint {
+                let j = self.clearance.get(c).expect("handle of this twin");
+                let r = j.report();
+                let f = &r.force;
+                let elastic = j.normal_law().elastic_force(r.state.penetration);
+                h.force = f.on_journal.length();
+                h.sample = ContactSample {
+                    onset: r.onset,
+                    impact: r.impact,
+                    penetration: r.state.penetration,
+                    rate: r.state.penetration_rate,
+                    damping_force: if f.normal_force > 0.0 {
+                        f.normal_force - elastic
+                    } else {
+                        0.0
+                    },
+                    friction_force: f.friction_force,
+                };
+            }
+        }
+        self.solve_ideal_reactions(bodies, gravity, t);
+        self.source_energy_before = self.drives.potential_energy()
+            + self
+                .clearance
+                .iter()
+                .map(|(_, j)| j.elastic_energy())
+                .sum::<f64>();
+        if rows {
+            std::mem::swap(&mut self.row_prev, &mut self.row_cur);
+            self.fill_row(t, bodies);
+        }
+    }
+
+    /// Completes the step that started from the state [`before_step`](Self::before_step) read:
+    /// ideal reactions (which only the step determines), metrics of that state over the step.
+    fn after_step(&mut self, bodies: &RigidBodySet, info: &StepInfo, gravity: Vector) {
+        self.update_force_metrics(info.t0, info.dt);
+        self.update_invariants(bodies, gravity, info);
+        // Work of the step's damping and friction forces over the step's motion: the
+        // penetration change, and the slip at the step's velocity.
+        for h in &self.hinges {
+            if let HingeJoint::Clearance(c) = h.joint {
+                let r = self.clearance.get(c).expect("handle of this twin").report();
+                let sample = &h.sample;
+                if sample.penetration > 0.0 {
+                    self.invariants.dissipated_j += sample.damping_force
+                        * (r.state.penetration - sample.penetration)
+                        + sample.friction_force * r.state.slip.length() * info.dt;
+                }
+            }
+        }
+    }
+
+    /// Completes the body motion of the current row from the step taken from its state:
+    /// a dynamic body's velocity at the state is the synchronous one,
+    /// `(h v[n-1/2] + h_prev v[n+1/2])/(h_prev + h)`, and its acceleration
+    /// `(v[n+1/2] - v[n-1/2])/kick`, what the step applied (the stored velocities live at half
+    /// steps); a driven body's are exact (`w x r` and `w x (w x r)` for a spin, 0 for a
+    /// translation).
+    fn complete_row_motion(&mut self, bodies_after: &RigidBodySet, info: &StepInfo) {
+        if !self.body_motion {
+            return;
+        }
+        let (h, h_prev) = (info.dt, (2.0 * info.kick - info.dt).max(0.0));
+        let mut col = 1 + 2 * self.bodies.len();
+        for b in self.bodies.iter().filter(|b| b.moves) {
+            let (vel, acc) = if let Some(k) = b.table {
+                // A tabulated drive: the table's acceleration at the state.
+                let (_, a, w, alpha) = self.prescribed.motions[k].rates(info.t0);
+                let r = b.rotation_before * b.local_com;
+                (None, a + alpha.cross(r) + w.cross(w.cross(r)))
+            } else if b.fixed {
+                // Driven: the row's velocity is exact; the acceleration is the spin's.
+                let rb = &bodies_after[b.handle];
+                let w = rb.angvel();
+                let r = b.rotation_before * b.local_com;
+                (None, w.cross(w.cross(r)))
+            } else {
+                let after = bodies_after[b.handle].linvel();
+                let sync = (h * b.linvel_before + h_prev * after) / (h_prev + h);
+                (Some(sync), (after - b.linvel_before) / info.kick)
+            };
+            if let Some(v) = vel {
+                self.row_cur[col + 3..col + 6].copy_from_slice(&[v.x, v.y, v.z]);
+            }
+            self.row_cur[col + 6..col + 9].copy_from_slice(&[acc.x, acc.y, acc.z]);
+            col += 9;
+        }
+    }
+
+    /// Ideal-joint reactions at the current state, exact: the constrained rigid-body equations
+    /// solved for the joint forces ([`ReactionSolver`]), whatever the step control.
+    fn solve_ideal_reactions(&mut self, bodies: &RigidBodySet, gravity: Vector, t: f64) {
+        if self.ideal_joints.is_empty() {
+            return;
+        }
+        // Tabulated drives at this state: their velocities and accelerations.
+        self.reactions.kinematic.clear();
+        for b in &self.bodies {
+            if let Some(k) = b.table {
+                let m = &self.prescribed.motions[k];
+                let (v, a, w, alpha) = m.rates(t);
+                self.reactions.kinematic.push(KinematicState {
+                    body: b.handle,
+                    linvel: v,
+                    angvel: w,
+                    linacc: a,
+                    angacc: alpha,
+                });
+            }
+        }
+        // The sources' wrenches act during the steps only: the solver gets them explicitly.
+        self.source_wrenches.clear();
+        self.source_wrenches
+            .extend_from_slice(self.drives.wrenches());
+        self.source_wrenches
+            .extend_from_slice(self.clearance.wrenches());
+        if let Some(forces) = self.reactions.solve_joints_with(
+            bodies,
+            &self.ideal_joints,
+            gravity,
+            &self.source_wrenches,
+        ) {
+            let n = self.ideal_hinges.len();
+            for (&hi, f) in self.ideal_hinges.iter().zip(forces) {
+                self.hinges[hi].force = f.length();
+            }
+            for (j, f) in self.joints.iter_mut().zip(&forces[n..]) {
+                j.1 = f.length();
+            }
+        }
+    }
+
+    /// Metrics of the state before the step (its sample and force), weighted by the step.
+    fn update_force_metrics(&mut self, t: f64, dt: f64) {
+        for h in &mut self.hinges {
+            let obs = h.observation();
+            h.recorder.record(t, dt, &obs);
+        }
+    }
+
+    /// Momentum and energy at the state before the step just taken, with its synchronous
+    /// velocities: the half-step velocities around it weighted by the steps,
+    /// `(h v_before + h_prev v_after)/(h_prev + h)` (second order, where the stored half-step
+    /// velocities alone would make the energy balance first order).
+    fn update_invariants(&mut self, bodies: &RigidBodySet, gravity: Vector, info: &StepInfo) {
+        let (h, h_prev) = (info.dt, (2.0 * info.kick - info.dt).max(0.0));
+        let sync = |before: Vector, after: Vector| (h * before + h_prev * after) / (h_prev + h);
+        let (mut p, mut l, mut ke, mut pe) = (Vector::ZERO, Vector::ZERO, 0.0, 0.0);
+        let inv = &mut self.invariants;
+        for b in &self.bodies {
+            if b.fixed {
+                continue;
+            }
+            let rb = &bodies[b.handle];
+            let com = b.com_before;
+            let v = sync(b.linvel_before, rb.linvel());
+            let w = sync(b.angvel_before, rb.angvel());
+            let mp = &rb.mass_properties().local_mprops;
+            // I w in world: R I_principal R^T w.
+            let rot = b.rotation_before * mp.principal_inertia_local_frame;
+            let iw = rot * (mp.principal_inertia() * (rot.inverse() * w));
+            let pb = b.mass * v;
+            let lb = com.cross(pb) + iw;
+            p += pb;
+            l += lb;
+            ke += 0.5 * b.mass * v.length_squared() + 0.5 * w.dot(iw);
+            pe -= b.mass * gravity.dot(com);
+            inv.max_p = inv.max_p.max(pb.length());
+            inv.max_l = inv.max_l.max(lb.length());
+        }
+        pe += self.source_energy_before;
+        let e = ke + pe + inv.dissipated_j;
+        let (p0, l0, e0, pe0) = *inv.p0.get_or_insert((p, l, e, pe));
+        inv.max_dp = inv.max_dp.max((p - p0).length());
+        inv.max_dl = inv.max_dl.max((l - l0).length());
+        inv.max_de = inv.max_de.max(e - e0);
+        inv.max_abs_de = inv.max_abs_de.max((e - e0).abs());
+        inv.max_dpe = inv.max_dpe.max((pe - pe0).abs());
+        inv.peak_kinetic_energy_j = inv.peak_kinetic_energy_j.max(ke);
+        inv.energy_scale_j = inv.peak_kinetic_energy_j.max(inv.max_dpe);
+        let rel = |d: f64, scale: f64| if scale > 0.0 { d / scale } else { 0.0 };
+        if inv.free_floating {
+            inv.linear_momentum_drift = Some(rel(inv.max_dp, inv.max_p));
+            inv.angular_momentum_drift = Some(rel(inv.max_dl, inv.max_l));
+        }
+        if inv.energy_scale_j >= MIN_ENERGY_SCALE_J && !inv.driven {
+            inv.energy_growth = Some(inv.max_de / inv.energy_scale_j);
+            inv.energy_error = Some(inv.max_abs_de / inv.energy_scale_j);
+        }
+    }
+
+    /// The row values of the current state into `row_cur`.
+    fn fill_row(&mut self, t: f64, bodies: &RigidBodySet) {
+        let axis_ref = self.reference_axis;
+        let v = &mut self.row_cur;
+        v.clear();
+        v.push(t);
+        for b in &self.bodies {
+            let rb = &bodies[b.handle];
+            v.push(b.angle.value().to_degrees());
+            v.push(rb.angvel().dot(axis_ref).to_degrees());
+        }
+        if self.body_motion {
+            for b in self.bodies.iter().filter(|b| b.moves) {
+                let rb = &bodies[b.handle];
+                let p = *rb.position() * b.local_com;
+                // The velocity of the centre of mass (a driven body's frame turns about its
+                // origin, so its centre of mass moves with `w x r`; a tabulated drive's
+                // velocities at the state are the table's, Rapier's the last step's mean).
+                let (v0, w) = match b.table {
+                    Some(k) => {
+                        let (v, _, w, _) = self.prescribed.motions[k].rates(t);
+                        (v, w)
+                    }
+                    None => (rb.linvel(), rb.angvel()),
+                };
+                let vel = v0 + w.cross(p - rb.translation());
+                // Velocity and acceleration are completed by the step from this state
+                // (`complete_row_motion`).
+                v.extend_from_slice(&[p.x, p.y, p.z, vel.x, vel.y, vel.z, 0.0, 0.0, 0.0]);
+            }
+        }
+        for h in &self.hinges {
+            let (r1, r2) = (
+                &bodies[self.bodies[h.bearing].handle],
+                &bodies[self.bodies[h.journal].handle],
+            );
+            let axis = *r1.rotation() * h.local_axis1;
+            v.push(h.angle.value().to_degrees());
+            v.push((r2.angvel() - r1.angvel()).dot(axis).to_degrees());
+            v.push(h.force);
+            match h.joint {
+                HingeJoint::Clearance(c) => {
+                    let r = self.clearance.get(c).expect("handle of this twin").report();
+                    let e = r.state.eccentricity;
+                    v.push(e.dot(*r1.rotation() * h.local_u1) * 1e3);
+                    v.push(e.dot(*r1.rotation() * h.local_v1) * 1e3);
+                    v.push(r.state.penetration.max(0.0) * 1e6);
+                    v.push(if r.state.penetration > 0.0 { 1.0 } else { 0.0 });
+                }
+                HingeJoint::Ideal => v.extend_from_slice(&[0.0, 0.0, 0.0, 0.0]),
+            }
+        }
+        for (_, f) in &self.joints {
+            v.push(*f);
+        }
+    }
+
+    /// Appends the row at time `t`, `w` of the way from the previous state to the current one
+    /// (linear; the contact flag from the nearer state).
+    fn write_row(&mut self, t: f64, w: f64) {
+        let contact_cols = &self.contact_columns;
+        let (prev, cur) = (&self.row_prev, &self.row_cur);
+        let v = &mut self.table.values;
+        v.push(t);
+        for (i, &b) in cur.iter().enumerate().skip(1) {
+            let a = prev.get(i).copied().unwrap_or(b);
+            v.push(if w >= 1.0 {
+                b
+            } else if w <= 0.0 {
+                a
+            } else if contact_cols.contains(&i) {
+                if w >= 0.5 { b } else { a }
+            } else {
+                a + (b - a) * w
+            });
+        }
+    }
+
+    /// Per-hinge metrics by hinge name.
+    pub fn hinge_metrics(&self) -> BTreeMap<String, HingeMetrics> {
+        self.hinges
+            .iter()
+            .map(|h| (h.name.clone(), h.recorder.metrics().clone()))
+            .collect()
+    }
+
+    /// The impact recorder of every hinge, by hinge name (ideal hinges record no impacts).
+    pub fn hinge_recorders(&self) -> BTreeMap<String, &ImpactRecorder> {
+        self.hinges
+            .iter()
+            .map(|h| (h.name.clone(), &h.recorder))
+            .collect()
+    }
+
+    /// Names of the hinges that are clearance joints in this twin, in scene order.
+    pub fn clearance_hinges(&self) -> Vec<&str> {
+        self.hinges
+            .iter()
+            .filter(|h| matches!(h.joint, HingeJoint::Clearance(_)))
+            .map(|h| h.name.as_str())
+            .collect()
+    }
+
+    /// Final angles (deg) of every body and hinge, by name.
+    pub fn final_angles_deg(&self) -> BTreeMap<String, f64> {
+        let mut m = BTreeMap::new();
+        for b in &self.bodies {
+            m.insert(b.name.clone(), b.angle.value().to_degrees());
+        }
+        for h in &self.hinges {
+            m.insert(h.name.clone(), h.angle.value().to_degrees());
+        }
+        m
+    }
+}
+
+/// The in-plane `u` direction of a hinge: the world axis least aligned with `axis`, made
+/// orthogonal to it (world x for the paper's hinge; then `v = axis x u` is world z).
+fn in_plane_u(axis: Vector) -> Vector {
+    let candidates = [Vector::X, Vector::Y, Vector::Z];
+    let mut best = candidates[0];
+    for c in candidates {
+        if c.dot(axis).abs() < best.dot(axis).abs() - 1e-12 {
+            best = c;
+        }
+    }
+    (best - best.dot(axis) * axis).normalize()
+}

@@ -1026,19 +1026,4 @@ mod tests {
             .to_string();
         assert!(msg.contains("limits"), "{msg}");
     }
-
-    #[test]
-    fn from_a_scene_spec() {
-        let scene = crate::scene::Scene::solar_panel();
-        let spec = scene.hinges[0].clearance.as_ref().unwrap();
-        let c = spec.clearance().unwrap();
-        assert!((c.geometry.clearance() - 0.5e-3).abs() < 1e-15);
-        assert_eq!(c.friction, FrictionModel::Bai(Bai::DRY));
-        assert_eq!(
-            c.normal,
-            Clearance::steel_improved_liu(0.010, 0.5e-3, 0.016)
-                .unwrap()
-                .normal
-        );
-    }
 }

@@ -1549,3 +1549,26 @@ fn descend(v: &serde_json::Value, key: &str) -> std::result::Result<Vec<String>,
         )),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn from_a_scene_spec() {
+        let scene = Scene::solar_panel();
+        let spec = scene.hinges[0].clearance.as_ref().unwrap();
+        let c = spec.clearance().unwrap();
+        assert!((c.geometry.clearance() - 0.5e-3).abs() < 1e-15);
+        assert_eq!(
+            c.friction,
+            crate::model::laws::FrictionModel::Bai(crate::model::laws::Bai::DRY)
+        );
+        assert_eq!(
+            c.normal,
+            Clearance::steel_improved_liu(0.010, 0.5e-3, 0.016)
+                .unwrap()
+                .normal
+        );
+    }
+}

@@ -1,0 +1,632 @@
+//! The [`Physics`] resource: the Rapier world, the clearance joints and the drives, and what each
+//! entity is in them. Its crate-side methods do the work of the systems; the systems only read
+//! the components and call them.
+
+use super::components::{Drive, Hinge};
+use crate::error::{Error, Result};
+use crate::rapier::convert::{BearingSide, Clearance, ClearanceModel, ConvertRevolute};
+use crate::rapier::drive::{DriveSet, TorsionSpring};
+use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle, ClearanceJointSet};
+use crate::rapier::large_step::{LargeStepJoint, LargeStepJointHandle, LargeStepJointSet};
+use crate::rapier::ledger::Wrench;
+use crate::rapier::reaction::{IdealRevolute, ReactionSolver};
+use crate::rapier::stepper::{ForceSource, GuardReport, StepControl, StepMode, Stepper};
+use bevy_ecs::prelude::*;
+use rapier3d_f64::math::Vector;
+use rapier3d_f64::prelude::{ImpulseJointHandle, PhysicsWorld, RigidBody, RigidBodyHandle};
+use std::collections::{BTreeMap, BTreeSet};
+
+/// The Rapier joint behind a hinge entity.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HingeJoint {
+    /// Rapier's revolute joint.
+    Ideal(ImpulseJointHandle),
+    /// A clearance joint of [`Physics::clearance`].
+    Clearance(ClearanceJointHandle),
+    /// A large-step clearance joint of [`Physics::large_step`].
+    LargeStep(LargeStepJointHandle),
+}
+
+/// Two bodies a hinge or a drive joins (bearing, journal).
+type BodyPair = (RigidBodyHandle, RigidBodyHandle);
+
+#[derive(Clone, Debug)]
+struct RealizedHinge {
+    joint: HingeJoint,
+    bodies: BodyPair,
+    frame: Hinge,
+    clearance: Option<Clearance>,
+}
+
+#[derive(Clone, Debug)]
+struct RealizedDrive {
+    set: DriveSet,
+    drive: Drive,
+    bodies: BodyPair,
+    axis: Vector,
+}
+
+/// The physics of an ECS world: the Rapier world, the clearance joints and the drives, and the
+/// map from entities to what they are in Rapier.
+#[derive(Resource)]
+pub struct Physics {
+    /// The Rapier world. Set gravity, the step (`integration_parameters.dt`) and colliders here;
+    /// bodies and joints are managed through the components.
+    pub world: PhysicsWorld,
+    clearance: ClearanceJointSet,
+    large_step: LargeStepJointSet,
+    bodies: BTreeMap<Entity, RigidBodyHandle>,
+    hinges: BTreeMap<Entity, RealizedHinge>,
+    drives: BTreeMap<Entity, RealizedDrive>,
+    error: Option<Error>,
+    /// The step control: the same public piece the scene runner uses.
+    stepper: Stepper,
+    /// Set when the sync systems changed joints, drives or bodies: the force sources are
+    /// evaluated again before the next step.
+    changed: bool,
+    reactions: ReactionSolver,
+    ideal_joints: Vec<IdealRevolute>,
+    source_wrenches: Vec<Wrench>,
+}
+
+impl Physics {
+    /// An empty world stepping by `dt` (s) under `gravity` (m/s^2), with one solver iteration
+    /// (the clearance hook's force is constant over a step; Rapier's substeps would make every
+    /// impact gain energy).
+    pub fn new(dt: f64, gravity: Vector) -> Self {
+        let mut world = PhysicsWorld::new();
+        world.integration_parameters.dt = dt;
+        world.integration_parameters.num_solver_iterations = 1;
+        world.gravity = gravity;
+        Self::from_world(world)
+    }
+
+    /// Wraps an existing Rapier world (its bodies and joints stay; entities refer to bodies with
+    /// [`Body::from_handle`](super::Body::from_handle)).
+    pub fn from_world(world: PhysicsWorld) -> Self {
+        let dt = world.integration_parameters.dt;
+        Physics {
+            world,
+            clearance: ClearanceJointSet::new(),
+            large_step: LargeStepJointSet::new(),
+            bodies: BTreeMap::new(),
+            hinges: BTreeMap::new(),
+            drives: BTreeMap::new(),
+            error: None,
+            stepper: Stepper::new(StepControl::fixed(dt)),
+            changed: true,
+            reactions: ReactionSolver::default(),
+            ideal_joints: Vec::new(),
+            source_wrenches: Vec::new(),
+        }
+    }
+
+    /// The step control: fixed steps of `world.integration_parameters.dt` by default (changing
+    /// `dt` between steps is followed). With [`StepControl::adaptive`] each run of the schedule
+    /// takes ONE accepted step of the stepper's choice, at most up to `time() + dt`: inside
+    /// contacts that step is far shorter than a frame, so a game loop must run the schedule until
+    /// `time()` reaches the frame's time (each run records its state and impacts).
+    pub fn set_step_control(&mut self, control: StepControl) {
+        self.stepper.set_control(control);
+    }
+
+    /// What the run-time guards recorded (rejected steps, penetrations beyond a law's validity,
+    /// steps at the floor).
+    pub fn guards(&self) -> &GuardReport {
+        self.stepper.guards()
+    }
+
+    /// The clearance joints (read-only: they follow the
+    /// [`ClearanceHinge`](super::ClearanceHinge) components).
+    pub fn clearance(&self) -> &ClearanceJointSet {
+        &self.clearance
+    }
+
+    /// The large-step clearance joints (read-only: they follow the
+    /// [`ClearanceHinge`](super::ClearanceHinge) components whose [`Clearance::model`] is
+    /// [`ClearanceModel::LargeStep`]).
+    pub fn large_step(&self) -> &LargeStepJointSet {
+        &self.large_step
+    }
+
+    /// The large-step clearance joint of a [`ClearanceHinge`](super::ClearanceHinge) entity.
+    pub fn large_step_joint(&self, entity: Entity) -> Option<&LargeStepJoint> {
+        match self.joint(entity)? {
+            HingeJoint::LargeStep(h) => self.large_step.get(h),
+            _ => None,
+        }
+    }
+
+    /// Simulated time, s.
+    pub fn time(&self) -> f64 {
+        self.stepper.time()
+    }
+
+    /// Steps taken.
+    pub fn steps(&self) -> u64 {
+        self.stepper.steps()
+    }
+
+    /// The first error of the systems, if any. While it is set the systems do nothing: the
+    /// simulation stops where it failed instead of running on a destroyed state.
+    pub fn error(&self) -> Option<&Error> {
+        self.error.as_ref()
+    }
+
+    /// Takes the error out, letting the systems run again.
+    pub fn take_error(&mut self) -> Option<Error> {
+        self.error.take()
+    }
+
+    /// The Rapier body of a [`Body`](super::Body) entity.
+    pub fn body(&self, entity: Entity) -> Option<RigidBodyHandle> {
+        self.bodies.get(&entity).copied()
+    }
+
+    /// The Rapier joint of a [`Hinge`] entity.
+    pub fn joint(&self, entity: Entity) -> Option<HingeJoint> {
+        self.hinges.get(&entity).map(|h| h.joint)
+    }
+
+    /// The clearance joint of a [`ClearanceHinge`](super::ClearanceHinge) entity.
+    pub fn clearance_joint(&self, entity: Entity) -> Option<&ClearanceJoint> {
+        match self.joint(entity)? {
+            HingeJoint::Clearance(h) => self.clearance.get(h),
+            HingeJoint::Ideal(_) | HingeJoint::LargeStep(_) => None,
+        }
+    }
+
+    /// The drive of a [`Drive`] entity.
+    pub fn drive(&self, entity: Entity) -> Option<&TorsionSpring> {
+        self.drives.get(&entity)?.set.drives().first()
+    }
+
+    /// Records `error` unless one is already set (the first error is the cause).
+    pub(super) fn fail(&mut self, error: Error) {
+        if self.error.is_none() {
+            self.error = Some(error);
+        }
+    }
+
+    /// The joint of hinge `entity` and the bodies it was realised between.
+    pub(super) fn realized_hinge(&self, entity: Entity) -> Option<(HingeJoint, BodyPair)> {
+        self.hinges.get(&entity).map(|h| (h.joint, h.bodies))
+    }
+
+    // ----- Bodies -----
+
+    /// Inserts `body` for `entity` (replacing its previous body) and returns its handle.
+    pub(super) fn insert_body(&mut self, entity: Entity, body: RigidBody) -> RigidBodyHandle {
+        self.remove_body(entity);
+        self.changed = true;
+        let h = self.world.bodies.insert(body);
+        self.bodies.insert(entity, h);
+        h
+    }
+
+    /// Makes the existing Rapier body `handle` the body of `entity` (its previous body goes, as
+    /// on removal).
+    pub(super) fn adopt_body(&mut self, entity: Entity, handle: RigidBodyHandle) -> Result<()> {
+        if !self.world.bodies.contains(handle) {
+            return Err(Error::invalid(
+                format!("body {entity}"),
+                format!("no rigid body with handle {handle:?} in the Rapier world"),
+            ));
+        }
+        self.remove_body(entity);
+        self.changed = true;
+        self.bodies.insert(entity, handle);
+        Ok(())
+    }
+
+    /// Removes the bodies of the entities not in `present`.
+    pub(super) fn remove_bodies_except(&mut self, present: &BTreeSet<Entity>) {
+        for e in absent(self.bodies.keys(), present) {
+            self.remove_body(e);
+        }
+    }
+
+    /// Removes the Rapier body of `entity` with every hinge and drive attached to it.
+    fn remove_body(&mut self, entity: Entity) {
+        let Some(handle) = self.bodies.remove(&entity) else {
+            return;
+        };
+        let joins = |(a, b): BodyPair| a == handle || b == handle;
+        let attached: Vec<Entity> = self
+            .hinges
+            .iter()
+            .filter(|(_, h)| joins(h.bodies))
+            .map(|(e, _)| *e)
+            .collect();
+        for e in attached {
+            self.unrealize_hinge(e);
+        }
+        let driven: Vec<Entity> = self
+            .drives
+            .iter()
+            .filter(|(_, d)| joins(d.bodies))
+            .map(|(e, _)| *e)
+            .collect();
+        for e in driven {
+            self.unrealize_drive(e);
+        }
+        let w = &mut self.world;
+        w.bodies.remove(
+            handle,
+            &mut w.islands,
+            &mut w.colliders,
+            &mut w.impulse_joints,
+            &mut w.multibody_joints,
+            &mut w.soft_bodies,
+            true,
+        );
+    }
+
+    // ----- Hinges and drives -----
+
+    /// Removes the joints and drives of the entities not in `present`.
+    pub(super) fn remove_hinges_except(&mut self, present: &BTreeSet<Entity>) {
+        for e in absent(self.hinges.keys().chain(self.drives.keys()), present) {
+            self.unrealize_hinge(e);
+            self.unrealize_drive(e);
+        }
+    }
+
+    /// Removes the Rapier joint of hinge `entity` (if realised).
+    fn unrealize_hinge(&mut self, entity: Entity) {
+        if let Some(h) = self.hinges.remove(&entity) {
+            self.changed = true;
+            match h.joint {
+                HingeJoint::Ideal(j) => {
+                    self.world.impulse_joints.remove(j, true);
+                }
+                HingeJoint::Clearance(c) => {
+                    self.clearance.remove(
+                        c,
+                        &mut self.world.bodies,
+                        &mut self.world.impulse_joints,
+                    );
+                    self.clearance_removed(c);
+                }
+                HingeJoint::LargeStep(k) => {
+                    self.large_step.remove(
+                        k,
+                        &mut self.world.bodies,
+                        &mut self.world.impulse_joints,
+                    );
+                }
+            }
+        }
+    }
+
+    /// Renumbers the clearance handles after the set removed `removed` (later handles shift down).
+    fn clearance_removed(&mut self, removed: ClearanceJointHandle) {
+        for h in self.hinges.values_mut() {
+            if let HingeJoint::Clearance(c) = &mut h.joint
+                && c.0 > removed.0
+            {
+                c.0 -= 1;
+            }
+        }
+    }
+
+    /// Takes back the last torques of drive `entity` and forgets it.
+    fn unrealize_drive(&mut self, entity: Entity) {
+        if let Some(mut d) = self.drives.remove(&entity) {
+            self.changed = true;
+            d.set.take_back(&mut self.world.bodies);
+        }
+    }
+
+    /// Brings hinge `entity` to the `desired` mode between `bodies`: `None` no joint,
+    /// `Some(None)` ideal, `Some(Some(c))` clearance `c`.
+    pub(super) fn reconcile_hinge(
+        &mut self,
+        entity: Entity,
+        frame: &Hinge,
+        desired: Option<Option<&Clearance>>,
+        bodies: BodyPair,
+    ) -> Result<()> {
+        let context = |e: Error| e.within(&format!("hinge {entity}"));
+        frame.validate().map_err(context)?;
+        if let Some(r) = self.hinges.get(&entity) {
+            let same_place = r.bodies == bodies && r.frame == *frame;
+            let w = &mut self.world;
+            // The swaps, in place: the plain API's conversions. A large-step joint is no force
+            // source, so only the compliant swaps make the stepper evaluate its forces again.
+            let swapped = match (r.joint, desired) {
+                (HingeJoint::Ideal(_), Some(None)) if same_place => return Ok(()),
+                (HingeJoint::Clearance(_) | HingeJoint::LargeStep(_), Some(Some(c)))
+                    if same_place && r.clearance.as_ref() == Some(c) =>
+                {
+                    return Ok(());
+                }
+                (HingeJoint::Ideal(j), Some(Some(c)))
+                    if same_place && c.model == ClearanceModel::LargeStep =>
+                {
+                    let h = self
+                        .large_step
+                        .convert_revolute(
+                            j,
+                            BearingSide::Body1,
+                            named(c, entity),
+                            &mut w.impulse_joints,
+                        )
+                        .map_err(context)?;
+                    Some((HingeJoint::LargeStep(h), Some(c)))
+                }
+                (HingeJoint::LargeStep(k), Some(None)) if same_place => {
+                    let j = self
+                        .large_step
+                        .revert_to_revolute(k, &mut w.bodies, &mut w.impulse_joints)
+                        .map_err(context)?;
+                    Some((HingeJoint::Ideal(j), None))
+                }
+                (HingeJoint::Ideal(j), Some(Some(c))) if same_place => {
+                    let h = self
+                        .clearance
+                        .convert_revolute(
+                            j,
+                            BearingSide::Body1,
+                            named(c, entity),
+                            &mut w.impulse_joints,
+                        )
+                        .map_err(context)?;
+                    self.changed = true;
+                    Some((HingeJoint::Clearance(h), Some(c)))
+                }
+                (HingeJoint::Clearance(k), Some(None)) if same_place => {
+                    let j = self
+                        .clearance
+                        .revert_to_revolute(k, &mut w.bodies, &mut w.impulse_joints)
+                        .map_err(context)?;
+                    self.changed = true;
+                    self.clearance_removed(k);
+                    Some((HingeJoint::Ideal(j), None))
+                }
+                _ => None,
+            };
+            match swapped {
+                Some((joint, clearance)) => {
+                    let r = self.hinges.get_mut(&entity).expect("realised");
+                    r.joint = joint;
+                    r.clearance = clearance.cloned();
+                    return Ok(());
+                }
+                None => self.unrealize_hinge(entity),
+            }
+        }
+        let Some(clearance) = desired else {
+            return Ok(());
+        };
+        let (a1, a2, x1, x2) = (
+            frame.local_anchor1,
+            frame.local_anchor2,
+            frame.local_axis1,
+            frame.local_axis2,
+        );
+        let w = &mut self.world;
+        let joint = match clearance {
+            None => HingeJoint::Ideal(w.impulse_joints.insert(
+                bodies.0,
+                bodies.1,
+                frame.revolute(),
+                true,
+            )),
+            Some(c) if c.model == ClearanceModel::LargeStep => {
+                let joint = named(c, entity)
+                    .large_step_joint(a1, a2, x1, x2)
+                    .map_err(context)?;
+                HingeJoint::LargeStep(self.large_step.insert(
+                    bodies.0,
+                    bodies.1,
+                    joint,
+                    &mut w.impulse_joints,
+                ))
+            }
+            Some(c) => {
+                let joint = named(c, entity).joint(a1, a2, x1, x2).map_err(context)?;
+                HingeJoint::Clearance(self.clearance.insert(
+                    bodies.0,
+                    bodies.1,
+                    joint,
+                    &mut w.impulse_joints,
+                ))
+            }
+        };
+        self.changed = true;
+        self.hinges.insert(
+            entity,
+            RealizedHinge {
+                joint,
+                bodies,
+                frame: frame.clone(),
+                clearance: clearance.cloned(),
+            },
+        );
+        Ok(())
+    }
+
+    /// Brings the drive of hinge `entity` to `desired`.
+    pub(super) fn reconcile_drive(
+        &mut self,
+        entity: Entity,
+        frame: &Hinge,
+        desired: Option<&Drive>,
+        bodies: BodyPair,
+    ) -> Result<()> {
+        if let Some(d) = self.drives.get(&entity) {
+            if Some(&d.drive) == desired && d.bodies == bodies && d.axis == frame.local_axis1 {
+                return Ok(());
+            }
+            self.unrealize_drive(entity);
+        }
+        let Some(drive) = desired else {
+            return Ok(());
+        };
+        let spring = TorsionSpring::new(
+            bodies.0,
+            bodies.1,
+            frame.local_axis1,
+            drive.torque0,
+            drive.stiffness,
+        )
+        .map_err(|e| e.within(&format!("drive {entity}")))?;
+        let mut set = DriveSet::new();
+        set.insert(spring);
+        self.changed = true;
+        self.drives.insert(
+            entity,
+            RealizedDrive {
+                set,
+                drive: *drive,
+                bodies,
+                axis: frame.local_axis1,
+            },
+        );
+        Ok(())
+    }
+
+    // ----- The step -----
+
+    /// Evaluates the force sources at the current state when the stepper needs it (see
+    /// [`apply_forces`](super::apply_forces)).
+    pub(super) fn prepare_forces(&mut self) -> Result<()> {
+        let Physics {
+            world,
+            clearance,
+            drives,
+            stepper,
+            changed,
+            ..
+        } = self;
+        if std::mem::take(changed) {
+            stepper.invalidate(false);
+        }
+        follow_dt(stepper, world);
+        stepper.prepare(world, &mut sources(clearance, drives))
+    }
+
+    /// One accepted step of the stepper, at most `integration_parameters.dt` long.
+    pub(super) fn step(&mut self) -> Result<()> {
+        let Physics {
+            world,
+            clearance,
+            drives,
+            stepper,
+            ..
+        } = self;
+        let dt = world.integration_parameters.dt;
+        follow_dt(stepper, world);
+        let until = stepper.time() + dt;
+        let result = stepper.step(world, &mut sources(clearance, drives), until);
+        // Rapier's `dt` as the user set it (the stepper sets it per step).
+        world.integration_parameters.dt = dt;
+        result.map(|_| ()).map_err(|mut e| {
+            if let Error::StepTooLarge { field, .. } = &mut e {
+                *field = "Physics::world.integration_parameters.dt".into();
+            }
+            e
+        })
+    }
+
+    /// [`LargeStepJointSet::before_step`]: substeps, friction motors.
+    pub(super) fn prepare_large_step(&mut self) {
+        let w = &mut self.world;
+        self.large_step.before_step(
+            &mut w.bodies,
+            &mut w.impulse_joints,
+            &w.integration_parameters,
+        );
+    }
+
+    /// [`LargeStepJointSet::after_step`]: readout and the impacts' bounce.
+    pub(super) fn finish_large_step(&mut self) {
+        let w = &mut self.world;
+        self.large_step.after_step(&mut w.bodies, &w.impulse_joints);
+    }
+
+    /// The exact reaction force magnitude of each ideal hinge at the current state (the runner's
+    /// piece, [`ReactionSolver`]), N; empty when the solver fails.
+    pub(super) fn ideal_forces(&mut self) -> BTreeMap<Entity, f64> {
+        self.ideal_joints.clear();
+        let mut ideal_entities = Vec::new();
+        for (e, r) in &self.hinges {
+            if let HingeJoint::Ideal(_) = r.joint {
+                self.ideal_joints.push(IdealRevolute {
+                    body1: r.bodies.0,
+                    body2: r.bodies.1,
+                    local_anchor1: r.frame.local_anchor1,
+                    local_anchor2: r.frame.local_anchor2,
+                    local_axis1: r.frame.unit_axis1(),
+                });
+                ideal_entities.push(*e);
+            }
+        }
+        // The sources' wrenches act during the steps only: the solver gets them explicitly.
+        self.source_wrenches.clear();
+        for d in self.drives.values() {
+            self.source_wrenches.extend_from_slice(d.set.wrenches());
+        }
+        self.source_wrenches
+            .extend_from_slice(self.clearance.wrenches());
+        self.reactions
+            .solve_with(
+                &self.world.bodies,
+                &self.ideal_joints,
+                self.world.gravity,
+                &self.source_wrenches,
+            )
+            .map(|f| {
+                ideal_entities
+                    .iter()
+                    .zip(f)
+                    .map(|(e, f)| (*e, f.length()))
+                    .collect()
+            })
+            .unwrap_or_default()
+    }
+}
+
+/// `c` with the entity as its name unless it has one.
+fn named(c: &Clearance, entity: Entity) -> Clearance {
+    let mut c = c.clone();
+    if c.name.is_none() {
+        c.name = Some(format!("hinge {entity}"));
+    }
+    c
+}
+
+/// The entities of `realized` not in `present`.
+fn absent<'a>(
+    realized: impl Iterator<Item = &'a Entity>,
+    present: &BTreeSet<Entity>,
+) -> Vec<Entity> {
+    realized
+        .filter(|e| !present.contains(*e))
+        .copied()
+        .collect()
+}
+
+/// Fixed steps follow `integration_parameters.dt` as the user sets it, between any two steps.
+fn follow_dt(stepper: &mut Stepper, world: &PhysicsWorld) {
+    let mut control = *stepper.control();
+    if control.mode == StepMode::Fixed {
+        control.max_dt = world.integration_parameters.dt;
+        stepper.set_control(control);
+    }
+}
+
+/// The force sources of the ECS world, in a fixed order (drives by entity, then the clearance
+/// joints: the runner's order, so both add forces to a body in the same order, to the bit).
+fn sources<'a>(
+    clearance: &'a mut ClearanceJointSet,
+    drives: &'a mut BTreeMap<Entity, RealizedDrive>,
+) -> Vec<&'a mut dyn ForceSource> {
+    let mut v: Vec<&mut dyn ForceSource> = Vec::with_capacity(1 + drives.len());
+    for d in drives.values_mut() {
+        v.push(&mut d.set);
+    }
+    v.push(clearance);
+    v
+}

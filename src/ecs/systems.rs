@@ -1,0 +1,227 @@
+//! The systems of a physics step, in [`PhysicsSet`](super::PhysicsSet) order: components to
+//! Rapier ([`sync_bodies`], [`sync_hinges`]), the forces and the step ([`apply_forces`],
+//! [`prepare_large_step`], [`step_physics`], [`finish_large_step`]), and Rapier back to the
+//! components ([`record`]). Each does nothing while [`Physics::error`] is set. Entities are
+//! visited in order, so that Rapier sees the same calls in the same order on every run.
+
+use super::components::{
+    Body, BodyState, ClearanceHinge, Drive, Hinge, HingeMode, HingeState, IdealHinge,
+};
+use super::physics::{HingeJoint, Physics};
+use crate::error::Error;
+use crate::model::kinematics::ContactMode;
+use bevy_ecs::prelude::*;
+use rapier3d_f64::math::Vector;
+use std::collections::BTreeSet;
+
+/// Inserts new [`Body`] components into Rapier and removes the bodies of removed ones.
+pub fn sync_bodies(mut physics: ResMut<Physics>, mut query: Query<(Entity, &mut Body)>) {
+    if physics.error().is_some() {
+        return;
+    }
+    let mut items: Vec<(Entity, Mut<Body>)> = query.iter_mut().collect();
+    items.sort_by_key(|(e, _)| *e);
+    let mut seen = BTreeSet::new();
+    for (entity, mut body) in items {
+        seen.insert(entity);
+        if let Some(rb) = body.pending.take() {
+            body.handle = Some(physics.insert_body(entity, *rb));
+        } else if let Some(h) = body.handle
+            && physics.body(entity) != Some(h)
+            && let Err(e) = physics.adopt_body(entity, h)
+        {
+            physics.fail(e);
+            return;
+        }
+    }
+    physics.remove_bodies_except(&seen);
+}
+
+/// Realises each [`Hinge`] as its mode component says (converting in place when only the mode
+/// changed), its [`Drive`], and removes the joints and drives of removed components.
+#[allow(clippy::type_complexity)]
+pub fn sync_hinges(
+    mut physics: ResMut<Physics>,
+    mut query: Query<(
+        Entity,
+        &Hinge,
+        Has<IdealHinge>,
+        Option<&ClearanceHinge>,
+        Option<&Drive>,
+        &mut HingeState,
+    )>,
+) {
+    if physics.error().is_some() {
+        return;
+    }
+    let mut items: Vec<_> = query.iter_mut().collect();
+    items.sort_by_key(|item| item.0);
+    let mut seen = BTreeSet::new();
+    for (entity, frame, ideal, clearance, drive, mut state) in items {
+        seen.insert(entity);
+        let body = |e: Entity, field: &str| {
+            physics.body(e).ok_or_else(|| {
+                Error::invalid(
+                    format!("hinge {entity}.{field}"),
+                    format!(
+                        "entity {e} has no Body (spawn a hinge's bodies with or before it, and \
+                         despawn the hinge with them)"
+                    ),
+                )
+            })
+        };
+        let bodies = match (body(frame.body1, "body1"), body(frame.body2, "body2")) {
+            (Ok(b1), Ok(b2)) => (b1, b2),
+            (Err(e), _) | (_, Err(e)) => {
+                physics.fail(e);
+                return;
+            }
+        };
+        let desired = match (clearance, ideal) {
+            (Some(c), _) => Some(Some(&c.0)),
+            (None, true) => Some(None),
+            (None, false) => None,
+        };
+        let reconciled = physics
+            .reconcile_hinge(entity, frame, desired, bodies)
+            .and_then(|()| physics.reconcile_drive(entity, frame, drive, bodies));
+        if let Err(e) = reconciled {
+            physics.fail(e);
+            return;
+        }
+        state.mode = match physics.joint(entity) {
+            None => HingeMode::None,
+            Some(HingeJoint::Ideal(_)) => HingeMode::Ideal,
+            Some(HingeJoint::Clearance(_)) => HingeMode::Clearance,
+            Some(HingeJoint::LargeStep(_)) => HingeMode::LargeStep,
+        };
+        if !state.angle_tracker.has_reference() {
+            let w = &physics.world.bodies;
+            if let (Some(r1), Some(r2)) = (w.get(bodies.0), w.get(bodies.1)) {
+                state
+                    .angle_tracker
+                    .set_reference(r1.rotation(), r2.rotation());
+            }
+        }
+    }
+    physics.remove_hinges_except(&seen);
+}
+
+/// Evaluates the force sources (torsion springs, the clearance force hook) at the current state
+/// when the stepper needs it: before the first step and after the sync systems changed
+/// something. Otherwise the stepper already evaluated them at the end of the last step.
+pub fn apply_forces(mut physics: ResMut<Physics>) {
+    if physics.error().is_some() {
+        return;
+    }
+    if let Err(e) = physics.prepare_forces() {
+        physics.fail(e);
+    }
+}
+
+/// One accepted step of the [`Stepper`](crate::rapier::stepper::Stepper) (fixed steps of
+/// `world.integration_parameters.dt` unless [`Physics::set_step_control`] chose otherwise):
+/// variable-step consistent kicks, step acceptance, guards. An error stops the systems where the
+/// state was last valid.
+pub fn step_physics(mut physics: ResMut<Physics>) {
+    if physics.error().is_some() {
+        return;
+    }
+    if let Err(e) = physics.step() {
+        physics.fail(e);
+    }
+}
+
+/// Prepares the large-step clearance joints for the step
+/// ([`LargeStepJointSet::before_step`](crate::rapier::large_step::LargeStepJointSet::before_step):
+/// substeps, friction motors).
+pub fn prepare_large_step(mut physics: ResMut<Physics>) {
+    if physics.error().is_some() {
+        return;
+    }
+    physics.prepare_large_step();
+}
+
+/// Finishes the step for the large-step clearance joints
+/// ([`LargeStepJointSet::after_step`](crate::rapier::large_step::LargeStepJointSet::after_step):
+/// readout and the impacts' bounce), before [`record`].
+pub fn finish_large_step(mut physics: ResMut<Physics>) {
+    if physics.error().is_some() {
+        return;
+    }
+    physics.finish_large_step();
+}
+
+/// Copies the state of the step into [`HingeState`] and [`BodyState`].
+pub fn record(
+    mut physics: ResMut<Physics>,
+    mut hinges: Query<(Entity, &Hinge, &mut HingeState)>,
+    mut bodies: Query<(&Body, &mut BodyState)>,
+) {
+    if physics.error().is_some() {
+        return;
+    }
+    let ideal_forces = physics.ideal_forces();
+    let physics = &*physics;
+    let w = &physics.world;
+    for (body, mut state) in bodies.iter_mut() {
+        if let Some(rb) = body.handle.and_then(|h| w.bodies.get(h)) {
+            *state = BodyState {
+                translation: rb.translation(),
+                rotation: *rb.rotation(),
+                linvel: rb.linvel(),
+                angvel: rb.angvel(),
+            };
+        }
+    }
+    for (entity, frame, mut state) in hinges.iter_mut() {
+        let Some((joint, (b1, b2))) = physics.realized_hinge(entity) else {
+            continue;
+        };
+        let (Some(rb1), Some(rb2)) = (w.bodies.get(b1), w.bodies.get(b2)) else {
+            continue;
+        };
+        let axis1 = frame.unit_axis1();
+        state.angle = state
+            .angle_tracker
+            .update(rb1.rotation(), rb2.rotation(), axis1);
+        state.rate = (rb2.angvel() - rb1.angvel()).dot(*rb1.rotation() * axis1);
+        match joint {
+            HingeJoint::Ideal(_) => {
+                state.force = ideal_forces.get(&entity).copied().unwrap_or(0.0);
+                state.penetration = 0.0;
+                state.eccentricity = Vector::ZERO;
+                state.contact = ContactMode::FreeFlight;
+            }
+            HingeJoint::Clearance(c) => {
+                if let Some(j) = physics.clearance().get(c) {
+                    let rep = j.report();
+                    state.force = rep.force.on_journal.length();
+                    state.penetration = rep.state.penetration;
+                    state.eccentricity = rep.state.eccentricity;
+                    state.contact = rep.mode;
+                    if rep.onset {
+                        state.impacts += 1;
+                    }
+                }
+            }
+            HingeJoint::LargeStep(k) => {
+                if let Some(j) = physics.large_step().get(k) {
+                    let rep = j.report();
+                    state.force = rep.normal_force;
+                    state.penetration = rep.eccentricity.length() - j.clearance();
+                    state.eccentricity = rep.eccentricity;
+                    state.contact = match (rep.contact, rep.onset) {
+                        (false, _) => ContactMode::FreeFlight,
+                        (true, true) => ContactMode::Impact,
+                        (true, false) => ContactMode::Continuous,
+                    };
+                    if rep.impact {
+                        state.impacts += 1;
+                    }
+                }
+            }
+        }
+        state.peak_force = state.peak_force.max(state.force);
+    }
+}

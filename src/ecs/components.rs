@@ -7,9 +7,7 @@ use crate::model::kinematics::ContactMode;
 use crate::rapier::convert::Clearance;
 use bevy_ecs::prelude::*;
 use rapier3d_f64::math::{Rotation, Vector};
-use rapier3d_f64::prelude::{
-    GenericJointBuilder, JointAxesMask, RevoluteJoint, RigidBody, RigidBodyHandle,
-};
+use rapier3d_f64::prelude::{RevoluteJoint, RigidBody, RigidBodyHandle};
 
 /// A rigid body. Spawn it with a Rapier description ([`Body::new`]); the sync system inserts it
 /// into [`Physics::world`](super::Physics::world) and records its handle. Removing the component
@@ -124,15 +122,12 @@ impl Hinge {
     /// The ideal Rapier revolute joint of this hinge (axes normalised, contacts between the
     /// bodies disabled).
     pub fn revolute(&self) -> RevoluteJoint {
-        RevoluteJoint {
-            data: GenericJointBuilder::new(JointAxesMask::LOCKED_REVOLUTE_AXES)
-                .local_axis1(self.local_axis1.normalize_or_zero())
-                .local_axis2(self.local_axis2.normalize_or_zero())
-                .local_anchor1(self.local_anchor1)
-                .local_anchor2(self.local_anchor2)
-                .contacts_enabled(false)
-                .build(),
-        }
+        crate::rapier::convert::revolute_joint([
+            self.local_anchor1,
+            self.local_anchor2,
+            self.local_axis1.normalize_or_zero(),
+            self.local_axis2.normalize_or_zero(),
+        ])
     }
 
     /// The unit axis in body 1's frame (a realised hinge was validated; `x` stands in otherwise).

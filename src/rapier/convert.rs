@@ -381,7 +381,7 @@ fn revolute_frames(joint: &GenericJoint) -> Result<[Vector; 4]> {
 /// bodies are disabled, as by the clearance joint's own out-of-plane lock (re-enable them with
 /// `GenericJoint::set_contacts_enabled` if your colliders need them).
 pub fn revolute_from_clearance(joint: &ClearanceJoint) -> RevoluteJoint {
-    revolute_with([
+    revolute_joint([
         joint.local_anchor1(),
         joint.local_anchor2(),
         joint.local_axis1(),
@@ -392,7 +392,7 @@ pub fn revolute_from_clearance(joint: &ClearanceJoint) -> RevoluteJoint {
 /// The ideal revolute joint with the anchors and axes of the large-step `joint` (contacts
 /// between the bodies disabled, as in [`revolute_from_clearance`]).
 pub fn revolute_from_large_step(joint: &LargeStepJoint) -> RevoluteJoint {
-    revolute_with([
+    revolute_joint([
         joint.local_anchor1(),
         joint.local_anchor2(),
         joint.local_axis1(),
@@ -400,7 +400,10 @@ pub fn revolute_from_large_step(joint: &LargeStepJoint) -> RevoluteJoint {
     ])
 }
 
-fn revolute_with([anchor1, anchor2, axis1, axis2]: [Vector; 4]) -> RevoluteJoint {
+/// The ideal revolute joint through `anchor1` / `anchor2` about `axis1` / `axis2` (body frames;
+/// axes as given), with contacts between the two bodies disabled: the joint a clearance joint
+/// converts back to, and the ECS layer's ideal hinge.
+pub fn revolute_joint([anchor1, anchor2, axis1, axis2]: [Vector; 4]) -> RevoluteJoint {
     let data = GenericJointBuilder::new(JointAxesMask::LOCKED_REVOLUTE_AXES)
         .local_axis1(axis1)
         .local_axis2(axis2)

@@ -7,12 +7,12 @@ use clearance_joint_app::study::metrics::{
     Trend, contact_arc_deg, count_in_windows, last_time_above, max_abs_difference, onset_times,
     path_length,
 };
-use clearance_joint_app::study::preset::{StudyKind, StudyOptions, run_studies};
 use clearance_joint_app::study::report::Verdict;
 use clearance_joint_app::study::sweep::{
     self, ExecOptions, MANIFEST, MetricsTable, Progress, Sweep,
 };
 use clearance_joint_app::study::{Axis, Grid, Shard};
+use clearance_joint_app::study::{StudyKind, StudyOptions, run_studies};
 use std::collections::BTreeSet;
 use std::path::PathBuf;
 

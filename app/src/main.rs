@@ -7,8 +7,9 @@ use clearance_joint::scene::report::comparison_table;
 use clearance_joint_app::cli::{self, merge::Merged, run::SceneRun, sweep::SweepJob};
 use clearance_joint_app::figures::run::draw_run_figures;
 use clearance_joint_app::progress::RunProgress;
+use clearance_joint_app::study::report::Verdict;
 use clearance_joint_app::study::sweep::{ExecOptions, MetricsTable, Progress};
-use clearance_joint_app::study::{StudyKind, StudyOptions, run_studies};
+use clearance_joint_app::study::{StudyOptions, run_studies, select};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -29,7 +30,8 @@ enum Command {
     Run(RunArgs),
     /// Run a grid of scenes, one ideal-vs-clearance run per point, plus a metrics table.
     Sweep(SweepArgs),
-    /// Run the paper's studies with figures and reports: clearance, torque, friction or all.
+    /// Run a study preset of the scene with figures and reports (the paper's scene: clearance,
+    /// torque, friction), or all of them.
     Study(StudyArgs),
     /// Gather the metrics tables of a sharded sweep into one.
     Merge(MergeArgs),
@@ -116,11 +118,12 @@ struct SweepArgs {
 /// `study NAME`.
 #[derive(Args, Debug, Clone)]
 struct StudyArgs {
-    /// clearance, torque, friction or all.
-    #[arg(value_parser = ["clearance", "torque", "friction", "all"])]
+    /// The preset's name, as the scene's `studies` declare it (the paper's scene: clearance,
+    /// torque, friction), or all.
     name: String,
-    /// Scene file (RON); default: the paper's solar-panel scene. The presets set
-    /// `hinge.*` and `drive.*`: the scene must name its clearance hinge `hinge` and its drive `drive`.
+    /// Scene file (RON); default: the paper's solar-panel scene. Its `studies` declare the
+    /// presets; a scene declaring none gets the paper's, which set `hinge.*` and `drive.*` and so
+    /// need a clearance hinge named `hinge` and a drive named `drive`.
     #[arg(long)]
     scene: Option<PathBuf>,
     /// Override a parameter in every case, after the study's own settings (repeatable),
@@ -326,13 +329,8 @@ fn fail_on_failures(table: &MetricsTable) -> clearance_joint::Result<()> {
 
 fn study(args: &StudyArgs) -> clearance_joint::Result<()> {
     let base = cli::load_scene(args.scene.as_deref())?;
-    clearance_joint_app::study::preset::check_names(&base)?;
+    let studies = select(&base, &args.name)?;
     warn(&base);
-    let kinds: Vec<StudyKind> = if args.name == "all" {
-        StudyKind::ALL.to_vec()
-    } else {
-        vec![StudyKind::parse(&args.name)?]
-    };
     let root = args
         .out
         .clone()
@@ -343,12 +341,11 @@ fn study(args: &StudyArgs) -> clearance_joint::Result<()> {
         no_figures: args.no_figures,
     };
     let start = Instant::now();
-    let outcomes = run_studies(&kinds, &base, &root, &options)?;
+    let outcomes = run_studies(&studies, &base, &root, &options)?;
     for o in &outcomes {
-        println!("{} study -> {}", o.kind.name(), o.report.display());
+        println!("{} study -> {}", o.study.name(), o.report.display());
         for c in &o.cases {
-            let h = c.metrics.hinges.values().find(|h| h.clearance_mm > 0.0);
-            if let Some(h) = h {
+            if let Some(h) = c.metrics.hinges.get(&o.study.hinge) {
                 println!(
                     "  {:<22} impacts {:>5}  peak force {:>9.3} N  RMS force {:>7.3} N  final hinge angle {:>8.3} deg (ideal {:>8.3}){}",
                     c.label,
@@ -362,7 +359,7 @@ fn study(args: &StudyArgs) -> clearance_joint::Result<()> {
             }
         }
         for c in &o.conclusions {
-            if c.verdict != clearance_joint_app::study::report::Verdict::NotTested {
+            if c.verdict != Verdict::NotTested {
                 println!("  paper conclusion {}: {}", c.number, c.verdict.text());
             }
         }

@@ -3,7 +3,7 @@
 
 use super::case::StudyCase;
 use super::grid::Shard;
-use super::preset::{StudyKind, check_names};
+use super::preset::Study;
 use super::report;
 use super::sweep::{ExecOptions, Failure, Job, MetricsTable, Sweep, TableRow, execute};
 use crate::figures::series::CaseSeries;
@@ -29,7 +29,7 @@ pub struct StudyOptions {
 #[derive(Clone, Debug)]
 pub struct StudyOutcome {
     /// Which study.
-    pub kind: StudyKind,
+    pub study: Study,
     /// Its folder.
     pub dir: PathBuf,
     /// Cases in axis order.
@@ -40,43 +40,42 @@ pub struct StudyOutcome {
     pub figures: Vec<PathBuf>,
     /// `report.md`.
     pub report: PathBuf,
-    /// The report's verdicts on the paper's conclusions.
+    /// The report's verdicts on the paper's conclusions (none unless [`Study::paper`]).
     pub conclusions: Vec<report::Conclusion>,
     /// Settings and names the report states.
     pub setup: report::Setup,
 }
 
-/// Runs `kinds` over `base` into `root/<name>/`: all their points in one parallel batch (one
-/// progress display), then per study the metrics table, figures and `report.md`; with more than
-/// one study, also `root/report.md` gathering their key tables and verdicts. Studies whose
-/// cases all finished are written even if another study failed; then the first failure is
-/// returned.
+/// Runs `studies` (presets of `base`, see [`super::preset::select`]) into `root/<name>/`: all
+/// their points in one parallel batch (one progress display), then per study the metrics table,
+/// figures and `report.md`; with more than one study, also `root/report.md` gathering their key
+/// tables and verdicts. Studies whose cases all finished are written even if another study
+/// failed; then the first failure is returned.
 pub fn run_studies(
-    kinds: &[StudyKind],
+    studies: &[Study],
     base: &Scene,
     root: &Path,
     options: &StudyOptions,
 ) -> Result<Vec<StudyOutcome>> {
-    check_names(base)?;
-    let mut plans: Vec<(StudyKind, PathBuf, Sweep, Vec<Job>)> = Vec::new();
+    let mut plans: Vec<(&Study, PathBuf, Sweep, Vec<Job>)> = Vec::new();
     // Each study's folder is claimed (created, checked writable, locked) before any case runs.
     let mut locks = Vec::new();
-    for &kind in kinds {
-        let dir = root.join(kind.name());
+    for study in studies {
+        let dir = root.join(study.name());
         locks.push(clearance_joint::scene::output::DirLock::acquire(&dir)?);
-        let sweep = kind.sweep(base, &options.extra_overrides);
+        let sweep = study.sweep(base, &options.extra_overrides);
         let jobs = sweep.jobs(&dir, Shard::ALL)?;
-        plans.push((kind, dir, sweep, jobs));
+        plans.push((study, dir, sweep, jobs));
     }
     let all_jobs: Vec<Job> = plans.iter().flat_map(|p| p.3.iter().cloned()).collect();
     let mut results = execute(&all_jobs, options.exec)?.into_iter();
     let mut outcomes = Vec::new();
     let mut first_error: Option<Error> = None;
-    for (kind, dir, sweep, jobs) in plans {
+    for (study, dir, sweep, jobs) in plans {
         let mut rows = Vec::new();
         let mut cases = Vec::new();
         let mut failures = Vec::new();
-        let labels = kind.labels();
+        let labels = study.labels();
         for job in &jobs {
             match results.next() {
                 Some(Ok(o)) => {
@@ -104,7 +103,7 @@ pub fn run_studies(
                     });
                     eprintln!(
                         "study {}: case `{}` failed: {e}",
-                        kind.name(),
+                        study.name(),
                         job.point.dir
                     );
                     first_error.get_or_insert(e);
@@ -136,13 +135,13 @@ pub fn run_studies(
             }
             continue;
         }
-        outcomes.push(finish_study(kind, dir, &sweep, cases, table, options)?);
+        outcomes.push(finish_study(study, dir, &sweep, cases, table, options)?);
     }
     if outcomes.len() > 1 {
         let entries: Vec<report::IndexEntry> = outcomes
             .iter()
             .map(|o| report::IndexEntry {
-                kind: o.kind,
+                study: &o.study,
                 setup: &o.setup,
                 cases: &o.cases,
                 conclusions: &o.conclusions,
@@ -159,7 +158,7 @@ pub fn run_studies(
 
 /// Figures and report of a study whose cases all finished.
 fn finish_study(
-    kind: StudyKind,
+    study: &Study,
     dir: PathBuf,
     sweep: &Sweep,
     cases: Vec<StudyCase>,
@@ -170,15 +169,15 @@ fn finish_study(
     let mut figure_stems = Vec::new();
     let series: Vec<CaseSeries> = cases
         .par_iter()
-        .map(|c| CaseSeries::load(c.label.clone(), &c.scene, &c.dir))
+        .map(|c| CaseSeries::load_hinge(c.label.clone(), &c.scene, &study.hinge, &c.dir))
         .collect::<Result<_>>()?;
     let timeline = report::Timeline::of(&series);
     if !options.no_figures {
-        let nums = kind.paper_figures();
+        let nums = study.paper_figures();
         let titles: Vec<String> = FigureKind::ALL
             .iter()
-            .zip(nums)
-            .map(|(f, n)| {
+            .enumerate()
+            .map(|(i, f)| {
                 let what = match f {
                     FigureKind::AnglesRates => "angles and angular rates, clearance vs ideal joint",
                     FigureKind::Force => "joint reaction force, ideal vs clearance joint",
@@ -186,7 +185,10 @@ fn finish_study(
                         "journal-centre trajectory inside the clearance circle"
                     }
                 };
-                format!("{} study: {what} (paper fig. {n})", kind.name())
+                match nums {
+                    Some(n) => format!("{} study: {what} (paper fig. {})", study.name(), n[i]),
+                    None => format!("{} study: {what}", study.name()),
+                }
             })
             .collect();
         let written: Vec<[PathBuf; 2]> = FigureKind::ALL
@@ -206,10 +208,15 @@ fn finish_study(
             figures.extend(paths);
         }
     }
-    let setup = report::Setup::of(kind, sweep, &cases);
-    let conclusions = report::conclusions(kind, &cases, Some(&timeline));
+    let setup = report::Setup::of(study, sweep, &cases);
+    // The paper's conclusions are about its scene and its three studies only.
+    let conclusions = if study.paper {
+        report::conclusions(study, &cases, Some(&timeline))
+    } else {
+        Vec::new()
+    };
     let text = report::study_report(
-        kind,
+        study,
         &setup,
         &cases,
         &figure_stems,
@@ -219,7 +226,7 @@ fn finish_study(
     let report_path = dir.join("report.md");
     write_atomic(&report_path, text.as_bytes())?;
     Ok(StudyOutcome {
-        kind,
+        study: study.clone(),
         dir,
         cases,
         table,

@@ -7,27 +7,51 @@ use super::timeline::Timeline;
 use super::verdict::{ANGLE_SLIGHT, Conclusion, EQUAL_TOL, FORCE_STRONG, RATE_VISIBLE, Verdict};
 use crate::figures::FigureKind;
 use crate::study::case::StudyCase;
-use crate::study::preset::StudyKind;
+use crate::study::preset::{Study, StudyKind};
 use std::fmt::Write as _;
 
-fn figure_caption(kind: StudyKind, f: FigureKind) -> String {
-    let [a, b, c] = kind.paper_figures();
+/// The caption of a study's figure, citing the paper's figure for one of its studies.
+fn figure_caption(study: &Study, f: FigureKind) -> String {
+    let cite = |i: usize| {
+        study
+            .paper_figures()
+            .map_or(String::new(), |n| format!(" (paper fig. {})", n[i]))
+    };
     match f {
         FigureKind::AnglesRates => format!(
-            "Angles and angular rates of the bodies vs time, each case with the ideal joint dashed (paper fig. {a})."
+            "Angles and angular rates of the bodies vs time, each case with the ideal joint dashed{}.",
+            cite(0)
         ),
         FigureKind::Force => format!(
-            "Joint reaction force vs time: ideal joint (left, its own scale) and clearance joint (right); each column shares its scale (paper fig. {b}). Lines keep the minimum and maximum of every pixel column, so no peak is lost."
+            "Joint reaction force vs time: ideal joint (left, its own scale) and clearance joint (right); each column shares its scale{}. Lines keep the minimum and maximum of every pixel column, so no peak is lost.",
+            cite(1)
         ),
         FigureKind::Trajectory => format!(
-            "Journal-centre trajectory in the bearing frame, drawn to scale with the clearance circle |e| = c (paper fig. {c})."
+            "Journal-centre trajectory in the bearing frame, drawn to scale with the clearance circle |e| = c{}.",
+            cite(2)
         ),
     }
 }
 
-/// The whole `report.md` of a study.
+/// Why a report judges none of the paper's conclusions.
+fn not_judged(study: &Study, scene: &str) -> String {
+    if study.spec.paper {
+        format!(
+            "Not judged: the preset is one of the paper's studies, but scene `{scene}` is not the paper's scene \
+             (`assets/solar_panel.ron`: its bodies, hinges, drives, gravity and axis), and the paper's conclusions \
+             (MODEL.md §5) are about that scene."
+        )
+    } else {
+        "Not judged: the paper's conclusions (MODEL.md §5) are about its scene and its three studies (`study \
+         clearance|torque|friction` on `assets/solar_panel.ron`), and this preset is not one of them."
+            .to_string()
+    }
+}
+
+/// The whole `report.md` of a study. `conclusions` are the paper's, judged only for one of the
+/// paper's studies on its scene ([`Study::paper`]); any other report says why it has none.
 pub fn study_report(
-    kind: StudyKind,
+    study: &Study,
     setup: &Setup,
     cases: &[StudyCase],
     figures: &[(FigureKind, String)],
@@ -35,14 +59,28 @@ pub fn study_report(
     timeline: Option<&Timeline>,
 ) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "# {} study: {}\n", kind.name(), kind.title());
-    let _ = writeln!(
-        s,
-        "Written by `cargo run --release -- study {}` (or `study all`); regenerated on every run, do not edit. \
-         Model: the project's specification MODEL.md (§4, the paper's scene). \
-         Nothing in the model is tuned to agree with the paper.\n",
-        kind.name()
-    );
+    let name = study.name();
+    let _ = writeln!(s, "# {name} study: {}\n", study.title());
+    if study.paper {
+        let _ = writeln!(
+            s,
+            "Written by `cargo run --release -- study {name}` (or `study all`); regenerated on every run, do not edit. \
+             Model: the project's specification MODEL.md (§4, the paper's scene). \
+             Nothing in the model is tuned to agree with the paper.\n"
+        );
+    } else {
+        let _ = writeln!(
+            s,
+            "Written by `cargo run --release -- study {name} --scene FILE` (or `study all`) for scene `{}`, from {}; \
+             regenerated on every run, do not edit.\n",
+            setup.scene,
+            if study.declared {
+                format!("the preset `{name}` its file declares")
+            } else {
+                format!("the paper's preset `{name}` (the scene declares none)")
+            }
+        );
+    }
     let _ = writeln!(s, "## Setup\n");
     let _ = writeln!(
         s,
@@ -74,7 +112,7 @@ pub fn study_report(
         "- The same step control for every case: {}; rows every {:e} s, {} s simulated, ideal and clearance twins in one world.",
         setup.stepping, setup.output_interval_s, setup.end_s
     );
-    if kind == StudyKind::Torque {
+    if study.paper && study.kind == StudyKind::Torque {
         let _ = writeln!(
             s,
             "- The paper's fixed step of 1e-4 s under-resolves the stronger impacts: at 3T and 5T it gives first-impact peaks \
@@ -139,9 +177,17 @@ pub fn study_report(
                 s,
                 "![{}]({stem}.png)\n\n{} SVG: [`{stem}.svg`]({stem}.svg).\n",
                 f.stem(),
-                figure_caption(kind, *f)
+                figure_caption(study, *f)
             );
         }
+    }
+    if !study.paper {
+        let _ = writeln!(
+            s,
+            "## The paper's conclusions\n\n{}",
+            not_judged(study, &setup.scene)
+        );
+        return s;
     }
     let _ = writeln!(s, "## The paper's conclusions against our numbers\n");
     let _ = writeln!(
@@ -172,22 +218,29 @@ pub fn study_report(
 #[derive(Clone, Copy, Debug)]
 pub struct IndexEntry<'a> {
     /// Which study.
-    pub kind: StudyKind,
+    pub study: &'a Study,
     /// Its settings.
     pub setup: &'a Setup,
     /// Its cases.
     pub cases: &'a [StudyCase],
-    /// Its verdicts on the paper's conclusions.
+    /// Its verdicts on the paper's conclusions (none unless [`Study::paper`]).
     pub conclusions: &'a [Conclusion],
 }
 
 /// `report.md` of `study all`: each study's key tables and verdicts, with links.
 pub fn index_report(entries: &[IndexEntry]) -> String {
-    let mut s = String::from(
-        "# The paper's studies: summary\n\nWritten by `cargo run --release -- study all`; each study's own report has its figures and full findings.\n\n",
-    );
+    let mut s = if entries.iter().all(|e| e.study.paper) {
+        String::from(
+            "# The paper's studies: summary\n\nWritten by `cargo run --release -- study all`; each study's own report has its figures and full findings.\n\n",
+        )
+    } else {
+        format!(
+            "# Studies of scene `{}`: summary\n\nWritten by `cargo run --release -- study all --scene FILE`; each study's own report has its figures and full findings.\n\n",
+            entries.first().map_or("", |e| e.setup.scene.as_str())
+        )
+    };
     for o in entries {
-        let name = o.kind.name();
+        let name = o.study.name();
         let _ = writeln!(
             s,
             "## {} study: [{name}/report.md]({name}/report.md)\n",

@@ -8,7 +8,7 @@ use super::verdict::{
 };
 use crate::study::case::StudyCase;
 use crate::study::metrics::Trend;
-use crate::study::preset::StudyKind;
+use crate::study::preset::{Study, StudyKind};
 use std::fmt::Write as _;
 
 /// The paper's conclusions (MODEL.md §5).
@@ -19,32 +19,29 @@ pub const PAPER: [&str; 4] = [
     "More friction (dry vs lubricated): smaller joint forces and fewer impacts, faster settling.",
 ];
 
-/// What our numbers show for each of the paper's four conclusions, for the cases of `kind`
-/// (`timeline`: contact onsets per window, when the series were read).
+/// What our numbers show for each of the paper's four conclusions, for the cases of `study`,
+/// one of the paper's studies ([`Study::paper`]: the judgement assumes the paper's scene and
+/// its cases in the paper's order) (`timeline`: contact onsets per window, when the series were
+/// read).
 pub fn conclusions(
-    kind: StudyKind,
+    study: &Study,
     cases: &[StudyCase],
     timeline: Option<&Timeline>,
 ) -> Vec<Conclusion> {
     let Some(first) = cases.first() else {
         return Vec::new();
     };
-    let hinge = first
-        .scene
-        .hinges
-        .iter()
-        .find(|h| h.clearance.is_some())
-        .map(|h| h.name.clone())
-        .unwrap_or_default();
+    let kind = study.kind;
+    let hinge = &study.hinge;
     let journal = first
         .scene
         .hinges
         .iter()
-        .find(|h| h.name == hinge)
+        .find(|h| &h.name == hinge)
         .map(|h| h.journal.clone())
         .unwrap_or_default();
     let end = first.metrics.end_s;
-    let hm = |c: &StudyCase| hinge_of(&c.metrics, &hinge);
+    let hm = |c: &StudyCase| hinge_of(&c.metrics, hinge);
     let bm = |c: &StudyCase| body_of(&c.metrics, &journal);
     let elsewhere = |n: u8, k: StudyKind| Conclusion {
         number: n,

@@ -1,7 +1,7 @@
 //! The run settings and names a study's report states.
 
 use crate::study::case::StudyCase;
-use crate::study::preset::StudyKind;
+use crate::study::preset::Study;
 use crate::study::sweep::Sweep;
 
 /// The run settings and names a report states.
@@ -19,7 +19,7 @@ pub struct Setup {
     pub overrides: Vec<String>,
     /// Swept path.
     pub axis: String,
-    /// Hinge shown (first clearance hinge).
+    /// Hinge shown (the study's clearance hinge).
     pub hinge: String,
     /// Movable bodies, the hinge's journal body first.
     pub bodies: Vec<String>,
@@ -28,14 +28,10 @@ pub struct Setup {
 }
 
 impl Setup {
-    /// The setup of `kind` from its sweep and cases.
-    pub fn of(kind: StudyKind, sweep: &Sweep, cases: &[StudyCase]) -> Setup {
+    /// The setup of `study` from its sweep and cases.
+    pub fn of(study: &Study, sweep: &Sweep, cases: &[StudyCase]) -> Setup {
         let scene = cases.first().map(|c| &c.scene).unwrap_or(&sweep.base);
-        let hinge = scene
-            .hinges
-            .iter()
-            .find(|h| h.clearance.is_some())
-            .or(scene.hinges.first());
+        let hinge = scene.hinges.iter().find(|h| h.name == study.hinge);
         let mut bodies: Vec<String> = scene
             .bodies
             .iter()
@@ -52,8 +48,8 @@ impl Setup {
             output_interval_s: scene.run.output_interval_s,
             end_s: scene.run.end_s,
             overrides: sweep.base_overrides.clone(),
-            axis: kind.axis().path,
-            hinge: hinge.map(|h| h.name.clone()).unwrap_or_default(),
+            axis: study.axis().path,
+            hinge: study.hinge.clone(),
             bodies,
             scene: sweep.base.name.clone(),
         }

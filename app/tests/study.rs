@@ -623,3 +623,44 @@ fn a_scene_declares_its_own_study() {
     );
     let _ = std::fs::remove_dir_all(&root);
 }
+
+/// A general study: any field by its path (here the pendulum's arm mass, as numbers), the report
+/// showing the scene's first clearance hinge; it judges none of the paper's conclusions.
+#[test]
+fn a_field_study_varies_any_path() {
+    let text = include_str!("../../assets/pendulum.ron");
+    let end = text.rfind(')').unwrap();
+    let scene = Scene::from_ron(
+        &format!(
+            "{}    studies: [(name: \"mass\", kind: Field(path: \"arm.mass_kg\"), values: [1, 2.5], \
+             set: [\"run.end_s=0.02\"])],\n{}",
+            &text[..end],
+            &text[end..]
+        ),
+        "pendulum with a study",
+    )
+    .unwrap();
+    let root = scratch("field");
+    let options = StudyOptions {
+        exec: quiet(),
+        extra_overrides: Vec::new(),
+        no_figures: true,
+    };
+    let studies = select(&scene, "all").unwrap();
+    assert_eq!(studies[0].hinge, "pivot");
+    let outcomes = run_studies(&studies, &scene, &root, &options).unwrap();
+    let o = &outcomes[0];
+    let masses: Vec<f64> = o.cases.iter().map(|c| c.scene.bodies[1].mass_kg).collect();
+    assert_eq!(masses, [1.0, 2.5]);
+    assert_eq!(o.cases[1].label, "arm.mass_kg = 2.5");
+    assert!(o.cases.iter().all(|c| c.metrics.end_s == 0.02));
+    assert!(o.conclusions.is_empty());
+    let report = std::fs::read_to_string(&o.report).unwrap();
+    assert!(
+        report.starts_with("# mass study: Influence of `arm.mass_kg`")
+            && report.contains("| arm.mass_kg = 1 |")
+            && report.contains("this preset is not one of them"),
+        "{report}"
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}

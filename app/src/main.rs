@@ -1,14 +1,16 @@
-//! Command-line front end: parses arguments, runs, prints. The work is in the library.
+//! The command line: parses arguments, calls the app library (`clearance_joint_app::cli` and
+//! `study`), prints what it returns, and sets the exit code.
 
 use clap::{Args, Parser, Subcommand};
-use clearance_joint::scene::output::{DirLock, MemoryEstimate};
+use clearance_joint::scene::Scene;
 use clearance_joint::scene::report::comparison_table;
-use clearance_joint::scene::runner::{RunOptions, Simulation};
-use clearance_joint::scene::{Scene, StepMode};
+use clearance_joint_app::cli::{self, merge::Merged, run::SceneRun, sweep::SweepJob};
+use clearance_joint_app::figures::run::draw_run_figures;
 use clearance_joint_app::progress::RunProgress;
-use clearance_joint_app::study::sweep::{self, ExecOptions, MetricsTable, Progress, Sweep};
-use clearance_joint_app::study::{Axis, Grid, Shard, StudyKind, StudyOptions, run_studies};
-use std::path::{Path, PathBuf};
+use clearance_joint_app::study::report::Verdict;
+use clearance_joint_app::study::sweep::{ExecOptions, MetricsTable, Progress};
+use clearance_joint_app::study::{StudyOptions, run_studies, select};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -28,7 +30,8 @@ enum Command {
     Run(RunArgs),
     /// Run a grid of scenes, one ideal-vs-clearance run per point, plus a metrics table.
     Sweep(SweepArgs),
-    /// Run the paper's studies with figures and reports: clearance, torque, friction or all.
+    /// Run a study preset of the scene with figures and reports (the paper's scene: clearance,
+    /// torque, friction), or all of them.
     Study(StudyArgs),
     /// Gather the metrics tables of a sharded sweep into one.
     Merge(MergeArgs),
@@ -51,28 +54,18 @@ struct ExecArgs {
 }
 
 impl ExecArgs {
-    /// The options, with the thread count capped at the cores (saying so) and used for the
-    /// global pool too (figures), so no setting spawns thousands of threads.
+    /// The options (saying so when the thread count was capped at the cores).
     fn options(&self) -> clearance_joint::Result<ExecOptions> {
-        let requested = self.jobs.or_else(|| {
-            std::env::var("RAYON_NUM_THREADS")
-                .ok()
-                .and_then(|v| v.trim().parse().ok())
-                .filter(|&n: &usize| n > 0)
-        });
-        let (threads, note) = sweep::thread_count(requested)?;
+        let (options, note) = cli::exec_options(
+            self.jobs,
+            progress_mode(&self.progress),
+            self.rerun,
+            self.memory.max_memory.as_deref(),
+        )?;
         if let Some(note) = note {
             eprintln!("note: {note}");
         }
-        let _ = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build_global();
-        Ok(ExecOptions {
-            progress: progress_mode(&self.progress),
-            threads: Some(threads),
-            rerun: self.rerun,
-            max_memory: self.memory.budget()?,
-        })
+        Ok(options)
     }
 }
 
@@ -96,10 +89,7 @@ struct MemoryArgs {
 
 impl MemoryArgs {
     fn budget(&self) -> clearance_joint::Result<Option<u64>> {
-        self.max_memory
-            .as_deref()
-            .map(clearance_joint::scene::output::parse_bytes)
-            .transpose()
+        cli::memory_budget(self.max_memory.as_deref())
     }
 }
 
@@ -128,11 +118,12 @@ struct SweepArgs {
 /// `study NAME`.
 #[derive(Args, Debug, Clone)]
 struct StudyArgs {
-    /// clearance, torque, friction or all.
-    #[arg(value_parser = ["clearance", "torque", "friction", "all"])]
+    /// The preset's name, as the scene's `studies` declare it (the paper's scene: clearance,
+    /// torque, friction), or all.
     name: String,
-    /// Scene file (RON); default: the paper's solar-panel scene. The presets set
-    /// `hinge.*` and `drive.*`: the scene must name its clearance hinge `hinge` and its drive `drive`.
+    /// Scene file (RON); default: the paper's solar-panel scene. Its `studies` declare the
+    /// presets; a scene declaring none gets the paper's, which set `hinge.*` and `drive.*` and so
+    /// need a clearance hinge named `hinge` and a drive named `drive`.
     #[arg(long)]
     scene: Option<PathBuf>,
     /// Override a parameter in every case, after the study's own settings (repeatable),
@@ -237,7 +228,7 @@ impl RunArgs {
     fn scene(&self) -> clearance_joint::Result<Scene> {
         let mut overrides = self.overrides.clone();
         overrides.extend(self.time.overrides());
-        base_scene(&self.scene)?.with_overrides(&overrides)
+        cli::load_scene(self.scene.as_deref())?.with_overrides(&overrides)
     }
 }
 
@@ -254,15 +245,8 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&scene.name));
-    if let Some(budget) = args
-        .memory
-        .budget()?
-        .or_else(clearance_joint::scene::output::available_memory)
-    {
-        MemoryEstimate::of(&scene).check(&scene, 1, budget)?;
-    }
-    // Before any work: the folder exists, is writable and is ours alone until the set is written.
-    let _lock = DirLock::acquire(&out)?;
+    let job = SceneRun::prepare(scene, out, args.memory.budget()?)?;
+    let scene = &job.scene;
     eprintln!(
         "running `{}`: {}, {} s simulated, ideal and clearance twins",
         scene.name,
@@ -270,131 +254,22 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
         clearance_joint::error::sig4(scene.run.end_s)
     );
     let mut progress = RunProgress::new(progress_mode(&args.progress));
-    let result = Simulation::new(&scene, RunOptions::default())?
-        .run_with_progress(|p| progress.update(p))
-        .map_err(|e| e.with_step_mode(scene.run.step == StepMode::Adaptive));
+    let result = job.execute(|p| progress.update(p));
     progress.finish();
     let result = result?;
-    let summary = result.write(&out)?;
+    let summary = result.write(&job.out)?;
     println!("{}", comparison_table(&summary));
-    let mut files = vec!["ideal.csv".to_string(), "clearance.csv".to_string()];
-    for t in &result.twins {
-        for h in t.clearance_hinges() {
-            files.push(format!("{}_{h}_impacts.csv", t.kind.name()));
-            if scene.drive_period().is_some() {
-                files.push(format!("{}_{h}_turns.csv", t.kind.name()));
-            }
-        }
-    }
-    files.push("summary.json".into());
     println!(
         "{} steps in {:.2} s wall; wrote {}/{{{}}}",
         result.steps,
         result.wall_s,
-        out.display(),
-        files.join(", ")
+        job.out.display(),
+        job.files(&result).join(", ")
     );
     if !args.no_figures {
-        let drawn = (|| -> clearance_joint::Result<()> {
-            use clearance_joint::scene::runner::TwinKind;
-            use clearance_joint_app::figures::series::CaseSeries;
-            use clearance_joint_app::figures::{Figure, FigureKind};
-            let (Some(ideal), Some(clear)) = (
-                result.twin(TwinKind::Ideal),
-                result.twin(TwinKind::Clearance),
-            ) else {
-                return Err(clearance_joint::Error::invalid(
-                    "--figures",
-                    "needs both twins",
-                ));
-            };
-            let series = [CaseSeries::from_tables(
-                scene.name.clone(),
-                &scene,
-                &ideal.table,
-                &clear.table,
-            )?];
-            // Driven mechanisms: each moving body's x acceleration against the driver's angle over
-            // the last turn, ideal against clearance.
-            if let (Some(period), true) = (scene.drive_period(), scene.run.body_motion) {
-                use clearance_joint::scene::MotionSpec;
-                let driver = scene
-                    .bodies
-                    .iter()
-                    .find(|b| matches!(b.motion, Some(MotionSpec::Spin { .. })))
-                    .map(|b| b.name.clone())
-                    .or_else(|| {
-                        scene
-                            .joints
-                            .iter()
-                            .find(|j| j.motor.is_some())
-                            .map(|j| j.body2.clone())
-                    });
-                let end = scene.run.end_s;
-                for b in scene
-                    .bodies
-                    .iter()
-                    .filter(|b| !b.fixed && b.motion.is_none())
-                {
-                    let (Some(driver), true) = (&driver, end >= period * (1.0 - 1e-9)) else {
-                        continue;
-                    };
-                    let column = format!("{}_ax_m_s2", b.name);
-                    let curve = |label: &str, t: &clearance_joint::table::Table| {
-                        let (Some(ts), Some(angle), Some(a)) = (
-                            t.column("t_s"),
-                            t.column(&format!("{driver}_angle_deg")),
-                            t.column(&column),
-                        ) else {
-                            return None;
-                        };
-                        let first = ts.iter().position(|&x| x >= end - period)?;
-                        let points = (first..ts.len())
-                            .map(|i| (angle[i] - angle[first], a[i]))
-                            .collect();
-                        Some((label.to_string(), points))
-                    };
-                    let curves: Vec<(String, Vec<(f64, f64)>)> = [
-                        curve("ideal", &ideal.table),
-                        curve("clearance", &clear.table),
-                    ]
-                    .into_iter()
-                    .flatten()
-                    .collect();
-                    if curves.is_empty() {
-                        continue;
-                    }
-                    let title = format!(
-                        "{}: {} acceleration along x over the last turn of {driver}",
-                        scene.name, b.name
-                    );
-                    let x_label = format!("{driver} angle from the turn's start (deg)");
-                    let paths = clearance_joint_app::figures::XyFigure {
-                        title: &title,
-                        x_label: &x_label,
-                        y_label: "acceleration along x (m/s^2)",
-                        curves: &curves,
-                    }
-                    .write(&out, &format!("{}_acceleration", b.name))?;
-                    for p in paths {
-                        println!("wrote {}", p.display());
-                    }
-                }
-            }
-            for kind in FigureKind::ALL {
-                let title = format!("{}: {}", scene.name, kind.stem().replace('_', " "));
-                let paths = Figure {
-                    kind,
-                    title: &title,
-                    cases: &series,
-                }
-                .write(&out, kind.stem())?;
-                for p in paths {
-                    println!("wrote {}", p.display());
-                }
-            }
-            Ok(())
-        })();
+        let drawn = draw_run_figures(scene, &result, &job.out, |p| {
+            println!("wrote {}", p.display())
+        });
         match drawn {
             Err(e) if !args.figures => eprintln!("no figures: {e}"),
             other => other?,
@@ -403,53 +278,34 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     Ok(())
 }
 
-fn base_scene(path: &Option<PathBuf>) -> clearance_joint::Result<Scene> {
-    match path {
-        Some(p) => Scene::load(p),
-        None => Ok(Scene::solar_panel()),
-    }
-}
-
 fn sweep(args: &SweepArgs) -> clearance_joint::Result<()> {
-    let base = base_scene(&args.scene)?;
+    let base = cli::load_scene(args.scene.as_deref())?;
     warn(&base);
     let exec = args.exec.options()?;
-    let axes = args
-        .axes
-        .iter()
-        .map(|a| Axis::parse(a))
-        .collect::<clearance_joint::Result<Vec<_>>>()?;
-    let fixed = args.time.overrides();
-    let shard = match &args.shard {
-        Some(s) => Shard::parse(s)?,
-        None => Shard::ALL,
-    };
     let out = args
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out/sweep"));
-    let sweep = Sweep::new("sweep", base, fixed, Grid::new(axes)?);
-    // Claim this shard's table (and check the folder) before any point runs; the points claim
-    // their own folders, so shards of one sweep can share it.
-    let stem = if shard.is_all() {
-        "metrics".to_string()
-    } else {
-        format!("metrics.shard-{}-of-{}", shard.index(), shard.count())
-    };
-    let _lock = DirLock::acquire_named(&out, &format!(".{stem}.lock"))?;
-    let n = shard.points(&sweep.grid).len();
+    let job = SweepJob::prepare(
+        base,
+        &args.axes,
+        args.time.overrides(),
+        args.shard.as_deref(),
+        out,
+    )?;
     eprintln!(
-        "sweep of {} points{}: {n} to run or reuse, into {}",
-        sweep.grid.len(),
-        if shard.is_all() {
+        "sweep of {} points{}: {} to run or reuse, into {}",
+        job.sweep.grid.len(),
+        if job.shard.is_all() {
             String::new()
         } else {
-            format!(" (shard {shard})")
+            format!(" (shard {})", job.shard)
         },
-        out.display()
+        job.points(),
+        job.out.display()
     );
     let start = Instant::now();
-    let outcome = sweep.run(&out, shard, exec)?;
+    let outcome = job.run(exec)?;
     let reused = outcome.points.iter().filter(|p| p.reused).count();
     println!(
         "{} points finished ({} run, {reused} reused), {} failed, in {:.2} s; table {}",
@@ -457,7 +313,9 @@ fn sweep(args: &SweepArgs) -> clearance_joint::Result<()> {
         outcome.points.len() - reused,
         outcome.table.failures.len(),
         start.elapsed().as_secs_f64(),
-        out.join(format!("{}.csv", outcome.table.stem())).display()
+        job.out
+            .join(format!("{}.csv", outcome.table.stem()))
+            .display()
     );
     fail_on_failures(&outcome.table)
 }
@@ -466,26 +324,13 @@ fn fail_on_failures(table: &MetricsTable) -> clearance_joint::Result<()> {
     for f in &table.failures {
         eprintln!("point `{}` failed: {}", f.point.dir, f.error);
     }
-    match table.failures.len() {
-        0 => Ok(()),
-        n => Err(clearance_joint::Error::invalid(
-            "sweep",
-            format!(
-                "{n} point(s) failed (listed above and in the table's `failures`); fix the cause and run again: finished points are reused"
-            ),
-        )),
-    }
+    cli::sweep::check_failures(table)
 }
 
 fn study(args: &StudyArgs) -> clearance_joint::Result<()> {
-    let base = base_scene(&args.scene)?;
-    clearance_joint_app::study::preset::check_names(&base)?;
+    let base = cli::load_scene(args.scene.as_deref())?;
+    let studies = select(&base, &args.name)?;
     warn(&base);
-    let kinds: Vec<StudyKind> = if args.name == "all" {
-        StudyKind::ALL.to_vec()
-    } else {
-        vec![StudyKind::parse(&args.name)?]
-    };
     let root = args
         .out
         .clone()
@@ -496,12 +341,11 @@ fn study(args: &StudyArgs) -> clearance_joint::Result<()> {
         no_figures: args.no_figures,
     };
     let start = Instant::now();
-    let outcomes = run_studies(&kinds, &base, &root, &options)?;
+    let outcomes = run_studies(&studies, &base, &root, &options)?;
     for o in &outcomes {
-        println!("{} study -> {}", o.kind.name(), o.report.display());
+        println!("{} study -> {}", o.study.name(), o.report.display());
         for c in &o.cases {
-            let h = c.metrics.hinges.values().find(|h| h.clearance_mm > 0.0);
-            if let Some(h) = h {
+            if let Some(h) = c.metrics.hinges.get(&o.study.hinge) {
                 println!(
                     "  {:<22} impacts {:>5}  peak force {:>9.3} N  RMS force {:>7.3} N  final hinge angle {:>8.3} deg (ideal {:>8.3}){}",
                     c.label,
@@ -515,7 +359,7 @@ fn study(args: &StudyArgs) -> clearance_joint::Result<()> {
             }
         }
         for c in &o.conclusions {
-            if c.verdict != clearance_joint_app::study::report::Verdict::NotTested {
+            if c.verdict != Verdict::NotTested {
                 println!("  paper conclusion {}: {}", c.number, c.verdict.text());
             }
         }
@@ -528,72 +372,22 @@ fn study(args: &StudyArgs) -> clearance_joint::Result<()> {
 }
 
 fn merge(args: &MergeArgs) -> clearance_joint::Result<()> {
-    let mut files = Vec::new();
-    for input in &args.inputs {
-        if input.is_dir() {
-            let found = sweep::shard_tables_in(input)?;
-            if found.is_empty() {
-                return Err(clearance_joint::Error::invalid(
-                    format!("merge input `{}`", input.display()),
-                    "holds no shard table (metrics.shard-K-of-N.json)",
-                ));
-            }
-            files.extend(found);
-        } else {
-            files.push(input.clone());
-        }
-    }
-    let tables = files
-        .iter()
-        .map(|f| MetricsTable::load(f))
-        .collect::<clearance_joint::Result<Vec<_>>>()?;
-    let merged = sweep::merge(&tables)?;
-    if !merged.missing.is_empty() && !args.incomplete {
-        return Err(clearance_joint::Error::invalid(
-            "merge",
-            format!(
-                "points {:?} are in no table, so nothing was written: run their shards (point i belongs to \
-                 shard i % N), or pass --incomplete to write metrics.incomplete.{{csv,json}} listing them",
-                merged.missing
-            ),
-        ));
-    }
-    let out = match &args.out {
-        Some(o) => o.clone(),
-        None => {
-            let first = &args.inputs[0];
-            if first.is_dir() {
-                first.clone()
-            } else {
-                first.parent().unwrap_or(Path::new(".")).to_path_buf()
-            }
-        }
-    };
-    let stem = if merged.missing.is_empty() {
-        "metrics"
-    } else {
-        "metrics.incomplete"
-    };
-    merged.write_named(&out, stem)?;
+    let Merged {
+        table,
+        inputs,
+        out,
+        stem,
+    } = cli::merge::merge(&args.inputs, args.out.as_deref(), args.incomplete)?;
     println!(
-        "merged {} table(s): {} of {} points, {} failed, {} missing -> {}",
-        tables.len(),
-        merged.rows.len(),
-        merged.sweep.points,
-        merged.failures.len(),
-        merged.missing.len(),
+        "merged {inputs} table(s): {} of {} points, {} failed, {} missing -> {}",
+        table.rows.len(),
+        table.sweep.points,
+        table.failures.len(),
+        table.missing.len(),
         out.join(format!("{stem}.csv")).display()
     );
-    if !merged.missing.is_empty() {
-        return Err(clearance_joint::Error::invalid(
-            "merge",
-            format!(
-                "points {:?} are in no table: run their shards (a point i belongs to shard i % N)",
-                merged.missing
-            ),
-        ));
-    }
-    fail_on_failures(&merged)
+    cli::merge::check_missing(&table)?;
+    fail_on_failures(&table)
 }
 
 fn main() -> ExitCode {

@@ -10,7 +10,7 @@ use clearance_joint::scene::{SOLAR_PANEL_RON, Scene};
 use clearance_joint_app::progress::{RunProgress, status};
 use clearance_joint_app::study::report::Verdict;
 use clearance_joint_app::study::sweep::{self, ExecOptions};
-use clearance_joint_app::study::{StudyKind, StudyOptions, run_studies};
+use clearance_joint_app::study::{StudyOptions, run_studies, select};
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
@@ -893,9 +893,10 @@ fn short_studies_give_no_verdict() {
         extra_overrides: vec!["run.end_s=0.01".into()],
         no_figures: true,
     };
+    let paper = Scene::solar_panel();
     let outcomes = run_studies(
-        &[StudyKind::Clearance],
-        &Scene::solar_panel(),
+        &select(&paper, "clearance").unwrap(),
+        &paper,
         &root,
         &options,
     )
@@ -912,13 +913,15 @@ fn short_studies_give_no_verdict() {
     }
     let report = std::fs::read_to_string(&outcomes[0].report).unwrap();
     assert!(report.contains("too little data to judge"), "{report}");
-    // And the study checks its names before running anything.
+    // And a scene declaring no presets, without the paper's names, is told what to declare
+    // before anything runs.
     let pendulum = Scene::from_ron(PENDULUM_RON, "pendulum.ron").unwrap();
-    let e = run_studies(&[StudyKind::Torque], &pendulum, &root, &options)
-        .unwrap_err()
-        .to_string();
+    let e = select(&pendulum, "torque").unwrap_err().to_string();
     assert!(
-        e.contains("hinge named `hinge`") && e.contains("`pivot`"),
+        e.contains("hinge named `hinge`")
+            && e.contains("`pivot`")
+            && e.contains("declares no study presets (`studies`)")
+            && e.contains("Clearance(hinge: \"pivot\")"),
         "{e}"
     );
     let _ = std::fs::remove_dir_all(&root);

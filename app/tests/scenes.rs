@@ -566,3 +566,80 @@ fn the_scene_runs_from_the_command_line_with_figures() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Issue 10 item 5: sweeps take the mechanism scenes and any of their fields as an axis: the
+/// run settings, a clearance joint's clearance, and an ideal joint's motor. Each point runs with
+/// its values (read back from the table and the manifests).
+#[test]
+fn sweeps_take_mechanism_scenes_and_any_field() {
+    use clearance_joint_app::study::sweep::{MANIFEST, Manifest, MetricsTable};
+    type Field = fn(&Scene) -> f64;
+    let cases: [(&str, [&str; 2], &[&str], Field); 2] = [
+        (
+            "slider_crank.ron",
+            ["run.end_s=0.001,0.002", "slider_pin.clearance_mm=0.25,0.5"],
+            &[],
+            |s| s.run.end_s,
+        ),
+        (
+            "four_bar.ron",
+            ["motor.factor=1e5,1e6", "rocker_pin.clearance_mm=0.1,0.2"],
+            &["--end", "0.004"],
+            |s| match s.joints[0].motor {
+                Some(clearance_joint::scene::MotorSpec::Velocity { factor, .. }) => factor,
+                _ => f64::NAN,
+            },
+        ),
+    ];
+    for (file, [first, clearance], extra, first_field) in cases {
+        let dir = std::env::temp_dir().join(format!(
+            "cj-sweep-{}-{}",
+            file.trim_end_matches(".ron"),
+            std::process::id()
+        ));
+        let _ = std::fs::remove_dir_all(&dir);
+        let out = Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
+            .args(["sweep", "--scene"])
+            .arg(asset_path(file))
+            .args(["--set", first, "--set", clearance])
+            .args(extra)
+            .args(["--progress", "quiet", "--out"])
+            .arg(&dir)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{file}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let table = MetricsTable::load(&dir.join("metrics.json")).unwrap();
+        assert_eq!(table.rows.len(), 4, "{file}");
+        let hinge = clearance.split('.').next().unwrap();
+        let values = |axis: &str| -> Vec<f64> {
+            let v: Vec<f64> = axis
+                .split_once('=')
+                .unwrap()
+                .1
+                .split(',')
+                .map(|x| x.parse().unwrap())
+                .collect();
+            v
+        };
+        let (firsts, clearances) = (values(first), values(clearance));
+        for (i, row) in table.rows.iter().enumerate() {
+            // The first axis varies slowest.
+            assert_eq!(
+                row.metrics.hinges[hinge].clearance_mm,
+                clearances[i % 2],
+                "{file} point {i}"
+            );
+            let m: Manifest = serde_json::from_str(
+                &std::fs::read_to_string(dir.join(&row.dir).join(MANIFEST)).unwrap(),
+            )
+            .unwrap();
+            let scene = Scene::from_ron(&m.scene_ron, "manifest").unwrap();
+            assert_eq!(first_field(&scene), firsts[i / 2], "{file} point {i}");
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+}

@@ -7,12 +7,12 @@ use clearance_joint_app::study::metrics::{
     Trend, contact_arc_deg, count_in_windows, last_time_above, max_abs_difference, onset_times,
     path_length,
 };
-use clearance_joint_app::study::preset::{StudyKind, StudyOptions, run_studies};
 use clearance_joint_app::study::report::Verdict;
 use clearance_joint_app::study::sweep::{
     self, ExecOptions, MANIFEST, MetricsTable, Progress, Sweep,
 };
 use clearance_joint_app::study::{Axis, Grid, Shard};
+use clearance_joint_app::study::{StudyOptions, run_studies, select};
 use std::collections::BTreeSet;
 use std::path::PathBuf;
 
@@ -440,9 +440,10 @@ fn clearance_study_shows_more_impacts_and_higher_peaks_as_c_grows() {
         extra_overrides: Vec::new(),
         no_figures: true,
     };
+    let paper = Scene::solar_panel();
     let outcomes = run_studies(
-        &[StudyKind::Clearance],
-        &Scene::solar_panel(),
+        &select(&paper, "clearance").unwrap(),
+        &paper,
         &root,
         &options,
     )
@@ -469,5 +470,197 @@ fn clearance_study_shows_more_impacts_and_higher_peaks_as_c_grows() {
     assert_ne!(c2.verdict, Verdict::NotTested);
     let table = MetricsTable::load(&root.join("clearance").join("metrics.json")).unwrap();
     assert_eq!(table.rows.len(), 3);
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// Issue 10 item 5: the paper's studies are declared in its scene file, exactly as they were
+/// built into the app before (same paths, values as written, fixed settings in the same order,
+/// labels), so their folders, tables and reports are unchanged.
+#[test]
+fn the_papers_presets_are_declared_in_its_scene() {
+    let scene = Scene::solar_panel();
+    let studies = clearance_joint_app::study::presets(&scene).unwrap();
+    let common = [
+        "run.step=Adaptive",
+        "run.output_interval_s=1e-4",
+        "run.end_s=5",
+    ];
+    // Name, swept path, values, labels, and the settings after the common ones.
+    type Preset<'a> = (&'a str, &'a str, &'a [&'a str], &'a [&'a str], [&'a str; 2]);
+    let expected: [Preset; 3] = [
+        (
+            "clearance",
+            "hinge.clearance_mm",
+            &["0.10", "0.25", "0.50"],
+            &["c = 0.10 mm", "c = 0.25 mm", "c = 0.50 mm"],
+            ["drive.torque_scale=1", "hinge.friction=Dry"],
+        ),
+        (
+            "torque",
+            "drive.torque_scale",
+            &["1", "3", "5"],
+            &["T", "3T", "5T"],
+            ["hinge.clearance_mm=0.5", "hinge.friction=Dry"],
+        ),
+        (
+            "friction",
+            "hinge.friction",
+            &["Dry", "Lubricated"],
+            &["dry (no lubrication)", "lubricated"],
+            ["hinge.clearance_mm=0.5", "drive.torque_scale=1"],
+        ),
+    ];
+    assert_eq!(studies.len(), 3);
+    for (s, (name, path, values, labels, fixed)) in studies.iter().zip(expected) {
+        assert_eq!(s.name(), name);
+        assert_eq!(s.axis(), Axis::new(path, values.iter().copied()));
+        assert_eq!(s.labels(), labels);
+        let set: Vec<&str> = common.iter().chain(&fixed).copied().collect();
+        assert_eq!(s.spec.set, set, "{name}");
+        assert_eq!(s.hinge, "hinge");
+        assert!(s.paper && s.declared, "{name}");
+    }
+    // `study all` is every preset; a name the scene does not declare is refused, listing them.
+    assert_eq!(select(&scene, "all").unwrap(), studies);
+    let e = select(&scene, "stiffness").unwrap_err().to_string();
+    assert!(
+        e.contains("unknown study `stiffness`")
+            && e.contains("`clearance`, `torque`, `friction`, or `all`"),
+        "{e}"
+    );
+    // The paper's presets on a scene that is not the paper's (a heavier panel) judge nothing.
+    let mut heavier = scene.clone();
+    heavier.bodies[1].mass_kg *= 2.0;
+    assert!(
+        clearance_joint_app::study::presets(&heavier)
+            .unwrap()
+            .iter()
+            .all(|s| s.spec.paper && !s.paper)
+    );
+}
+
+/// A study of a scene that is not the paper's: the preset's cases run, the report says why it
+/// judges none of the paper's conclusions, and nothing cites the paper's figures.
+#[test]
+fn a_paper_preset_off_the_paper_scene_gives_no_verdict() {
+    let root = scratch("off-paper");
+    let mut scene = Scene::solar_panel();
+    scene.bodies[1].mass_kg *= 2.0;
+    let options = StudyOptions {
+        exec: quiet(),
+        extra_overrides: vec!["run.end_s=0.01".into()],
+        no_figures: true,
+    };
+    let outcomes = run_studies(
+        &select(&scene, "friction").unwrap(),
+        &scene,
+        &root,
+        &options,
+    )
+    .unwrap();
+    assert_eq!(outcomes[0].cases.len(), 2);
+    assert!(outcomes[0].conclusions.is_empty());
+    let report = std::fs::read_to_string(&outcomes[0].report).unwrap();
+    assert!(
+        report.contains("is not the paper's scene") && !report.contains("paper section"),
+        "{report}"
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// Issue 10 item 5: a preset declared in another scene's file runs from the command line by its
+/// name (the slider-crank's clearance study of its rod-slider pin, cut to 2 ms), with figures of
+/// that pin and a report that judges nothing of the paper; an undeclared name lists the presets.
+#[test]
+fn a_scene_declares_its_own_study() {
+    let root = scratch("slider-study");
+    let scene = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/slider_crank.ron");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
+        .args(["study", "pin_clearance", "--scene"])
+        .arg(&scene)
+        .args(["--set", "run.end_s=0.002", "--progress", "quiet", "--out"])
+        .arg(&root)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(stdout.contains("pin_clearance study ->"), "{stdout}");
+    for label in ["c = 0.25 mm", "c = 0.5 mm", "c = 1.0 mm"] {
+        assert!(stdout.contains(label), "{stdout}");
+    }
+    assert!(!stdout.contains("paper conclusion"), "{stdout}");
+    let dir = root.join("pin_clearance");
+    let table = MetricsTable::load(&dir.join("metrics.json")).unwrap();
+    let cs: Vec<f64> = table
+        .rows
+        .iter()
+        .map(|r| r.metrics.hinges["slider_pin"].clearance_mm)
+        .collect();
+    assert_eq!(cs, [0.25, 0.5, 1.0]);
+    assert!(table.rows.iter().all(|r| r.metrics.end_s == 0.002));
+    let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
+    assert!(
+        report.contains(
+            "# pin_clearance study: Influence of the clearance size (`slider_pin.clearance_mm`)"
+        ) && report.contains("Not judged")
+            && report.contains("![trajectory](trajectory.png)")
+            && !report.contains("paper fig."),
+        "{report}"
+    );
+    assert!(dir.join("joint_force.png").is_file());
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
+        .args(["study", "clearance", "--scene"])
+        .arg(&scene)
+        .arg("--out")
+        .arg(&root)
+        .output()
+        .unwrap();
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(
+        e.contains("unknown study `clearance`: scene `slider_crank` declares `pin_clearance`"),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// A general study: any field by its path (here the pendulum's arm mass, as numbers), the report
+/// showing the scene's first clearance hinge; it judges none of the paper's conclusions.
+#[test]
+fn a_field_study_varies_any_path() {
+    let text = include_str!("../../assets/pendulum.ron");
+    let end = text.rfind(')').unwrap();
+    let scene = Scene::from_ron(
+        &format!(
+            "{}    studies: [(name: \"mass\", kind: Field(path: \"arm.mass_kg\"), values: [1, 2.5], \
+             set: [\"run.end_s=0.02\"])],\n{}",
+            &text[..end],
+            &text[end..]
+        ),
+        "pendulum with a study",
+    )
+    .unwrap();
+    let root = scratch("field");
+    let options = StudyOptions {
+        exec: quiet(),
+        extra_overrides: Vec::new(),
+        no_figures: true,
+    };
+    let studies = select(&scene, "all").unwrap();
+    assert_eq!(studies[0].hinge, "pivot");
+    let outcomes = run_studies(&studies, &scene, &root, &options).unwrap();
+    let o = &outcomes[0];
+    let masses: Vec<f64> = o.cases.iter().map(|c| c.scene.bodies[1].mass_kg).collect();
+    assert_eq!(masses, [1.0, 2.5]);
+    assert_eq!(o.cases[1].label, "arm.mass_kg = 2.5");
+    assert!(o.cases.iter().all(|c| c.metrics.end_s == 0.02));
+    assert!(o.conclusions.is_empty());
+    let report = std::fs::read_to_string(&o.report).unwrap();
+    assert!(
+        report.starts_with("# mass study: Influence of `arm.mass_kg`")
+            && report.contains("| arm.mass_kg = 1 |")
+            && report.contains("this preset is not one of them"),
+        "{report}"
+    );
     let _ = std::fs::remove_dir_all(&root);
 }

@@ -41,6 +41,9 @@ pub struct Scene {
     /// Time stepping and output.
     #[serde(default)]
     pub run: RunSettings,
+    /// Study presets: named sweeps of one parameter, run by the app's `study <name>`.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub studies: Vec<super::StudySpec>,
 }
 
 /// A rigid body with principal axes along the world axes at t = 0, at rest.
@@ -489,6 +492,7 @@ impl Scene {
             Error::parse(origin, format!("{}{hint}", excerpt(&e.to_string(), 300)))
         })?;
         scene.validate()?;
+        scene.validate_studies()?;
         Ok(scene)
     }
 
@@ -1031,7 +1035,7 @@ fn speed_mm_s(field: &str, v: f64) -> Result<f64> {
 }
 
 /// Letters, digits, `_` and `-`: safe in CSV headers and file names.
-fn is_plain_name(name: &str) -> bool {
+pub(super) fn is_plain_name(name: &str) -> bool {
     !name.is_empty()
         && name
             .chars()

@@ -2,6 +2,7 @@
 //! twin side by side, with its time series, impact lists, summary and guards written whole.
 //!
 //! - The scene format ([`Scene`] and its parts), validated with errors naming the field.
+//! - Study presets declared in a scene ([`StudySpec`]): named sweeps the app's `study` runs.
 //! - [`runner`]: builds the twins in one Rapier world and steps them with the
 //!   [`Stepper`](crate::rapier::stepper::Stepper).
 //! - [`output`]: result files written whole or not at all, folder locks, memory estimates.
@@ -14,5 +15,7 @@ mod format;
 pub mod output;
 pub mod report;
 pub mod runner;
+mod study;
 
 pub use format::*;
+pub use study::*;

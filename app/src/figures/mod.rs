@@ -1,4 +1,4 @@
-//! Figures of a study, one per figure kind of the paper, as PNG and SVG (plotters):
+//! Figures of a run or a study, one per figure kind of the paper, as PNG and SVG (plotters):
 //! - angles and rates of every movable body vs time, each case with its ideal curve
 //!   (the paper's figs 3, 6, 9);
 //! - joint force vs time, ideal and clearance joint, one row per case (figs 4, 7, 10);
@@ -10,7 +10,11 @@
 //! closer than a fraction of a pixel to the last kept one ([`decimate_path`]). PNG text is drawn
 //! with DejaVu Sans embedded in the binary (`assets/fonts/`), so nothing depends on the fonts of
 //! the machine.
+//!
+//! - [`series`]: the time series of one case, read from a run's tables or a point's CSV files.
+//! - [`run`]: the figures of one scene run (`run`, the default job).
 
+pub mod run;
 pub mod series;
 
 use clearance_joint::error::{Error, Result};

@@ -26,7 +26,7 @@ pub struct BodySeries {
 pub struct CaseSeries {
     /// Legend label, e.g. `c = 0.10 mm`.
     pub label: String,
-    /// Name of the hinge shown (the first hinge with clearance).
+    /// Name of the hinge shown (a study's, or the first hinge with clearance).
     pub hinge: String,
     /// Its radial clearance, mm.
     pub clearance_mm: f64,
@@ -59,6 +59,27 @@ impl CaseSeries {
             .iter()
             .find(|h| h.clearance.is_some())
             .ok_or_else(|| Error::invalid("hinges", "no hinge has a clearance: nothing to plot"))?;
+        Self::from_hinge_tables(label, scene, &hinge.name, ideal, clear)
+    }
+
+    /// Extracts the series of `scene`'s clearance hinge `hinge` from the two twins' tables.
+    pub fn from_hinge_tables(
+        label: impl Into<String>,
+        scene: &Scene,
+        hinge: &str,
+        ideal: &Table,
+        clear: &Table,
+    ) -> Result<CaseSeries> {
+        let hinge = scene
+            .hinges
+            .iter()
+            .find(|h| h.name == hinge && h.clearance.is_some())
+            .ok_or_else(|| {
+                Error::invalid(
+                    format!("hinges[{hinge}]"),
+                    "is not a hinge with clearance: nothing to plot",
+                )
+            })?;
         let col = |t: &Table, name: &str| {
             t.column(name)
                 .ok_or_else(|| Error::invalid("output table", format!("has no column `{name}`")))
@@ -94,11 +115,23 @@ impl CaseSeries {
         })
     }
 
-    /// Reads a point folder's `ideal.csv` and `clearance.csv`.
+    /// Reads a point folder's `ideal.csv` and `clearance.csv` (the first clearance hinge).
     pub fn load(label: impl Into<String>, scene: &Scene, dir: &Path) -> Result<CaseSeries> {
         let ideal = read_csv(&dir.join("ideal.csv"))?;
         let clear = read_csv(&dir.join("clearance.csv"))?;
         Self::from_tables(label, scene, &ideal, &clear)
+    }
+
+    /// Reads a point folder's `ideal.csv` and `clearance.csv` for the clearance hinge `hinge`.
+    pub fn load_hinge(
+        label: impl Into<String>,
+        scene: &Scene,
+        hinge: &str,
+        dir: &Path,
+    ) -> Result<CaseSeries> {
+        let ideal = read_csv(&dir.join("ideal.csv"))?;
+        let clear = read_csv(&dir.join("clearance.csv"))?;
+        Self::from_hinge_tables(label, scene, hinge, &ideal, &clear)
     }
 }
 

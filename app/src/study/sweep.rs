@@ -32,7 +32,8 @@ pub const MANIFEST: &str = "point.json";
 pub struct Sweep {
     /// Name of the sweep (table header, progress messages).
     pub name: String,
-    /// The scene before any override.
+    /// The scene before any override, without study presets: they are not part of a run, so a
+    /// point's scene and manifest hold only what ran (and editing a preset reuses finished points).
     pub base: Scene,
     /// Overrides applied to every point before the point's own.
     pub base_overrides: Vec<String>,
@@ -146,13 +147,14 @@ pub struct Failure {
 }
 
 impl Sweep {
-    /// A sweep of `grid` over `base` with fixed `base_overrides`.
+    /// A sweep of `grid` over `base` (its study presets dropped) with fixed `base_overrides`.
     pub fn new(
         name: impl Into<String>,
-        base: Scene,
+        mut base: Scene,
         base_overrides: Vec<String>,
         grid: Grid,
     ) -> Sweep {
+        base.studies.clear();
         Sweep {
             name: name.into(),
             base,

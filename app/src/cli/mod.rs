@@ -1,0 +1,61 @@
+//! What the commands do between parsing their arguments and printing: the binary
+//! (`src/main.rs`) parses, calls these, and prints what they return.
+//!
+//! - [`run`]: one scene's ideal-vs-clearance run into a result set (`run`, the default job).
+//! - [`sweep`]: a grid of runs, or a shard of it, into one folder (`sweep`).
+//! - [`merge`]: the tables of a sharded sweep gathered into one (`merge`).
+//!
+//! `study` needs nothing here: it selects and runs presets with [`crate::study`].
+
+pub mod merge;
+pub mod run;
+pub mod sweep;
+
+use crate::study::sweep::{ExecOptions, Progress, thread_count};
+use clearance_joint::error::Result;
+use clearance_joint::scene::Scene;
+use std::path::Path;
+
+/// The scene file at `path`, or without one the paper's solar-panel scene.
+pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
+    match path {
+        Some(p) => Scene::load(p),
+        None => Ok(Scene::solar_panel()),
+    }
+}
+
+/// The memory budget `--max-memory SIZE` (e.g. `4G`), if given.
+pub fn memory_budget(max_memory: Option<&str>) -> Result<Option<u64>> {
+    max_memory
+        .map(clearance_joint::scene::output::parse_bytes)
+        .transpose()
+}
+
+/// Execution options of the parallel commands. The thread count is the request (else
+/// `RAYON_NUM_THREADS`, else one per core) capped at the cores, and is used for the global
+/// pool too (figures), so no setting spawns thousands of threads. Returns the options and, when
+/// the request was cut, a note saying so.
+pub fn exec_options(
+    jobs: Option<usize>,
+    progress: Progress,
+    rerun: bool,
+    max_memory: Option<&str>,
+) -> Result<(ExecOptions, Option<String>)> {
+    let requested = jobs.or_else(|| {
+        std::env::var("RAYON_NUM_THREADS")
+            .ok()
+            .and_then(|v| v.trim().parse().ok())
+            .filter(|&n: &usize| n > 0)
+    });
+    let (threads, note) = thread_count(requested)?;
+    let _ = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build_global();
+    let options = ExecOptions {
+        progress,
+        threads: Some(threads),
+        rerun,
+        max_memory: memory_budget(max_memory)?,
+    };
+    Ok((options, note))
+}

@@ -1,0 +1,113 @@
+//! The figures of one scene run (`run`, the default job): angles and rates, joint force and
+//! journal orbit of the first clearance hinge, and for driven mechanisms each moving body's
+//! acceleration over the driver's last turn, ideal against clearance.
+
+use super::series::CaseSeries;
+use super::{Figure, FigureKind, XyFigure};
+use clearance_joint::error::{Error, Result};
+use clearance_joint::scene::runner::{RunResult, TwinKind};
+use clearance_joint::scene::{MotionSpec, Scene};
+use clearance_joint::table::Table;
+use std::path::Path;
+
+/// Draws the figures of `result` (a run of `scene`) into `out`, PNG and SVG, calling `written`
+/// with each file as soon as it is written. Fails when the run lacks a twin or the scene has no
+/// clearance hinge to plot.
+pub fn draw_run_figures(
+    scene: &Scene,
+    result: &RunResult,
+    out: &Path,
+    mut written: impl FnMut(&Path),
+) -> Result<()> {
+    let (Some(ideal), Some(clear)) = (
+        result.twin(TwinKind::Ideal),
+        result.twin(TwinKind::Clearance),
+    ) else {
+        return Err(Error::invalid("--figures", "needs both twins"));
+    };
+    let series = [CaseSeries::from_tables(
+        scene.name.clone(),
+        scene,
+        &ideal.table,
+        &clear.table,
+    )?];
+    // Driven mechanisms: each moving body's x acceleration against the driver's angle over
+    // the last turn, ideal against clearance.
+    if let (Some(period), true) = (scene.drive_period(), scene.run.body_motion) {
+        let driver = scene
+            .bodies
+            .iter()
+            .find(|b| matches!(b.motion, Some(MotionSpec::Spin { .. })))
+            .map(|b| b.name.clone())
+            .or_else(|| {
+                scene
+                    .joints
+                    .iter()
+                    .find(|j| j.motor.is_some())
+                    .map(|j| j.body2.clone())
+            });
+        let end = scene.run.end_s;
+        for b in scene
+            .bodies
+            .iter()
+            .filter(|b| !b.fixed && b.motion.is_none())
+        {
+            let (Some(driver), true) = (&driver, end >= period * (1.0 - 1e-9)) else {
+                continue;
+            };
+            let column = format!("{}_ax_m_s2", b.name);
+            let curve = |label: &str, t: &Table| {
+                let (Some(ts), Some(angle), Some(a)) = (
+                    t.column("t_s"),
+                    t.column(&format!("{driver}_angle_deg")),
+                    t.column(&column),
+                ) else {
+                    return None;
+                };
+                let first = ts.iter().position(|&x| x >= end - period)?;
+                let points = (first..ts.len())
+                    .map(|i| (angle[i] - angle[first], a[i]))
+                    .collect();
+                Some((label.to_string(), points))
+            };
+            let curves: Vec<(String, Vec<(f64, f64)>)> = [
+                curve("ideal", &ideal.table),
+                curve("clearance", &clear.table),
+            ]
+            .into_iter()
+            .flatten()
+            .collect();
+            if curves.is_empty() {
+                continue;
+            }
+            let title = format!(
+                "{}: {} acceleration along x over the last turn of {driver}",
+                scene.name, b.name
+            );
+            let x_label = format!("{driver} angle from the turn's start (deg)");
+            let paths = XyFigure {
+                title: &title,
+                x_label: &x_label,
+                y_label: "acceleration along x (m/s^2)",
+                curves: &curves,
+            }
+            .write(out, &format!("{}_acceleration", b.name))?;
+            for p in paths {
+                written(&p);
+            }
+        }
+    }
+    for kind in FigureKind::ALL {
+        let title = format!("{}: {}", scene.name, kind.stem().replace('_', " "));
+        let paths = Figure {
+            kind,
+            title: &title,
+            cases: &series,
+        }
+        .write(out, kind.stem())?;
+        for p in paths {
+            written(&p);
+        }
+    }
+    Ok(())
+}

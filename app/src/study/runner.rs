@@ -1,0 +1,238 @@
+//! Runs studies end to end: every case in one parallel batch, then per study its metrics table,
+//! figures and report, and the summary of `study all`.
+
+use super::case::StudyCase;
+use super::grid::Shard;
+use super::preset::Study;
+use super::report;
+use super::sweep::{ExecOptions, Failure, Job, MetricsTable, Sweep, TableRow, execute};
+use crate::figures::series::CaseSeries;
+use crate::figures::{Figure, FigureKind};
+use clearance_joint::error::{Error, Result};
+use clearance_joint::scene::Scene;
+use clearance_joint::scene::output::write_atomic;
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Options of a study run.
+#[derive(Clone, Debug, Default)]
+pub struct StudyOptions {
+    /// Parallelism, progress and reuse of finished points.
+    pub exec: ExecOptions,
+    /// Overrides applied to every case after the study's own (e.g. `run.end_s=0.3` for a quick look).
+    pub extra_overrides: Vec<String>,
+    /// Skip the figures (faster; the report then has none).
+    pub no_figures: bool,
+}
+
+/// A finished study: its cases, table, figures and report.
+#[derive(Clone, Debug)]
+pub struct StudyOutcome {
+    /// Which study.
+    pub study: Study,
+    /// Its folder.
+    pub dir: PathBuf,
+    /// Cases in axis order.
+    pub cases: Vec<StudyCase>,
+    /// The metrics table written to `metrics.csv` / `metrics.json`.
+    pub table: MetricsTable,
+    /// Figure files written (PNG and SVG).
+    pub figures: Vec<PathBuf>,
+    /// `report.md`.
+    pub report: PathBuf,
+    /// The report's verdicts on the paper's conclusions (none unless [`Study::paper`]).
+    pub conclusions: Vec<report::Conclusion>,
+    /// Settings and names the report states.
+    pub setup: report::Setup,
+}
+
+/// Runs `studies` (presets of `base`, see [`super::preset::select`]) into `root/<name>/`: all
+/// their points in one parallel batch (one progress display), then per study the metrics table,
+/// figures and `report.md`; with more than one study, also `root/report.md` gathering their key
+/// tables and verdicts. Studies whose cases all finished are written even if another study
+/// failed; then the first failure is returned.
+pub fn run_studies(
+    studies: &[Study],
+    base: &Scene,
+    root: &Path,
+    options: &StudyOptions,
+) -> Result<Vec<StudyOutcome>> {
+    let mut plans: Vec<(&Study, PathBuf, Sweep, Vec<Job>)> = Vec::new();
+    // Each study's folder is claimed (created, checked writable, locked) before any case runs.
+    let mut locks = Vec::new();
+    for study in studies {
+        let dir = root.join(study.name());
+        locks.push(clearance_joint::scene::output::DirLock::acquire(&dir)?);
+        let sweep = study.sweep(base, &options.extra_overrides);
+        let jobs = sweep.jobs(&dir, Shard::ALL)?;
+        plans.push((study, dir, sweep, jobs));
+    }
+    let all_jobs: Vec<Job> = plans.iter().flat_map(|p| p.3.iter().cloned()).collect();
+    let mut results = execute(&all_jobs, options.exec)?.into_iter();
+    let mut outcomes = Vec::new();
+    let mut first_error: Option<Error> = None;
+    for (study, dir, sweep, jobs) in plans {
+        let mut rows = Vec::new();
+        let mut cases = Vec::new();
+        let mut failures = Vec::new();
+        let labels = study.labels();
+        for job in &jobs {
+            match results.next() {
+                Some(Ok(o)) => {
+                    rows.push(TableRow {
+                        point: o.manifest.point.clone(),
+                        dir: format!("points/{}", job.point.dir),
+                        metrics: o.manifest.metrics.clone(),
+                    });
+                    cases.push(StudyCase {
+                        label: labels
+                            .get(job.point.index)
+                            .cloned()
+                            .unwrap_or_else(|| job.point.dir.clone()),
+                        value: job.point.assignments[0].1.clone(),
+                        scene: job.scene.clone(),
+                        metrics: o.manifest.metrics,
+                        dir: job.dir.clone(),
+                        reused: o.reused,
+                    });
+                }
+                Some(Err(e)) => {
+                    failures.push(Failure {
+                        point: job.point.clone(),
+                        error: e.to_string(),
+                    });
+                    eprintln!(
+                        "study {}: case `{}` failed: {e}",
+                        study.name(),
+                        job.point.dir
+                    );
+                    first_error.get_or_insert(e);
+                }
+                None => {
+                    return Err(Error::invalid("study", "a case has no result"));
+                }
+            }
+        }
+        let table = MetricsTable {
+            sweep: sweep.info(),
+            shard: None,
+            rows,
+            failures,
+            missing: Vec::new(),
+        };
+        table.write(&dir)?;
+        if !table.failures.is_empty() {
+            // No report for an incomplete study; an older one must not pass for this run's.
+            let stale = dir.join("report.md");
+            if let Err(e) = std::fs::remove_file(&stale)
+                && e.kind() != std::io::ErrorKind::NotFound
+            {
+                return Err(Error::Io {
+                    action: "cannot remove",
+                    path: stale,
+                    source: e,
+                });
+            }
+            continue;
+        }
+        outcomes.push(finish_study(study, dir, &sweep, cases, table, options)?);
+    }
+    if outcomes.len() > 1 {
+        let entries: Vec<report::IndexEntry> = outcomes
+            .iter()
+            .map(|o| report::IndexEntry {
+                study: &o.study,
+                setup: &o.setup,
+                cases: &o.cases,
+                conclusions: &o.conclusions,
+            })
+            .collect();
+        let index = report::index_report(&entries);
+        write_atomic(&root.join("report.md"), index.as_bytes())?;
+    }
+    match first_error {
+        Some(e) => Err(e),
+        None => Ok(outcomes),
+    }
+}
+
+/// Figures and report of a study whose cases all finished.
+fn finish_study(
+    study: &Study,
+    dir: PathBuf,
+    sweep: &Sweep,
+    cases: Vec<StudyCase>,
+    table: MetricsTable,
+    options: &StudyOptions,
+) -> Result<StudyOutcome> {
+    let mut figures = Vec::new();
+    let mut figure_stems = Vec::new();
+    let series: Vec<CaseSeries> = cases
+        .par_iter()
+        .map(|c| CaseSeries::load_hinge(c.label.clone(), &c.scene, &study.hinge, &c.dir))
+        .collect::<Result<_>>()?;
+    let timeline = report::Timeline::of(&series);
+    if !options.no_figures {
+        let nums = study.paper_figures();
+        let titles: Vec<String> = FigureKind::ALL
+            .iter()
+            .enumerate()
+            .map(|(i, f)| {
+                let what = match f {
+                    FigureKind::AnglesRates => "angles and angular rates, clearance vs ideal joint",
+                    FigureKind::Force => "joint reaction force, ideal vs clearance joint",
+                    FigureKind::Trajectory => {
+                        "journal-centre trajectory inside the clearance circle"
+                    }
+                };
+                match nums {
+                    Some(n) => format!("{} study: {what} (paper fig. {})", study.name(), n[i]),
+                    None => format!("{} study: {what}", study.name()),
+                }
+            })
+            .collect();
+        let written: Vec<[PathBuf; 2]> = FigureKind::ALL
+            .par_iter()
+            .zip(titles.par_iter())
+            .map(|(&f, title)| {
+                Figure {
+                    kind: f,
+                    title,
+                    cases: &series,
+                }
+                .write(&dir, f.stem())
+            })
+            .collect::<Result<_>>()?;
+        for (f, paths) in FigureKind::ALL.iter().zip(written) {
+            figure_stems.push((*f, f.stem().to_string()));
+            figures.extend(paths);
+        }
+    }
+    let setup = report::Setup::of(study, sweep, &cases);
+    // The paper's conclusions are about its scene and its three studies only.
+    let conclusions = if study.paper {
+        report::conclusions(study, &cases, Some(&timeline))
+    } else {
+        Vec::new()
+    };
+    let text = report::study_report(
+        study,
+        &setup,
+        &cases,
+        &figure_stems,
+        &conclusions,
+        Some(&timeline),
+    );
+    let report_path = dir.join("report.md");
+    write_atomic(&report_path, text.as_bytes())?;
+    Ok(StudyOutcome {
+        study: study.clone(),
+        dir,
+        cases,
+        table,
+        figures,
+        report: report_path,
+        conclusions,
+        setup,
+    })
+}

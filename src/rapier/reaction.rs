@@ -461,6 +461,8 @@ pub struct ReactionSolver {
     entries: Vec<Entry>,
     forces: Vec<Vector>,
     motors: Vec<Option<f64>>,
+    /// Per joint with a motor: the relative speed along its axis at the state.
+    motor_rates: Vec<f64>,
     revolutes: Vec<IdealJoint>,
     extra: Vec<Wrench>,
 }
@@ -583,6 +585,18 @@ impl ReactionSolver {
     /// body). `None` for a body neither in the joints nor in [`track`](Self::track).
     pub fn acceleration(&self, body: RigidBodyHandle) -> Option<(Vector, Vector)> {
         self.entry(body).map(|e| (e.acc, e.alpha))
+    }
+
+    /// The relative speed of joint `k`'s bodies along its motor's axis at the state of the last
+    /// solve: rad/s about a revolute's axis, m/s along a prismatic axis (body 2 relative to
+    /// body 1). Times [`motor`](Self::motor), the power the motor delivers. `None` without a
+    /// motor.
+    pub fn motor_rate(&self, k: usize) -> Option<f64> {
+        self.motors
+            .get(k)
+            .copied()
+            .flatten()
+            .map(|_| self.motor_rates[k])
     }
 
     fn entry(&self, body: RigidBodyHandle) -> Option<&Entry> {
@@ -852,8 +866,20 @@ impl ReactionSolver {
             (e.f, e.t) = e.applied();
         }
         self.motors.clear();
+        self.motor_rates.clear();
         for (j, &(i1, i2)) in joints.iter().zip(pairs) {
             let (e1, e2) = (self.entries[i1], self.entries[i2]);
+            self.motor_rates.push(match j {
+                IdealJoint::MotorRevolute(j) | IdealJoint::SoftMotorRevolute(j, _) => {
+                    (e1.rot * j.local_axis1).normalize().dot(e2.w - e1.w)
+                }
+                IdealJoint::MotorPrismatic(j) | IdealJoint::SoftMotorPrismatic(j, _) => {
+                    let axis = (e1.rot * j.local_axis1).normalize();
+                    let p2 = e2.pose * j.local_anchor2;
+                    axis.dot((e2.v + e2.w.cross(p2 - e2.com)) - (e1.v + e1.w.cross(p2 - e1.com)))
+                }
+                _ => 0.0,
+            });
             let motor = match j {
                 IdealJoint::SoftMotorRevolute(j, m) => {
                     let axis = (e1.rot * j.local_axis1).normalize();
@@ -1472,7 +1498,6 @@ mod tests {
         solver.solve_joints(&bodies, &[IdealJoint::SoftMotorPrismatic(j, m)], g);
         assert!((solver.motor(0).unwrap() - 36.0).abs() < 1e-12);
         // Held speed against a 3 N push: the motor pulls back 3 N, nothing accelerates.
-        let mut bodies = bodies;
         bodies[s].add_force(Vector::new(3.0, 0.0, 0.0), false);
         let f = solver
             .solve_joints(&bodies, &[IdealJoint::MotorPrismatic(j)], g)

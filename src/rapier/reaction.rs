@@ -17,7 +17,8 @@
 //! (the [`Stepper`](crate::rapier::stepper::Stepper) makes that exactly half the last step), and
 //! they satisfy the joints at the previous positions, not the current ones. The solver therefore
 //! (1) advances the stored velocities by [`velocity_lag`](ReactionSolver::velocity_lag) with the
-//! accelerations it solves (a fixed point, three passes), and (2) projects them onto the joints'
+//! accelerations it solves at them (second order in the lag: a second pass), and (2) projects
+//! them onto the joints'
 //! velocity constraints at the current positions (the mass-weighted least change), so that the
 //! centripetal and Coriolis terms are those of a state of the ideal mechanism. A mechanism whose
 //! motion is fully prescribed (a driven crank) then gets its exact velocities from the
@@ -668,9 +669,10 @@ impl ReactionSolver {
                 return None;
             }
         }
-        // The state's velocities: a fixed point of "advance the stored velocities by the lag
-        // with the accelerations, project onto the joints" (one pass without a lag).
-        let passes = if self.velocity_lag > 0.0 { 3 } else { 1 };
+        // The state's velocities: the stored ones advanced by the lag with the accelerations
+        // solved at the stored ones, projected onto the joints (an error of second order in the
+        // lag; one pass without a lag).
+        let passes = if self.velocity_lag > 0.0 { 2 } else { 1 };
         for pass in 0..passes {
             if pass > 0 {
                 let lag = self.velocity_lag;

@@ -471,8 +471,11 @@ pub struct RunSettings {
     /// at the floor) fails the run instead of being reported (`--strict`).
     #[serde(default)]
     pub strict: bool,
-    /// Writes each moving body's centre-of-mass position and velocity along the world axes
-    /// (`<body>_x_m`, ..., `<body>_vz_m_s`) in the rows.
+    /// Writes each moving body's centre-of-mass position, velocity and acceleration along the
+    /// world axes (`<body>_x_m`, ..., `<body>_vz_m_s`, ..., `<body>_az_m_s2`) in the rows: a
+    /// dynamic body's velocity and acceleration solved at each state from the constrained
+    /// equations (the joints' and the clearance contacts' forces known), a driven body's its
+    /// drive's.
     #[serde(default)]
     pub body_motion: bool,
 }

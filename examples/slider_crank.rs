@@ -14,7 +14,8 @@
 //! the step applied at state `n` (the stored velocities live at half steps, so a velocity read
 //! at a state is not the state's velocity). The ideal pin force is the exact reaction of the
 //! constrained equations at each state (`ReactionSolver` with the crank pin, the slider pin and
-//! the prismatic guide); the clearance pin force is the contact and friction force.
+//! the prismatic guide, told that the stored velocities lag the state by half the last step);
+//! the clearance pin force is the contact and friction force.
 
 use clearance_joint::Result;
 use clearance_joint::model::angle::twist_angle;
@@ -248,6 +249,8 @@ pub fn simulate(clearance: Option<Clearance>, dt: f64, end: f64) -> Result<Run> 
             Some(pin) => ContactObservation::of(m.clearance.get(pin).expect("pin")),
             None => {
                 let g = m.world.gravity;
+                // Rapier's velocities lag the state by half the last step.
+                reactions.velocity_lag = 0.5 * stepper.last_dt();
                 let f = reactions
                     .solve_joints(&m.world.bodies, &m.ideal, g)
                     .map_or(f64::NAN, |f| f[1].length());

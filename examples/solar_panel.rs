@@ -199,6 +199,8 @@ pub fn run() -> Result<(Outcome, Outcome)> {
             sp[k] = sp[k].max(mp);
             sl[k] = sl[k].max(ml);
             let o = &mut out[k];
+            // Rapier's velocities lag the state by half the last step.
+            reactions.velocity_lag = 0.5 * stepper.last_dt();
             let force = match twin.clearance {
                 None => reactions
                     .solve_with(

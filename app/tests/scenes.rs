@@ -410,8 +410,11 @@ fn four_bar_linkage_runs_with_a_clearance_joint() {
     assert!(result.guards.is_clean(), "{:?}", result.guards.violations);
     let ideal = result.twin(TwinKind::Ideal).unwrap();
     let angles = ideal.final_angles_deg();
+    // Rapier's velocity motor is a stiff servo: its small speed error grows with the step and,
+    // under adaptive steps, does not average out over a turn (720.012 deg at steps of at most
+    // 5e-6 s, 720.00003 at fixed 2e-6 s).
     assert!(
-        (angles["crank"] - 720.0).abs() < 1e-3,
+        (angles["crank"] - 720.0).abs() < 0.05,
         "{}",
         angles["crank"]
     );
@@ -469,12 +472,11 @@ fn ball_joint_and_weld_carry_their_weights() {
         assert!((b - 3.0 * 9.81).abs() < 1e-6, "ball {b}");
         assert!((w - 9.81).abs() < 1e-6, "weld {w}");
     }
-    // At rest: the rows' accelerations are zero after the first state (where Rapier's one
-    // solver iteration, not yet warm-started, leaves the chain sagging for a step), the
-    // positions the start's.
+    // At rest: the rows' accelerations, solved at each state, are zero from the first state on
+    // (Rapier's one solver iteration, not yet warm-started, leaves the chain sagging for a step:
+    // a difference of velocities would show it), the positions the start's.
     let ay = table.column("weight_ay_m_s2").unwrap();
-    assert!(ay[0] < -1.0, "{ay:?}");
-    assert!(ay[2..].iter().all(|a| a.abs() < 1e-6), "{ay:?}");
+    assert!(ay.iter().all(|a| a.abs() < 1e-6), "{ay:?}");
     // Rapier's joints, solved with one iteration, sag 14.7 um under the two weights.
     let y = table.column("weight_y_m").unwrap();
     assert!(y.iter().all(|v| (v + 0.7).abs() < 2e-5), "{y:?}");

@@ -1,14 +1,34 @@
-//! Exact reactions of ideal joints (revolute, prismatic, fixed, spherical) at a state, from the constrained rigid-body equations
-//! (not from Rapier's impulses or momentum differences, which carry its integrator's lag).
+//! Exact reactions of ideal joints (revolute, prismatic, fixed, spherical, with or without a
+//! motor) at a state, from the constrained rigid-body equations (not from Rapier's impulses or
+//! momentum differences, which carry its integrator's lag).
 //!
 //! For bodies with mass matrices `M`, applied wrenches `F` (user forces and torques, gravity,
-//! gyroscopic terms) and joints whose constraints have Jacobian `J` and velocity-product
-//! terms `c` (`J a + c = 0` for the accelerations `a`), the multipliers solve
+//! gyroscopic terms, soft motors) and joints whose constraints have Jacobian `J` and
+//! velocity-product terms `c` (`J a + c = 0` for the accelerations `a`), the multipliers solve
 //! `J M^-1 J^T lambda = -c - J M^-1 F`: the joint forces the ideal mechanism needs at this
-//! position and velocity. They do not depend on the step: the same state gives the same reaction
-//! whatever the step control, which momentum balances over a step do not achieve (Rapier's
-//! constraint turns a jointed body's velocity by the motion since the previous step, while applied
-//! forces act over the current one).
+//! position and velocity, and the accelerations `a = M^-1 (F + J^T lambda)`. They do not depend
+//! on the step: the same state gives the same reaction whatever the step control, which
+//! momentum balances over a step do not achieve (Rapier's constraint turns a jointed body's
+//! velocity by the motion since the previous step, while applied forces act over the current
+//! one).
+//!
+//! **The state's velocities.** Rapier's stored velocities are not the state's: with one solver
+//! iteration a step is symplectic Euler, whose velocities live half a step before the positions
+//! (the [`Stepper`](crate::rapier::stepper::Stepper) makes that exactly half the last step), and
+//! they satisfy the joints at the previous positions, not the current ones. The solver therefore
+//! (1) advances the stored velocities by [`velocity_lag`](ReactionSolver::velocity_lag) with the
+//! accelerations it solves at them (second order in the lag: a second pass), and (2) projects
+//! them onto the joints'
+//! velocity constraints at the current positions (the mass-weighted least change), so that the
+//! centripetal and Coriolis terms are those of a state of the ideal mechanism. A mechanism whose
+//! motion is fully prescribed (a driven crank) then gets its exact velocities from the
+//! projection, whatever the step.
+//!
+//! **Motors.** A velocity motor that holds its speed ([`IdealJoint::MotorRevolute`],
+//! [`IdealJoint::MotorPrismatic`]) is one more constraint row (`d(speed)/dt = 0`), its multiplier
+//! the motor torque or force. A soft motor ([`SoftMotor`]: Rapier's spring-damper
+//! `k (x_target - x) + c (v_target - v)`, times the row's effective mass in Rapier's
+//! acceleration-based model) is an applied wrench computed from the state.
 //!
 //! ```
 //! use clearance_joint::rapier::reaction::{IdealRevolute, ReactionSolver};
@@ -34,11 +54,14 @@
 //! let mut solver = ReactionSolver::default();
 //! let forces = solver.solve(&bodies, &[joint], Vector::new(0.0, -9.81, 0.0)).unwrap();
 //! assert!((forces[0] - Vector::new(0.0, 2.0 * 9.81, 0.0)).length() < 1e-9);
+//! // At rest, held: no acceleration.
+//! let (a, alpha) = solver.acceleration(arm).unwrap();
+//! assert!(a.length() < 1e-12 && alpha.length() < 1e-12);
 //! ```
 
 use crate::rapier::ledger::Wrench;
-use rapier3d_f64::math::Vector;
-use rapier3d_f64::prelude::{RigidBody, RigidBodyHandle, RigidBodySet};
+use rapier3d_f64::math::{AngularInertia, Pose, Rotation, Vector};
+use rapier3d_f64::prelude::{JointMotor, MotorModel, RigidBody, RigidBodyHandle, RigidBodySet};
 
 /// An ideal revolute joint for [`ReactionSolver::solve`]: anchors and axis in the bodies' frames
 /// (body 1's axis; body 2's follows from the constraint).
@@ -57,9 +80,9 @@ pub struct IdealRevolute {
 }
 
 /// An ideal prismatic joint for [`ReactionSolver::solve_joints`]: body 2 slides along the axis
-/// without turning relative to body 1. Limits and motors are not modelled: the reaction is the
-/// one of a free slide (a limit in contact or a motor adds a force along the axis that the
-/// solver does not know).
+/// without turning relative to body 1. Limits are not modelled: the reaction is the one of a
+/// free slide (a limit in contact adds a force along the axis that the solver does not know).
+/// A motor is ([`IdealJoint::MotorPrismatic`], [`IdealJoint::SoftMotorPrismatic`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct IdealPrismatic {
     /// First body (the guide).
@@ -101,6 +124,75 @@ pub struct IdealSpherical {
     pub local_anchor2: Vector,
 }
 
+/// A soft joint motor, Rapier's ([`JointMotor`] with its [`MotorModel`]): on the joint's free
+/// axis it exerts on body 2 (and the opposite on body 1)
+/// `F = k (x_target - x) + c (v_target - v)`, clamped to `max_force`: N m about the axis for a
+/// revolute (`x` the angle, rad), N along the axis for a prismatic joint (`x` the displacement,
+/// m). With [`MotorModel::AccelerationBased`] (Rapier's default) `F` is further multiplied by
+/// the effective mass of the motor's row as Rapier builds it: `1/(a . (I1^-1 + I2^-1) a)` about
+/// the axis `a` of a revolute, the two bodies' inverse masses and lever terms along a prismatic
+/// axis (the joint's other rows and the rest of the mechanism play no part).
+///
+/// This is the limit of Rapier's implicit motor row as the step shrinks (Rapier evaluates the
+/// law at the end of each step): the motor's force as a function of the state. The angle is
+/// Rapier's, `2 asin` of the relative rotation's component along the axis (in `[-pi, pi]`, the
+/// error to the target wrapped to the shorter way round), zero when the bodies' frames are
+/// aligned, as for a joint built with `RevoluteJointBuilder::new(axis)` between bodies that
+/// start unrotated; the displacement is `(p2 - p1) . a`, zero when the anchors coincide.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SoftMotor {
+    /// Target angle (rad) or displacement (m).
+    pub target_pos: f64,
+    /// Target angular (rad/s) or linear (m/s) speed.
+    pub target_vel: f64,
+    /// Stiffness `k`: N m/rad or N/m force-based, 1/s^2 acceleration-based.
+    pub stiffness: f64,
+    /// Damping `c`: N m s/rad or N s/m force-based, 1/s acceleration-based.
+    pub damping: f64,
+    /// The largest force or torque the motor exerts (N or N m; `f64::MAX` for none).
+    pub max_force: f64,
+    /// How Rapier reads the stiffness and damping.
+    pub model: MotorModel,
+}
+
+impl SoftMotor {
+    /// A force-based motor (stiffness and damping in physical units) without a force limit.
+    pub fn force_based(target_pos: f64, target_vel: f64, stiffness: f64, damping: f64) -> Self {
+        SoftMotor {
+            target_pos,
+            target_vel,
+            stiffness,
+            damping,
+            max_force: f64::MAX,
+            model: MotorModel::ForceBased,
+        }
+    }
+
+    /// The motor of a Rapier joint axis (`joint.motor(JointAxis::AngX)`, say).
+    pub fn from_rapier(motor: &JointMotor) -> Self {
+        SoftMotor {
+            target_pos: motor.target_pos,
+            target_vel: motor.target_vel,
+            stiffness: motor.stiffness,
+            damping: motor.damping,
+            max_force: motor.max_force,
+            model: motor.model,
+        }
+    }
+
+    /// The force on body 2 along the axis for a position error `x - x_target` (wrapped for an
+    /// angle), a speed `v` and the row's effective mass `row_mass` (used by the
+    /// acceleration-based model only).
+    pub fn force(&self, position_error: f64, v: f64, row_mass: f64) -> f64 {
+        let f = -self.stiffness * position_error + self.damping * (self.target_vel - v);
+        let f = match self.model {
+            MotorModel::ForceBased => f,
+            MotorModel::AccelerationBased => row_mass * f,
+        };
+        f.clamp(-self.max_force, self.max_force)
+    }
+}
+
 /// Any ideal joint the solver handles.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum IdealJoint {
@@ -114,29 +206,42 @@ pub enum IdealJoint {
     Spherical(IdealSpherical),
     /// A revolute whose velocity motor holds the relative angular speed constant: the revolute's
     /// constraints plus one along the axis (its multiplier is the motor torque). Exact for a
-    /// motor that holds its speed; a soft motor's speed error is not in it.
+    /// motor that holds its speed; a stiff motor's small speed error is not in it.
     MotorRevolute(IdealRevolute),
+    /// A prismatic joint whose velocity motor holds the relative speed along the axis constant:
+    /// one more row (its multiplier is the motor force), as [`MotorRevolute`](Self::MotorRevolute).
+    MotorPrismatic(IdealPrismatic),
+    /// A revolute with a soft motor: the motor's torque is applied from the state.
+    SoftMotorRevolute(IdealRevolute, SoftMotor),
+    /// A prismatic joint with a soft motor: the motor's force is applied from the state.
+    SoftMotorPrismatic(IdealPrismatic, SoftMotor),
 }
 
 impl IdealJoint {
     fn bodies(&self) -> (RigidBodyHandle, RigidBodyHandle) {
         match self {
-            IdealJoint::Revolute(j) => (j.body1, j.body2),
-            IdealJoint::Prismatic(j) => (j.body1, j.body2),
+            IdealJoint::Revolute(j)
+            | IdealJoint::MotorRevolute(j)
+            | IdealJoint::SoftMotorRevolute(j, _) => (j.body1, j.body2),
+            IdealJoint::Prismatic(j)
+            | IdealJoint::MotorPrismatic(j)
+            | IdealJoint::SoftMotorPrismatic(j, _) => (j.body1, j.body2),
             IdealJoint::Fixed(j) => (j.body1, j.body2),
             IdealJoint::Spherical(j) => (j.body1, j.body2),
-            IdealJoint::MotorRevolute(j) => (j.body1, j.body2),
         }
     }
 
-    /// Constraint rows (linear rows first) and how many are linear.
-    fn rows(&self) -> (usize, usize) {
+    /// How many of the joint's rows (the first ones) carry the reported joint force.
+    fn force_rows(&self) -> usize {
         match self {
-            IdealJoint::Revolute(_) => (5, 3),
-            IdealJoint::Prismatic(_) => (5, 2),
-            IdealJoint::Fixed(_) => (6, 3),
-            IdealJoint::Spherical(_) => (3, 3),
-            IdealJoint::MotorRevolute(_) => (6, 3),
+            IdealJoint::Revolute(_)
+            | IdealJoint::MotorRevolute(_)
+            | IdealJoint::SoftMotorRevolute(..)
+            | IdealJoint::Fixed(_)
+            | IdealJoint::Spherical(_) => 3,
+            IdealJoint::Prismatic(_)
+            | IdealJoint::MotorPrismatic(_)
+            | IdealJoint::SoftMotorPrismatic(..) => 2,
         }
     }
 }
@@ -165,29 +270,6 @@ impl From<IdealFixed> for IdealJoint {
     }
 }
 
-/// Solves for ideal-joint reactions; keeps its buffers between calls (no allocation per step
-/// once sized).
-#[derive(Clone, Debug, Default)]
-pub struct ReactionSolver {
-    /// Dense `J M^-1 J^T`, row-major.
-    a: Vec<f64>,
-    /// Right-hand side, then the multipliers.
-    b: Vec<f64>,
-    a_copy: Vec<f64>,
-    b_copy: Vec<f64>,
-    /// Per joint and row: the Jacobian blocks `(linear, angular)` for body 1 and body 2.
-    rows: Vec<[Vector; 4]>,
-    /// First row of each joint.
-    starts: Vec<usize>,
-    forces: Vec<Vector>,
-    joints: Vec<IdealJoint>,
-    extra: Vec<Wrench>,
-    /// Bodies whose motion is prescribed with a nonzero acceleration (a tabulated drive): their
-    /// velocities and accelerations at the state. Other kinematic bodies are taken to move at
-    /// constant velocity.
-    pub kinematic: Vec<KinematicState>,
-}
-
 /// The prescribed state of a kinematic body at the state solved: velocity and acceleration of
 /// its centre of mass (its frame origin when it has no mass), angular velocity and acceleration.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -204,58 +286,186 @@ pub struct KinematicState {
     pub angacc: Vector,
 }
 
-/// What the solver needs of one body.
-struct BodyTerms {
-    inv_mass: f64,
-    com: Vector,
-    angvel: Vector,
-    /// Applied force and torque (with gravity and the gyroscopic term).
-    force: Vector,
-    torque: Vector,
+/// One body of the solve.
+#[derive(Clone, Copy, Debug)]
+struct Entry {
+    handle: RigidBodyHandle,
     dynamic: bool,
+    gyroscopic: bool,
+    inv_mass: f64,
+    inv_inertia: AngularInertia,
+    /// World rotation of the principal axes and the principal inertia (gyroscopic term).
+    principal_rot: Rotation,
+    principal: Vector,
+    pose: Pose,
+    rot: Rotation,
+    com: Vector,
+    /// Stored velocities (Rapier's, or the prescribed ones of a driven body).
+    stored_v: Vector,
+    stored_w: Vector,
+    /// The state's velocities.
+    v: Vector,
+    w: Vector,
+    /// Applied force and torque that do not depend on the velocities (user forces, extra
+    /// wrenches, gravity).
+    f0: Vector,
+    t0: Vector,
+    /// All applied at the state's velocities (with the gyroscopic term and soft motors).
+    f: Vector,
+    t: Vector,
+    /// Prescribed accelerations of a driven body.
+    prescribed: Option<(Vector, Vector)>,
+    /// The accelerations solved.
+    acc: Vector,
+    alpha: Vector,
 }
 
-fn terms(rb: &RigidBody, handle: RigidBodyHandle, gravity: Vector, extra: &[Wrench]) -> BodyTerms {
-    let (mut f_extra, mut t_extra) = (Vector::ZERO, Vector::ZERO);
-    for w in extra.iter().filter(|w| w.body == handle) {
-        f_extra += w.force;
-        t_extra += w.torque;
+impl Entry {
+    fn new(
+        rb: &RigidBody,
+        handle: RigidBodyHandle,
+        gravity: Vector,
+        extra: &[Wrench],
+        kinematic: &[KinematicState],
+    ) -> Entry {
+        let (mut f_extra, mut t_extra) = (Vector::ZERO, Vector::ZERO);
+        for w in extra.iter().filter(|w| w.body == handle) {
+            f_extra += w.force;
+            t_extra += w.torque;
+        }
+        let mp = &rb.mass_properties().local_mprops;
+        let dynamic = rb.is_dynamic();
+        let mass = if mp.inv_mass > 0.0 {
+            1.0 / mp.inv_mass
+        } else {
+            0.0
+        };
+        let mut e = Entry {
+            handle,
+            dynamic,
+            gyroscopic: rb.gyroscopic_forces_enabled(),
+            inv_mass: if dynamic { mp.inv_mass } else { 0.0 },
+            inv_inertia: mp.world_inv_inertia(rb.rotation()),
+            principal_rot: *rb.rotation() * mp.principal_inertia_local_frame,
+            principal: mp.principal_inertia(),
+            pose: *rb.position(),
+            rot: *rb.rotation(),
+            com: crate::rapier::ledger::world_center_of_mass(rb),
+            stored_v: rb.linvel(),
+            stored_w: rb.angvel(),
+            v: rb.linvel(),
+            w: rb.angvel(),
+            f0: rb.user_force() + f_extra + mass * rb.gravity_scale() * gravity,
+            t0: rb.user_torque() + t_extra,
+            f: Vector::ZERO,
+            t: Vector::ZERO,
+            prescribed: None,
+            acc: Vector::ZERO,
+            alpha: Vector::ZERO,
+        };
+        if let Some(k) = kinematic.iter().find(|k| k.body == handle) {
+            (e.stored_v, e.stored_w) = (k.linvel, k.angvel);
+            (e.v, e.w) = (k.linvel, k.angvel);
+            e.prescribed = Some((k.linacc, k.angacc));
+        }
+        e
     }
-    let mp = &rb.mass_properties().local_mprops;
-    let com = crate::rapier::ledger::world_center_of_mass(rb);
-    let w = rb.angvel();
-    let dynamic = rb.is_dynamic();
-    let rot = *rb.rotation() * mp.principal_inertia_local_frame;
-    let iw = rot * (mp.principal_inertia() * (rot.inverse() * w));
-    let gyro = if rb.gyroscopic_forces_enabled() {
-        w.cross(iw)
-    } else {
-        Vector::ZERO
-    };
-    let mass = if mp.inv_mass > 0.0 {
-        1.0 / mp.inv_mass
-    } else {
-        0.0
-    };
-    BodyTerms {
-        inv_mass: if dynamic { mp.inv_mass } else { 0.0 },
-        com,
-        angvel: w,
-        force: rb.user_force() + f_extra + mass * rb.gravity_scale() * gravity,
-        torque: rb.user_torque() + t_extra - gyro,
-        dynamic,
-    }
-}
 
-impl BodyTerms {
-    /// `M^-1 (f, t)` of this body.
-    fn apply_inv_mass(&self, rb: &RigidBody, f: Vector, t: Vector) -> (Vector, Vector) {
+    /// `M^-1 (f, t)` of this body (zero unless dynamic).
+    fn apply_inv_mass(&self, f: Vector, t: Vector) -> (Vector, Vector) {
         if !self.dynamic {
             return (Vector::ZERO, Vector::ZERO);
         }
-        let mp = &rb.mass_properties().local_mprops;
-        (self.inv_mass * f, mp.world_inv_inertia(rb.rotation()) * t)
+        (self.inv_mass * f, self.inv_inertia * t)
     }
+
+    /// The applied wrench at the state's velocities (before soft motors): with the gyroscopic
+    /// term `-w x (I w)`.
+    fn applied(&self) -> (Vector, Vector) {
+        let gyro = if self.gyroscopic {
+            let r = self.principal_rot;
+            self.w.cross(r * (self.principal * (r.inverse() * self.w)))
+        } else {
+            Vector::ZERO
+        };
+        (self.f0, self.t0 - gyro)
+    }
+
+    /// The accelerations without the joints: `M^-1 F`, or the prescribed ones of a driven body
+    /// (zero for a fixed body and a kinematic body moving steadily).
+    fn free_acceleration(&self) -> (Vector, Vector) {
+        match self.prescribed {
+            Some(p) => p,
+            None => self.apply_inv_mass(self.f, self.t),
+        }
+    }
+}
+
+/// One constraint row between two bodies of the solve.
+#[derive(Clone, Copy, Debug)]
+struct Row {
+    /// Indices of the two bodies in the solve's body table.
+    b1: usize,
+    b2: usize,
+    /// Jacobian blocks: linear and angular for body 1, then for body 2.
+    jac: [Vector; 4],
+    /// The velocity-product term: `J a + c = 0`.
+    c: f64,
+    /// A position constraint (its velocity `J v` is zero); false for a motor's speed row.
+    position: bool,
+}
+
+impl Row {
+    fn dot(&self, a1: (Vector, Vector), a2: (Vector, Vector)) -> f64 {
+        self.jac[0].dot(a1.0)
+            + self.jac[1].dot(a1.1)
+            + self.jac[2].dot(a2.0)
+            + self.jac[3].dot(a2.1)
+    }
+}
+
+/// Solves for ideal-joint reactions; keeps its buffers between calls (no allocation per step
+/// once sized).
+#[derive(Clone, Debug, Default)]
+pub struct ReactionSolver {
+    /// Bodies whose motion is prescribed with a nonzero acceleration (a tabulated drive): their
+    /// velocities and accelerations at the state. Other kinematic bodies are taken to move at
+    /// constant velocity.
+    pub kinematic: Vec<KinematicState>,
+    /// How long before the state the bodies' stored velocities are, s: the stored velocities are
+    /// advanced by it with the accelerations solved. Half the last step for Rapier's velocities
+    /// after a step of the [`Stepper`](crate::rapier::stepper::Stepper)
+    /// (`stepper.last_dt() / 2`; 0 before the first step, whose velocities are the initial
+    /// state's) or of a plain Rapier loop at constant steps (`dt / 2`). Default 0: the stored
+    /// velocities are taken as the state's (and only projected onto the joints).
+    pub velocity_lag: f64,
+    /// Further bodies whose velocities and accelerations at the state the solve reports
+    /// ([`velocity`](Self::velocity), [`acceleration`](Self::acceleration)) though no listed
+    /// joint holds them (a free body, one held by clearance joints only).
+    pub track: Vec<RigidBodyHandle>,
+    /// Dense `J M^-1 J^T` and its LU factors, row-major; the same for the position rows alone.
+    a: Vec<f64>,
+    lu: Vec<f64>,
+    piv: Vec<usize>,
+    a_pos: Vec<f64>,
+    lu_pos: Vec<f64>,
+    piv_pos: Vec<usize>,
+    scratch: Vec<f64>,
+    /// Indices of the position rows.
+    pos_rows: Vec<usize>,
+    /// Right-hand side, then the multipliers.
+    b: Vec<f64>,
+    b_pos: Vec<f64>,
+    rows: Vec<Row>,
+    /// First row of each joint.
+    starts: Vec<usize>,
+    entries: Vec<Entry>,
+    forces: Vec<Vector>,
+    motors: Vec<Option<f64>>,
+    /// Per joint with a motor: the relative speed along its axis at the state.
+    motor_rates: Vec<f64>,
+    revolutes: Vec<IdealJoint>,
+    extra: Vec<Wrench>,
 }
 
 /// Two unit vectors orthogonal to `axis` and to each other.
@@ -269,6 +479,23 @@ fn orthonormal_pair(axis: Vector) -> (Vector, Vector) {
     };
     let t1 = axis.cross(helper).normalize();
     (t1, axis.cross(t1))
+}
+
+/// Rapier's revolute angle: `2 asin` of the relative rotation's component along the axis
+/// (`local_axis1`, body 1's frame), the relative rotation taken with a nonnegative real part.
+fn rapier_angle(rot1: Rotation, rot2: Rotation, local_axis1: Vector) -> f64 {
+    let q = rot1.inverse() * rot2;
+    let s = if q.w < 0.0 { -1.0 } else { 1.0 };
+    2.0 * (s * q.xyz().dot(local_axis1.normalize()))
+        .clamp(-1.0, 1.0)
+        .asin()
+}
+
+/// `a - b` wrapped to `[-pi, pi]`, as Rapier compares a motor's angle with its target.
+fn angle_difference(a: f64, b: f64) -> f64 {
+    let d = a - b;
+    let other = d - d.signum() * std::f64::consts::TAU;
+    if d.abs() < other.abs() { d } else { other }
 }
 
 impl ReactionSolver {
@@ -297,13 +524,13 @@ impl ReactionSolver {
         gravity: Vector,
         extra: &[Wrench],
     ) -> Option<&[Vector]> {
-        let mut all = std::mem::take(&mut self.joints);
+        let mut all = std::mem::take(&mut self.revolutes);
         all.clear();
         all.extend(joints.iter().map(|&j| IdealJoint::Revolute(j)));
         let ok = self
             .solve_joints_with(bodies, &all, gravity, extra)
             .is_some();
-        self.joints = all;
+        self.revolutes = all;
         if ok { Some(&self.forces) } else { None }
     }
 
@@ -323,12 +550,13 @@ impl ReactionSolver {
         if r { Some(&self.forces) } else { None }
     }
 
-    /// [`solve`](Self::solve) for any mix of revolute, prismatic, fixed and spherical joints: the force on
-    /// each joint's body 2 at its anchor (N, world frame; for a prismatic joint the part normal to
-    /// the axis, the only one an ideal slide carries). Every ideal joint of the mechanism must be
-    /// listed: a joint left out is a free motion to the solver. Kinematic bodies are taken to move
-    /// at constant velocity (their accelerations are those of a rigid rotation at their angular
-    /// velocity).
+    /// [`solve`](Self::solve) for any mix of revolute, prismatic, fixed and spherical joints, with
+    /// or without motors: the force on each joint's body 2 at its anchor (N, world frame; for a
+    /// prismatic joint the part normal to the axis, the only one an ideal slide carries; a
+    /// motor's torque or force is [`motor`](Self::motor)). Every ideal joint of the mechanism
+    /// must be listed: a joint left out is a free motion to the solver. Kinematic bodies are
+    /// taken to move at constant velocity (their accelerations are those of a rigid rotation at
+    /// their angular velocity) unless [`kinematic`](Self::kinematic) prescribes them.
     pub fn solve_joints(
         &mut self,
         bodies: &RigidBodySet,
@@ -338,179 +566,431 @@ impl ReactionSolver {
         self.solve_joints_with(bodies, joints, gravity, &[])
     }
 
+    /// The motor torque (N m about the axis, revolute) or force (N along the axis, prismatic) on
+    /// body 2 of joint `k` of the last solve: the held-speed row's multiplier or the soft
+    /// motor's law at the state. `None` without a motor (or before a solve).
+    pub fn motor(&self, k: usize) -> Option<f64> {
+        self.motors.get(k).copied().flatten()
+    }
+
+    /// Velocity of the centre of mass (m/s) and angular velocity (rad/s) of `body` at the state
+    /// of the last solve: the stored ones advanced by [`velocity_lag`](Self::velocity_lag) and
+    /// made consistent with the joints. `None` for a body neither in the joints nor in
+    /// [`track`](Self::track).
+    pub fn velocity(&self, body: RigidBodyHandle) -> Option<(Vector, Vector)> {
+        self.entry(body).map(|e| (e.v, e.w))
+    }
+
+    /// Acceleration of the centre of mass (m/s^2) and angular acceleration (rad/s^2) of `body`
+    /// at the state of the last solve, `M^-1 (F + J^T lambda)` (the prescribed ones of a driven
+    /// body). `None` for a body neither in the joints nor in [`track`](Self::track).
+    pub fn acceleration(&self, body: RigidBodyHandle) -> Option<(Vector, Vector)> {
+        self.entry(body).map(|e| (e.acc, e.alpha))
+    }
+
+    /// The relative speed of joint `k`'s bodies along its motor's axis at the state of the last
+    /// solve: rad/s about a revolute's axis, m/s along a prismatic axis (body 2 relative to
+    /// body 1). Times [`motor`](Self::motor), the power the motor delivers. `None` without a
+    /// motor.
+    pub fn motor_rate(&self, k: usize) -> Option<f64> {
+        self.motors
+            .get(k)
+            .copied()
+            .flatten()
+            .map(|_| self.motor_rates[k])
+    }
+
+    fn entry(&self, body: RigidBodyHandle) -> Option<&Entry> {
+        self.entries.iter().find(|e| e.handle == body)
+    }
+
+    /// Index of `handle` in the body table, adding it first if needed.
+    fn body_index(
+        &mut self,
+        bodies: &RigidBodySet,
+        handle: RigidBodyHandle,
+        gravity: Vector,
+    ) -> Option<usize> {
+        if let Some(i) = self.entries.iter().position(|e| e.handle == handle) {
+            return Some(i);
+        }
+        let rb = bodies.get(handle)?;
+        self.entries.push(Entry::new(
+            rb,
+            handle,
+            gravity,
+            &self.extra,
+            &self.kinematic,
+        ));
+        Some(self.entries.len() - 1)
+    }
+
     fn solve_joints_inner(
         &mut self,
         bodies: &RigidBodySet,
         joints: &[IdealJoint],
         gravity: Vector,
     ) -> Option<()> {
-        self.b.clear();
-        self.rows.clear();
-        self.starts.clear();
+        self.entries.clear();
         self.forces.clear();
-        // Jacobian rows and right-hand sides.
+        self.motors.clear();
+        self.starts.clear();
+        let mut pairs = Vec::with_capacity(joints.len());
         for j in joints {
-            self.starts.push(self.rows.len());
             let (h1, h2) = j.bodies();
-            let (rb1, rb2) = (bodies.get(h1)?, bodies.get(h2)?);
-            let (mut t1, mut t2) = (
-                terms(rb1, h1, gravity, &self.extra),
-                terms(rb2, h2, gravity, &self.extra),
-            );
-            let (mut a1f, mut a1t) = t1.apply_inv_mass(rb1, t1.force, t1.torque);
-            let (mut a2f, mut a2t) = t2.apply_inv_mass(rb2, t2.force, t2.torque);
-            // A driven body's state and accelerations are prescribed.
-            let (mut v1, mut v2) = (rb1.linvel(), rb2.linvel());
-            for k in &self.kinematic {
-                if k.body == h1 {
-                    (v1, t1.angvel, a1f, a1t) = (k.linvel, k.angvel, k.linacc, k.angacc);
-                }
-                if k.body == h2 {
-                    (v2, t2.angvel, a2f, a2t) = (k.linvel, k.angvel, k.linacc, k.angacc);
-                }
-            }
-            let (w1, w2) = (t1.angvel, t2.angvel);
-            match j {
-                IdealJoint::Revolute(j) | IdealJoint::MotorRevolute(j) => {
-                    let r1 = *rb1.position() * j.local_anchor1 - t1.com;
-                    let r2 = *rb2.position() * j.local_anchor2 - t2.com;
-                    let axis = (*rb1.rotation() * j.local_axis1).normalize();
-                    let (u1, u2) = orthonormal_pair(axis);
-                    // Linear rows: p2 - p1 = 0, `J a + c = 0` with c the centripetal terms.
-                    let c_lin = w2.cross(w2.cross(r2)) - w1.cross(w1.cross(r1));
-                    let free_lin = a2f + a2t.cross(r2) - a1f - a1t.cross(r1);
-                    for d in [Vector::X, Vector::Y, Vector::Z] {
-                        self.rows.push([-d, -r1.cross(d), d, r2.cross(d)]);
-                        self.b.push(-(c_lin.dot(d) + free_lin.dot(d)));
-                    }
-                    // Angular rows: (w2 - w1).t = 0 for the two directions t normal to the
-                    // axis, which turn with body 1.
-                    let motor =
-                        matches!(joints[self.starts.len() - 1], IdealJoint::MotorRevolute(_));
-                    let dirs: &[Vector] = if motor { &[u1, u2, axis] } else { &[u1, u2] };
-                    for &t in dirs {
-                        let c_ang = (w2 - w1).dot(w1.cross(t));
-                        self.rows.push([Vector::ZERO, -t, Vector::ZERO, t]);
-                        self.b.push(-(c_ang + (a2t - a1t).dot(t)));
-                    }
-                }
-                IdealJoint::Prismatic(j) => {
-                    let p1 = *rb1.position() * j.local_anchor1;
-                    let p2 = *rb2.position() * j.local_anchor2;
-                    let (r1, r2) = (p1 - t1.com, p2 - t2.com);
-                    let d = p2 - p1;
-                    let axis = (*rb1.rotation() * j.local_axis1).normalize();
-                    let (u1, u2) = orthonormal_pair(axis);
-                    // Linear rows: g = (p2 - p1).t = 0 for t normal to the axis, turning with
-                    // body 1. g'' = (a_p2 - a_p1).t + 2 (v_p2 - v_p1).(w1 x t)
-                    //   + d.(alpha1 x t + w1 x (w1 x t)); the alpha1 term moves body 1's angular
-                    // block to the lever of p2 (the reaction acts at the slider's point).
-                    let v_rel = (v2 + w2.cross(r2)) - (v1 + w1.cross(r1));
-                    let c_pts = w2.cross(w2.cross(r2)) - w1.cross(w1.cross(r1));
-                    let free_pts = a2f + a2t.cross(r2) - a1f - a1t.cross(r1);
-                    for t in [u1, u2] {
-                        let wt = w1.cross(t);
-                        let c = c_pts.dot(t) + 2.0 * v_rel.dot(wt) + d.dot(w1.cross(wt));
-                        let free = free_pts.dot(t) + a1t.dot(t.cross(d));
-                        self.rows.push([-t, -(r1 + d).cross(t), t, r2.cross(t)]);
-                        self.b.push(-(c + free));
-                    }
-                    // Angular rows: w2 - w1 = 0 along the world axes (no relative rotation at
-                    // all, so the turning of the directions adds nothing).
-                    for e in [Vector::X, Vector::Y, Vector::Z] {
-                        self.rows.push([Vector::ZERO, -e, Vector::ZERO, e]);
-                        self.b.push(-(a2t - a1t).dot(e));
-                    }
-                }
-                IdealJoint::Spherical(j) => {
-                    let r1 = *rb1.position() * j.local_anchor1 - t1.com;
-                    let r2 = *rb2.position() * j.local_anchor2 - t2.com;
-                    let c_lin = w2.cross(w2.cross(r2)) - w1.cross(w1.cross(r1));
-                    let free_lin = a2f + a2t.cross(r2) - a1f - a1t.cross(r1);
-                    for d in [Vector::X, Vector::Y, Vector::Z] {
-                        self.rows.push([-d, -r1.cross(d), d, r2.cross(d)]);
-                        self.b.push(-(c_lin.dot(d) + free_lin.dot(d)));
-                    }
-                }
-                IdealJoint::Fixed(j) => {
-                    let r1 = *rb1.position() * j.local_anchor1 - t1.com;
-                    let r2 = *rb2.position() * j.local_anchor2 - t2.com;
-                    let c_lin = w2.cross(w2.cross(r2)) - w1.cross(w1.cross(r1));
-                    let free_lin = a2f + a2t.cross(r2) - a1f - a1t.cross(r1);
-                    for d in [Vector::X, Vector::Y, Vector::Z] {
-                        self.rows.push([-d, -r1.cross(d), d, r2.cross(d)]);
-                        self.b.push(-(c_lin.dot(d) + free_lin.dot(d)));
-                    }
-                    for e in [Vector::X, Vector::Y, Vector::Z] {
-                        self.rows.push([Vector::ZERO, -e, Vector::ZERO, e]);
-                        self.b.push(-(a2t - a1t).dot(e));
-                    }
-                }
-            }
+            pairs.push((
+                self.body_index(bodies, h1, gravity)?,
+                self.body_index(bodies, h2, gravity)?,
+            ));
         }
+        for i in 0..self.track.len() {
+            self.body_index(bodies, self.track[i], gravity)?;
+        }
+        // The Jacobian depends on the positions only: rows at the stored velocities, then the
+        // matrices (all rows, and the position rows for the projection).
+        self.build_rows(joints, &pairs);
         let n = self.rows.len();
-        self.a.clear();
-        self.a.resize(n * n, 0.0);
-        // A = J M^-1 J^T: entries between rows sharing a body.
-        for (p, jp) in joints.iter().enumerate() {
-            let (sp, np) = (self.starts[p], jp.rows().0);
-            let bp_h = jp.bodies();
-            for (q, jq) in joints.iter().enumerate() {
-                let (sq, nq) = (self.starts[q], jq.rows().0);
-                let bq_h = jq.bodies();
-                for (bp, hp) in [(0usize, bp_h.0), (2, bp_h.1)] {
-                    for (bq, hq) in [(0usize, bq_h.0), (2, bq_h.1)] {
-                        if hp != hq {
-                            continue;
-                        }
-                        let rb = bodies.get(hp)?;
-                        let t = terms(rb, hp, gravity, &self.extra);
-                        if !t.dynamic {
-                            continue;
-                        }
-                        for i in 0..np {
-                            let row_p = self.rows[sp + i];
-                            let (mf, mt) = t.apply_inv_mass(rb, row_p[bp], row_p[bp + 1]);
-                            for k in 0..nq {
-                                let row_q = self.rows[sq + k];
-                                self.a[(sp + i) * n + sq + k] +=
-                                    mf.dot(row_q[bq]) + mt.dot(row_q[bq + 1]);
-                            }
-                        }
-                    }
+        self.assemble();
+        self.pos_rows.clear();
+        self.pos_rows
+            .extend((0..n).filter(|&i| self.rows[i].position));
+        if !factor_regularised(&self.a, &mut self.lu, &mut self.piv, n) {
+            return None;
+        }
+        let np = self.pos_rows.len();
+        if np < n {
+            self.a_pos.clear();
+            for &i in &self.pos_rows {
+                for &k in &self.pos_rows {
+                    self.a_pos.push(self.a[i * n + k]);
                 }
             }
-        }
-        self.a_copy.clone_from(&self.a);
-        self.b_copy.clone_from(&self.b);
-        if !solve_dense(&mut self.a, &mut self.b, n) {
-            // Redundant constraints: a least-norm share through a small regularisation.
-            let scale = self.a_copy.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-            for i in 0..n {
-                self.a_copy[i * n + i] += 1e-12 * scale;
-            }
-            std::mem::swap(&mut self.a, &mut self.a_copy);
-            std::mem::swap(&mut self.b, &mut self.b_copy);
-            if !solve_dense(&mut self.a, &mut self.b, n) {
+            if !factor_regularised(&self.a_pos, &mut self.lu_pos, &mut self.piv_pos, np) {
                 return None;
             }
         }
-        // The force on body 2: the linear rows' multipliers along their directions.
+        // The state's velocities: the stored ones advanced by the lag with the accelerations
+        // solved at the stored ones, projected onto the joints (an error of second order in the
+        // lag; one pass without a lag).
+        let passes = if self.velocity_lag > 0.0 { 2 } else { 1 };
+        for pass in 0..passes {
+            if pass > 0 {
+                let lag = self.velocity_lag;
+                for e in self.entries.iter_mut().filter(|e| e.dynamic) {
+                    e.v = e.stored_v + lag * e.acc;
+                    e.w = e.stored_w + lag * e.alpha;
+                }
+            }
+            self.project(n);
+            self.build_rows(joints, &pairs);
+            self.apply_motors(joints, &pairs);
+            self.accelerations(n);
+        }
+        // The force on body 2: the force rows' multipliers along their directions.
         for (k, j) in joints.iter().enumerate() {
-            let (s, lin) = (self.starts[k], j.rows().1);
+            let s = self.starts[k];
             let mut f = Vector::ZERO;
-            for i in 0..lin {
-                f += self.b[s + i] * self.rows[s + i][2];
+            for i in 0..j.force_rows() {
+                f += self.b[s + i] * self.rows[s + i].jac[2];
             }
             self.forces.push(f);
         }
         Some(())
     }
+
+    /// The rows of every joint at the bodies' current velocities (the Jacobian from the
+    /// positions, the velocity-product terms `c` from the velocities).
+    fn build_rows(&mut self, joints: &[IdealJoint], pairs: &[(usize, usize)]) {
+        self.rows.clear();
+        self.starts.clear();
+        for (j, &(i1, i2)) in joints.iter().zip(pairs) {
+            self.starts.push(self.rows.len());
+            let (e1, e2) = (&self.entries[i1], &self.entries[i2]);
+            let (v1, v2, w1, w2) = (e1.v, e2.v, e1.w, e2.w);
+            let held = matches!(
+                j,
+                IdealJoint::MotorRevolute(_) | IdealJoint::MotorPrismatic(_)
+            );
+            let mut push = |jac: [Vector; 4], c: f64, position: bool| {
+                self.rows.push(Row {
+                    b1: i1,
+                    b2: i2,
+                    jac,
+                    c,
+                    position,
+                })
+            };
+            // Point-coincidence rows `p2 - p1 = 0` along the world axes, `c` the centripetal
+            // terms.
+            let point_rows =
+                |push: &mut dyn FnMut([Vector; 4], f64, bool), r1: Vector, r2: Vector| {
+                    let c_lin = w2.cross(w2.cross(r2)) - w1.cross(w1.cross(r1));
+                    for d in [Vector::X, Vector::Y, Vector::Z] {
+                        push([-d, -r1.cross(d), d, r2.cross(d)], c_lin.dot(d), true);
+                    }
+                };
+            // No relative rotation about the world axes.
+            let weld_rows = |push: &mut dyn FnMut([Vector; 4], f64, bool)| {
+                for e in [Vector::X, Vector::Y, Vector::Z] {
+                    push([Vector::ZERO, -e, Vector::ZERO, e], 0.0, true);
+                }
+            };
+            match j {
+                IdealJoint::Revolute(j)
+                | IdealJoint::MotorRevolute(j)
+                | IdealJoint::SoftMotorRevolute(j, _) => {
+                    let r1 = e1.pose * j.local_anchor1 - e1.com;
+                    let r2 = e2.pose * j.local_anchor2 - e2.com;
+                    let axis = (e1.rot * j.local_axis1).normalize();
+                    let (u1, u2) = orthonormal_pair(axis);
+                    point_rows(&mut push, r1, r2);
+                    // (w2 - w1).t = 0 for the two directions t normal to the axis, which turn
+                    // with body 1; a held speed adds t = axis (a speed row).
+                    let ang = |t: Vector| (w2 - w1).dot(w1.cross(t));
+                    push([Vector::ZERO, -u1, Vector::ZERO, u1], ang(u1), true);
+                    push([Vector::ZERO, -u2, Vector::ZERO, u2], ang(u2), true);
+                    if held {
+                        push([Vector::ZERO, -axis, Vector::ZERO, axis], ang(axis), false);
+                    }
+                }
+                IdealJoint::Prismatic(j)
+                | IdealJoint::MotorPrismatic(j)
+                | IdealJoint::SoftMotorPrismatic(j, _) => {
+                    let p1 = e1.pose * j.local_anchor1;
+                    let p2 = e2.pose * j.local_anchor2;
+                    let (r1, r2) = (p1 - e1.com, p2 - e2.com);
+                    let d = p2 - p1;
+                    let axis = (e1.rot * j.local_axis1).normalize();
+                    let (u1, u2) = orthonormal_pair(axis);
+                    // g = (p2 - p1).t = 0 for t normal to the axis, turning with body 1:
+                    // g'' = (a_p2 - a_p1).t + 2 (v_p2 - v_p1).(w1 x t)
+                    //   + d.(alpha1 x t + w1 x (w1 x t)); the alpha1 term moves body 1's angular
+                    // block to the lever of p2 (the reaction acts at the slider's point). A held
+                    // speed along the axis is the same with t = axis (a speed row).
+                    let v_rel = (v2 + w2.cross(r2)) - (v1 + w1.cross(r1));
+                    let c_pts = w2.cross(w2.cross(r2)) - w1.cross(w1.cross(r1));
+                    let row = |t: Vector| {
+                        let wt = w1.cross(t);
+                        (
+                            [-t, -(r1 + d).cross(t), t, r2.cross(t)],
+                            c_pts.dot(t) + 2.0 * v_rel.dot(wt) + d.dot(w1.cross(wt)),
+                        )
+                    };
+                    for t in [u1, u2] {
+                        let (jac, c) = row(t);
+                        push(jac, c, true);
+                    }
+                    weld_rows(&mut push);
+                    if held {
+                        let (jac, c) = row(axis);
+                        push(jac, c, false);
+                    }
+                }
+                IdealJoint::Spherical(j) => {
+                    let r1 = e1.pose * j.local_anchor1 - e1.com;
+                    let r2 = e2.pose * j.local_anchor2 - e2.com;
+                    point_rows(&mut push, r1, r2);
+                }
+                IdealJoint::Fixed(j) => {
+                    let r1 = e1.pose * j.local_anchor1 - e1.com;
+                    let r2 = e2.pose * j.local_anchor2 - e2.com;
+                    point_rows(&mut push, r1, r2);
+                    weld_rows(&mut push);
+                }
+            }
+        }
+    }
+
+    /// `A = J M^-1 J^T` into `self.a`: entries between rows sharing a body.
+    fn assemble(&mut self) {
+        let n = self.rows.len();
+        self.a.clear();
+        self.a.resize(n * n, 0.0);
+        for p in 0..n {
+            let rp = self.rows[p];
+            for (bp, side) in [(rp.b1, 0usize), (rp.b2, 2)] {
+                let e = &self.entries[bp];
+                if !e.dynamic {
+                    continue;
+                }
+                let (mf, mt) = e.apply_inv_mass(rp.jac[side], rp.jac[side + 1]);
+                for (q, rq) in self.rows.iter().enumerate() {
+                    for (bq, sq) in [(rq.b1, 0usize), (rq.b2, 2)] {
+                        if bq == bp {
+                            self.a[p * n + q] += mf.dot(rq.jac[sq]) + mt.dot(rq.jac[sq + 1]);
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Makes the dynamic bodies' velocities satisfy the position rows, `J v = 0`, with the
+    /// least change in the mass metric: `v -= M^-1 J^T mu`, `(J M^-1 J^T) mu = J v`.
+    fn project(&mut self, n: usize) {
+        let np = self.pos_rows.len();
+        if np == 0 {
+            return;
+        }
+        self.b_pos.clear();
+        for &i in &self.pos_rows {
+            let r = &self.rows[i];
+            let (e1, e2) = (&self.entries[r.b1], &self.entries[r.b2]);
+            self.b_pos.push(r.dot((e1.v, e1.w), (e2.v, e2.w)));
+        }
+        if np < n {
+            lu_solve(
+                &self.lu_pos,
+                &self.piv_pos,
+                &mut self.b_pos,
+                &mut self.scratch,
+                np,
+            );
+        } else {
+            lu_solve(&self.lu, &self.piv, &mut self.b_pos, &mut self.scratch, n);
+        }
+        for (k, &i) in self.pos_rows.iter().enumerate() {
+            let r = self.rows[i];
+            let mu = self.b_pos[k];
+            for (b, side) in [(r.b1, 0usize), (r.b2, 2)] {
+                let e = &mut self.entries[b];
+                let (dv, dw) = e.apply_inv_mass(r.jac[side] * mu, r.jac[side + 1] * mu);
+                e.v -= dv;
+                e.w -= dw;
+            }
+        }
+    }
+
+    /// The applied wrenches at the state's velocities: the bodies' own, then the soft motors'
+    /// (recorded in `self.motors`, as are the held motors' placeholders).
+    fn apply_motors(&mut self, joints: &[IdealJoint], pairs: &[(usize, usize)]) {
+        for e in &mut self.entries {
+            (e.f, e.t) = e.applied();
+        }
+        self.motors.clear();
+        self.motor_rates.clear();
+        for (j, &(i1, i2)) in joints.iter().zip(pairs) {
+            let (e1, e2) = (self.entries[i1], self.entries[i2]);
+            self.motor_rates.push(match j {
+                IdealJoint::MotorRevolute(j) | IdealJoint::SoftMotorRevolute(j, _) => {
+                    (e1.rot * j.local_axis1).normalize().dot(e2.w - e1.w)
+                }
+                IdealJoint::MotorPrismatic(j) | IdealJoint::SoftMotorPrismatic(j, _) => {
+                    let axis = (e1.rot * j.local_axis1).normalize();
+                    let p2 = e2.pose * j.local_anchor2;
+                    axis.dot((e2.v + e2.w.cross(p2 - e2.com)) - (e1.v + e1.w.cross(p2 - e1.com)))
+                }
+                _ => 0.0,
+            });
+            let motor = match j {
+                IdealJoint::SoftMotorRevolute(j, m) => {
+                    let axis = (e1.rot * j.local_axis1).normalize();
+                    let angle = rapier_angle(e1.rot, e2.rot, j.local_axis1);
+                    let rate = axis.dot(e2.w - e1.w);
+                    let inv = |e: &Entry| {
+                        if e.dynamic {
+                            axis.dot(e.inv_inertia * axis)
+                        } else {
+                            0.0
+                        }
+                    };
+                    let mass = inv_or_zero(inv(&e1) + inv(&e2));
+                    let tau = m.force(angle_difference(angle, m.target_pos), rate, mass);
+                    self.entries[i2].t += tau * axis;
+                    self.entries[i1].t -= tau * axis;
+                    Some(tau)
+                }
+                IdealJoint::SoftMotorPrismatic(j, m) => {
+                    let p1 = e1.pose * j.local_anchor1;
+                    let p2 = e2.pose * j.local_anchor2;
+                    let axis = (e1.rot * j.local_axis1).normalize();
+                    // Body 1's point under the slider's (Rapier's lever for body 1).
+                    let (r1, r2) = (p2 - e1.com, p2 - e2.com);
+                    let rate = axis.dot((e2.v + e2.w.cross(r2)) - (e1.v + e1.w.cross(r1)));
+                    let inv = |e: &Entry, r: Vector| {
+                        if e.dynamic {
+                            let ra = r.cross(axis);
+                            e.inv_mass + ra.dot(e.inv_inertia * ra)
+                        } else {
+                            0.0
+                        }
+                    };
+                    let mass = inv_or_zero(inv(&e1, r1) + inv(&e2, r2));
+                    let f = m.force((p2 - p1).dot(axis) - m.target_pos, rate, mass) * axis;
+                    self.entries[i2].f += f;
+                    self.entries[i2].t += r2.cross(f);
+                    self.entries[i1].f -= f;
+                    self.entries[i1].t -= r1.cross(f);
+                    Some(f.dot(axis))
+                }
+                // The held motors' multipliers come with the solve.
+                IdealJoint::MotorRevolute(_) | IdealJoint::MotorPrismatic(_) => Some(0.0),
+                _ => None,
+            };
+            self.motors.push(motor);
+        }
+    }
+
+    /// Solves `A lambda = -c - J M^-1 F` at the state's velocities and sets every body's
+    /// accelerations `M^-1 (F + J^T lambda)` and the held motors' multipliers.
+    fn accelerations(&mut self, n: usize) {
+        for e in &mut self.entries {
+            (e.acc, e.alpha) = e.free_acceleration();
+        }
+        self.b.clear();
+        for r in &self.rows {
+            let (e1, e2) = (&self.entries[r.b1], &self.entries[r.b2]);
+            self.b
+                .push(-(r.c + r.dot((e1.acc, e1.alpha), (e2.acc, e2.alpha))));
+        }
+        lu_solve(&self.lu, &self.piv, &mut self.b, &mut self.scratch, n);
+        for (r, &lambda) in self.rows.iter().zip(&self.b) {
+            for (b, side) in [(r.b1, 0usize), (r.b2, 2)] {
+                let e = &mut self.entries[b];
+                let (da, dalpha) = e.apply_inv_mass(r.jac[side] * lambda, r.jac[side + 1] * lambda);
+                e.acc += da;
+                e.alpha += dalpha;
+            }
+        }
+        // A held motor's speed row is its joint's last.
+        for (k, m) in self.motors.iter_mut().enumerate() {
+            if let Some(v) = m {
+                let next = self.starts.get(k + 1).copied().unwrap_or(n);
+                if !self.rows[next - 1].position {
+                    *v = self.b[next - 1];
+                }
+            }
+        }
+    }
 }
 
-/// Gaussian elimination with partial pivoting on the `n x n` row-major `a`; the solution replaces
-/// `b`. False when `a` is singular to working precision.
-fn solve_dense(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
+fn inv_or_zero(x: f64) -> f64 {
+    if x > 0.0 { 1.0 / x } else { 0.0 }
+}
+
+/// LU factors of the `n x n` row-major `a` into `lu`, with a relative regularisation of 1e-12
+/// on the diagonal when `a` is singular (redundant constraints: a least-norm share). False when
+/// even that fails.
+fn factor_regularised(a: &[f64], lu: &mut Vec<f64>, piv: &mut Vec<usize>, n: usize) -> bool {
+    lu.clear();
+    lu.extend_from_slice(a);
+    if lu_factor(lu, piv, n) {
+        return true;
+    }
+    lu.clear();
+    lu.extend_from_slice(a);
+    let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for i in 0..n {
+        lu[i * n + i] += 1e-12 * scale;
+    }
+    lu_factor(lu, piv, n)
+}
+
+/// LU factorisation with partial pivoting of the `n x n` row-major `a` in place (`piv` the row
+/// order). False when `a` is singular to working precision.
+fn lu_factor(a: &mut [f64], piv: &mut Vec<usize>, n: usize) -> bool {
+    piv.clear();
+    piv.extend(0..n);
     let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     if !(scale > 0.0) && n > 0 {
         return false;
@@ -526,26 +1006,40 @@ fn solve_dense(a: &mut [f64], b: &mut [f64], n: usize) -> bool {
             for k in 0..n {
                 a.swap(pivot * n + k, col * n + k);
             }
-            b.swap(pivot, col);
+            piv.swap(pivot, col);
         }
         for i in col + 1..n {
             let f = a[i * n + col] / a[col * n + col];
+            a[i * n + col] = f;
             if f != 0.0 {
-                for k in col..n {
+                for k in col + 1..n {
                     a[i * n + k] -= f * a[col * n + k];
                 }
-                b[i] -= f * b[col];
             }
         }
     }
-    for col in (0..n).rev() {
-        let mut s = b[col];
-        for k in col + 1..n {
-            s -= a[col * n + k] * b[k];
-        }
-        b[col] = s / a[col * n + col];
-    }
     true
+}
+
+/// Solves `A x = b` from the factors of [`lu_factor`]; the solution replaces `b`.
+fn lu_solve(lu: &[f64], piv: &[usize], b: &mut [f64], scratch: &mut Vec<f64>, n: usize) {
+    scratch.clear();
+    scratch.extend(piv.iter().map(|&p| b[p]));
+    b.copy_from_slice(scratch);
+    for i in 0..n {
+        let mut s = b[i];
+        for k in 0..i {
+            s -= lu[i * n + k] * b[k];
+        }
+        b[i] = s;
+    }
+    for i in (0..n).rev() {
+        let mut s = b[i];
+        for k in i + 1..n {
+            s -= lu[i * n + k] * b[k];
+        }
+        b[i] = s / lu[i * n + i];
+    }
 }
 
 /// Computes the local mass properties of every dynamic body that has none yet (Rapier does it at
@@ -556,7 +1050,6 @@ pub fn prepare_mass_properties(bodies: &mut RigidBodySet) {
         crate::rapier::ledger::ensure_mass_properties(bodies, None, h);
     }
 }
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -567,10 +1060,18 @@ mod tests {
         // 2x + y = 3, x + 3y = 5 -> x = 0.8, y = 1.4
         let mut a = vec![2.0, 1.0, 1.0, 3.0];
         let mut b = vec![3.0, 5.0];
-        assert!(solve_dense(&mut a, &mut b, 2));
+        let (mut piv, mut scratch) = (Vec::new(), Vec::new());
+        assert!(lu_factor(&mut a, &mut piv, 2));
+        lu_solve(&a, &piv, &mut b, &mut scratch, 2);
         assert!((b[0] - 0.8).abs() < 1e-15 && (b[1] - 1.4).abs() < 1e-15);
+        // With a row swap: y = 2, x + y = 3 -> x = 1.
+        let mut a = vec![0.0, 1.0, 1.0, 1.0];
+        let mut b = vec![2.0, 3.0];
+        assert!(lu_factor(&mut a, &mut piv, 2));
+        lu_solve(&a, &piv, &mut b, &mut scratch, 2);
+        assert!((b[0] - 1.0).abs() < 1e-15 && (b[1] - 2.0).abs() < 1e-15);
         let mut a = vec![1.0, 2.0, 2.0, 4.0];
-        assert!(!solve_dense(&mut a, &mut [1.0, 2.0], 2));
+        assert!(!lu_factor(&mut a, &mut piv, 2));
     }
 
     #[test]
@@ -802,11 +1303,8 @@ mod tests {
             .solve_joints(&bodies, &[IdealJoint::MotorRevolute(j)], g)
             .unwrap()[0];
         assert!((f - Vector::new(0.0, 19.62, 0.0)).length() < 1e-9, "{f:?}");
-        assert!(
-            (solver.b[5] - 2.0 * 9.81 * 0.3).abs() < 1e-9,
-            "{}",
-            solver.b[5]
-        );
+        let tau = solver.motor(0).unwrap();
+        assert!((tau - 2.0 * 9.81 * 0.3).abs() < 1e-9, "{tau}");
         // Without the motor the arm falls: the pivot carries less than the weight,
         // m g (1 - m r^2 / I_pivot) with I_pivot = 0.03 + 2 * 0.09 = 0.21.
         let f = solver.solve(&bodies, &[j], g).unwrap()[0];
@@ -850,5 +1348,211 @@ mod tests {
             .solve_joints(&bodies, &[j.into()], Vector::ZERO)
             .unwrap()[0];
         assert!((f - Vector::new(0.0, 6.0, 0.0)).length() < 1e-9, "{f:?}");
+    }
+
+    /// The 2 kg arm of these tests on a fixed base: centre of mass `r` = 0.3 m out along its
+    /// own x axis, turned by `angle` about z, spinning at `w` about z (consistent velocities).
+    fn arm_at(angle: f64, w: f64) -> (RigidBodySet, IdealRevolute) {
+        let mut bodies = RigidBodySet::new();
+        let base = bodies.insert(RigidBodyBuilder::fixed());
+        let rot = Rotation::from_rotation_z(angle);
+        let com = rot * Vector::new(0.3, 0.0, 0.0);
+        let arm = bodies.insert(
+            RigidBodyBuilder::dynamic()
+                .translation(com)
+                .rotation(Vector::new(0.0, 0.0, angle))
+                .linvel(Vector::new(0.0, 0.0, w).cross(com))
+                .angvel(Vector::new(0.0, 0.0, w))
+                .additional_mass_properties(MassProperties::new(
+                    Vector::ZERO,
+                    2.0,
+                    Vector::new(0.01, 0.02, 0.03),
+                )),
+        );
+        prepare_mass_properties(&mut bodies);
+        let j = IdealRevolute {
+            body1: base,
+            body2: arm,
+            local_anchor1: Vector::ZERO,
+            local_anchor2: Vector::new(-0.3, 0.0, 0.0),
+            local_axis1: Vector::Z,
+        };
+        (bodies, j)
+    }
+
+    #[test]
+    fn soft_revolute_motor_by_hand() {
+        // Level arm turning at 1 rad/s under gravity -y; a force-based motor k = 10 N m/rad,
+        // c = 2 N m s/rad towards 0.5 rad at rest: torque 10 * 0.5 + 2 * (0 - 1) = 3 N m.
+        // alpha = (3 - m g r)/I_pivot, I_pivot = 0.03 + 2 * 0.09 = 0.21.
+        let (bodies, j) = arm_at(0.0, 1.0);
+        let g = Vector::new(0.0, -9.81, 0.0);
+        let m = SoftMotor::force_based(0.5, 0.0, 10.0, 2.0);
+        let mut solver = ReactionSolver::default();
+        let f = solver
+            .solve_joints(&bodies, &[IdealJoint::SoftMotorRevolute(j, m)], g)
+            .unwrap()[0];
+        assert!((solver.motor(0).unwrap() - 3.0).abs() < 1e-12);
+        let alpha = (3.0 - 2.0 * 9.81 * 0.3) / 0.21;
+        let (a, al) = solver.acceleration(j.body2).unwrap();
+        let expected_a = Vector::new(-0.3, alpha * 0.3, 0.0);
+        assert!(
+            (al - Vector::new(0.0, 0.0, alpha)).length() < 1e-9,
+            "{al:?}"
+        );
+        assert!((a - expected_a).length() < 1e-9, "{a:?}");
+        // The pivot supplies m a - m g.
+        assert!((f - (2.0 * expected_a - 2.0 * g)).length() < 1e-9, "{f:?}");
+        // Acceleration-based: the same law times the row's inertia, the arm's own 0.03 about z
+        // (Rapier's motor row is not coupled to the joint's point constraints).
+        let m = SoftMotor {
+            model: MotorModel::AccelerationBased,
+            ..m
+        };
+        solver.solve_joints(&bodies, &[IdealJoint::SoftMotorRevolute(j, m)], g);
+        assert!((solver.motor(0).unwrap() - 0.03 * 3.0).abs() < 1e-12);
+        // A force limit clamps it.
+        let m = SoftMotor {
+            max_force: 1.0,
+            ..m
+        };
+        solver.solve_joints(&bodies, &[IdealJoint::SoftMotorRevolute(j, m)], g);
+        assert!((solver.motor(0).unwrap() - 0.03 * 3.0).abs() < 1e-12);
+        let m = SoftMotor {
+            max_force: 0.05,
+            ..m
+        };
+        solver.solve_joints(&bodies, &[IdealJoint::SoftMotorRevolute(j, m)], g);
+        assert_eq!(solver.motor(0), Some(0.05));
+    }
+
+    #[test]
+    fn soft_motor_angle_is_rapiers() {
+        // At rest turned by 0.2 rad towards 0.5 rad: 10 * 0.3 = 3 N m.
+        let (bodies, j) = arm_at(0.2, 0.0);
+        let mut solver = ReactionSolver::default();
+        let m = SoftMotor::force_based(0.5, 0.0, 10.0, 0.0);
+        solver.solve_joints(
+            &bodies,
+            &[IdealJoint::SoftMotorRevolute(j, m)],
+            Vector::ZERO,
+        );
+        assert!((solver.motor(0).unwrap() - 3.0).abs() < 1e-12);
+        // At -3 rad towards +3 rad the short way is through pi: the error is
+        // -6 + 2 pi = 0.283 rad, the torque -2.83 N m (a quaternion past pi is read as such).
+        let (bodies, j) = arm_at(-3.0, 0.0);
+        let m = SoftMotor::force_based(3.0, 0.0, 10.0, 0.0);
+        solver.solve_joints(
+            &bodies,
+            &[IdealJoint::SoftMotorRevolute(j, m)],
+            Vector::ZERO,
+        );
+        let expected = -10.0 * (-6.0 + std::f64::consts::TAU);
+        assert!((solver.motor(0).unwrap() - expected).abs() < 1e-9);
+        let (bodies, j) = arm_at(3.5, 0.0);
+        let m = SoftMotor::force_based(0.0, 0.0, 10.0, 0.0);
+        solver.solve_joints(
+            &bodies,
+            &[IdealJoint::SoftMotorRevolute(j, m)],
+            Vector::ZERO,
+        );
+        let expected = -10.0 * (3.5 - std::f64::consts::TAU);
+        assert!((solver.motor(0).unwrap() - expected).abs() < 1e-9);
+    }
+
+    #[test]
+    fn soft_and_held_prismatic_motors_by_hand() {
+        // 2 kg slider 0.1 m along a fixed guide on x, moving at 0.5 m/s, gravity -y; a
+        // force-based motor k = 100 N/m, c = 4 N s/m towards 0.3 m: 100 * 0.2 + 4 * (0 - 0.5)
+        // = 18 N along x, a = 9 m/s^2; the guide carries the weight.
+        let mut bodies = RigidBodySet::new();
+        let base = bodies.insert(RigidBodyBuilder::fixed());
+        let s = slider(
+            &mut bodies,
+            Vector::new(0.1, 0.0, 0.0),
+            Vector::new(0.5, 0.0, 0.0),
+            Vector::ZERO,
+        );
+        prepare_mass_properties(&mut bodies);
+        let j = IdealPrismatic {
+            body1: base,
+            body2: s,
+            local_anchor1: Vector::ZERO,
+            local_anchor2: Vector::ZERO,
+            local_axis1: Vector::X,
+        };
+        let g = Vector::new(0.0, -9.81, 0.0);
+        let m = SoftMotor::force_based(0.3, 0.0, 100.0, 4.0);
+        let mut solver = ReactionSolver::default();
+        let f = solver
+            .solve_joints(&bodies, &[IdealJoint::SoftMotorPrismatic(j, m)], g)
+            .unwrap()[0];
+        assert!((solver.motor(0).unwrap() - 18.0).abs() < 1e-12);
+        assert!((f - Vector::new(0.0, 19.62, 0.0)).length() < 1e-9, "{f:?}");
+        let (a, al) = solver.acceleration(s).unwrap();
+        assert!((a - Vector::new(9.0, 0.0, 0.0)).length() < 1e-9 && al.length() < 1e-9);
+        // Acceleration-based: times the row's mass, the slider's 2 kg (its point is its centre
+        // of mass; the guide is fixed).
+        let m = SoftMotor {
+            model: MotorModel::AccelerationBased,
+            ..m
+        };
+        solver.solve_joints(&bodies, &[IdealJoint::SoftMotorPrismatic(j, m)], g);
+        assert!((solver.motor(0).unwrap() - 36.0).abs() < 1e-12);
+        // Held speed against a 3 N push: the motor pulls back 3 N, nothing accelerates.
+        bodies[s].add_force(Vector::new(3.0, 0.0, 0.0), false);
+        let f = solver
+            .solve_joints(&bodies, &[IdealJoint::MotorPrismatic(j)], g)
+            .unwrap()[0];
+        assert!((solver.motor(0).unwrap() + 3.0).abs() < 1e-12);
+        assert!((f - Vector::new(0.0, 19.62, 0.0)).length() < 1e-9, "{f:?}");
+        assert!(solver.acceleration(s).unwrap().0.length() < 1e-12);
+    }
+
+    #[test]
+    fn velocities_are_projected_onto_the_joints() {
+        // The arm's stored velocities disagree: spinning at 5 rad/s, its centre of mass at rest.
+        // The least change in the mass metric that turns it about the pivot: minimise
+        // m (0.3 w)^2 + I (w - 5)^2 -> w = 5 I/(m 0.09 + I) = 5 * 0.03/0.21 = 5/7 rad/s.
+        let (mut bodies, j) = arm_at(0.0, 5.0);
+        bodies[j.body2].set_linvel(Vector::ZERO, false);
+        let mut solver = ReactionSolver::default();
+        let f = solver.solve(&bodies, &[j], Vector::ZERO).unwrap()[0];
+        let w = 5.0 / 7.0;
+        let (v, wv) = solver.velocity(j.body2).unwrap();
+        assert!((wv - Vector::new(0.0, 0.0, w)).length() < 1e-12, "{wv:?}");
+        assert!(
+            (v - Vector::new(0.0, 0.3 * w, 0.0)).length() < 1e-12,
+            "{v:?}"
+        );
+        // The centripetal pull at the projected speed.
+        assert!((f - Vector::new(-2.0 * w * w * 0.3, 0.0, 0.0)).length() < 1e-9);
+    }
+
+    #[test]
+    fn stored_velocities_are_advanced_by_the_lag() {
+        // Level arm, stored 2 rad/s, 0.01 s before the state: under gravity alone the angular
+        // acceleration at level is -m g r/I_pivot whatever the speed, so the state's speed is
+        // 2 + 0.01 alpha, and the pivot pulls with its centripetal force.
+        let (bodies, j) = arm_at(0.0, 2.0);
+        let g = Vector::new(0.0, -9.81, 0.0);
+        let mut solver = ReactionSolver {
+            velocity_lag: 0.01,
+            ..ReactionSolver::default()
+        };
+        let f = solver.solve(&bodies, &[j], g).unwrap()[0];
+        let alpha = -2.0 * 9.81 * 0.3 / 0.21;
+        let w = 2.0 + 0.01 * alpha;
+        let (_, wv) = solver.velocity(j.body2).unwrap();
+        assert!((wv.z - w).abs() < 1e-12, "{wv:?} against {w}");
+        assert!((f.x + 2.0 * w * w * 0.3).abs() < 1e-9, "{f:?}");
+        // A tracked free body falls.
+        let mut bodies = bodies;
+        let free = slider(&mut bodies, Vector::Y, Vector::ZERO, Vector::ZERO);
+        prepare_mass_properties(&mut bodies);
+        solver.track = vec![free];
+        solver.solve(&bodies, &[j], g).unwrap();
+        assert!((solver.acceleration(free).unwrap().0 - g).length() < 1e-12);
+        assert!((solver.velocity(free).unwrap().0 - 0.01 * g).length() < 1e-12);
     }
 }

@@ -130,24 +130,79 @@ pub struct JointSpec {
     pub point_m: [f64; 3],
     /// Which joint.
     pub kind: JointKindSpec,
-    /// A motor on the joint's free axis (revolute joints).
+    /// A motor on the joint's free axis: `Velocity` or `Position` on a `Revolute` joint,
+    /// `LinearVelocity` or `LinearPosition` on a `Prismatic` joint without `limits_m`.
     #[serde(default)]
     pub motor: Option<MotorSpec>,
 }
 
-/// A joint motor (Rapier's, acceleration-based model).
+/// A joint motor, Rapier's (`set_motor_velocity`, `set_motor`). Its torque or force is written
+/// as `<joint>_motor_nm` (revolute) or `<joint>_motor_n` (prismatic), the torque or force on
+/// body 2 about or along the axis.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum MotorSpec {
-    /// Drives the relative angular speed to `target_rad_s` with Rapier's damping `factor` (1/s,
-    /// higher holds the speed more stiffly). The joint forces reported are those of a motor that
-    /// holds its speed exactly.
+    /// Holds the relative angular speed at `target_rad_s` (revolute), Rapier's velocity motor
+    /// (acceleration-based) with damping `factor` (1/s; high: a stiff motor). The joint forces
+    /// and the motor torque reported are those of a motor that holds its speed exactly.
     Velocity {
         /// Target relative angular speed of body 2 about the axis, rad/s.
         target_rad_s: f64,
         /// Rapier's motor damping factor, 1/s.
         factor: f64,
     },
+    /// A torsional spring and damper towards an angle (revolute), Rapier's force-based motor:
+    /// torque `stiffness (target_rad - angle) + damping (target_rad_s - rate)` on body 2, the
+    /// angle of body 2 relative to body 1 about the axis from the start (in `[-pi, pi]`, the
+    /// error taken the shorter way round). With no stiffness and a `target_rad_s` it is a soft
+    /// velocity motor (a torque falling linearly with speed). Reported exactly: the torque is
+    /// a function of the state.
+    Position {
+        /// Target angle, rad, in `[-pi, pi]`.
+        target_rad: f64,
+        /// Stiffness, N m/rad.
+        stiffness_nm_per_rad: f64,
+        /// Damping, N m s/rad.
+        damping_nm_s_per_rad: f64,
+        /// Target relative angular speed of the damping term, rad/s (default 0: the damping
+        /// resists any motion).
+        #[serde(default)]
+        target_rad_s: f64,
+    },
+    /// Holds the relative speed along the axis at `target_m_s` (prismatic), as
+    /// [`Velocity`](Self::Velocity).
+    LinearVelocity {
+        /// Target speed of body 2 along the axis, m/s.
+        target_m_s: f64,
+        /// Rapier's motor damping factor, 1/s.
+        factor: f64,
+    },
+    /// A linear spring and damper towards a displacement (prismatic), Rapier's force-based
+    /// motor: force `stiffness (target_m - x) + damping (target_m_s - speed)` on body 2 along the
+    /// axis, `x` its displacement from the start.
+    LinearPosition {
+        /// Target displacement along the axis from the start, m.
+        target_m: f64,
+        /// Stiffness, N/m.
+        stiffness_n_per_m: f64,
+        /// Damping, N s/m.
+        damping_n_s_per_m: f64,
+        /// Target speed of the damping term, m/s (default 0).
+        #[serde(default)]
+        target_m_s: f64,
+    },
+}
+
+impl MotorSpec {
+    /// The variant's name as written in a scene.
+    pub fn name(&self) -> &'static str {
+        match self {
+            MotorSpec::Velocity { .. } => "Velocity",
+            MotorSpec::Position { .. } => "Position",
+            MotorSpec::LinearVelocity { .. } => "LinearVelocity",
+            MotorSpec::LinearPosition { .. } => "LinearPosition",
+        }
+    }
 }
 
 /// The kinds of [`JointSpec`].
@@ -419,8 +474,11 @@ pub struct RunSettings {
     /// at the floor) fails the run instead of being reported (`--strict`).
     #[serde(default)]
     pub strict: bool,
-    /// Writes each moving body's centre-of-mass position and velocity along the world axes
-    /// (`<body>_x_m`, ..., `<body>_vz_m_s`) in the rows.
+    /// Writes each moving body's centre-of-mass position, velocity and acceleration along the
+    /// world axes (`<body>_x_m`, ..., `<body>_vz_m_s`, ..., `<body>_az_m_s2`) in the rows: a
+    /// dynamic body's velocity and acceleration solved at each state from the constrained
+    /// equations (the joints' and the clearance contacts' forces known), a driven body's its
+    /// drive's.
     #[serde(default)]
     pub body_motion: bool,
 }
@@ -805,30 +863,8 @@ impl Scene {
             if let JointKindSpec::Revolute { axis } = &j.kind {
                 unit(axis, &format!("{p}.kind.axis"))?;
             }
-            match (&j.motor, &j.kind) {
-                (
-                    Some(MotorSpec::Velocity {
-                        target_rad_s,
-                        factor,
-                    }),
-                    JointKindSpec::Revolute { .. },
-                ) => {
-                    in_range(
-                        &format!("{p}.motor.target_rad_s"),
-                        *target_rad_s,
-                        -RATE_MAX,
-                        RATE_MAX,
-                        "rad/s",
-                    )?;
-                    in_range(&format!("{p}.motor.factor"), *factor, 1e-6, 1e12, "1/s")?;
-                }
-                (Some(_), _) => {
-                    return Err(Error::invalid(
-                        format!("{p}.motor"),
-                        "a motor is supported on a `Revolute` joint only (prismatic motors are not in the scene format yet)",
-                    ));
-                }
-                (None, _) => {}
+            if let Some(m) = &j.motor {
+                validate_motor(m, &j.kind, &format!("{p}.motor"))?;
             }
             if let JointKindSpec::Prismatic { axis, limits_m } = &j.kind {
                 unit(axis, &format!("{p}.kind.axis"))?;
@@ -1025,6 +1061,119 @@ pub const LENGTH_MM_RANGE: (f64, f64) = (1e-3, 1e4);
 pub const CLEARANCE_MM_RANGE: (f64, f64) = (1e-6, 1e3);
 /// Range of a speed given in mm/s (friction transition speeds, impact-speed floor).
 pub const SPEED_MM_S_RANGE: (f64, f64) = (1e-9, 1e5);
+
+/// Largest motor stiffness: N m/rad (revolute) or N/m (prismatic).
+pub const MOTOR_STIFFNESS_MAX: f64 = 1e12;
+/// Largest motor damping: N m s/rad (revolute) or N s/m (prismatic).
+pub const MOTOR_DAMPING_MAX: f64 = 1e9;
+/// Range of a velocity motor's damping factor, 1/s.
+pub const MOTOR_FACTOR_RANGE: (f64, f64) = (1e-6, 1e12);
+
+/// A joint's motor (at `p`, e.g. `joints[motor].motor`) against the joint's kind and the
+/// physical ranges of its fields.
+fn validate_motor(m: &MotorSpec, kind: &JointKindSpec, p: &str) -> Result<()> {
+    let (revolute, prismatic) = (
+        matches!(kind, JointKindSpec::Revolute { .. }),
+        matches!(kind, JointKindSpec::Prismatic { .. }),
+    );
+    let wrong = |needs: &str, other: &str| {
+        Err(Error::invalid(
+            p,
+            format!("a `{}` motor needs a `{needs}` joint{other}", m.name()),
+        ))
+    };
+    let factor = |f: f64| {
+        in_range(
+            &format!("{p}.factor"),
+            f,
+            MOTOR_FACTOR_RANGE.0,
+            MOTOR_FACTOR_RANGE.1,
+            "1/s",
+        )
+    };
+    let spring = |k: (&str, f64, &str), c: (&str, f64, &str)| -> Result<()> {
+        in_range(&format!("{p}.{}", k.0), k.1, 0.0, MOTOR_STIFFNESS_MAX, k.2)?;
+        in_range(&format!("{p}.{}", c.0), c.1, 0.0, MOTOR_DAMPING_MAX, c.2)?;
+        if k.1 == 0.0 && c.1 == 0.0 {
+            return Err(Error::invalid(
+                p,
+                format!("`{}` and `{}` are both 0: the motor does nothing", k.0, c.0),
+            ));
+        }
+        Ok(())
+    };
+    let rate =
+        |field: &str, v: f64| in_range(&format!("{p}.{field}"), v, -RATE_MAX, RATE_MAX, "rad/s");
+    let speed =
+        |field: &str, v: f64| in_range(&format!("{p}.{field}"), v, -SPEED_MAX, SPEED_MAX, "m/s");
+    match m {
+        MotorSpec::Velocity {
+            target_rad_s,
+            factor: f,
+        } => {
+            if !revolute {
+                return wrong("Revolute", " (on a `Prismatic` joint: `LinearVelocity`)");
+            }
+            rate("target_rad_s", *target_rad_s)?;
+            factor(*f)?;
+        }
+        MotorSpec::Position {
+            target_rad,
+            stiffness_nm_per_rad,
+            damping_nm_s_per_rad,
+            target_rad_s,
+        } => {
+            if !revolute {
+                return wrong("Revolute", " (on a `Prismatic` joint: `LinearPosition`)");
+            }
+            // Rapier measures the angle in [-pi, pi]: a target beyond is never reached.
+            let pi = std::f64::consts::PI;
+            in_range(&format!("{p}.target_rad"), *target_rad, -pi, pi, "rad")?;
+            spring(
+                ("stiffness_nm_per_rad", *stiffness_nm_per_rad, "N m/rad"),
+                ("damping_nm_s_per_rad", *damping_nm_s_per_rad, "N m s/rad"),
+            )?;
+            rate("target_rad_s", *target_rad_s)?;
+        }
+        MotorSpec::LinearVelocity {
+            target_m_s,
+            factor: f,
+        } => {
+            if !prismatic {
+                return wrong("Prismatic", " (on a `Revolute` joint: `Velocity`)");
+            }
+            speed("target_m_s", *target_m_s)?;
+            factor(*f)?;
+        }
+        MotorSpec::LinearPosition {
+            target_m,
+            stiffness_n_per_m,
+            damping_n_s_per_m,
+            target_m_s,
+        } => {
+            if !prismatic {
+                return wrong("Prismatic", " (on a `Revolute` joint: `Position`)");
+            }
+            position(&format!("{p}.target_m"), *target_m)?;
+            spring(
+                ("stiffness_n_per_m", *stiffness_n_per_m, "N/m"),
+                ("damping_n_s_per_m", *damping_n_s_per_m, "N s/m"),
+            )?;
+            speed("target_m_s", *target_m_s)?;
+        }
+    }
+    if let JointKindSpec::Prismatic {
+        limits_m: Some(_), ..
+    } = kind
+    {
+        return Err(Error::invalid(
+            p,
+            "a motor on a prismatic joint with `limits_m` is not supported: the reported \
+             reactions would not know when the limit, not the motor, holds the slider",
+        ));
+    }
+    Ok(())
+}
 
 fn position(field: &str, x: f64) -> Result<f64> {
     in_range(field, x, -POSITION_MAX, POSITION_MAX, "m")

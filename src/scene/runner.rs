@@ -13,7 +13,7 @@ use crate::rapier::prescribed::{
 };
 use crate::rapier::reaction::{
     IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, KinematicState,
-    ReactionSolver,
+    ReactionSolver, SoftMotor,
 };
 use crate::rapier::stepper::{ForceSource, GuardReport, StepInfo, Stepper};
 use crate::scene::{JointKindSpec, MotionSpec, MotorSpec, Scene};
@@ -161,12 +161,18 @@ pub struct Twin {
     ideal_hinges: Vec<usize>,
     /// The scene's other joints: name and force on body 2 at the current state, N.
     joints: Vec<(String, f64)>,
+    /// Per scene joint: its motor's torque (N m) or force (N) at the current state, `None`
+    /// for a joint without motor (no column).
+    motors: Vec<Option<f64>>,
     body_motion: bool,
     reactions: ReactionSolver,
     /// The drives' and clearance joints' wrenches at the current state (scratch).
     source_wrenches: Vec<crate::rapier::ledger::Wrench>,
     /// Spring and contact elastic energy at the state before the current step, J.
     source_energy_before: f64,
+    /// The joint motors in Rapier, with the index of their scene joint: their impulses over each
+    /// step give their work.
+    motor_joints: Vec<(ImpulseJointHandle, JointAxis, usize)>,
     reference_axis: Vector,
     /// Output rows.
     pub table: Table,
@@ -182,8 +188,8 @@ pub struct Twin {
 /// Conservation checks over every step.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Invariants {
-    /// A prescribed motion or a motor drives the scene: it does work the balance does not know,
-    /// so the energy figures are null.
+    /// A prescribed motion drives the scene: it does work the balance does not know, so the
+    /// energy figures are null. (A joint motor's work is in the balance: `motor_work_j`.)
     #[serde(skip)]
     pub driven: bool,
     /// Largest `|P(t) - P(0)|` over the largest single-body linear momentum seen; null when the
@@ -192,9 +198,9 @@ pub struct Invariants {
     /// Largest `|L(t) - L(0)|` (about the origin) over the largest single-body angular momentum
     /// seen; null when the scene is not free-floating.
     pub angular_momentum_drift: Option<f64>,
-    /// Largest growth of the energy balance `E(t) + D(t) - E(0)` (E: kinetic, gravity, spring and
-    /// contact elastic energy; D: the work dissipated so far by contact damping and friction) over
-    /// the energy scale. Fixed supports and ideal joints do no work, so the balance holds with
+    /// Largest growth of the energy balance `E(t) + D(t) - W(t) - E(0)` (E: kinetic, gravity,
+    /// spring and contact elastic energy; D: the work dissipated so far by contact damping and
+    /// friction; W: the joint motors' work) over the energy scale. Fixed supports and ideal joints do no work, so the balance holds with
     /// gravity and grounds too, and energy gained by the integration shows even in a run that
     /// dissipates. Null when nothing moved (an energy scale below 1e-9 J: no scale to judge by),
     /// and when a prescribed motion drives the scene (its work is not in the balance).
@@ -208,6 +214,10 @@ pub struct Invariants {
     pub peak_kinetic_energy_j: f64,
     /// Work dissipated by contact damping and friction over the run, J.
     pub dissipated_j: f64,
+    /// Work done by the joint motors on the bodies over the run, J: at each step, the impulse
+    /// Rapier's motor row applied times the joint's speed at the step's start. The energy
+    /// balance counts it as energy put in: `E(t) + D(t) - W(t) - E(0)`.
+    pub motor_work_j: f64,
     #[serde(skip)]
     free_floating: bool,
     #[serde(skip)]
@@ -532,8 +542,9 @@ impl Simulation {
         let t = self.time();
         let gravity = self.world.gravity;
         let rows = !self.skip_rows;
+        let lag = 0.5 * self.stepper.last_dt();
         for twin in &mut self.twins {
-            twin.before_step(&self.world.bodies, gravity, t, rows);
+            twin.before_step(&self.world.bodies, gravity, t, lag, rows);
         }
         let target = self.target();
         let info = {
@@ -543,12 +554,13 @@ impl Simulation {
                 .map_err(|e| name_step_field(e, "run.dt_s"))?
         };
         for twin in &mut self.twins {
-            twin.after_step(&self.world.bodies, &info, gravity);
-            if rows {
-                twin.complete_row_motion(&self.world.bodies, &info);
-            }
+            twin.after_step(
+                &self.world.bodies,
+                &self.world.impulse_joints,
+                &info,
+                gravity,
+            );
         }
-        // Rows up to this state, now that its step gave its velocities and accelerations.
         self.write_rows(t);
         self.t_prev = t;
         if let [ideal, clear] = self.twins.as_slice() {
@@ -558,8 +570,8 @@ impl Simulation {
         Ok(())
     }
 
-    /// Records the final state: invariants, a last row at `end_s` whose forces are those at that
-    /// state (ideal reactions from one more step, taken and undone), final metrics.
+    /// Records the final state: invariants, a last row at `end_s` (its reactions, velocities and
+    /// accelerations solved at that state like every other), final metrics.
     fn finish(&mut self) -> Result<()> {
         {
             let mut sources = sources(&mut self.twins);
@@ -568,26 +580,9 @@ impl Simulation {
         let t = self.time();
         let gravity = self.world.gravity;
         let rows = !self.skip_rows;
+        let lag = 0.5 * self.stepper.last_dt();
         for twin in &mut self.twins {
-            twin.before_step(&self.world.bodies, gravity, t, rows);
-        }
-        if rows && self.scene.run.body_motion {
-            // The final state's velocities and accelerations from one more step, taken and
-            // undone.
-            let mut twins = std::mem::take(&mut self.twins);
-            let peeked = {
-                let mut sources = sources(&mut twins);
-                let dt = self.scene.run.dt_s;
-                self.stepper
-                    .peek(&mut self.world, &mut sources, dt, |world, info| {
-                        (world.bodies.clone(), *info)
-                    })
-            };
-            self.twins = twins;
-            let (bodies, info) = peeked.map_err(|e| name_step_field(e, "run.dt_s"))?;
-            for twin in &mut self.twins {
-                twin.complete_row_motion(&bodies, &info);
-            }
+            twin.before_step(&self.world.bodies, gravity, t, lag, rows);
         }
         self.write_rows(t);
         let duration = self.time();
@@ -820,8 +815,9 @@ impl Twin {
                 ideal_hinges.push(i);
             }
         }
-        let mut joints = Vec::new();
-        for j in &scene.joints {
+        let (mut joints, mut motors, mut motor_columns) = (Vec::new(), Vec::new(), Vec::new());
+        let mut motor_joints = Vec::new();
+        for (k, j) in scene.joints.iter().enumerate() {
             let (i1, i2) = (
                 scene.body_index(&j.body1).unwrap(),
                 scene.body_index(&j.body2).unwrap(),
@@ -840,14 +836,32 @@ impl Twin {
                     if let Some(l) = limits_m {
                         rj = rj.limits(*l);
                     }
-                    world.impulse_joints.insert(b1, b2, rj, true);
-                    IdealJoint::Prismatic(IdealPrismatic {
+                    let ideal = IdealPrismatic {
                         body1: b1,
                         body2: b2,
                         local_anchor1: a1,
                         local_anchor2: a2,
                         local_axis1: axis,
-                    })
+                    };
+                    // Validated: only linear motors on a prismatic joint.
+                    let ideal = match motor_of(j.motor.as_ref()) {
+                        Some(Motor::Held { target, factor }) => {
+                            rj = rj.motor_velocity(target, factor);
+                            IdealJoint::MotorPrismatic(ideal)
+                        }
+                        Some(Motor::Soft(m)) => {
+                            rj = rj
+                                .set_motor(m.target_pos, m.target_vel, m.stiffness, m.damping)
+                                .motor_model(MotorModel::ForceBased);
+                            IdealJoint::SoftMotorPrismatic(ideal, m)
+                        }
+                        None => IdealJoint::Prismatic(ideal),
+                    };
+                    let h = world.impulse_joints.insert(b1, b2, rj, true);
+                    if j.motor.is_some() {
+                        motor_joints.push((h, JointAxis::LinX, k));
+                    }
+                    ideal
                 }
                 JointKindSpec::Revolute { axis } => {
                     let axis = Vector::from(*axis).normalize();
@@ -862,20 +876,25 @@ impl Twin {
                         local_anchor2: a2,
                         local_axis1: axis,
                     };
-                    match &j.motor {
-                        Some(MotorSpec::Velocity {
-                            target_rad_s,
-                            factor,
-                        }) => {
-                            rj = rj.motor_velocity(*target_rad_s, *factor);
-                            world.impulse_joints.insert(b1, b2, rj, true);
+                    // Validated: only angular motors on a revolute joint.
+                    let ideal = match motor_of(j.motor.as_ref()) {
+                        Some(Motor::Held { target, factor }) => {
+                            rj = rj.motor_velocity(target, factor);
                             IdealJoint::MotorRevolute(ideal)
                         }
-                        None => {
-                            world.impulse_joints.insert(b1, b2, rj, true);
-                            IdealJoint::Revolute(ideal)
+                        Some(Motor::Soft(m)) => {
+                            rj = rj
+                                .motor(m.target_pos, m.target_vel, m.stiffness, m.damping)
+                                .motor_model(MotorModel::ForceBased);
+                            IdealJoint::SoftMotorRevolute(ideal, m)
                         }
+                        None => IdealJoint::Revolute(ideal),
+                    };
+                    let h = world.impulse_joints.insert(b1, b2, rj, true);
+                    if j.motor.is_some() {
+                        motor_joints.push((h, JointAxis::AngX, k));
                     }
+                    ideal
                 }
                 JointKindSpec::Fixed => {
                     let rj = FixedJointBuilder::new()
@@ -906,6 +925,14 @@ impl Twin {
             };
             ideal_joints.push(ideal);
             joints.push((j.name.clone(), 0.0));
+            motors.push(j.motor.as_ref().map(|_| 0.0));
+            if j.motor.is_some() {
+                let unit = match j.kind {
+                    JointKindSpec::Prismatic { .. } => "n",
+                    _ => "nm",
+                };
+                motor_columns.push(format!("{}_motor_{unit}", j.name));
+            }
         }
         let mut columns = vec!["t_s".to_string()];
         for b in &bodies {
@@ -940,6 +967,15 @@ impl Twin {
         for (name, _) in &joints {
             columns.push(format!("{name}_force_n"));
         }
+        columns.extend(motor_columns);
+        // The rows' velocities and accelerations of every dynamic body come from the solve,
+        // held by an ideal joint or not.
+        let mut reactions = ReactionSolver::default();
+        reactions.track = bodies
+            .iter()
+            .filter(|b| !b.fixed)
+            .map(|b| b.handle)
+            .collect();
         Ok(Twin {
             kind,
             bodies,
@@ -949,11 +985,13 @@ impl Twin {
             ideal_joints,
             ideal_hinges,
             joints,
+            motors,
             body_motion,
             prescribed,
-            reactions: ReactionSolver::default(),
+            reactions,
             source_wrenches: Vec::new(),
             source_energy_before: 0.0,
+            motor_joints,
             reference_axis: Vector::from(scene.reference_axis).normalize(),
             contact_columns: columns
                 .iter()
@@ -967,8 +1005,7 @@ impl Twin {
             invariants: Invariants {
                 free_floating: scene.gravity == [0.0; 3]
                     && scene.bodies.iter().all(|b| !b.fixed && b.motion.is_none()),
-                driven: scene.bodies.iter().any(|b| b.motion.is_some())
-                    || scene.joints.iter().any(|j| j.motor.is_some()),
+                driven: scene.bodies.iter().any(|b| b.motion.is_some()),
                 ..Invariants::default()
             },
         })
@@ -976,7 +1013,15 @@ impl Twin {
 
     /// Reads the state before a step (from the sources' evaluation at it): invariants, the
     /// clearance samples and forces, the angles, and (with `rows`) the row values of the state.
-    fn before_step(&mut self, bodies: &RigidBodySet, gravity: Vector, t: f64, rows: bool) {
+    /// `lag`: how long before the state the stored velocities are (half the last step), s.
+    fn before_step(
+        &mut self,
+        bodies: &RigidBodySet,
+        gravity: Vector,
+        t: f64,
+        lag: f64,
+        rows: bool,
+    ) {
         let axis_ref = self.reference_axis;
         for b in &mut self.bodies {
             let rb = &bodies[b.handle];
@@ -1014,7 +1059,7 @@ impl Twin {
                 };
             }
         }
-        self.solve_ideal_reactions(bodies, gravity, t);
+        self.solve_ideal_reactions(bodies, gravity, t, lag);
         self.source_energy_before = self.drives.potential_energy()
             + self
                 .clearance
@@ -1029,9 +1074,24 @@ impl Twin {
 
     /// Completes the step that started from the state [`before_step`](Self::before_step) read:
     /// ideal reactions (which only the step determines), metrics of that state over the step.
-    fn after_step(&mut self, bodies: &RigidBodySet, info: &StepInfo, gravity: Vector) {
+    fn after_step(
+        &mut self,
+        bodies: &RigidBodySet,
+        joints: &ImpulseJointSet,
+        info: &StepInfo,
+        gravity: Vector,
+    ) {
         self.update_force_metrics(info.t0, info.dt);
         self.update_invariants(bodies, gravity, info);
+        // The motors' work over the step: the angular or linear impulse Rapier's motor row
+        // applied to body 2 (minus its stored impulse) times the joint's speed at the state the
+        // step started from (the solve's synchronous one), what a kick does to kinetic energy.
+        let n = self.ideal_hinges.len();
+        for &(h, axis, k) in &self.motor_joints {
+            if let (Some(j), Some(rate)) = (joints.get(h), self.reactions.motor_rate(n + k)) {
+                self.invariants.motor_work_j -= j.data.motors[axis as usize].impulse * rate;
+            }
+        }
         // Work of the step's damping and friction forces over the step's motion: the
         // penetration change, and the slip at the step's velocity.
         for h in &self.hinges {
@@ -1047,49 +1107,15 @@ impl Twin {
         }
     }
 
-    /// Completes the body motion of the current row from the step taken from its state:
-    /// a dynamic body's velocity at the state is the synchronous one,
-    /// `(h v[n-1/2] + h_prev v[n+1/2])/(h_prev + h)`, and its acceleration
-    /// `(v[n+1/2] - v[n-1/2])/kick`, what the step applied (the stored velocities live at half
-    /// steps); a driven body's are exact (`w x r` and `w x (w x r)` for a spin, 0 for a
-    /// translation).
-    fn complete_row_motion(&mut self, bodies_after: &RigidBodySet, info: &StepInfo) {
-        if !self.body_motion {
+    /// Ideal-joint reactions, motor torques and the bodies' velocities and accelerations at the
+    /// current state, exact: the constrained rigid-body equations solved for the joint forces
+    /// ([`ReactionSolver`]), whatever the step control (the stored velocities, `lag` before the
+    /// state, advanced to it).
+    fn solve_ideal_reactions(&mut self, bodies: &RigidBodySet, gravity: Vector, t: f64, lag: f64) {
+        if self.ideal_joints.is_empty() && !self.body_motion {
             return;
         }
-        let (h, h_prev) = (info.dt, (2.0 * info.kick - info.dt).max(0.0));
-        let mut col = 1 + 2 * self.bodies.len();
-        for b in self.bodies.iter().filter(|b| b.moves) {
-            let (vel, acc) = if let Some(k) = b.table {
-                // A tabulated drive: the table's acceleration at the state.
-                let (_, a, w, alpha) = self.prescribed.motions[k].rates(info.t0);
-                let r = b.rotation_before * b.local_com;
-                (None, a + alpha.cross(r) + w.cross(w.cross(r)))
-            } else if b.fixed {
-                // Driven: the row's velocity is exact; the acceleration is the spin's.
-                let rb = &bodies_after[b.handle];
-                let w = rb.angvel();
-                let r = b.rotation_before * b.local_com;
-                (None, w.cross(w.cross(r)))
-            } else {
-                let after = bodies_after[b.handle].linvel();
-                let sync = (h * b.linvel_before + h_prev * after) / (h_prev + h);
-                (Some(sync), (after - b.linvel_before) / info.kick)
-            };
-            if let Some(v) = vel {
-                self.row_cur[col + 3..col + 6].copy_from_slice(&[v.x, v.y, v.z]);
-            }
-            self.row_cur[col + 6..col + 9].copy_from_slice(&[acc.x, acc.y, acc.z]);
-            col += 9;
-        }
-    }
-
-    /// Ideal-joint reactions at the current state, exact: the constrained rigid-body equations
-    /// solved for the joint forces ([`ReactionSolver`]), whatever the step control.
-    fn solve_ideal_reactions(&mut self, bodies: &RigidBodySet, gravity: Vector, t: f64) {
-        if self.ideal_joints.is_empty() {
-            return;
-        }
+        self.reactions.velocity_lag = lag;
         // Tabulated drives at this state: their velocities and accelerations.
         self.reactions.kinematic.clear();
         for b in &self.bodies {
@@ -1123,6 +1149,11 @@ impl Twin {
             }
             for (j, f) in self.joints.iter_mut().zip(&forces[n..]) {
                 j.1 = f.length();
+            }
+            for (k, m) in self.motors.iter_mut().enumerate() {
+                if let Some(m) = m {
+                    *m = self.reactions.motor(n + k).unwrap_or(0.0);
+                }
             }
         }
     }
@@ -1166,7 +1197,7 @@ impl Twin {
             inv.max_l = inv.max_l.max(lb.length());
         }
         pe += self.source_energy_before;
-        let e = ke + pe + inv.dissipated_j;
+        let e = ke + pe + inv.dissipated_j - inv.motor_work_j;
         let (p0, l0, e0, pe0) = *inv.p0.get_or_insert((p, l, e, pe));
         inv.max_dp = inv.max_dp.max((p - p0).length());
         inv.max_dl = inv.max_dl.max((l - l0).length());
@@ -1201,20 +1232,27 @@ impl Twin {
             for b in self.bodies.iter().filter(|b| b.moves) {
                 let rb = &bodies[b.handle];
                 let p = *rb.position() * b.local_com;
-                // The velocity of the centre of mass (a driven body's frame turns about its
-                // origin, so its centre of mass moves with `w x r`; a tabulated drive's
-                // velocities at the state are the table's, Rapier's the last step's mean).
-                let (v0, w) = match b.table {
-                    Some(k) => {
-                        let (v, _, w, _) = self.prescribed.motions[k].rates(t);
-                        (v, w)
+                let r = *rb.rotation() * b.local_com;
+                // The centre of mass's velocity and acceleration at the state: a dynamic body's
+                // from the constrained solve (`solve_ideal_reactions`); a tabulated drive's from
+                // its table; a steady drive's those of its spin (its frame turns about its
+                // origin, so its centre of mass moves with `w x r`).
+                let (vel, acc) = match (b.table, b.fixed) {
+                    (Some(k), _) => {
+                        let (v0, a, w, alpha) = self.prescribed.motions[k].rates(t);
+                        (v0 + w.cross(r), a + alpha.cross(r) + w.cross(w.cross(r)))
                     }
-                    None => (rb.linvel(), rb.angvel()),
+                    (None, true) => {
+                        let w = rb.angvel();
+                        (rb.linvel() + w.cross(r), w.cross(w.cross(r)))
+                    }
+                    (None, false) => {
+                        let (vel, _) = self.reactions.velocity(b.handle).unwrap_or_default();
+                        let (acc, _) = self.reactions.acceleration(b.handle).unwrap_or_default();
+                        (vel, acc)
+                    }
                 };
-                let vel = v0 + w.cross(p - rb.translation());
-                // Velocity and acceleration are completed by the step from this state
-                // (`complete_row_motion`).
-                v.extend_from_slice(&[p.x, p.y, p.z, vel.x, vel.y, vel.z, 0.0, 0.0, 0.0]);
+                v.extend_from_slice(&[p.x, p.y, p.z, vel.x, vel.y, vel.z, acc.x, acc.y, acc.z]);
             }
         }
         for h in &self.hinges {
@@ -1241,6 +1279,7 @@ impl Twin {
         for (_, f) in &self.joints {
             v.push(*f);
         }
+        v.extend(self.motors.iter().flatten());
     }
 
     /// Appends the row at time `t`, `w` of the way from the previous state to the current one
@@ -1300,6 +1339,52 @@ impl Twin {
         }
         m
     }
+}
+
+/// A scene motor in Rapier's terms.
+enum Motor {
+    /// A velocity motor that holds its speed: target (rad/s or m/s) and damping factor (1/s).
+    Held { target: f64, factor: f64 },
+    /// A force-based spring-damper.
+    Soft(SoftMotor),
+}
+
+fn motor_of(spec: Option<&MotorSpec>) -> Option<Motor> {
+    Some(match spec? {
+        MotorSpec::Velocity {
+            target_rad_s,
+            factor,
+        } => Motor::Held {
+            target: *target_rad_s,
+            factor: *factor,
+        },
+        MotorSpec::LinearVelocity { target_m_s, factor } => Motor::Held {
+            target: *target_m_s,
+            factor: *factor,
+        },
+        MotorSpec::Position {
+            target_rad,
+            stiffness_nm_per_rad,
+            damping_nm_s_per_rad,
+            target_rad_s,
+        } => Motor::Soft(SoftMotor::force_based(
+            *target_rad,
+            *target_rad_s,
+            *stiffness_nm_per_rad,
+            *damping_nm_s_per_rad,
+        )),
+        MotorSpec::LinearPosition {
+            target_m,
+            stiffness_n_per_m,
+            damping_n_s_per_m,
+            target_m_s,
+        } => Motor::Soft(SoftMotor::force_based(
+            *target_m,
+            *target_m_s,
+            *stiffness_n_per_m,
+            *damping_n_s_per_m,
+        )),
+    })
 }
 
 /// The in-plane `u` direction of a hinge: the world axis least aligned with `axis`, made

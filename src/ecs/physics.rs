@@ -570,6 +570,9 @@ impl Physics {
         }
         self.source_wrenches
             .extend_from_slice(self.clearance.wrenches());
+        // Rapier's stored velocities are half the last step behind the positions (the runner's
+        // correction, the same solver).
+        self.reactions.velocity_lag = 0.5 * self.stepper.last_dt();
         self.reactions
             .solve_with(
                 &self.world.bodies,

@@ -9,6 +9,7 @@ use std::process::Command;
 #[allow(dead_code)]
 #[path = "../examples/drop_in.rs"]
 mod drop_in;
+#[cfg(feature = "ecs")]
 #[allow(dead_code)]
 #[path = "../examples/ecs.rs"]
 mod ecs;
@@ -68,6 +69,7 @@ fn drop_in_converts_the_elbow_and_the_arm_rattles() {
     }
 }
 
+#[cfg(feature = "ecs")]
 #[test]
 fn ecs_swap_is_the_plain_api_run() {
     // The ECS layer is thin: the arm with a ClearanceHinge steps exactly like drop_in's arm
@@ -235,12 +237,14 @@ fn example_binaries_run_headless_and_print_the_comparison() {
             build.args(["--profile", other]);
         }
     }
+    // The `ecs` example needs the feature of the same name.
+    if cfg!(feature = "ecs") {
+        build.args(["--example", "ecs"]);
+    }
     let out = build
         .args([
             "--example",
             "drop_in",
-            "--example",
-            "ecs",
             "--example",
             "solar_panel",
             "--example",
@@ -274,6 +278,9 @@ fn example_binaries_run_headless_and_print_the_comparison() {
             &["ideal slider acceleration", "closed form", "first impact"][..],
         ),
     ] {
+        if name == "ecs" && !cfg!(feature = "ecs") {
+            continue;
+        }
         let exe = dir.join(format!("{name}{}", std::env::consts::EXE_SUFFIX));
         let out = Command::new(&exe)
             .output()

@@ -1,7 +1,7 @@
-//! The runner: builds a scene twice in one Rapier world, an ideal twin (every hinge a Rapier
-//! revolute joint) and a clearance twin (hinges with clearance become [`ClearanceJoint`](crate::rapier::joint::ClearanceJoint)s), steps
-//! both together, and records both.
+//! A twin: its bodies, hinges, joints and drives built from the scene, tracked, and its rows.
 
+use super::HingeMetrics;
+use super::invariants::Invariants;
 use crate::error::Result;
 use crate::model::angle::{HingeAngle, UnwrappedAngle, twist_angle};
 use crate::model::laws::NormalForceLaw;
@@ -15,14 +15,13 @@ use crate::rapier::reaction::{
     IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, KinematicState,
     ReactionSolver, SoftMotor,
 };
-use crate::rapier::stepper::{ForceSource, GuardReport, StepInfo, Stepper};
+use crate::rapier::stepper::StepInfo;
 use crate::scene::{JointKindSpec, MotionSpec, MotorSpec, Scene};
 use crate::table::Table;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
-use std::time::Instant;
 
 /// Which hinges a twin models with clearance.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -44,34 +43,13 @@ impl TwinKind {
     }
 }
 
-/// Which twins to build.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Twins {
-    /// Both, side by side in one world (the default).
-    #[default]
-    Both,
-    /// Only the ideal twin (for cost measurements).
-    IdealOnly,
-    /// Only the clearance twin (for cost measurements).
-    ClearanceOnly,
-}
-
-/// Run options beyond the scene.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct RunOptions {
-    /// Which twins to build.
-    pub twins: Twins,
-    /// Keep output rows (off for benchmarks: metrics are still computed every step).
-    pub skip_rows: bool,
-}
-
 #[derive(Clone, Debug)]
-struct BodyTrack {
-    name: String,
-    handle: RigidBodyHandle,
-    mass: f64,
+pub(super) struct BodyTrack {
+    pub(super) name: String,
+    pub(super) handle: RigidBodyHandle,
+    pub(super) mass: f64,
     /// Fixed or driven by a prescribed motion: outside the energy and momentum balances.
-    fixed: bool,
+    pub(super) fixed: bool,
     /// Not a fixed body (driven bodies move).
     moves: bool,
     /// The body's tabulated motion (index in the twin's prescribed set).
@@ -79,11 +57,11 @@ struct BodyTrack {
     /// The centre of mass in the body's frame (not the origin for a spinning body), m.
     local_com: Vector,
     angle: UnwrappedAngle,
-    linvel_before: Vector,
+    pub(super) linvel_before: Vector,
     /// Angular velocity, centre of mass and rotation at the state before the current step.
-    angvel_before: Vector,
-    com_before: Vector,
-    rotation_before: rapier3d_f64::math::Rotation,
+    pub(super) angvel_before: Vector,
+    pub(super) com_before: Vector,
+    pub(super) rotation_before: rapier3d_f64::math::Rotation,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -93,26 +71,26 @@ enum HingeJoint {
 }
 
 #[derive(Clone, Debug)]
-struct HingeTrack {
-    name: String,
+pub(super) struct HingeTrack {
+    pub(super) name: String,
     joint: HingeJoint,
     bearing: usize,
     journal: usize,
     local_axis1: Vector,
     local_u1: Vector,
     local_v1: Vector,
-    angle: HingeAngle,
+    pub(super) angle: HingeAngle,
     /// Force magnitude at the state before the current step (the clearance hook's force, or the
     /// ideal reaction once the step determined it), N.
-    force: f64,
+    pub(super) force: f64,
     /// The clearance contact at the state before the current step.
     sample: ContactSample,
-    recorder: ImpactRecorder,
+    pub(super) recorder: ImpactRecorder,
 }
 
 impl HingeTrack {
     /// The state before the current step, for the recorder.
-    fn observation(&self) -> ContactObservation {
+    pub(super) fn observation(&self) -> ContactObservation {
         match self.joint {
             HingeJoint::Ideal => ContactObservation::ideal(self.force),
             HingeJoint::Clearance(_) => ContactObservation {
@@ -140,15 +118,13 @@ struct ContactSample {
     friction_force: f64,
 }
 
-pub use crate::rapier::metrics::HingeMetrics;
-
 /// One twin: its bodies, joints, drives and records.
 #[derive(Debug)]
 pub struct Twin {
     /// Ideal or clearance.
     pub kind: TwinKind,
-    bodies: Vec<BodyTrack>,
-    hinges: Vec<HingeTrack>,
+    pub(super) bodies: Vec<BodyTrack>,
+    pub(super) hinges: Vec<HingeTrack>,
     /// The clearance joints of this twin.
     pub clearance: ClearanceJointSet,
     /// The drives of this twin.
@@ -169,11 +145,11 @@ pub struct Twin {
     /// The drives' and clearance joints' wrenches at the current state (scratch).
     source_wrenches: Vec<crate::rapier::ledger::Wrench>,
     /// Spring and contact elastic energy at the state before the current step, J.
-    source_energy_before: f64,
+    pub(super) source_energy_before: f64,
     /// The joint motors in Rapier, with the index of their scene joint: their impulses over each
     /// step give their work.
     motor_joints: Vec<(ImpulseJointHandle, JointAxis, usize)>,
-    reference_axis: Vector,
+    pub(super) reference_axis: Vector,
     /// Output rows.
     pub table: Table,
     /// Row values at the previous and the current state.
@@ -185,442 +161,8 @@ pub struct Twin {
     pub invariants: Invariants,
 }
 
-/// Conservation checks over every step.
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct Invariants {
-    /// A prescribed motion drives the scene: it does work the balance does not know, so the
-    /// energy figures are null. (A joint motor's work is in the balance: `motor_work_j`.)
-    #[serde(skip)]
-    pub driven: bool,
-    /// Largest `|P(t) - P(0)|` over the largest single-body linear momentum seen; null when the
-    /// scene is not free-floating (gravity or a fixed body: momentum is not conserved).
-    pub linear_momentum_drift: Option<f64>,
-    /// Largest `|L(t) - L(0)|` (about the origin) over the largest single-body angular momentum
-    /// seen; null when the scene is not free-floating.
-    pub angular_momentum_drift: Option<f64>,
-    /// Largest growth of the energy balance `E(t) + D(t) - W(t) - E(0)` (E: kinetic, gravity,
-    /// spring and contact elastic energy; D: the work dissipated so far by contact damping and
-    /// friction; W: the joint motors' work) over the energy scale. Fixed supports and ideal joints do no work, so the balance holds with
-    /// gravity and grounds too, and energy gained by the integration shows even in a run that
-    /// dissipates. Null when nothing moved (an energy scale below 1e-9 J: no scale to judge by),
-    /// and when a prescribed motion drives the scene (its work is not in the balance).
-    pub energy_growth: Option<f64>,
-    /// Largest `|E(t) + D(t) - E(0)|` over the energy scale (null when nothing moved).
-    pub energy_error: Option<f64>,
-    /// The energy scale: the larger of the peak kinetic energy and the largest change of the
-    /// potential energy, J.
-    pub energy_scale_j: f64,
-    /// Peak kinetic energy, J.
-    pub peak_kinetic_energy_j: f64,
-    /// Work dissipated by contact damping and friction over the run, J.
-    pub dissipated_j: f64,
-    /// Work done by the joint motors on the bodies over the run, J: at each step, the impulse
-    /// Rapier's motor row applied times the joint's speed at the step's start. The energy
-    /// balance counts it as energy put in: `E(t) + D(t) - W(t) - E(0)`.
-    pub motor_work_j: f64,
-    #[serde(skip)]
-    free_floating: bool,
-    #[serde(skip)]
-    p0: Option<(Vector, Vector, f64, f64)>,
-    #[serde(skip)]
-    max_p: f64,
-    #[serde(skip)]
-    max_l: f64,
-    #[serde(skip)]
-    max_dp: f64,
-    #[serde(skip)]
-    max_dl: f64,
-    #[serde(skip)]
-    max_de: f64,
-    #[serde(skip)]
-    max_abs_de: f64,
-    #[serde(skip)]
-    max_dpe: f64,
-}
-
-/// Below this energy scale (J) nothing moved enough for the energy balance to be judged.
-const MIN_ENERGY_SCALE_J: f64 = 1e-9;
-
-/// Energy growth above this fraction of the energy scale is a guard violation.
-pub const ENERGY_GROWTH_LIMIT: f64 = 1e-2;
-
-/// A scene built in a Rapier world, ready to step.
-pub struct Simulation {
-    /// The Rapier world holding both twins.
-    pub world: PhysicsWorld,
-    /// The twins, ideal first.
-    pub twins: Vec<Twin>,
-    /// The step control (the same public piece a plain-Rapier loop uses).
-    pub stepper: Stepper,
-    scene: Scene,
-    /// Index of the next output row (row `k` is at `k * output_interval_s`, the last at `end_s`).
-    next_row: u64,
-    /// Time of the previous state (rows between it and the current one are interpolated).
-    t_prev: f64,
-    /// The row at `end_s` is written.
-    rows_done: bool,
-    skip_rows: bool,
-    comparison: ComparisonSums,
-}
-
-pub use crate::rapier::stepper::left_physical_range;
-
-/// The clearance twin against the ideal twin, from every internal step (both twins built).
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct Comparison {
-    /// Per body: deviation of its angular rate (about the reference axis) from the ideal twin's.
-    pub bodies: BTreeMap<String, RateDeviation>,
-    /// Per hinge: settling of the joint force.
-    pub hinges: BTreeMap<String, Settling>,
-}
-
-/// Rate deviation of one body, clearance twin minus ideal twin.
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct RateDeviation {
-    /// Root-mean-square over the run (time-weighted), deg/s.
-    pub rms_deg_s: f64,
-    /// Largest absolute deviation, deg/s.
-    pub max_deg_s: f64,
-}
-
-/// When the joint force of a hinge settles.
-#[derive(Clone, Debug, Default, Serialize)]
-pub struct Settling {
-    /// The last time at which the clearance joint force exceeded the ideal joint force by more
-    /// than `band_n`: after it the force stays within one ideal peak of the rigid hinge's load.
-    /// 0 when it never did.
-    pub settling_time_s: f64,
-    /// The band: the ideal twin's peak joint force on this hinge, N.
-    pub band_n: f64,
-}
-
-/// Running sums behind [`Comparison`].
-#[derive(Clone, Debug, Default)]
-struct ComparisonSums {
-    rate_sq_time: Vec<f64>,
-    rate_max: Vec<f64>,
-    /// Per hinge, a stack of `(t, excess)` with decreasing excess and increasing time: for any band
-    /// `b`, the last time the excess exceeded `b` is the latest entry above `b`.
-    excess: Vec<Vec<(f64, f64)>>,
-}
-
-impl ComparisonSums {
-    fn record(&mut self, ideal: &Twin, clear: &Twin, bodies: &RigidBodySet, t: f64, dt: f64) {
-        let n = ideal.bodies.len();
-        self.rate_sq_time.resize(n, 0.0);
-        self.rate_max.resize(n, 0.0);
-        self.excess.resize(ideal.hinges.len(), Vec::new());
-        let axis = ideal.reference_axis;
-        for (i, (bi, bc)) in ideal.bodies.iter().zip(&clear.bodies).enumerate() {
-            let d = (bodies[bc.handle].angvel() - bodies[bi.handle].angvel())
-                .dot(axis)
-                .to_degrees();
-            self.rate_sq_time[i] += d * d * dt;
-            self.rate_max[i] = self.rate_max[i].max(d.abs());
-        }
-        for (k, (hi, hc)) in ideal.hinges.iter().zip(&clear.hinges).enumerate() {
-            let excess = hc.force - hi.force;
-            // The band is the ideal peak at the end, at least the peak so far: an excess within
-            // it can never be the answer, so it is not stored (memory stays bounded in practice).
-            if excess <= hi.recorder.metrics().peak_force_n {
-                continue;
-            }
-            let stack = &mut self.excess[k];
-            while stack.last().is_some_and(|&(_, e)| e <= excess) {
-                stack.pop();
-            }
-            stack.push((t, excess));
-        }
-    }
-
-    fn finish(&self, ideal: &Twin, duration: f64) -> Comparison {
-        let mut c = Comparison::default();
-        for (i, b) in ideal.bodies.iter().enumerate() {
-            let rms = if duration > 0.0 {
-                (self.rate_sq_time.get(i).copied().unwrap_or(0.0) / duration).sqrt()
-            } else {
-                0.0
-            };
-            c.bodies.insert(
-                b.name.clone(),
-                RateDeviation {
-                    rms_deg_s: rms,
-                    max_deg_s: self.rate_max.get(i).copied().unwrap_or(0.0),
-                },
-            );
-        }
-        for (k, h) in ideal.hinges.iter().enumerate() {
-            let band = h.recorder.metrics().peak_force_n;
-            let last = self
-                .excess
-                .get(k)
-                .and_then(|s| s.iter().rev().find(|&&(_, e)| e > band))
-                .map_or(0.0, |&(t, _)| t);
-            c.hinges.insert(
-                h.name.clone(),
-                Settling {
-                    settling_time_s: last,
-                    band_n: band,
-                },
-            );
-        }
-        c
-    }
-}
-
-/// Where a run is, passed to the callback of [`Simulation::run_with_progress`].
-#[derive(Clone, Copy, Debug)]
-pub struct Progress {
-    /// Simulated time reached, s.
-    pub t: f64,
-    /// Simulated time at the end of the run, s.
-    pub end: f64,
-    /// Internal steps taken so far.
-    pub steps: u64,
-}
-
-/// The result of a whole run.
-#[derive(Debug)]
-pub struct RunResult {
-    /// The scene that ran (after overrides).
-    pub scene: Scene,
-    /// Twins with their tables and invariants.
-    pub twins: Vec<Twin>,
-    /// Internal steps taken.
-    pub steps: u64,
-    /// Wall time of the whole run (both twins share one world), s.
-    pub wall_s: f64,
-    /// Clearance twin against ideal twin (when both were built).
-    pub comparison: Option<Comparison>,
-    /// What the run-time guards saw (the stepper's, plus energy growth).
-    pub guards: GuardReport,
-}
-
-impl Simulation {
-    /// Builds the world for `scene`.
-    pub fn new(scene: &Scene, options: RunOptions) -> Result<Simulation> {
-        scene.validate()?;
-        let control = scene.run.step_control();
-        control.validate().map_err(|e| e.within("run"))?;
-        let mut world = PhysicsWorld::new();
-        world.gravity = Vector::from(scene.gravity);
-        world.integration_parameters.dt = scene.run.dt_s;
-        // One substep: the hook's force is constant over the step (substeps gain energy).
-        world.integration_parameters.num_solver_iterations = 1;
-        let kinds: &[TwinKind] = match options.twins {
-            Twins::Both => &[TwinKind::Ideal, TwinKind::Clearance],
-            Twins::IdealOnly => &[TwinKind::Ideal],
-            Twins::ClearanceOnly => &[TwinKind::Clearance],
-        };
-        let mut twins = Vec::new();
-        for &kind in kinds {
-            twins.push(Twin::build(scene, kind, &mut world)?);
-        }
-        // Mass properties before the first step (Rapier computes them in it; the reactions and
-        // the hooks need them at the initial state).
-        crate::rapier::reaction::prepare_mass_properties(&mut world.bodies);
-        Ok(Simulation {
-            world,
-            twins,
-            stepper: Stepper::new(control),
-            scene: scene.clone(),
-            next_row: 0,
-            t_prev: 0.0,
-            rows_done: false,
-            skip_rows: options.skip_rows,
-            comparison: ComparisonSums::default(),
-        })
-    }
-
-    /// Simulated time, s.
-    pub fn time(&self) -> f64 {
-        self.stepper.time()
-    }
-
-    fn done(&self) -> bool {
-        self.time() >= self.scene.run.end_s
-    }
-
-    /// Writes the rows whose times lie in `(t_prev, t]` (and the row at 0 at the first state),
-    /// interpolated between the previous state and the current one: rows sit exactly at
-    /// multiples of `output_interval_s` (and at `end_s`) whatever the steps, and never change them.
-    fn write_rows(&mut self, t: f64) {
-        if self.skip_rows {
-            return;
-        }
-        let run = &self.scene.run;
-        let (oi, end) = (run.output_interval_s, run.end_s);
-        // Rounding of summed steps: a row within a billionth of a step counts as reached.
-        let slack = 1e-9 * run.max_dt_s.max(run.dt_s);
-        while !self.rows_done {
-            let grid = self.next_row as f64 * oi;
-            let last = grid >= end - slack;
-            let r = if last { end } else { grid };
-            if r > t + slack {
-                return;
-            }
-            let w = if t > self.t_prev {
-                ((r - self.t_prev) / (t - self.t_prev)).clamp(0.0, 1.0)
-            } else {
-                1.0
-            };
-            for twin in &mut self.twins {
-                twin.write_row(r, w);
-            }
-            self.next_row += 1;
-            self.rows_done = last;
-        }
-    }
-
-    /// Where the next step may go at most: the end. Rows never shorten a step (a row is the
-    /// first state at or after its time), so the physics is the same for any output interval.
-    fn target(&self) -> f64 {
-        self.scene.run.end_s
-    }
-
-    /// Runs to `run.end_s`.
-    pub fn run(self) -> Result<RunResult> {
-        self.run_with_progress(|_| {})
-    }
-
-    /// Runs to `run.end_s`, calling `progress` after every internal step (e.g. to show simulated
-    /// time, steps per second and an ETA on a terminal; the call should be cheap).
-    pub fn run_with_progress(mut self, mut progress: impl FnMut(&Progress)) -> Result<RunResult> {
-        let start = Instant::now();
-        while !self.done() {
-            self.step()?;
-            progress(&Progress {
-                t: self.time(),
-                end: self.scene.run.end_s,
-                steps: self.stepper.steps(),
-            });
-        }
-        self.finish()?;
-        let comparison = match self.twins.as_slice() {
-            [ideal, _] => Some(self.comparison.finish(ideal, self.time())),
-            _ => None,
-        };
-        let mut guards = self.stepper.guards().clone();
-        for twin in &self.twins {
-            let g = twin.invariants.energy_growth.unwrap_or(0.0);
-            if g > ENERGY_GROWTH_LIMIT {
-                guards.violation(&format!("energy:{}", twin.kind.name()), || {
-                    format!(
-                        "the {} twin gained energy: {} of its energy scale (limit {})",
-                        twin.kind.name(),
-                        crate::error::sig4(g),
-                        ENERGY_GROWTH_LIMIT
-                    )
-                });
-            }
-        }
-        if self.scene.run.strict && !guards.is_clean() {
-            return Err(crate::Error::Guard {
-                t: self.time(),
-                violations: guards.violations.join("; "),
-            });
-        }
-        Ok(RunResult {
-            comparison,
-            scene: self.scene,
-            twins: self.twins,
-            steps: self.stepper.steps(),
-            wall_s: start.elapsed().as_secs_f64(),
-            guards,
-        })
-    }
-
-    /// Advances one accepted internal step: records the state before it (invariants, a row when
-    /// due, the contact samples), lets the stepper take it, then completes what only the step
-    /// determines (ideal reactions, metrics).
-    pub fn step(&mut self) -> Result<()> {
-        {
-            // The sources' forces at the first state, before it is read.
-            let mut sources = sources(&mut self.twins);
-            self.stepper.prepare(&mut self.world, &mut sources)?;
-        }
-        let t = self.time();
-        let gravity = self.world.gravity;
-        let rows = !self.skip_rows;
-        let lag = 0.5 * self.stepper.last_dt();
-        for twin in &mut self.twins {
-            twin.before_step(&self.world.bodies, gravity, t, lag, rows);
-        }
-        let target = self.target();
-        let info = {
-            let mut sources = sources(&mut self.twins);
-            self.stepper
-                .step(&mut self.world, &mut sources, target)
-                .map_err(|e| name_step_field(e, "run.dt_s"))?
-        };
-        for twin in &mut self.twins {
-            twin.after_step(
-                &self.world.bodies,
-                &self.world.impulse_joints,
-                &info,
-                gravity,
-            );
-        }
-        self.write_rows(t);
-        self.t_prev = t;
-        if let [ideal, clear] = self.twins.as_slice() {
-            self.comparison
-                .record(ideal, clear, &self.world.bodies, info.t0, info.dt);
-        }
-        Ok(())
-    }
-
-    /// Records the final state: invariants, a last row at `end_s` (its reactions, velocities and
-    /// accelerations solved at that state like every other), final metrics.
-    fn finish(&mut self) -> Result<()> {
-        {
-            let mut sources = sources(&mut self.twins);
-            self.stepper.prepare(&mut self.world, &mut sources)?;
-        }
-        let t = self.time();
-        let gravity = self.world.gravity;
-        let rows = !self.skip_rows;
-        let lag = 0.5 * self.stepper.last_dt();
-        for twin in &mut self.twins {
-            twin.before_step(&self.world.bodies, gravity, t, lag, rows);
-        }
-        self.write_rows(t);
-        let duration = self.time();
-        for twin in &mut self.twins {
-            // The final state counts for peaks and onsets (it carries no time).
-            for h in &mut twin.hinges {
-                let obs = h.observation();
-                h.recorder.finish(duration, &obs);
-                h.recorder.set_final_angle_deg(h.angle.value().to_degrees());
-            }
-        }
-        Ok(())
-    }
-}
-
-/// The force sources of all twins, for the stepper.
-fn sources(twins: &mut [Twin]) -> Vec<&mut dyn ForceSource> {
-    let mut v: Vec<&mut dyn ForceSource> = Vec::with_capacity(3 * twins.len());
-    for t in twins.iter_mut() {
-        v.push(&mut t.drives);
-        v.push(&mut t.clearance);
-        if !t.prescribed.motions.is_empty() {
-            v.push(&mut t.prescribed);
-        }
-    }
-    v
-}
-
-/// Names the scene's step field in a step-limit error (the stepper knows only `dt`).
-fn name_step_field(mut e: crate::Error, name: &str) -> crate::Error {
-    if let crate::Error::StepTooLarge { field, .. } = &mut e {
-        *field = name.into();
-    }
-    e
-}
-
 impl Twin {
-    fn build(scene: &Scene, kind: TwinKind, world: &mut PhysicsWorld) -> Result<Twin> {
+    pub(super) fn build(scene: &Scene, kind: TwinKind, world: &mut PhysicsWorld) -> Result<Twin> {
         let mut bodies = Vec::new();
         let mut prescribed = PrescribedSet::default();
         for (i, b) in scene.bodies.iter().enumerate() {
@@ -1002,19 +544,18 @@ impl Twin {
             table: Table::new(columns),
             row_prev: Vec::new(),
             row_cur: Vec::new(),
-            invariants: Invariants {
-                free_floating: scene.gravity == [0.0; 3]
+            invariants: Invariants::new(
+                scene.gravity == [0.0; 3]
                     && scene.bodies.iter().all(|b| !b.fixed && b.motion.is_none()),
-                driven: scene.bodies.iter().any(|b| b.motion.is_some()),
-                ..Invariants::default()
-            },
+                scene.bodies.iter().any(|b| b.motion.is_some()),
+            ),
         })
     }
 
     /// Reads the state before a step (from the sources' evaluation at it): invariants, the
     /// clearance samples and forces, the angles, and (with `rows`) the row values of the state.
     /// `lag`: how long before the state the stored velocities are (half the last step), s.
-    fn before_step(
+    pub(super) fn before_step(
         &mut self,
         bodies: &RigidBodySet,
         gravity: Vector,
@@ -1074,7 +615,7 @@ impl Twin {
 
     /// Completes the step that started from the state [`before_step`](Self::before_step) read:
     /// ideal reactions (which only the step determines), metrics of that state over the step.
-    fn after_step(
+    pub(super) fn after_step(
         &mut self,
         bodies: &RigidBodySet,
         joints: &ImpulseJointSet,
@@ -1166,57 +707,6 @@ impl Twin {
         }
     }
 
-    /// Momentum and energy at the state before the step just taken, with its synchronous
-    /// velocities: the half-step velocities around it weighted by the steps,
-    /// `(h v_before + h_prev v_after)/(h_prev + h)` (second order, where the stored half-step
-    /// velocities alone would make the energy balance first order).
-    fn update_invariants(&mut self, bodies: &RigidBodySet, gravity: Vector, info: &StepInfo) {
-        let (h, h_prev) = (info.dt, (2.0 * info.kick - info.dt).max(0.0));
-        let sync = |before: Vector, after: Vector| (h * before + h_prev * after) / (h_prev + h);
-        let (mut p, mut l, mut ke, mut pe) = (Vector::ZERO, Vector::ZERO, 0.0, 0.0);
-        let inv = &mut self.invariants;
-        for b in &self.bodies {
-            if b.fixed {
-                continue;
-            }
-            let rb = &bodies[b.handle];
-            let com = b.com_before;
-            let v = sync(b.linvel_before, rb.linvel());
-            let w = sync(b.angvel_before, rb.angvel());
-            let mp = &rb.mass_properties().local_mprops;
-            // I w in world: R I_principal R^T w.
-            let rot = b.rotation_before * mp.principal_inertia_local_frame;
-            let iw = rot * (mp.principal_inertia() * (rot.inverse() * w));
-            let pb = b.mass * v;
-            let lb = com.cross(pb) + iw;
-            p += pb;
-            l += lb;
-            ke += 0.5 * b.mass * v.length_squared() + 0.5 * w.dot(iw);
-            pe -= b.mass * gravity.dot(com);
-            inv.max_p = inv.max_p.max(pb.length());
-            inv.max_l = inv.max_l.max(lb.length());
-        }
-        pe += self.source_energy_before;
-        let e = ke + pe + inv.dissipated_j - inv.motor_work_j;
-        let (p0, l0, e0, pe0) = *inv.p0.get_or_insert((p, l, e, pe));
-        inv.max_dp = inv.max_dp.max((p - p0).length());
-        inv.max_dl = inv.max_dl.max((l - l0).length());
-        inv.max_de = inv.max_de.max(e - e0);
-        inv.max_abs_de = inv.max_abs_de.max((e - e0).abs());
-        inv.max_dpe = inv.max_dpe.max((pe - pe0).abs());
-        inv.peak_kinetic_energy_j = inv.peak_kinetic_energy_j.max(ke);
-        inv.energy_scale_j = inv.peak_kinetic_energy_j.max(inv.max_dpe);
-        let rel = |d: f64, scale: f64| if scale > 0.0 { d / scale } else { 0.0 };
-        if inv.free_floating {
-            inv.linear_momentum_drift = Some(rel(inv.max_dp, inv.max_p));
-            inv.angular_momentum_drift = Some(rel(inv.max_dl, inv.max_l));
-        }
-        if inv.energy_scale_j >= MIN_ENERGY_SCALE_J && !inv.driven {
-            inv.energy_growth = Some(inv.max_de / inv.energy_scale_j);
-            inv.energy_error = Some(inv.max_abs_de / inv.energy_scale_j);
-        }
-    }
-
     /// The row values of the current state into `row_cur`.
     fn fill_row(&mut self, t: f64, bodies: &RigidBodySet) {
         let axis_ref = self.reference_axis;
@@ -1284,7 +774,7 @@ impl Twin {
 
     /// Appends the row at time `t`, `w` of the way from the previous state to the current one
     /// (linear; the contact flag from the nearer state).
-    fn write_row(&mut self, t: f64, w: f64) {
+    pub(super) fn write_row(&mut self, t: f64, w: f64) {
         let contact_cols = &self.contact_columns;
         let (prev, cur) = (&self.row_prev, &self.row_cur);
         let v = &mut self.table.values;

@@ -1,0 +1,80 @@
+//! Dense LU factorisation and solve of the constraint matrix, regularised when singular.
+
+/// LU factors of the `n x n` row-major `a` into `lu`, with a relative regularisation of 1e-12
+/// on the diagonal when `a` is singular (redundant constraints: a least-norm share). False when
+/// even that fails.
+pub(super) fn factor_regularised(
+    a: &[f64],
+    lu: &mut Vec<f64>,
+    piv: &mut Vec<usize>,
+    n: usize,
+) -> bool {
+    lu.clear();
+    lu.extend_from_slice(a);
+    if lu_factor(lu, piv, n) {
+        return true;
+    }
+    lu.clear();
+    lu.extend_from_slice(a);
+    let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for i in 0..n {
+        lu[i * n + i] += 1e-12 * scale;
+    }
+    lu_factor(lu, piv, n)
+}
+
+/// LU factorisation with partial pivoting of the `n x n` row-major `a` in place (`piv` the row
+/// order). False when `a` is singular to working precision.
+pub(super) fn lu_factor(a: &mut [f64], piv: &mut Vec<usize>, n: usize) -> bool {
+    piv.clear();
+    piv.extend(0..n);
+    let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    if !(scale > 0.0) && n > 0 {
+        return false;
+    }
+    for col in 0..n {
+        let pivot = (col..n)
+            .max_by(|&i, &k| a[i * n + col].abs().total_cmp(&a[k * n + col].abs()))
+            .unwrap_or(col);
+        if !(a[pivot * n + col].abs() > 1e-12 * scale) {
+            return false;
+        }
+        if pivot != col {
+            for k in 0..n {
+                a.swap(pivot * n + k, col * n + k);
+            }
+            piv.swap(pivot, col);
+        }
+        for i in col + 1..n {
+            let f = a[i * n + col] / a[col * n + col];
+            a[i * n + col] = f;
+            if f != 0.0 {
+                for k in col + 1..n {
+                    a[i * n + k] -= f * a[col * n + k];
+                }
+            }
+        }
+    }
+    true
+}
+
+/// Solves `A x = b` from the factors of [`lu_factor`]; the solution replaces `b`.
+pub(super) fn lu_solve(lu: &[f64], piv: &[usize], b: &mut [f64], scratch: &mut Vec<f64>, n: usize) {
+    scratch.clear();
+    scratch.extend(piv.iter().map(|&p| b[p]));
+    b.copy_from_slice(scratch);
+    for i in 0..n {
+        let mut s = b[i];
+        for k in 0..i {
+            s -= lu[i * n + k] * b[k];
+        }
+        b[i] = s;
+    }
+    for i in (0..n).rev() {
+        let mut s = b[i];
+        for k in i + 1..n {
+            s -= lu[i * n + k] * b[k];
+        }
+        b[i] = s / lu[i * n + i];
+    }
+}

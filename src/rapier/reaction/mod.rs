@@ -1,0 +1,260 @@
+//! Exact reactions of ideal joints (revolute, prismatic, fixed, spherical, with or without a
+//! motor) at a state, from the constrained rigid-body equations (not from Rapier's impulses or
+//! momentum differences, which carry its integrator's lag).
+//!
+//! For bodies with mass matrices `M`, applied wrenches `F` (user forces and torques, gravity,
+//! gyroscopic terms, soft motors) and joints whose constraints have Jacobian `J` and
+//! velocity-product terms `c` (`J a + c = 0` for the accelerations `a`), the multipliers solve
+//! `J M^-1 J^T lambda = -c - J M^-1 F`: the joint forces the ideal mechanism needs at this
+//! position and velocity, and the accelerations `a = M^-1 (F + J^T lambda)`. They do not depend
+//! on the step: the same state gives the same reaction whatever the step control, which
+//! momentum balances over a step do not achieve (Rapier's constraint turns a jointed body's
+//! velocity by the motion since the previous step, while applied forces act over the current
+//! one).
+//!
+//! **The state's velocities.** Rapier's stored velocities are not the state's: with one solver
+//! iteration a step is symplectic Euler, whose velocities live half a step before the positions
+//! (the [`Stepper`](crate::rapier::stepper::Stepper) makes that exactly half the last step), and
+//! they satisfy the joints at the previous positions, not the current ones. The solver therefore
+//! (1) advances the stored velocities by [`velocity_lag`](ReactionSolver::velocity_lag) with the
+//! accelerations it solves at them (second order in the lag: a second pass), and (2) projects
+//! them onto the joints'
+//! velocity constraints at the current positions (the mass-weighted least change), so that the
+//! centripetal and Coriolis terms are those of a state of the ideal mechanism. A mechanism whose
+//! motion is fully prescribed (a driven crank) then gets its exact velocities from the
+//! projection, whatever the step.
+//!
+//! **Motors.** A velocity motor that holds its speed ([`IdealJoint::MotorRevolute`],
+//! [`IdealJoint::MotorPrismatic`]) is one more constraint row (`d(speed)/dt = 0`), its multiplier
+//! the motor torque or force. A soft motor ([`SoftMotor`]: Rapier's spring-damper
+//! `k (x_target - x) + c (v_target - v)`, times the row's effective mass in Rapier's
+//! acceleration-based model) is an applied wrench computed from the state.
+//!
+//! ```
+//! use clearance_joint::rapier::reaction::{IdealRevolute, ReactionSolver};
+//! use rapier3d_f64::prelude::*;
+//! use rapier3d_f64::math::Vector;
+//!
+//! // A 2 kg arm hanging at rest 0.3 m below a fixed pivot carries its weight.
+//! let mut bodies = RigidBodySet::new();
+//! let base = bodies.insert(RigidBodyBuilder::fixed());
+//! let arm = bodies.insert(
+//!     RigidBodyBuilder::dynamic()
+//!         .translation(Vector::new(0.0, -0.3, 0.0))
+//!         .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02))),
+//! );
+//! # clearance_joint::rapier::reaction::prepare_mass_properties(&mut bodies);
+//! let joint = IdealRevolute {
+//!     body1: base,
+//!     body2: arm,
+//!     local_anchor1: Vector::ZERO,
+//!     local_anchor2: Vector::new(0.0, 0.3, 0.0),
+//!     local_axis1: Vector::Z,
+//! };
+//! let mut solver = ReactionSolver::default();
+//! let forces = solver.solve(&bodies, &[joint], Vector::new(0.0, -9.81, 0.0)).unwrap();
+//! assert!((forces[0] - Vector::new(0.0, 2.0 * 9.81, 0.0)).length() < 1e-9);
+//! // At rest, held: no acceleration.
+//! let (a, alpha) = solver.acceleration(arm).unwrap();
+//! assert!(a.length() < 1e-12 && alpha.length() < 1e-12);
+//! ```
+
+mod body;
+mod joints;
+mod lu;
+mod motor;
+mod rows;
+mod solve;
+#[cfg(test)]
+mod tests;
+
+pub use body::KinematicState;
+pub use joints::{IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical};
+pub use motor::SoftMotor;
+
+use crate::rapier::ledger::Wrench;
+use body::Entry;
+use rapier3d_f64::math::Vector;
+use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
+use rows::Row;
+
+/// Solves for ideal-joint reactions; keeps its buffers between calls (no allocation per step
+/// once sized).
+#[derive(Clone, Debug, Default)]
+pub struct ReactionSolver {
+    /// Bodies whose motion is prescribed with a nonzero acceleration (a tabulated drive): their
+    /// velocities and accelerations at the state. Other kinematic bodies are taken to move at
+    /// constant velocity.
+    pub kinematic: Vec<KinematicState>,
+    /// How long before the state the bodies' stored velocities are, s: the stored velocities are
+    /// advanced by it with the accelerations solved. Half the last step for Rapier's velocities
+    /// after a step of the [`Stepper`](crate::rapier::stepper::Stepper)
+    /// (`stepper.last_dt() / 2`; 0 before the first step, whose velocities are the initial
+    /// state's) or of a plain Rapier loop at constant steps (`dt / 2`). Default 0: the stored
+    /// velocities are taken as the state's (and only projected onto the joints).
+    pub velocity_lag: f64,
+    /// Further bodies whose velocities and accelerations at the state the solve reports
+    /// ([`velocity`](Self::velocity), [`acceleration`](Self::acceleration)) though no listed
+    /// joint holds them (a free body, one held by clearance joints only).
+    pub track: Vec<RigidBodyHandle>,
+    /// Dense `J M^-1 J^T` and its LU factors, row-major; the same for the position rows alone.
+    a: Vec<f64>,
+    lu: Vec<f64>,
+    piv: Vec<usize>,
+    a_pos: Vec<f64>,
+    lu_pos: Vec<f64>,
+    piv_pos: Vec<usize>,
+    scratch: Vec<f64>,
+    /// Indices of the position rows.
+    pos_rows: Vec<usize>,
+    /// Right-hand side, then the multipliers.
+    b: Vec<f64>,
+    b_pos: Vec<f64>,
+    rows: Vec<Row>,
+    /// First row of each joint.
+    starts: Vec<usize>,
+    entries: Vec<Entry>,
+    forces: Vec<Vector>,
+    motors: Vec<Option<f64>>,
+    /// Per joint with a motor: the relative speed along its axis at the state.
+    motor_rates: Vec<f64>,
+    revolutes: Vec<IdealJoint>,
+    extra: Vec<Wrench>,
+}
+
+impl ReactionSolver {
+    /// The force on each joint's body 2 (N, world frame), in the order of `joints`, at the bodies'
+    /// current state under their user forces and torques and `gravity`. Redundant constraints (a
+    /// closed loop, whose reactions rigid dynamics alone do not determine) get a least-norm
+    /// share through a relative regularisation of 1e-12, used only when the system is singular.
+    /// `None` when a body is missing. Only the listed joints are constraints: contacts with
+    /// colliders are not part of the solve.
+    pub fn solve(
+        &mut self,
+        bodies: &RigidBodySet,
+        joints: &[IdealRevolute],
+        gravity: Vector,
+    ) -> Option<&[Vector]> {
+        self.solve_with(bodies, joints, gravity, &[])
+    }
+
+    /// [`solve`](Self::solve) with further applied wrenches on the bodies: those of the force
+    /// sources the [`Stepper`](crate::rapier::stepper::Stepper) adds during its steps only (drives,
+    /// clearance contacts), which the bodies' user forces do not hold between steps.
+    pub fn solve_with(
+        &mut self,
+        bodies: &RigidBodySet,
+        joints: &[IdealRevolute],
+        gravity: Vector,
+        extra: &[Wrench],
+    ) -> Option<&[Vector]> {
+        let mut all = std::mem::take(&mut self.revolutes);
+        all.clear();
+        all.extend(joints.iter().map(|&j| IdealJoint::Revolute(j)));
+        let ok = self
+            .solve_joints_with(bodies, &all, gravity, extra)
+            .is_some();
+        self.revolutes = all;
+        if ok { Some(&self.forces) } else { None }
+    }
+
+    /// [`solve_joints`](Self::solve_joints) with further applied wrenches, as in
+    /// [`solve_with`](Self::solve_with).
+    pub fn solve_joints_with(
+        &mut self,
+        bodies: &RigidBodySet,
+        joints: &[IdealJoint],
+        gravity: Vector,
+        extra: &[Wrench],
+    ) -> Option<&[Vector]> {
+        self.extra.clear();
+        self.extra.extend_from_slice(extra);
+        let r = self.solve_joints_inner(bodies, joints, gravity).is_some();
+        self.extra.clear();
+        if r { Some(&self.forces) } else { None }
+    }
+
+    /// [`solve`](Self::solve) for any mix of revolute, prismatic, fixed and spherical joints, with
+    /// or without motors: the force on each joint's body 2 at its anchor (N, world frame; for a
+    /// prismatic joint the part normal to the axis, the only one an ideal slide carries; a
+    /// motor's torque or force is [`motor`](Self::motor)). Every ideal joint of the mechanism
+    /// must be listed: a joint left out is a free motion to the solver. Kinematic bodies are
+    /// taken to move at constant velocity (their accelerations are those of a rigid rotation at
+    /// their angular velocity) unless [`kinematic`](Self::kinematic) prescribes them.
+    pub fn solve_joints(
+        &mut self,
+        bodies: &RigidBodySet,
+        joints: &[IdealJoint],
+        gravity: Vector,
+    ) -> Option<&[Vector]> {
+        self.solve_joints_with(bodies, joints, gravity, &[])
+    }
+
+    /// The motor torque (N m about the axis, revolute) or force (N along the axis, prismatic) on
+    /// body 2 of joint `k` of the last solve: the held-speed row's multiplier or the soft
+    /// motor's law at the state. `None` without a motor (or before a solve).
+    pub fn motor(&self, k: usize) -> Option<f64> {
+        self.motors.get(k).copied().flatten()
+    }
+
+    /// Velocity of the centre of mass (m/s) and angular velocity (rad/s) of `body` at the state
+    /// of the last solve: the stored ones advanced by [`velocity_lag`](Self::velocity_lag) and
+    /// made consistent with the joints. `None` for a body neither in the joints nor in
+    /// [`track`](Self::track).
+    pub fn velocity(&self, body: RigidBodyHandle) -> Option<(Vector, Vector)> {
+        self.entry(body).map(|e| (e.v, e.w))
+    }
+
+    /// Acceleration of the centre of mass (m/s^2) and angular acceleration (rad/s^2) of `body`
+    /// at the state of the last solve, `M^-1 (F + J^T lambda)` (the prescribed ones of a driven
+    /// body). `None` for a body neither in the joints nor in [`track`](Self::track).
+    pub fn acceleration(&self, body: RigidBodyHandle) -> Option<(Vector, Vector)> {
+        self.entry(body).map(|e| (e.acc, e.alpha))
+    }
+
+    /// The relative speed of joint `k`'s bodies along its motor's axis at the state of the last
+    /// solve: rad/s about a revolute's axis, m/s along a prismatic axis (body 2 relative to
+    /// body 1). Times [`motor`](Self::motor), the power the motor delivers. `None` without a
+    /// motor.
+    pub fn motor_rate(&self, k: usize) -> Option<f64> {
+        self.motors
+            .get(k)
+            .copied()
+            .flatten()
+            .map(|_| self.motor_rates[k])
+    }
+
+    fn entry(&self, body: RigidBodyHandle) -> Option<&Entry> {
+        self.entries.iter().find(|e| e.handle == body)
+    }
+
+    /// Index of `handle` in the body table, adding it first if needed.
+    fn body_index(
+        &mut self,
+        bodies: &RigidBodySet,
+        handle: RigidBodyHandle,
+        gravity: Vector,
+    ) -> Option<usize> {
+        if let Some(i) = self.entries.iter().position(|e| e.handle == handle) {
+            return Some(i);
+        }
+        let rb = bodies.get(handle)?;
+        self.entries.push(Entry::new(
+            rb,
+            handle,
+            gravity,
+            &self.extra,
+            &self.kinematic,
+        ));
+        Some(self.entries.len() - 1)
+    }
+}
+
+/// Computes the local mass properties of every dynamic body that has none yet (Rapier does it at
+/// the first step; the solver needs them before).
+pub fn prepare_mass_properties(bodies: &mut RigidBodySet) {
+    let handles: Vec<RigidBodyHandle> = bodies.iter().map(|(h, _)| h).collect();
+    for h in handles {
+        crate::rapier::ledger::ensure_mass_properties(bodies, None, h);
+    }
+}

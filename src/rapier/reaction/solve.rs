@@ -1,0 +1,149 @@
+//! The solve: the state's velocities (advanced by the lag, projected), then the accelerations.
+
+use super::lu::{factor_regularised, lu_solve};
+use super::{IdealJoint, ReactionSolver};
+use rapier3d_f64::math::Vector;
+use rapier3d_f64::prelude::RigidBodySet;
+
+impl ReactionSolver {
+    pub(super) fn solve_joints_inner(
+        &mut self,
+        bodies: &RigidBodySet,
+        joints: &[IdealJoint],
+        gravity: Vector,
+    ) -> Option<()> {
+        self.entries.clear();
+        self.forces.clear();
+        self.motors.clear();
+        self.starts.clear();
+        let mut pairs = Vec::with_capacity(joints.len());
+        for j in joints {
+            let (h1, h2) = j.bodies();
+            pairs.push((
+                self.body_index(bodies, h1, gravity)?,
+                self.body_index(bodies, h2, gravity)?,
+            ));
+        }
+        for i in 0..self.track.len() {
+            self.body_index(bodies, self.track[i], gravity)?;
+        }
+        // The Jacobian depends on the positions only: rows at the stored velocities, then the
+        // matrices (all rows, and the position rows for the projection).
+        self.build_rows(joints, &pairs);
+        let n = self.rows.len();
+        self.assemble();
+        self.pos_rows.clear();
+        self.pos_rows
+            .extend((0..n).filter(|&i| self.rows[i].position));
+        if !factor_regularised(&self.a, &mut self.lu, &mut self.piv, n) {
+            return None;
+        }
+        let np = self.pos_rows.len();
+        if np < n {
+            self.a_pos.clear();
+            for &i in &self.pos_rows {
+                for &k in &self.pos_rows {
+                    self.a_pos.push(self.a[i * n + k]);
+                }
+            }
+            if !factor_regularised(&self.a_pos, &mut self.lu_pos, &mut self.piv_pos, np) {
+                return None;
+            }
+        }
+        // The state's velocities: the stored ones advanced by the lag with the accelerations
+        // solved at the stored ones, projected onto the joints (an error of second order in the
+        // lag; one pass without a lag).
+        let passes = if self.velocity_lag > 0.0 { 2 } else { 1 };
+        for pass in 0..passes {
+            if pass > 0 {
+                let lag = self.velocity_lag;
+                for e in self.entries.iter_mut().filter(|e| e.dynamic) {
+                    e.v = e.stored_v + lag * e.acc;
+                    e.w = e.stored_w + lag * e.alpha;
+                }
+            }
+            self.project(n);
+            self.build_rows(joints, &pairs);
+            self.apply_motors(joints, &pairs);
+            self.accelerations(n);
+        }
+        // The force on body 2: the force rows' multipliers along their directions.
+        for (k, j) in joints.iter().enumerate() {
+            let s = self.starts[k];
+            let mut f = Vector::ZERO;
+            for i in 0..j.force_rows() {
+                f += self.b[s + i] * self.rows[s + i].jac[2];
+            }
+            self.forces.push(f);
+        }
+        Some(())
+    }
+
+    /// Makes the dynamic bodies' velocities satisfy the position rows, `J v = 0`, with the
+    /// least change in the mass metric: `v -= M^-1 J^T mu`, `(J M^-1 J^T) mu = J v`.
+    fn project(&mut self, n: usize) {
+        let np = self.pos_rows.len();
+        if np == 0 {
+            return;
+        }
+        self.b_pos.clear();
+        for &i in &self.pos_rows {
+            let r = &self.rows[i];
+            let (e1, e2) = (&self.entries[r.b1], &self.entries[r.b2]);
+            self.b_pos.push(r.dot((e1.v, e1.w), (e2.v, e2.w)));
+        }
+        if np < n {
+            lu_solve(
+                &self.lu_pos,
+                &self.piv_pos,
+                &mut self.b_pos,
+                &mut self.scratch,
+                np,
+            );
+        } else {
+            lu_solve(&self.lu, &self.piv, &mut self.b_pos, &mut self.scratch, n);
+        }
+        for (k, &i) in self.pos_rows.iter().enumerate() {
+            let r = self.rows[i];
+            let mu = self.b_pos[k];
+            for (b, side) in [(r.b1, 0usize), (r.b2, 2)] {
+                let e = &mut self.entries[b];
+                let (dv, dw) = e.apply_inv_mass(r.jac[side] * mu, r.jac[side + 1] * mu);
+                e.v -= dv;
+                e.w -= dw;
+            }
+        }
+    }
+
+    /// Solves `A lambda = -c - J M^-1 F` at the state's velocities and sets every body's
+    /// accelerations `M^-1 (F + J^T lambda)` and the held motors' multipliers.
+    fn accelerations(&mut self, n: usize) {
+        for e in &mut self.entries {
+            (e.acc, e.alpha) = e.free_acceleration();
+        }
+        self.b.clear();
+        for r in &self.rows {
+            let (e1, e2) = (&self.entries[r.b1], &self.entries[r.b2]);
+            self.b
+                .push(-(r.c + r.dot((e1.acc, e1.alpha), (e2.acc, e2.alpha))));
+        }
+        lu_solve(&self.lu, &self.piv, &mut self.b, &mut self.scratch, n);
+        for (r, &lambda) in self.rows.iter().zip(&self.b) {
+            for (b, side) in [(r.b1, 0usize), (r.b2, 2)] {
+                let e = &mut self.entries[b];
+                let (da, dalpha) = e.apply_inv_mass(r.jac[side] * lambda, r.jac[side + 1] * lambda);
+                e.acc += da;
+                e.alpha += dalpha;
+            }
+        }
+        // A held motor's speed row is its joint's last.
+        for (k, m) in self.motors.iter_mut().enumerate() {
+            if let Some(v) = m {
+                let next = self.starts.get(k + 1).copied().unwrap_or(n);
+                if !self.rows[next - 1].position {
+                    *v = self.b[next - 1];
+                }
+            }
+        }
+    }
+}

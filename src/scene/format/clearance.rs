@@ -1,0 +1,434 @@
+//! The clearance spec: geometry, materials, contact and friction laws, converted to SI laws.
+
+use super::limits::*;
+use crate::error::{Error, Result, in_range, positive, sig4};
+use crate::model::laws::{
+    Ambrosio, Bai, BearingGeometry, Coulomb, DELTA_MAX_RANGE, EXPONENT_RANGE, FloresEtAl,
+    FrictionModel, GonthierEtAl, Hertz, HuntCrossley, ImprovedLiu, KelvinVoigt, LankaraniNikravesh,
+    LiuEtAl, Material, MaxDamping, NormalModel, Threlfall, effective_modulus,
+};
+use crate::rapier::convert::Clearance;
+use crate::rapier::joint::OutOfPlaneLock;
+use serde::{Deserialize, Serialize};
+
+/// Geometry, materials and laws of a clearance joint (MODEL.md §1-3, table 2 of the paper).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ClearanceSpec {
+    /// Bearing (hole) diameter, mm.
+    pub bearing_diameter_mm: f64,
+    /// Radial clearance `c = R_b - R_j`, mm.
+    pub clearance_mm: f64,
+    /// Axial length (bearing width) `L`, mm.
+    pub width_mm: f64,
+    /// Bearing material.
+    pub bearing_material: Material,
+    /// Journal material.
+    pub journal_material: Material,
+    /// Normal contact law.
+    pub contact: ContactSpec,
+    /// Friction law.
+    #[serde(default)]
+    pub friction: FrictionSpec,
+    /// Floor on the impact velocity of the hysteresis laws, mm/s.
+    #[serde(default = "default_min_impact_speed")]
+    pub min_impact_speed_mm_s: f64,
+    /// Gap a free flight must open for the next contact to count as an impact, um (default 0.1).
+    #[serde(default = "default_min_separation")]
+    pub min_separation_um: f64,
+    /// What holds the out-of-plane degrees of freedom.
+    #[serde(default)]
+    pub lock: OutOfPlaneLock,
+}
+
+fn default_min_impact_speed() -> f64 {
+    crate::rapier::joint::DEFAULT_MIN_IMPACT_SPEED * 1e3
+}
+fn default_min_separation() -> f64 {
+    crate::rapier::joint::DEFAULT_MIN_SEPARATION * 1e6
+}
+
+/// Normal contact law by name (MODEL.md §2). Stiffness `None` means the Lankarani-Nikravesh
+/// geometric stiffness from the joint's radii and materials.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum ContactSpec {
+    /// `K delta^n`.
+    Hertz {
+        /// `K`, N/m^n (default: geometric).
+        #[serde(default)]
+        stiffness: Option<f64>,
+        /// `n` (default 1.5).
+        #[serde(default = "default_exponent")]
+        exponent: f64,
+    },
+    /// `K delta + D delta_dot`.
+    KelvinVoigt {
+        /// `K`, N/m.
+        stiffness: f64,
+        /// `D`, N s/m.
+        damping: f64,
+    },
+    /// Hunt-Crossley.
+    HuntCrossley {
+        /// `K` (default: geometric).
+        #[serde(default)]
+        stiffness: Option<f64>,
+        /// `n` (default 1.5).
+        #[serde(default = "default_exponent")]
+        exponent: f64,
+        /// `cr`.
+        restitution: f64,
+    },
+    /// Lankarani-Nikravesh (n = 1.5).
+    LankaraniNikravesh {
+        /// `K` (default: geometric).
+        #[serde(default)]
+        stiffness: Option<f64>,
+        /// `cr`.
+        restitution: f64,
+    },
+    /// Flores et al. 2011.
+    FloresEtAl {
+        /// `K` (default: geometric).
+        #[serde(default)]
+        stiffness: Option<f64>,
+        /// `n` (default 1.5).
+        #[serde(default = "default_exponent")]
+        exponent: f64,
+        /// `cr`.
+        restitution: f64,
+    },
+    /// Gonthier et al. 2004.
+    GonthierEtAl {
+        /// `K` (default: geometric).
+        #[serde(default)]
+        stiffness: Option<f64>,
+        /// `n` (default 1.5).
+        #[serde(default = "default_exponent")]
+        exponent: f64,
+        /// `cr`.
+        restitution: f64,
+    },
+    /// Liu et al. 2007 (elastic, cylindrical).
+    LiuEtAl,
+    /// The paper's improved law.
+    ImprovedLiu {
+        /// Material exponent `n` (default 1: the paper gives none; n = 1 is Liu's elastic law).
+        #[serde(default = "one")]
+        exponent: f64,
+        /// Damping saturation depth, mm (default 0.1).
+        #[serde(default = "default_delta_max_mm")]
+        delta_max_mm: f64,
+        /// `eta`, s (default 0.01, the paper's "1 %"); ignored when `d_max_n_s_per_m` is given.
+        #[serde(default = "default_eta")]
+        eta_s: f64,
+        /// Explicit maximum damping, N s/m.
+        #[serde(default)]
+        d_max_n_s_per_m: Option<f64>,
+    },
+}
+
+fn default_exponent() -> f64 {
+    1.5
+}
+pub(super) fn one() -> f64 {
+    1.0
+}
+fn default_delta_max_mm() -> f64 {
+    0.1
+}
+fn default_eta() -> f64 {
+    ImprovedLiu::DEFAULT_ETA
+}
+
+/// Friction law by name (MODEL.md §3). Speeds in mm/s.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum FrictionSpec {
+    /// No friction.
+    #[default]
+    None,
+    /// Regularised Coulomb.
+    Coulomb {
+        /// `mu_d`.
+        mu_d: f64,
+        /// `v_eps`, mm/s.
+        v_eps_mm_s: f64,
+    },
+    /// Threlfall.
+    Threlfall {
+        /// `mu_d`.
+        mu_d: f64,
+        /// `v_0`, mm/s.
+        v0_mm_s: f64,
+    },
+    /// Ambrosio.
+    Ambrosio {
+        /// `mu_d`.
+        mu_d: f64,
+        /// `v_0`, mm/s.
+        v0_mm_s: f64,
+        /// `v_1`, mm/s.
+        v1_mm_s: f64,
+    },
+    /// Bai / Adams stiction.
+    Bai {
+        /// `mu_s`.
+        mu_s: f64,
+        /// `mu_d`.
+        mu_d: f64,
+        /// `v_s`, mm/s.
+        v_s_mm_s: f64,
+        /// `v_d`, mm/s.
+        v_d_mm_s: f64,
+    },
+    /// Bai with the paper's dry coefficients (table 3).
+    Dry,
+    /// Bai with the paper's lubricated coefficients (table 3).
+    Lubricated,
+}
+
+/// The laws and geometry of a validated clearance spec.
+#[derive(Clone, Copy, Debug)]
+pub struct ClearanceParams {
+    /// Radial geometry (SI).
+    pub geometry: BearingGeometry,
+    /// Normal law.
+    pub normal: NormalModel,
+    /// Friction law.
+    pub friction: FrictionModel,
+    /// Floor on the impact speed, m/s.
+    pub min_impact_speed: f64,
+    /// Gap that separates two impacts, m.
+    pub min_separation: f64,
+}
+
+impl ClearanceSpec {
+    /// The [`Clearance`] this spec describes (validated; errors name the field relative to
+    /// this spec).
+    pub fn clearance(&self) -> Result<Clearance> {
+        let p = self.build()?;
+        Ok(Clearance {
+            min_impact_speed: p.min_impact_speed,
+            min_separation: p.min_separation,
+            ..Clearance::new(p.geometry, p.normal)
+                .friction(p.friction)
+                .lock(self.lock)
+        })
+    }
+
+    /// Validates and converts to SI laws; errors name the field relative to this spec.
+    pub fn build(&self) -> Result<ClearanceParams> {
+        let (lo, hi) = LENGTH_MM_RANGE;
+        let c = positive("clearance_mm", self.clearance_mm)? * 1e-3;
+        in_range(
+            "clearance_mm",
+            self.clearance_mm,
+            CLEARANCE_MM_RANGE.0,
+            CLEARANCE_MM_RANGE.1,
+            "mm",
+        )?;
+        let rb = in_range(
+            "bearing_diameter_mm",
+            self.bearing_diameter_mm,
+            lo,
+            hi,
+            "mm",
+        )? * 0.5e-3;
+        let len = in_range("width_mm", self.width_mm, lo, hi, "mm")? * 1e-3;
+        if c >= rb {
+            return Err(Error::invalid(
+                "clearance_mm",
+                format!(
+                    "the journal would be larger than nothing: clearance {} mm >= bearing radius {} mm",
+                    sig4(self.clearance_mm),
+                    sig4(rb * 1e3)
+                ),
+            ));
+        }
+        let geometry = BearingGeometry::from_clearance(rb, c, len)?;
+        self.bearing_material
+            .validate()
+            .map_err(|e| e.within("bearing_material"))?;
+        self.journal_material
+            .validate()
+            .map_err(|e| e.within("journal_material"))?;
+        let e_star = effective_modulus(&self.bearing_material, &self.journal_material);
+        let geometric = LankaraniNikravesh::stiffness_from_geometry(
+            &geometry,
+            &self.bearing_material,
+            &self.journal_material,
+        );
+        // The geometric stiffness is Lankarani-Nikravesh's, in N/m^1.5: a default only for n = 1.5.
+        let k_n = |s: &Option<f64>, n: f64| -> Result<f64> {
+            // The exponent first: a NaN or absurd exponent is the fault, not the missing stiffness.
+            in_range("exponent", n, EXPONENT_RANGE.0, EXPONENT_RANGE.1, "")?;
+            match s {
+                Some(k) => Ok(*k),
+                None if n == LankaraniNikravesh::EXPONENT => Ok(geometric),
+                None => Err(Error::invalid(
+                    "stiffness",
+                    format!(
+                        "must be given for exponent {}: the default (the Lankarani-Nikravesh geometric stiffness) \
+                         is in N/m^1.5 and holds only for exponent 1.5",
+                        sig4(n)
+                    ),
+                )),
+            }
+        };
+        let normal = (|| -> Result<NormalModel> {
+            Ok(match &self.contact {
+                ContactSpec::Hertz {
+                    stiffness,
+                    exponent,
+                } => NormalModel::Hertz(Hertz::new(k_n(stiffness, *exponent)?, *exponent)?),
+                ContactSpec::KelvinVoigt { stiffness, damping } => {
+                    NormalModel::KelvinVoigt(KelvinVoigt::new(*stiffness, *damping)?)
+                }
+                ContactSpec::HuntCrossley {
+                    stiffness,
+                    exponent,
+                    restitution,
+                } => NormalModel::HuntCrossley(HuntCrossley::new(
+                    k_n(stiffness, *exponent)?,
+                    *exponent,
+                    *restitution,
+                )?),
+                ContactSpec::LankaraniNikravesh {
+                    stiffness,
+                    restitution,
+                } => NormalModel::LankaraniNikravesh(LankaraniNikravesh::new(
+                    k_n(stiffness, LankaraniNikravesh::EXPONENT)?,
+                    LankaraniNikravesh::EXPONENT,
+                    *restitution,
+                )?),
+                ContactSpec::FloresEtAl {
+                    stiffness,
+                    exponent,
+                    restitution,
+                } => NormalModel::FloresEtAl(FloresEtAl::new(
+                    k_n(stiffness, *exponent)?,
+                    *exponent,
+                    *restitution,
+                )?),
+                ContactSpec::GonthierEtAl {
+                    stiffness,
+                    exponent,
+                    restitution,
+                } => NormalModel::GonthierEtAl(GonthierEtAl::new(
+                    k_n(stiffness, *exponent)?,
+                    *exponent,
+                    *restitution,
+                )?),
+                ContactSpec::LiuEtAl => NormalModel::LiuEtAl(LiuEtAl::new(e_star, len, c)?),
+                ContactSpec::ImprovedLiu {
+                    exponent,
+                    delta_max_mm,
+                    eta_s,
+                    d_max_n_s_per_m,
+                } => {
+                    let damping = match d_max_n_s_per_m {
+                        Some(d) => MaxDamping::Explicit(*d),
+                        None => MaxDamping::Eta(*eta_s),
+                    };
+                    NormalModel::ImprovedLiu(ImprovedLiu::new(
+                        e_star,
+                        len,
+                        c,
+                        *exponent,
+                        in_range(
+                            "delta_max_mm",
+                            *delta_max_mm,
+                            DELTA_MAX_RANGE.0 * 1e3,
+                            DELTA_MAX_RANGE.1 * 1e3,
+                            "mm",
+                        )? * 1e-3,
+                        damping,
+                    )?)
+                }
+            })
+        })()
+        .map_err_within("contact")?;
+        let mm = 1e-3;
+        let friction = (|| -> Result<FrictionModel> {
+            Ok(match &self.friction {
+                FrictionSpec::None => FrictionModel::None,
+                FrictionSpec::Coulomb { mu_d, v_eps_mm_s } => {
+                    speed_mm_s("v_eps_mm_s", *v_eps_mm_s)?;
+                    FrictionModel::Coulomb(Coulomb::new(*mu_d, v_eps_mm_s * mm)?)
+                }
+                FrictionSpec::Threlfall { mu_d, v0_mm_s } => {
+                    speed_mm_s("v0_mm_s", *v0_mm_s)?;
+                    FrictionModel::Threlfall(Threlfall::new(*mu_d, v0_mm_s * mm)?)
+                }
+                FrictionSpec::Ambrosio {
+                    mu_d,
+                    v0_mm_s,
+                    v1_mm_s,
+                } => {
+                    in_range("v0_mm_s", *v0_mm_s, 0.0, SPEED_MM_S_RANGE.1, "mm/s")?;
+                    speed_mm_s("v1_mm_s", *v1_mm_s)?;
+                    FrictionModel::Ambrosio(Ambrosio::new(*mu_d, v0_mm_s * mm, v1_mm_s * mm)?)
+                }
+                FrictionSpec::Bai {
+                    mu_s,
+                    mu_d,
+                    v_s_mm_s,
+                    v_d_mm_s,
+                } => {
+                    speed_mm_s("v_s_mm_s", *v_s_mm_s)?;
+                    speed_mm_s("v_d_mm_s", *v_d_mm_s)?;
+                    FrictionModel::Bai(Bai::new(*mu_s, *mu_d, v_s_mm_s * mm, v_d_mm_s * mm)?)
+                }
+                FrictionSpec::Dry => FrictionModel::Bai(Bai::DRY),
+                FrictionSpec::Lubricated => FrictionModel::Bai(Bai::LUBRICATED),
+            })
+        })()
+        .map_err_within("friction")?;
+        let min_impact_speed =
+            speed_mm_s("min_impact_speed_mm_s", self.min_impact_speed_mm_s)? * mm;
+        let min_separation =
+            in_range("min_separation_um", self.min_separation_um, 0.0, 1e4, "um")? * 1e-6;
+        Ok(ClearanceParams {
+            geometry,
+            normal,
+            friction,
+            min_impact_speed,
+            min_separation,
+        })
+    }
+}
+
+trait WithinExt<T> {
+    fn map_err_within(self, prefix: &str) -> Result<T>;
+}
+impl<T> WithinExt<T> for Result<T> {
+    fn map_err_within(self, prefix: &str) -> Result<T> {
+        self.map_err(|e| e.within(prefix))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+
+    #[test]
+    fn from_a_scene_spec() {
+        let scene = Scene::solar_panel();
+        let spec = scene.hinges[0].clearance.as_ref().unwrap();
+        let c = spec.clearance().unwrap();
+        assert!((c.geometry.clearance() - 0.5e-3).abs() < 1e-15);
+        assert_eq!(
+            c.friction,
+            crate::model::laws::FrictionModel::Bai(crate::model::laws::Bai::DRY)
+        );
+        assert_eq!(
+            c.normal,
+            Clearance::steel_improved_liu(0.010, 0.5e-3, 0.016)
+                .unwrap()
+                .normal
+        );
+    }
+}

@@ -1,0 +1,136 @@
+//! Hinges (ideal or with a clearance), their validation, the planar model's limits, warnings.
+
+use super::limits::*;
+use super::{ClearanceSpec, FrictionSpec, Scene};
+use crate::error::{Error, Result, sig4};
+use crate::rapier::joint::OutOfPlaneLock;
+use rapier3d_f64::math::Vector;
+use serde::{Deserialize, Serialize};
+
+/// A hinge: ideal (Rapier revolute joint) unless `clearance` is given.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HingeSpec {
+    /// Unique name (CSV column prefix).
+    pub name: String,
+    /// Body carrying the bearing (hole).
+    pub bearing: String,
+    /// Body carrying the journal (pin).
+    pub journal: String,
+    /// World position of the hinge (bearing and journal centre) at t = 0, m.
+    pub point_m: [f64; 3],
+    /// Hinge axis (world, t = 0); positive rotation of the journal body about it is positive angle.
+    pub axis: [f64; 3],
+    /// Radial play; `None` makes the hinge ideal in both twins.
+    #[serde(default)]
+    pub clearance: Option<ClearanceSpec>,
+}
+
+impl Scene {
+    /// The hinges' fields and clearance specs (names into `names`).
+    pub(super) fn validate_hinges<'a>(
+        &'a self,
+        names: &mut std::collections::HashSet<&'a str>,
+    ) -> Result<()> {
+        for h in &self.hinges {
+            let p = format!("hinges[{}]", h.name);
+            if !is_plain_name(&h.name) {
+                return Err(Error::invalid(
+                    p,
+                    "name must be letters, digits, `_` and `-` (it prefixes CSV columns)",
+                ));
+            }
+            if !names.insert(h.name.as_str()) {
+                return Err(Error::invalid(
+                    p,
+                    "duplicate name (bodies, hinges and drives share one namespace)",
+                ));
+            }
+            for (field, body) in [("bearing", &h.bearing), ("journal", &h.journal)] {
+                if self.body_index(body).is_none() {
+                    return Err(Error::invalid(
+                        format!("{p}.{field}"),
+                        format!("no body named `{body}`"),
+                    ));
+                }
+            }
+            if h.bearing == h.journal {
+                return Err(Error::invalid(
+                    format!("{p}.journal"),
+                    "must differ from the bearing body",
+                ));
+            }
+            for (i, x) in h.point_m.iter().enumerate() {
+                position(&format!("{p}.point_m[{i}]"), *x)?;
+            }
+            unit(&h.axis, &format!("{p}.axis"))?;
+            if let Some(c) = &h.clearance {
+                c.build().map_err(|e| e.within(&format!("{p}.clearance")))?;
+                if c.lock == OutOfPlaneLock::None {
+                    return Err(Error::invalid(
+                        format!("{p}.clearance.lock"),
+                        "`None` leaves the axial translation and the tilts free, and a scene has no locked axes to \
+                         hold them: use `Joint` (plain-API users may lock the bodies' axes themselves)",
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+impl Scene {
+    /// Settings that are valid but probably not what was meant, each naming its field (the CLI
+    /// prints them as warnings before running).
+    pub fn warnings(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        for h in &self.hinges {
+            let Some(c) = &h.clearance else { continue };
+            if let FrictionSpec::Bai { mu_s, mu_d, .. } = c.friction
+                && mu_s < mu_d
+            {
+                out.push(format!(
+                    "`hinges[{}].clearance.friction`: Bai with mu_s = {} below mu_d = {} is not stiction \
+                     (the coefficient rises from mu_s to mu_d as the journal slips faster); swap them if \
+                     stiction was meant",
+                    h.name,
+                    sig4(mu_s),
+                    sig4(mu_d)
+                ));
+            }
+        }
+        out
+    }
+
+    /// The clearance model is planar (MODEL.md §4): contact and friction act in the plane normal
+    /// to each clearance hinge's axis, and the out-of-plane degrees of freedom are held rigidly.
+    /// A scene whose loads would act out of that plane is refused, naming what cannot be represented.
+    pub(super) fn validate_planar(&self) -> Result<()> {
+        let a_ref = Vector::from(self.reference_axis);
+        let g = Vector::from(self.gravity);
+        for h in self.hinges.iter().filter(|h| h.clearance.is_some()) {
+            let p = format!("hinges[{}]", h.name);
+            let a = Vector::from(h.axis).normalize();
+            if a.cross(a_ref).length() > 1e-9 {
+                return Err(Error::invalid(
+                    format!("{p}.axis"),
+                    "a clearance hinge must be parallel to the scene's reference_axis: the planar clearance \
+                     model has no axial or tilting contact, so non-parallel hinges (out-of-plane motion) \
+                     cannot be represented; make this hinge ideal or align it",
+                ));
+            }
+            if g.dot(a).abs() > 1e-9 * g.length().max(1e-300) && g.length() > 0.0 {
+                return Err(Error::invalid(
+                    "gravity",
+                    format!(
+                        "has a component along the axis of clearance hinge `{}`: an axial (out-of-plane) load, \
+                         which the planar clearance model cannot carry through contact; put gravity in the \
+                         hinge plane or make the hinge ideal",
+                        h.name
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}

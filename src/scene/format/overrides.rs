@@ -1,0 +1,250 @@
+//! `path=value` overrides of a scene's fields, the path found in the scene's JSON form.
+
+use super::Scene;
+use crate::error::{Error, Result};
+
+impl Scene {
+    /// Applies `path=value` overrides. The first segment of `path` is a top-level field (`run`,
+    /// `gravity`, ...) or the name of a body, hinge or drive; the following segments are fields,
+    /// found at any depth below when unique (`hinge.clearance_mm` is
+    /// `hinges[hinge].clearance.clearance_mm`). The value is JSON (`0.25`, `[0,0,-9.81]`,
+    /// `{"HuntCrossley":{"restitution":0.9}}`) or else a bare word (`Lubricated`).
+    pub fn with_overrides<S: AsRef<str>>(&self, overrides: &[S]) -> Result<Scene> {
+        if overrides.is_empty() {
+            return Ok(self.clone());
+        }
+        let mut value =
+            serde_json::to_value(self).map_err(|e| Error::invalid("scene", e.to_string()))?;
+        for o in overrides {
+            let o = o.as_ref();
+            let (path, raw) = o
+                .split_once('=')
+                .ok_or_else(|| Error::parse(format!("override `{o}`"), "expected `path=value`"))?;
+            let new: serde_json::Value = serde_json::from_str(raw.trim())
+                .unwrap_or_else(|_| serde_json::Value::String(raw.trim().to_string()));
+            let path = path.trim();
+            let slot = locate(&mut value, path)?;
+            check_group(path, slot, &new)?;
+            *slot = new;
+        }
+        let scene: Scene = serde_json::from_value(value).map_err(|e| {
+            Error::parse(
+                format!(
+                    "overrides {:?}",
+                    overrides.iter().map(|s| s.as_ref()).collect::<Vec<_>>()
+                ),
+                e.to_string(),
+            )
+        })?;
+        scene.validate()?;
+        Ok(scene)
+    }
+}
+
+/// Refuses a scalar written over a group of settings (`--set run=5`): only one of its fields
+/// can be meant. A law (an enum) may be replaced by a bare name or an object, and an optional
+/// group by `null`.
+fn check_group(path: &str, slot: &serde_json::Value, new: &serde_json::Value) -> Result<()> {
+    let Some(fields) = slot.as_object() else {
+        return Ok(());
+    };
+    let is_enum = fields.len() == 1
+        && fields
+            .keys()
+            .next()
+            .is_some_and(|k| k.starts_with(|c: char| c.is_ascii_uppercase()));
+    if is_enum || new.is_object() || new.is_null() {
+        return Ok(());
+    }
+    let names: Vec<&str> = fields.keys().map(String::as_str).collect();
+    let example = names.first().copied().unwrap_or("field");
+    Err(Error::invalid(
+        path,
+        format!(
+            "is a group of settings ({}): set one of them, e.g. `--set {path}.{example}=VALUE`",
+            names.join(", ")
+        ),
+    ))
+}
+
+/// One step of a path into the scene's JSON: an object key or an array index.
+#[derive(Clone, Debug)]
+enum Step {
+    Key(String),
+    Index(usize),
+}
+
+/// Finds the JSON slot an override path names (see [`Scene::with_overrides`]). The first
+/// segment is a top-level field, the name of a body, hinge, joint or drive, or `bodies[name]`,
+/// `hinges[name]`, `joints[name]`, `drives[name]` (the form error messages use). A name that is also a
+/// top-level field (a body called `run`) is taken where the rest of the path exists.
+fn locate<'a>(root: &'a mut serde_json::Value, path: &str) -> Result<&'a mut serde_json::Value> {
+    let unknown = |reason: String| Error::invalid(path, reason);
+    let mut segments = path.split('.');
+    let first = segments
+        .next()
+        .filter(|s| !s.is_empty())
+        .ok_or_else(|| unknown("empty parameter path".into()))?;
+    let rest: Vec<&str> = segments.collect();
+    let obj = root
+        .as_object()
+        .ok_or_else(|| unknown("scene is not an object".into()))?;
+    let item = |list: &str, name: &str| -> Option<Vec<Step>> {
+        let items = obj.get(list)?.as_array()?;
+        let i = items
+            .iter()
+            .position(|it| it.get("name").and_then(|n| n.as_str()) == Some(name))?;
+        Some(vec![Step::Key(list.to_string()), Step::Index(i)])
+    };
+    let mut starts: Vec<(String, Vec<Step>)> = Vec::new();
+    if let Some((list, name)) = first
+        .strip_suffix(']')
+        .and_then(|f| f.split_once('['))
+        .filter(|(l, _)| ["bodies", "hinges", "joints", "drives"].contains(l))
+    {
+        let start = item(list, name).ok_or_else(|| {
+            let what = match list {
+                "bodies" => "body",
+                "hinges" => "hinge",
+                "joints" => "joint",
+                _ => "drive",
+            };
+            unknown(format!("no {what} named `{name}`"))
+        })?;
+        starts.push((format!("{list}[{name}]"), start));
+    } else {
+        if obj.contains_key(first) {
+            starts.push((
+                format!("the top-level field `{first}`"),
+                vec![Step::Key(first.to_string())],
+            ));
+        }
+        for (list, what) in [
+            ("bodies", "body"),
+            ("hinges", "hinge"),
+            ("joints", "joint"),
+            ("drives", "drive"),
+        ] {
+            if let Some(start) = item(list, first) {
+                starts.push((format!("the {what} `{first}` ({list}[{first}])"), start));
+            }
+        }
+    }
+    if starts.is_empty() {
+        return Err(unknown(format!(
+            "`{first}` is neither a top-level field nor the name of a body, hinge, joint or drive"
+        )));
+    }
+    let resolved: Vec<(String, std::result::Result<Vec<Step>, String>)> = starts
+        .into_iter()
+        .map(|(what, start)| {
+            let found = resolve(root_at(root, &start), &rest).map(|tail| {
+                let mut steps = start;
+                steps.extend(tail);
+                steps
+            });
+            (what, found)
+        })
+        .collect();
+    let ok: Vec<&(String, std::result::Result<Vec<Step>, String>)> =
+        resolved.iter().filter(|(_, r)| r.is_ok()).collect();
+    let steps = match ok.as_slice() {
+        [(_, Ok(steps))] => steps.clone(),
+        [] => {
+            let (_, Err(reason)) = &resolved[0] else {
+                unreachable!("no start resolved")
+            };
+            return Err(unknown(reason.clone()));
+        }
+        several => {
+            return Err(unknown(format!(
+                "`{first}` names {}: write `{}.{}` for the body, hinge or drive, or rename it",
+                several
+                    .iter()
+                    .map(|(w, _)| w.as_str())
+                    .collect::<Vec<_>>()
+                    .join(" and "),
+                several
+                    .iter()
+                    .find_map(|(w, _)| w.split_once('(').map(|(_, p)| p.trim_end_matches(')')))
+                    .unwrap_or(first),
+                rest.join(".")
+            )));
+        }
+    };
+    let mut cur = root;
+    for step in &steps {
+        cur = match step {
+            Step::Key(k) => cur.get_mut(k.as_str()),
+            Step::Index(i) => cur.get_mut(*i),
+        }
+        .expect("path just resolved");
+    }
+    Ok(cur)
+}
+
+fn root_at<'a>(root: &'a serde_json::Value, steps: &[Step]) -> &'a serde_json::Value {
+    let mut cur = root;
+    for step in steps {
+        cur = match step {
+            Step::Key(k) => &cur[k.as_str()],
+            Step::Index(i) => &cur[*i],
+        };
+    }
+    cur
+}
+
+/// The steps below `v` to the field named by `segments`, each segment a direct child or the
+/// unique field of that name at any depth.
+fn resolve(v: &serde_json::Value, segments: &[&str]) -> std::result::Result<Vec<Step>, String> {
+    let mut steps = Vec::new();
+    let mut cur = v;
+    for seg in segments {
+        let found = descend(cur, seg)?;
+        for k in found {
+            cur = &cur[k.as_str()];
+            steps.push(Step::Key(k));
+        }
+    }
+    Ok(steps)
+}
+
+/// The key path to the child `key` of `v`, or to the unique field called `key` at any depth below it.
+fn descend(v: &serde_json::Value, key: &str) -> std::result::Result<Vec<String>, String> {
+    fn paths(
+        v: &serde_json::Value,
+        key: &str,
+        prefix: &mut Vec<String>,
+        out: &mut Vec<Vec<String>>,
+    ) {
+        if let Some(o) = v.as_object() {
+            for (k, child) in o {
+                prefix.push(k.clone());
+                if k == key {
+                    out.push(prefix.clone());
+                }
+                paths(child, key, prefix, out);
+                prefix.pop();
+            }
+        }
+    }
+    if v.get(key).is_some() {
+        return Ok(vec![key.to_string()]);
+    }
+    let mut found = Vec::new();
+    paths(v, key, &mut Vec::new(), &mut found);
+    match found.len() {
+        0 => Err(format!(
+            "no field `{key}` here (is the hinge ideal, or the name misspelt?)"
+        )),
+        1 => Ok(found.remove(0)),
+        _ => Err(format!(
+            "`{key}` is ambiguous: {}",
+            found
+                .iter()
+                .map(|p| p.join("."))
+                .collect::<Vec<_>>()
+                .join(", ")
+        )),
+    }
+}

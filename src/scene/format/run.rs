@@ -1,0 +1,152 @@
+//! Run settings: time stepping and output, and their validation.
+
+use super::limits::*;
+use crate::error::{Error, Result, in_range, positive, sig4};
+use serde::{Deserialize, Serialize};
+
+/// Time stepping and output.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RunSettings {
+    /// Fixed steps: the step, s (default 1e-4, the paper's).
+    #[serde(default = "default_dt")]
+    pub dt_s: f64,
+    /// Adaptive steps: the largest step, s (default 1e-3). Free flight is second order in the
+    /// step (variable-step Störmer-Verlet), so it needs no smaller step; contacts are approached
+    /// and resolved by the step control whatever this is.
+    #[serde(default = "default_max_dt")]
+    pub max_dt_s: f64,
+    /// Simulated time, s.
+    #[serde(default = "default_end")]
+    pub end_s: f64,
+    /// Interval between CSV rows, s: a row is the first state at or after each multiple of it
+    /// (with fixed steps, every `round(interval/dt)`-th step). Rows never change the steps: the
+    /// physics does not depend on the output interval.
+    #[serde(default = "default_dt")]
+    pub output_interval_s: f64,
+    /// How the step is chosen.
+    #[serde(default)]
+    pub step: StepMode,
+    /// Adaptive steps: the fraction of a contact's natural period `2 pi/omega` one step may cover.
+    #[serde(default = "default_tolerance")]
+    pub tolerance: f64,
+    /// Whether a guard violation (a penetration beyond the law's validity, energy gained, steps
+    /// at the floor) fails the run instead of being reported (`--strict`).
+    #[serde(default)]
+    pub strict: bool,
+    /// Writes each moving body's centre-of-mass position, velocity and acceleration along the
+    /// world axes (`<body>_x_m`, ..., `<body>_vz_m_s`, ..., `<body>_az_m_s2`) in the rows: a
+    /// dynamic body's velocity and acceleration solved at each state from the constrained
+    /// equations (the joints' and the clearance contacts' forces known), a driven body's its
+    /// drive's.
+    #[serde(default)]
+    pub body_motion: bool,
+}
+
+pub use crate::rapier::stepper::StepMode;
+
+fn default_tolerance() -> f64 {
+    0.0075
+}
+
+fn default_max_dt() -> f64 {
+    1e-3
+}
+
+fn default_dt() -> f64 {
+    1e-4
+}
+fn default_end() -> f64 {
+    5.0
+}
+
+impl RunSettings {
+    /// The stepper's control for these settings.
+    pub fn step_control(&self) -> crate::rapier::stepper::StepControl {
+        let c = match self.step {
+            StepMode::Fixed => crate::rapier::stepper::StepControl::fixed(self.dt_s),
+            StepMode::Adaptive => {
+                crate::rapier::stepper::StepControl::adaptive(self.max_dt_s, self.tolerance)
+            }
+        };
+        c.strict(self.strict)
+    }
+
+    /// The step control in words, e.g. "adaptive steps of at most 1e-3 s (tolerance 0.0075 of a
+    /// contact period)".
+    pub fn stepping(&self) -> String {
+        match self.step {
+            StepMode::Fixed => format!("fixed step {:e} s", self.dt_s),
+            StepMode::Adaptive => format!(
+                "adaptive steps of at most {:e} s (tolerance {} of a contact period)",
+                self.max_dt_s, self.tolerance
+            ),
+        }
+    }
+}
+
+impl Default for RunSettings {
+    fn default() -> Self {
+        RunSettings {
+            dt_s: default_dt(),
+            max_dt_s: default_max_dt(),
+            end_s: default_end(),
+            output_interval_s: default_dt(),
+            step: StepMode::default(),
+            tolerance: default_tolerance(),
+            strict: false,
+            body_motion: false,
+        }
+    }
+}
+
+impl RunSettings {
+    /// Checks the settings; errors name the field as `run.<field>`.
+    pub(super) fn validate(&self) -> Result<()> {
+        let r = self;
+        positive("run.dt_s", r.dt_s)?;
+        in_range("run.dt_s", r.dt_s, DT_RANGE.0, DT_RANGE.1, "s")?;
+        in_range("run.max_dt_s", r.max_dt_s, DT_RANGE.0, DT_RANGE.1, "s")?;
+        positive("run.end_s", r.end_s)?;
+        in_range("run.end_s", r.end_s, END_RANGE.0, END_RANGE.1, "s")?;
+        positive("run.output_interval_s", r.output_interval_s)?;
+        in_range(
+            "run.output_interval_s",
+            r.output_interval_s,
+            DT_RANGE.0,
+            END_RANGE.1,
+            "s",
+        )?;
+        crate::error::in_range_open_closed("run.tolerance", r.tolerance, 0.0, 1.0)?;
+        in_range("run.tolerance", r.tolerance, TOLERANCE_MIN, 1.0, "")?;
+        if r.end_s / r.output_interval_s > MAX_ROWS {
+            return Err(Error::invalid(
+                "run.output_interval_s",
+                format!(
+                    "{} rows to reach run.end_s = {} s: more than {} (memory); use a larger interval",
+                    sig4(r.end_s / r.output_interval_s),
+                    sig4(r.end_s),
+                    sig4(MAX_ROWS)
+                ),
+            ));
+        }
+        if r.step == StepMode::Fixed && r.end_s / r.dt_s > MAX_STEPS {
+            return Err(Error::invalid(
+                "run.dt_s",
+                format!(
+                    "{} steps to reach run.end_s = {} s: more than {}; use a larger step or a shorter run",
+                    sig4(r.end_s / r.dt_s),
+                    sig4(r.end_s),
+                    sig4(MAX_STEPS)
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// Most output rows a run may keep (each row is a few hundred bytes for a small scene; the CLI
+/// also checks the bytes of a run against the memory available before it starts).
+const MAX_ROWS: f64 = 1e7;
+/// Most steps (`run.end_s / run.dt_s`) a run may take.
+const MAX_STEPS: f64 = 1e9;

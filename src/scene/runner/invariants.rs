@@ -1,0 +1,136 @@
+//! Conservation checks over every step: momentum drift and the energy balance.
+
+use super::twin::Twin;
+use crate::rapier::stepper::StepInfo;
+use rapier3d_f64::math::Vector;
+use rapier3d_f64::prelude::*;
+use serde::Serialize;
+
+/// Conservation checks over every step.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Invariants {
+    /// A prescribed motion drives the scene: it does work the balance does not know, so the
+    /// energy figures are null. (A joint motor's work is in the balance: `motor_work_j`.)
+    #[serde(skip)]
+    pub driven: bool,
+    /// Largest `|P(t) - P(0)|` over the largest single-body linear momentum seen; null when the
+    /// scene is not free-floating (gravity or a fixed body: momentum is not conserved).
+    pub linear_momentum_drift: Option<f64>,
+    /// Largest `|L(t) - L(0)|` (about the origin) over the largest single-body angular momentum
+    /// seen; null when the scene is not free-floating.
+    pub angular_momentum_drift: Option<f64>,
+    /// Largest growth of the energy balance `E(t) + D(t) - W(t) - E(0)` (E: kinetic, gravity,
+    /// spring and contact elastic energy; D: the work dissipated so far by contact damping and
+    /// friction; W: the joint motors' work) over the energy scale. Fixed supports and ideal joints do no work, so the balance holds with
+    /// gravity and grounds too, and energy gained by the integration shows even in a run that
+    /// dissipates. Null when nothing moved (an energy scale below 1e-9 J: no scale to judge by),
+    /// and when a prescribed motion drives the scene (its work is not in the balance).
+    pub energy_growth: Option<f64>,
+    /// Largest `|E(t) + D(t) - E(0)|` over the energy scale (null when nothing moved).
+    pub energy_error: Option<f64>,
+    /// The energy scale: the larger of the peak kinetic energy and the largest change of the
+    /// potential energy, J.
+    pub energy_scale_j: f64,
+    /// Peak kinetic energy, J.
+    pub peak_kinetic_energy_j: f64,
+    /// Work dissipated by contact damping and friction over the run, J.
+    pub dissipated_j: f64,
+    /// Work done by the joint motors on the bodies over the run, J: at each step, the impulse
+    /// Rapier's motor row applied times the joint's speed at the step's start. The energy
+    /// balance counts it as energy put in: `E(t) + D(t) - W(t) - E(0)`.
+    pub motor_work_j: f64,
+    #[serde(skip)]
+    free_floating: bool,
+    #[serde(skip)]
+    p0: Option<(Vector, Vector, f64, f64)>,
+    #[serde(skip)]
+    max_p: f64,
+    #[serde(skip)]
+    max_l: f64,
+    #[serde(skip)]
+    max_dp: f64,
+    #[serde(skip)]
+    max_dl: f64,
+    #[serde(skip)]
+    max_de: f64,
+    #[serde(skip)]
+    max_abs_de: f64,
+    #[serde(skip)]
+    max_dpe: f64,
+}
+
+impl Invariants {
+    /// Empty checks for a scene that is free-floating (no gravity, no fixed or driven body:
+    /// momentum is conserved) or driven by a prescribed motion (its work is not in the balance).
+    pub(super) fn new(free_floating: bool, driven: bool) -> Invariants {
+        Invariants {
+            free_floating,
+            driven,
+            ..Invariants::default()
+        }
+    }
+}
+
+/// Below this energy scale (J) nothing moved enough for the energy balance to be judged.
+const MIN_ENERGY_SCALE_J: f64 = 1e-9;
+
+/// Energy growth above this fraction of the energy scale is a guard violation.
+pub const ENERGY_GROWTH_LIMIT: f64 = 1e-2;
+
+impl Twin {
+    /// Momentum and energy at the state before the step just taken, with its synchronous
+    /// velocities: the half-step velocities around it weighted by the steps,
+    /// `(h v_before + h_prev v_after)/(h_prev + h)` (second order, where the stored half-step
+    /// velocities alone would make the energy balance first order).
+    pub(super) fn update_invariants(
+        &mut self,
+        bodies: &RigidBodySet,
+        gravity: Vector,
+        info: &StepInfo,
+    ) {
+        let (h, h_prev) = (info.dt, (2.0 * info.kick - info.dt).max(0.0));
+        let sync = |before: Vector, after: Vector| (h * before + h_prev * after) / (h_prev + h);
+        let (mut p, mut l, mut ke, mut pe) = (Vector::ZERO, Vector::ZERO, 0.0, 0.0);
+        let inv = &mut self.invariants;
+        for b in &self.bodies {
+            if b.fixed {
+                continue;
+            }
+            let rb = &bodies[b.handle];
+            let com = b.com_before;
+            let v = sync(b.linvel_before, rb.linvel());
+            let w = sync(b.angvel_before, rb.angvel());
+            let mp = &rb.mass_properties().local_mprops;
+            // I w in world: R I_principal R^T w.
+            let rot = b.rotation_before * mp.principal_inertia_local_frame;
+            let iw = rot * (mp.principal_inertia() * (rot.inverse() * w));
+            let pb = b.mass * v;
+            let lb = com.cross(pb) + iw;
+            p += pb;
+            l += lb;
+            ke += 0.5 * b.mass * v.length_squared() + 0.5 * w.dot(iw);
+            pe -= b.mass * gravity.dot(com);
+            inv.max_p = inv.max_p.max(pb.length());
+            inv.max_l = inv.max_l.max(lb.length());
+        }
+        pe += self.source_energy_before;
+        let e = ke + pe + inv.dissipated_j - inv.motor_work_j;
+        let (p0, l0, e0, pe0) = *inv.p0.get_or_insert((p, l, e, pe));
+        inv.max_dp = inv.max_dp.max((p - p0).length());
+        inv.max_dl = inv.max_dl.max((l - l0).length());
+        inv.max_de = inv.max_de.max(e - e0);
+        inv.max_abs_de = inv.max_abs_de.max((e - e0).abs());
+        inv.max_dpe = inv.max_dpe.max((pe - pe0).abs());
+        inv.peak_kinetic_energy_j = inv.peak_kinetic_energy_j.max(ke);
+        inv.energy_scale_j = inv.peak_kinetic_energy_j.max(inv.max_dpe);
+        let rel = |d: f64, scale: f64| if scale > 0.0 { d / scale } else { 0.0 };
+        if inv.free_floating {
+            inv.linear_momentum_drift = Some(rel(inv.max_dp, inv.max_p));
+            inv.angular_momentum_drift = Some(rel(inv.max_dl, inv.max_l));
+        }
+        if inv.energy_scale_j >= MIN_ENERGY_SCALE_J && !inv.driven {
+            inv.energy_growth = Some(inv.max_de / inv.energy_scale_j);
+            inv.energy_error = Some(inv.max_abs_de / inv.energy_scale_j);
+        }
+    }
+}

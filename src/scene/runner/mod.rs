@@ -1,0 +1,314 @@
+//! The runner: builds a scene twice in one Rapier world, an ideal twin (every hinge a Rapier
+//! revolute joint) and a clearance twin (hinges with clearance become [`ClearanceJoint`](crate::rapier::joint::ClearanceJoint)s), steps
+//! both together, and records both.
+
+mod comparison;
+mod invariants;
+mod twin;
+
+pub use comparison::{Comparison, RateDeviation, Settling};
+pub use invariants::{ENERGY_GROWTH_LIMIT, Invariants};
+pub use twin::{Twin, TwinKind};
+
+use crate::error::Result;
+use crate::rapier::stepper::{ForceSource, GuardReport, Stepper};
+use crate::scene::Scene;
+use comparison::ComparisonSums;
+use rapier3d_f64::math::Vector;
+use rapier3d_f64::prelude::*;
+use std::time::Instant;
+
+/// Which twins to build.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Twins {
+    /// Both, side by side in one world (the default).
+    #[default]
+    Both,
+    /// Only the ideal twin (for cost measurements).
+    IdealOnly,
+    /// Only the clearance twin (for cost measurements).
+    ClearanceOnly,
+}
+
+/// Run options beyond the scene.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct RunOptions {
+    /// Which twins to build.
+    pub twins: Twins,
+    /// Keep output rows (off for benchmarks: metrics are still computed every step).
+    pub skip_rows: bool,
+}
+
+pub use crate::rapier::metrics::HingeMetrics;
+
+/// A scene built in a Rapier world, ready to step.
+pub struct Simulation {
+    /// The Rapier world holding both twins.
+    pub world: PhysicsWorld,
+    /// The twins, ideal first.
+    pub twins: Vec<Twin>,
+    /// The step control (the same public piece a plain-Rapier loop uses).
+    pub stepper: Stepper,
+    scene: Scene,
+    /// Index of the next output row (row `k` is at `k * output_interval_s`, the last at `end_s`).
+    next_row: u64,
+    /// Time of the previous state (rows between it and the current one are interpolated).
+    t_prev: f64,
+    /// The row at `end_s` is written.
+    rows_done: bool,
+    skip_rows: bool,
+    comparison: ComparisonSums,
+}
+
+pub use crate::rapier::stepper::left_physical_range;
+
+/// Where a run is, passed to the callback of [`Simulation::run_with_progress`].
+#[derive(Clone, Copy, Debug)]
+pub struct Progress {
+    /// Simulated time reached, s.
+    pub t: f64,
+    /// Simulated time at the end of the run, s.
+    pub end: f64,
+    /// Internal steps taken so far.
+    pub steps: u64,
+}
+
+/// The result of a whole run.
+#[derive(Debug)]
+pub struct RunResult {
+    /// The scene that ran (after overrides).
+    pub scene: Scene,
+    /// Twins with their tables and invariants.
+    pub twins: Vec<Twin>,
+    /// Internal steps taken.
+    pub steps: u64,
+    /// Wall time of the whole run (both twins share one world), s.
+    pub wall_s: f64,
+    /// Clearance twin against ideal twin (when both were built).
+    pub comparison: Option<Comparison>,
+    /// What the run-time guards saw (the stepper's, plus energy growth).
+    pub guards: GuardReport,
+}
+
+impl Simulation {
+    /// Builds the world for `scene`.
+    pub fn new(scene: &Scene, options: RunOptions) -> Result<Simulation> {
+        scene.validate()?;
+        let control = scene.run.step_control();
+        control.validate().map_err(|e| e.within("run"))?;
+        let mut world = PhysicsWorld::new();
+        world.gravity = Vector::from(scene.gravity);
+        world.integration_parameters.dt = scene.run.dt_s;
+        // One substep: the hook's force is constant over the step (substeps gain energy).
+        world.integration_parameters.num_solver_iterations = 1;
+        let kinds: &[TwinKind] = match options.twins {
+            Twins::Both => &[TwinKind::Ideal, TwinKind::Clearance],
+            Twins::IdealOnly => &[TwinKind::Ideal],
+            Twins::ClearanceOnly => &[TwinKind::Clearance],
+        };
+        let mut twins = Vec::new();
+        for &kind in kinds {
+            twins.push(Twin::build(scene, kind, &mut world)?);
+        }
+        // Mass properties before the first step (Rapier computes them in it; the reactions and
+        // the hooks need them at the initial state).
+        crate::rapier::reaction::prepare_mass_properties(&mut world.bodies);
+        Ok(Simulation {
+            world,
+            twins,
+            stepper: Stepper::new(control),
+            scene: scene.clone(),
+            next_row: 0,
+            t_prev: 0.0,
+            rows_done: false,
+            skip_rows: options.skip_rows,
+            comparison: ComparisonSums::default(),
+        })
+    }
+
+    /// Simulated time, s.
+    pub fn time(&self) -> f64 {
+        self.stepper.time()
+    }
+
+    fn done(&self) -> bool {
+        self.time() >= self.scene.run.end_s
+    }
+
+    /// Writes the rows whose times lie in `(t_prev, t]` (and the row at 0 at the first state),
+    /// interpolated between the previous state and the current one: rows sit exactly at
+    /// multiples of `output_interval_s` (and at `end_s`) whatever the steps, and never change them.
+    fn write_rows(&mut self, t: f64) {
+        if self.skip_rows {
+            return;
+        }
+        let run = &self.scene.run;
+        let (oi, end) = (run.output_interval_s, run.end_s);
+        // Rounding of summed steps: a row within a billionth of a step counts as reached.
+        let slack = 1e-9 * run.max_dt_s.max(run.dt_s);
+        while !self.rows_done {
+            let grid = self.next_row as f64 * oi;
+            let last = grid >= end - slack;
+            let r = if last { end } else { grid };
+            if r > t + slack {
+                return;
+            }
+            let w = if t > self.t_prev {
+                ((r - self.t_prev) / (t - self.t_prev)).clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            for twin in &mut self.twins {
+                twin.write_row(r, w);
+            }
+            self.next_row += 1;
+            self.rows_done = last;
+        }
+    }
+
+    /// Where the next step may go at most: the end. Rows never shorten a step (a row is the
+    /// first state at or after its time), so the physics is the same for any output interval.
+    fn target(&self) -> f64 {
+        self.scene.run.end_s
+    }
+
+    /// Runs to `run.end_s`.
+    pub fn run(self) -> Result<RunResult> {
+        self.run_with_progress(|_| {})
+    }
+
+    /// Runs to `run.end_s`, calling `progress` after every internal step (e.g. to show simulated
+    /// time, steps per second and an ETA on a terminal; the call should be cheap).
+    pub fn run_with_progress(mut self, mut progress: impl FnMut(&Progress)) -> Result<RunResult> {
+        let start = Instant::now();
+        while !self.done() {
+            self.step()?;
+            progress(&Progress {
+                t: self.time(),
+                end: self.scene.run.end_s,
+                steps: self.stepper.steps(),
+            });
+        }
+        self.finish()?;
+        let comparison = match self.twins.as_slice() {
+            [ideal, _] => Some(self.comparison.finish(ideal, self.time())),
+            _ => None,
+        };
+        let mut guards = self.stepper.guards().clone();
+        for twin in &self.twins {
+            let g = twin.invariants.energy_growth.unwrap_or(0.0);
+            if g > ENERGY_GROWTH_LIMIT {
+                guards.violation(&format!("energy:{}", twin.kind.name()), || {
+                    format!(
+                        "the {} twin gained energy: {} of its energy scale (limit {})",
+                        twin.kind.name(),
+                        crate::error::sig4(g),
+                        ENERGY_GROWTH_LIMIT
+                    )
+                });
+            }
+        }
+        if self.scene.run.strict && !guards.is_clean() {
+            return Err(crate::Error::Guard {
+                t: self.time(),
+                violations: guards.violations.join("; "),
+            });
+        }
+        Ok(RunResult {
+            comparison,
+            scene: self.scene,
+            twins: self.twins,
+            steps: self.stepper.steps(),
+            wall_s: start.elapsed().as_secs_f64(),
+            guards,
+        })
+    }
+
+    /// Advances one accepted internal step: records the state before it (invariants, a row when
+    /// due, the contact samples), lets the stepper take it, then completes what only the step
+    /// determines (ideal reactions, metrics).
+    pub fn step(&mut self) -> Result<()> {
+        {
+            // The sources' forces at the first state, before it is read.
+            let mut sources = sources(&mut self.twins);
+            self.stepper.prepare(&mut self.world, &mut sources)?;
+        }
+        let t = self.time();
+        let gravity = self.world.gravity;
+        let rows = !self.skip_rows;
+        let lag = 0.5 * self.stepper.last_dt();
+        for twin in &mut self.twins {
+            twin.before_step(&self.world.bodies, gravity, t, lag, rows);
+        }
+        let target = self.target();
+        let info = {
+            let mut sources = sources(&mut self.twins);
+            self.stepper
+                .step(&mut self.world, &mut sources, target)
+                .map_err(|e| name_step_field(e, "run.dt_s"))?
+        };
+        for twin in &mut self.twins {
+            twin.after_step(
+                &self.world.bodies,
+                &self.world.impulse_joints,
+                &info,
+                gravity,
+            );
+        }
+        self.write_rows(t);
+        self.t_prev = t;
+        if let [ideal, clear] = self.twins.as_slice() {
+            self.comparison
+                .record(ideal, clear, &self.world.bodies, info.t0, info.dt);
+        }
+        Ok(())
+    }
+
+    /// Records the final state: invariants, a last row at `end_s` (its reactions, velocities and
+    /// accelerations solved at that state like every other), final metrics.
+    fn finish(&mut self) -> Result<()> {
+        {
+            let mut sources = sources(&mut self.twins);
+            self.stepper.prepare(&mut self.world, &mut sources)?;
+        }
+        let t = self.time();
+        let gravity = self.world.gravity;
+        let rows = !self.skip_rows;
+        let lag = 0.5 * self.stepper.last_dt();
+        for twin in &mut self.twins {
+            twin.before_step(&self.world.bodies, gravity, t, lag, rows);
+        }
+        self.write_rows(t);
+        let duration = self.time();
+        for twin in &mut self.twins {
+            // The final state counts for peaks and onsets (it carries no time).
+            for h in &mut twin.hinges {
+                let obs = h.observation();
+                h.recorder.finish(duration, &obs);
+                h.recorder.set_final_angle_deg(h.angle.value().to_degrees());
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The force sources of all twins, for the stepper.
+fn sources(twins: &mut [Twin]) -> Vec<&mut dyn ForceSource> {
+    let mut v: Vec<&mut dyn ForceSource> = Vec::with_capacity(3 * twins.len());
+    for t in twins.iter_mut() {
+        v.push(&mut t.drives);
+        v.push(&mut t.clearance);
+        if !t.prescribed.motions.is_empty() {
+            v.push(&mut t.prescribed);
+        }
+    }
+    v
+}
+
+/// Names the scene's step field in a step-limit error (the stepper knows only `dt`).
+fn name_step_field(mut e: crate::Error, name: &str) -> crate::Error {
+    if let crate::Error::StepTooLarge { field, .. } = &mut e {
+        *field = name.into();
+    }
+    e
+}

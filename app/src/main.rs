@@ -307,6 +307,17 @@ fn sweep(args: &SweepArgs) -> clearance_joint::Result<()> {
     let start = Instant::now();
     let outcome = job.run(exec)?;
     let reused = outcome.points.iter().filter(|p| p.reused).count();
+    let flagged = outcome
+        .points
+        .iter()
+        .filter(|p| !p.manifest.metrics.guard_violations.is_empty())
+        .count();
+    if flagged > 0 {
+        eprintln!(
+            "WARNING: {flagged} point(s) left the model's validity (run-time guards; column \
+             `guard_violations`, and each point's summary.json); `--strict` makes them failures"
+        );
+    }
     println!(
         "{} points finished ({} run, {reused} reused), {} failed, in {:.2} s; table {}",
         outcome.points.len(),

@@ -412,13 +412,18 @@ fn four_bar_linkage_runs_with_a_clearance_joint() {
     let angles = ideal.final_angles_deg();
     // Rapier's velocity motor is a stiff servo: its small speed error grows with the step and,
     // under adaptive steps, does not average out over a turn (720.012 deg at steps of at most
-    // 5e-6 s, 720.00003 at fixed 2e-6 s).
+    // 5e-6 s with `factor` 1e6, 720.027 with the scene's 1e8, 720.00003 at fixed 2e-6 s).
     assert!(
         (angles["crank"] - 720.0).abs() < 0.05,
         "{}",
         angles["crank"]
     );
-    assert!(angles["rocker"].abs() < 0.01 && angles["coupler"].abs() < 0.01);
+    // The loop closes where the crank ends: its 0.027 deg of drift turns the rocker and the
+    // coupler by about half of that (-0.0136 deg each, measured).
+    assert!(
+        angles["rocker"].abs() < 0.03 && angles["coupler"].abs() < 0.03,
+        "{angles:?}"
+    );
     let m = ideal.hinge_metrics();
     // Inertia and weight of a 0.5 kg linkage at 600 rpm: about a hundred newtons.
     for (name, h) in &m {

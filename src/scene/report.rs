@@ -216,7 +216,7 @@ pub fn summary_json(summary: &Summary) -> Result<String> {
         serde_json::to_value(summary).map_err(|e| Error::invalid("summary", e.to_string()))?;
     // serde_json writes a non-finite float as null: a null is allowed only where a metric is
     // legitimately absent (no impact yet, only one twin), so a NaN anywhere else is caught here.
-    const MAY_BE_NULL: [&str; 8] = [
+    const MAY_BE_NULL: [&str; 9] = [
         "first_impact_t_s",
         "first_impact_peak_n",
         "comparison",
@@ -225,6 +225,7 @@ pub fn summary_json(summary: &Summary) -> Result<String> {
         "first_invalid_penetration",
         "energy_growth",
         "energy_error",
+        "motor_speed_error",
     ];
     fn check(v: &serde_json::Value, key: &str, path: &str, end: f64) -> Result<()> {
         match v {

@@ -228,6 +228,12 @@ impl RunMetrics {
             ("end_s".into(), Some(self.end_s)),
             ("steps".into(), Some(self.steps as f64)),
             ("wall_s".into(), Some(self.wall_s)),
+            // A point outside the model's validity says so in the table too.
+            ("rejected_steps".into(), Some(self.rejected_steps as f64)),
+            (
+                "guard_violations".into(),
+                Some(self.guard_violations.len() as f64),
+            ),
         ];
         for (name, b) in &self.bodies {
             for (k, v) in [

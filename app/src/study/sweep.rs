@@ -432,12 +432,20 @@ impl Reporter {
         let n = self.done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
         let what = match outcome {
             Ok(o) if o.reused => "reused (finished earlier)".to_string(),
-            Ok(_) => format!("done in {seconds:.2} s"),
+            Ok(o) => match o.manifest.metrics.guard_violations.as_slice() {
+                [] => format!("done in {seconds:.2} s"),
+                v => format!(
+                    "done in {seconds:.2} s; WARNING, outside the model's validity: {}",
+                    v.join("; ")
+                ),
+            },
             Err(e) => format!("FAILED: {e}"),
         };
         let line = format!("[{n}/{}] {}: {what}", self.total, job.point.dir);
         if let Some(bar) = &self.bar {
-            if outcome.is_err() {
+            let warned =
+                matches!(outcome, Ok(o) if !o.manifest.metrics.guard_violations.is_empty());
+            if outcome.is_err() || warned {
                 bar.println(&line);
             }
             bar.set_message(job.point.dir.clone());

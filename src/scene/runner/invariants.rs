@@ -39,6 +39,13 @@ pub struct Invariants {
     /// Rapier's motor row applied times the joint's speed at the step's start. The energy
     /// balance counts it as energy put in: `E(t) + D(t) - W(t) - E(0)`.
     pub motor_work_j: f64,
+    /// Largest `|speed - target| / |target|` (the target floored at 1e-3) of the velocity motors,
+    /// which are reported as holding their speed exactly (their torques and the reactions are
+    /// solved so): how far that holds. Null without velocity motors.
+    pub motor_speed_error: Option<f64>,
+    /// The velocity motor where `motor_speed_error` was largest, and when, s.
+    #[serde(skip)]
+    pub motor_speed_error_at: Option<(String, f64)>,
     #[serde(skip)]
     free_floating: bool,
     #[serde(skip)]
@@ -73,6 +80,10 @@ impl Invariants {
 
 /// Below this energy scale (J) nothing moved enough for the energy balance to be judged.
 const MIN_ENERGY_SCALE_J: f64 = 1e-9;
+
+/// A velocity motor's speed error above this fraction of its target is a guard violation: its
+/// torque and the reactions are solved as if it held its speed.
+pub const MOTOR_SPEED_ERROR_LIMIT: f64 = 1e-2;
 
 /// Energy growth above this fraction of the energy scale is a guard violation.
 pub const ENERGY_GROWTH_LIMIT: f64 = 1e-2;

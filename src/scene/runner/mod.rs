@@ -7,7 +7,7 @@ mod invariants;
 mod twin;
 
 pub use comparison::{Comparison, RateDeviation, Settling};
-pub use invariants::{ENERGY_GROWTH_LIMIT, Invariants};
+pub use invariants::{ENERGY_GROWTH_LIMIT, Invariants, MOTOR_SPEED_ERROR_LIMIT};
 pub use twin::{Twin, TwinKind};
 
 use crate::error::Result;
@@ -204,6 +204,24 @@ impl Simulation {
                         twin.kind.name(),
                         crate::error::sig4(g),
                         ENERGY_GROWTH_LIMIT
+                    )
+                });
+            }
+        }
+        for twin in &self.twins {
+            let inv = &twin.invariants;
+            if let (Some(e), Some((name, t))) = (inv.motor_speed_error, &inv.motor_speed_error_at)
+                && e > MOTOR_SPEED_ERROR_LIMIT
+            {
+                guards.violation(&format!("motor:{}", twin.kind.name()), || {
+                    format!(
+                        "the {} twin's velocity motor `{name}` missed its speed by {} of its \
+                         target at t = {} s (limit {}): its torque and the reactions assume it \
+                         holds it; raise its `factor` or shorten the steps (`run.max_dt_s`)",
+                        twin.kind.name(),
+                        crate::error::sig4(e),
+                        crate::error::sig4(*t),
+                        MOTOR_SPEED_ERROR_LIMIT
                     )
                 });
             }

@@ -149,6 +149,8 @@ pub struct Twin {
     /// The joint motors in Rapier, with the index of their scene joint: their impulses over each
     /// step give their work.
     motor_joints: Vec<(ImpulseJointHandle, JointAxis, usize)>,
+    /// The velocity motors (reported as holding their speed): motor index, target, joint name.
+    held_motors: Vec<(usize, f64, String)>,
     pub(super) reference_axis: Vector,
     /// Output rows.
     pub table: Table,
@@ -359,7 +361,11 @@ impl Twin {
         }
         let (mut joints, mut motors, mut motor_columns) = (Vec::new(), Vec::new(), Vec::new());
         let mut motor_joints = Vec::new();
+        let mut held_motors = Vec::new();
         for (k, j) in scene.joints.iter().enumerate() {
+            if let Some(Motor::Held { target, .. }) = motor_of(j.motor.as_ref()) {
+                held_motors.push((k, target, j.name.clone()));
+            }
             let (i1, i2) = (
                 scene.body_index(&j.body1).unwrap(),
                 scene.body_index(&j.body2).unwrap(),
@@ -534,6 +540,7 @@ impl Twin {
             source_wrenches: Vec::new(),
             source_energy_before: 0.0,
             motor_joints,
+            held_motors,
             reference_axis: Vector::from(scene.reference_axis).normalize(),
             contact_columns: columns
                 .iter()
@@ -631,6 +638,17 @@ impl Twin {
         for &(h, axis, k) in &self.motor_joints {
             if let (Some(j), Some(rate)) = (joints.get(h), self.reactions.motor_rate(n + k)) {
                 self.invariants.motor_work_j -= j.data.motors[axis as usize].impulse * rate;
+            }
+        }
+        // How far the velocity motors hold their speed, at the state the step started from.
+        for (k, target, name) in &self.held_motors {
+            if let Some(rate) = self.reactions.motor_rate(n + k) {
+                let e = (rate - target).abs() / target.abs().max(1e-3);
+                let inv = &mut self.invariants;
+                if inv.motor_speed_error.is_none_or(|w| e > w) {
+                    inv.motor_speed_error = Some(e);
+                    inv.motor_speed_error_at = Some((name.clone(), info.t0));
+                }
             }
         }
         // Work of the step's damping and friction forces over the step's motion: the

@@ -57,7 +57,7 @@ pub struct BodyRunMetrics {
     pub mean_rate_ideal_deg_s: f64,
 }
 
-/// Metrics of one hinge. Every-step values come from the runner (`sim.rs`); "rows" values are
+/// Metrics of one hinge. Every-step values come from the runner (`clearance_joint::scene::runner`); "rows" values are
 /// computed here from the output rows (one per output interval).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct HingeRunMetrics {

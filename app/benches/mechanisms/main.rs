@@ -1,0 +1,301 @@
+//! The mechanism matrix (issue 16): each scene of the benchmark set at the library's defaults
+//! against the project's own converged fixed-step runs, step halving shown.
+//!
+//! `cargo bench --bench mechanisms` runs the full scenes (about 10 minutes on a 2-core machine)
+//! and prints two markdown tables, also written to `bench_out/mechanisms.md`. Options after
+//! `--`: `--quick` (or `MECHANISMS_QUICK=1`) runs the shortened scenes (the first crank turn, the
+//! first impacts); any other word keeps only the cases whose name contains it
+//! (`cargo bench --bench mechanisms -- --quick slider`).
+//!
+//! Per scene, three fixed steps each half the previous are run; the finest is the reference. The
+//! first impact of the default is compared with the reference's; later statistics (the motion
+//! turns chaotic after some impacts) with the spread of the three fixed runs.
+
+mod matrix;
+
+use matrix::*;
+use std::fmt::Write as _;
+
+/// Wall-time cap of one run, s: a run that stalls is reported, not waited for.
+const CAP_S: f64 = 30.0;
+
+struct Row {
+    label: String,
+    o: Outcome,
+    w: Option<WindowStats>,
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args()
+        .skip(1)
+        .filter(|a| a != "--bench")
+        .collect();
+    let quick = args.iter().any(|a| a == "--quick")
+        || std::env::var("MECHANISMS_QUICK").is_ok_and(|v| v == "1");
+    let filters: Vec<&String> = args.iter().filter(|a| !a.starts_with("--")).collect();
+    quiet_abandon();
+    let mut detail = String::new();
+    let mut summary = String::new();
+    let _ = writeln!(
+        summary,
+        "| scene | default: steps, wall (s) | reference: fixed dt (s), steps, wall (s) | \
+         first impact, default vs reference: onset (us), approach, peak, penetration, duration | \
+         impacts matched (default; half-step run) | window statistics of the default outside the \
+         converged spread | ideal twin vs closed form (default; reference) | default's guards |"
+    );
+    let _ = writeln!(summary, "|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(
+        detail,
+        "| scene | run | steps | wall (s) | first onset (s) | approach (m/s) | peak (N) | \
+         penetration (um) | duration (us) | matched | window: largest force (N) | deepest (um) | \
+         onsets per unit | contact fraction | RMS acc. diff (m/s^2) | guards |"
+    );
+    let _ = writeln!(
+        detail,
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
+    let total = std::time::Instant::now();
+    for case in cases() {
+        if !filters.is_empty() && !filters.iter().any(|f| case.name.contains(f.as_str())) {
+            continue;
+        }
+        let (end, start) = if quick {
+            (case.quick_end_s, case.quick_window_start_s)
+        } else {
+            (case.end_s, case.window_start_s)
+        };
+        let mut rows: Vec<Row> = Vec::new();
+        let steppings = case
+            .fixed_dt
+            .iter()
+            .map(|&dt| Stepping::Fixed(dt))
+            .chain([Stepping::Default]);
+        for s in steppings {
+            let o = run(&case, s, end, start, CAP_S);
+            eprintln!(
+                "{}: {} {} steps, {:.2} s{}",
+                case.name,
+                s.label(),
+                o.steps,
+                o.wall_s,
+                o.error
+                    .as_ref()
+                    .map(|e| format!(" ({e})"))
+                    .unwrap_or_default()
+            );
+            let w = o
+                .error
+                .is_none()
+                .then(|| window(&o.impacts, start, end, case.unit));
+            let label = match s {
+                Stepping::Fixed(_) if rows.len() == 2 => format!("{} (reference)", s.label()),
+                _ => s.label(),
+            };
+            rows.push(Row { label, o, w });
+        }
+        let reference = &rows[2];
+        for r in &rows {
+            let _ = writeln!(detail, "{}", detail_row(&case, r, reference));
+        }
+        let _ = writeln!(summary, "{}", summary_row(&case, &rows));
+    }
+    let unit_note = "Onsets per unit: per crank turn for the slider-crank and the four-bar, per \
+                     second otherwise. Window: after the first turn (slider-crank, four-bar), after \
+                     1 s (solar panel), 0.5 s (deployable array), 0.25 s (double pendulum); halved \
+                     in the quick mode.";
+    let md = format!(
+        "## Mechanism matrix{}\n\n{summary}\n{detail}\n{unit_note}\n\nTotal wall time {:.0} s.\n",
+        if quick {
+            " (quick: shortened scenes)"
+        } else {
+            ""
+        },
+        total.elapsed().as_secs_f64()
+    );
+    println!("{md}");
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../bench_out");
+    let _ = std::fs::create_dir_all(&dir);
+    let name = if quick {
+        "mechanisms_quick.md"
+    } else {
+        "mechanisms.md"
+    };
+    if let Err(e) = std::fs::write(dir.join(name), md) {
+        eprintln!("cannot write bench_out/{name}: {e}");
+    }
+}
+
+fn sig(x: f64) -> String {
+    if !x.is_finite() {
+        return "-".into();
+    }
+    let a = x.abs();
+    if a == 0.0 {
+        "0".into()
+    } else if !(1e-3..1e5).contains(&a) {
+        format!("{x:.3e}")
+    } else {
+        let digits = (4 - 1 - a.log10().floor() as i32).max(0) as usize;
+        format!("{x:.digits$}")
+    }
+}
+
+fn pct(x: f64) -> String {
+    if x.is_finite() {
+        format!("{:+.2} %", 100.0 * x)
+    } else {
+        "-".into()
+    }
+}
+
+fn guards(o: &Outcome) -> String {
+    match &o.error {
+        Some(e) => format!("**failed**: {}", e.chars().take(160).collect::<String>()),
+        None if o.violations.is_empty() => "clean".into(),
+        None => format!(
+            "{} violation(s): {}",
+            o.violations.len(),
+            o.violations
+                .iter()
+                .map(|v| v.chars().take(90).collect::<String>())
+                .collect::<Vec<_>>()
+                .join("; ")
+        ),
+    }
+}
+
+fn detail_row(case: &Case, r: &Row, reference: &Row) -> String {
+    let o = &r.o;
+    if o.error.is_some() {
+        return format!(
+            "| {} | {} | {} | {:.2} | | | | | | | | | | | | {} |",
+            case.name,
+            r.label,
+            o.steps,
+            o.wall_s,
+            guards(o)
+        );
+    }
+    let first = o.impacts.first();
+    let f = |g: &dyn Fn(&clearance_joint::rapier::metrics::Impact) -> f64| {
+        first.map_or("-".into(), |i| sig(g(i)))
+    };
+    let w = r.w.unwrap_or_default();
+    format!(
+        "| {} | {} | {} | {:.2} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+        case.name,
+        r.label,
+        o.steps,
+        o.wall_s,
+        first.map_or("-".into(), |i| format!("{:.7}", i.onset_t_s)),
+        f(&|i| i.approach_speed_m_s),
+        f(&|i| i.peak_force_n),
+        f(&|i| i.max_penetration_um),
+        f(&|i| i.duration_s * 1e6),
+        if reference.o.error.is_none() {
+            format!(
+                "{} of {}",
+                matched(&o.impacts, &reference.o.impacts),
+                reference.o.impacts.len()
+            )
+        } else {
+            "-".into()
+        },
+        sig(w.largest_force_n),
+        sig(w.deepest_um),
+        sig(w.onsets_per_unit),
+        sig(w.contact_fraction),
+        sig(o.rms_acc_diff),
+        guards(o)
+    )
+}
+
+fn summary_row(case: &Case, rows: &[Row]) -> String {
+    let (half, reference, default) = (&rows[1], &rows[2], &rows[3]);
+    let (d, r) = (&default.o, &reference.o);
+    let cost = |o: &Outcome| format!("{}, {:.2}", o.steps, o.wall_s);
+    let mut first = String::from("-");
+    let mut matches = String::from("-");
+    let mut outside = String::from("-");
+    if r.error.is_none() && d.error.is_none() {
+        if let (Some(a), Some(b)) = (d.impacts.first(), r.impacts.first()) {
+            first = format!(
+                "{:+.2}, {}, {}, {}, {}",
+                (a.onset_t_s - b.onset_t_s) * 1e6,
+                pct(rel(a.approach_speed_m_s, b.approach_speed_m_s)),
+                pct(rel(a.peak_force_n, b.peak_force_n)),
+                pct(rel(a.max_penetration_um, b.max_penetration_um)),
+                pct(rel(a.duration_s, b.duration_s))
+            );
+        } else if d.impacts.is_empty() != r.impacts.is_empty() {
+            first = format!(
+                "impacts: default {}, reference {}",
+                d.impacts.len(),
+                r.impacts.len()
+            );
+        }
+        matches = format!(
+            "{}; {} (of {})",
+            matched(&d.impacts, &r.impacts),
+            if half.o.error.is_none() {
+                matched(&half.o.impacts, &r.impacts).to_string()
+            } else {
+                "-".into()
+            },
+            r.impacts.len()
+        );
+        // The spread of the converged (fixed) runs that completed.
+        let fixed: Vec<(WindowStats, f64)> = rows[..3]
+            .iter()
+            .filter_map(|x| x.w.map(|w| (w, x.o.rms_acc_diff)))
+            .collect();
+        let dw = default.w.unwrap_or_default();
+        let stat = |name: &str, v: f64, get: &dyn Fn(&(WindowStats, f64)) -> f64| {
+            let lo = fixed.iter().map(get).fold(f64::INFINITY, f64::min);
+            let hi = fixed.iter().map(get).fold(f64::NEG_INFINITY, f64::max);
+            (v < lo || v > hi).then(|| format!("{name} {} [{}, {}]", sig(v), sig(lo), sig(hi)))
+        };
+        let out: Vec<String> = [
+            stat("force", dw.largest_force_n, &|x| x.0.largest_force_n),
+            stat("depth", dw.deepest_um, &|x| x.0.deepest_um),
+            stat("onsets", dw.onsets_per_unit, &|x| x.0.onsets_per_unit),
+            stat("contact", dw.contact_fraction, &|x| x.0.contact_fraction),
+            stat("acc", d.rms_acc_diff, &|x| x.1),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
+        outside = if out.is_empty() {
+            "none".into()
+        } else {
+            out.join("; ")
+        };
+    }
+    let closed = match (d.closed_form_error, r.closed_form_error) {
+        (None, None) => "-".into(),
+        (a, b) => format!(
+            "{}; {}",
+            a.map_or("-".into(), |x| format!("{:.2e}", x)),
+            b.map_or("-".into(), |x| format!("{:.2e}", x))
+        ),
+    };
+    let dt = match reference.o.stepping {
+        Stepping::Fixed(dt) => format!("{dt:e}"),
+        Stepping::Default => "-".into(),
+    };
+    format!(
+        "| {} | {} | {dt}, {} | {first} | {matches} | {outside} | {closed} | {} |",
+        case.name,
+        if d.error.is_none() {
+            cost(d)
+        } else {
+            format!("failed after {:.1} s", d.wall_s)
+        },
+        if r.error.is_none() {
+            cost(r)
+        } else {
+            "failed".into()
+        },
+        guards(d)
+    )
+}

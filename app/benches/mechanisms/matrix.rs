@@ -1,0 +1,458 @@
+//! The mechanism matrix: scenes of the benchmark set, each run at the library's defaults and at
+//! fixed steps halved twice, and the figures that compare them. Shared by the benchmark
+//! (`cargo bench --bench mechanisms`) and the accuracy test (`app/tests/matrix.rs`).
+//!
+//! Every run goes through the library's runner ([`Simulation`]); every figure comes from its
+//! impact lists ([`Impact`], recorded at every internal step) and its output rows.
+
+#![allow(dead_code)] // the test uses a part of it
+
+use clearance_joint::rapier::metrics::Impact;
+use clearance_joint::scene::Scene;
+use clearance_joint::scene::runner::{RunOptions, Simulation, TwinKind, Twins};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Where a case's statistics are taken after the first impacts (they turn chaotic).
+#[derive(Clone, Copy, Debug)]
+pub enum Unit {
+    /// A driven mechanism: per crank turn of this length, s.
+    Turn(f64),
+    /// Per second.
+    Second,
+}
+
+/// The ideal slider-crank's slider acceleration in closed form (crank `l1`, rod `l2`, m;
+/// crank speed `omega`, rad/s; crank angle 0 at t = 0).
+#[derive(Clone, Copy, Debug)]
+pub struct SliderCrankForm {
+    /// Crank length, m.
+    pub l1: f64,
+    /// Rod length, m.
+    pub l2: f64,
+    /// Crank speed, rad/s.
+    pub omega: f64,
+}
+
+impl SliderCrankForm {
+    /// `x''(theta)` of `x = l1 cos(theta) + sqrt(l2^2 - l1^2 sin^2(theta))`, m/s^2.
+    pub fn acceleration(&self, theta: f64) -> f64 {
+        let (l1, l2) = (self.l1, self.l2);
+        let s = (l2 * l2 - (l1 * theta.sin()).powi(2)).sqrt();
+        let q = l1 * l1;
+        let x2 = -l1 * theta.cos()
+            - q * (2.0 * theta).cos() / s
+            - q * q * (2.0 * theta).sin().powi(2) / (4.0 * s.powi(3));
+        self.omega * self.omega * x2
+    }
+}
+
+/// One scene of the matrix.
+#[derive(Clone, Debug)]
+pub struct Case {
+    /// Label in the tables.
+    pub name: &'static str,
+    /// Scene file under the repository's `assets/`.
+    pub file: &'static str,
+    /// `--set` overrides that make the variant (applied before the run settings).
+    pub set: Vec<String>,
+    /// The clearance hinge measured.
+    pub hinge: &'static str,
+    /// The body whose acceleration is compared with the ideal twin's.
+    pub probe: &'static str,
+    /// Simulated time, s (full run), and of the quick run.
+    pub end_s: f64,
+    /// Simulated time of the quick (shortened) run, s.
+    pub quick_end_s: f64,
+    /// Start of the statistics window, s (its end is the run's end).
+    pub window_start_s: f64,
+    /// Start of the window in the quick run, s.
+    pub quick_window_start_s: f64,
+    /// Onsets per turn or per second.
+    pub unit: Unit,
+    /// Fixed steps, each half the previous; the last is the reference.
+    pub fixed_dt: [f64; 3],
+    /// Output rows, s (for the acceleration comparison; rows never change the steps).
+    pub output_interval_s: f64,
+    /// The ideal twin's closed form, where one exists.
+    pub closed_form: Option<SliderCrankForm>,
+}
+
+const FLORES: &str = "flores_slider_crank.ron";
+const OMEGA_5000: f64 = 5000.0 * std::f64::consts::TAU / 60.0;
+const OMEGA_2000: f64 = 2000.0 * std::f64::consts::TAU / 60.0;
+
+fn flores(name: &'static str, set: &[&str], omega: f64) -> Case {
+    let turn = std::f64::consts::TAU / omega;
+    Case {
+        name,
+        file: FLORES,
+        set: set.iter().map(|s| s.to_string()).collect(),
+        hinge: "slider_pin",
+        probe: "slider",
+        end_s: 3.0 * turn,
+        quick_end_s: turn,
+        window_start_s: turn,
+        quick_window_start_s: 0.5 * turn,
+        unit: Unit::Turn(turn),
+        fixed_dt: [1e-6, 5e-7, 2.5e-7],
+        output_interval_s: 1e-5,
+        closed_form: Some(SliderCrankForm {
+            l1: 0.05,
+            l2: 0.12,
+            omega,
+        }),
+    }
+}
+
+/// The matrix: the slider-crank (c = 0.5 and 0.1 mm, 2000 rpm), the four-bar, the paper's solar
+/// panel at T, 3T and 5T, the deployable array and the double pendulum.
+pub fn cases() -> Vec<Case> {
+    let panel = |name: &'static str, scale: &str| Case {
+        name,
+        file: "solar_panel.ron",
+        set: vec![format!("drive.torque_scale={scale}")],
+        hinge: "hinge",
+        probe: "panel",
+        end_s: 5.0,
+        quick_end_s: 0.25,
+        window_start_s: 1.0,
+        quick_window_start_s: 0.125,
+        unit: Unit::Second,
+        fixed_dt: [4e-6, 2e-6, 1e-6],
+        output_interval_s: 1e-4,
+        closed_form: None,
+    };
+    vec![
+        flores("slider-crank c=0.5mm", &[], OMEGA_5000),
+        flores(
+            "slider-crank c=0.1mm",
+            &["slider_pin.clearance_mm=0.1"],
+            OMEGA_5000,
+        ),
+        flores(
+            "slider-crank 2000rpm",
+            &[
+                "crank.rate_rad_s=209.43951023931953",
+                "rod.velocity_m_s=[0,5.235987755982989,0]",
+                "rod.angular_velocity_rad_s=[0,0,-87.26646259971649]",
+            ],
+            OMEGA_2000,
+        ),
+        Case {
+            name: "four-bar",
+            file: "four_bar.ron",
+            set: vec![],
+            hinge: "rocker_pin",
+            probe: "rocker",
+            end_s: 0.2,
+            quick_end_s: 0.05,
+            window_start_s: 0.1,
+            quick_window_start_s: 0.025,
+            unit: Unit::Turn(0.1),
+            fixed_dt: [2e-6, 1e-6, 5e-7],
+            output_interval_s: 1e-4,
+            closed_form: None,
+        },
+        panel("solar panel T", "1"),
+        panel("solar panel 3T", "3"),
+        panel("solar panel 5T", "5"),
+        Case {
+            name: "deployable array",
+            file: "deployable_array.ron",
+            set: vec![],
+            hinge: "root",
+            probe: "panel3",
+            end_s: 2.0,
+            quick_end_s: 0.3,
+            window_start_s: 0.5,
+            quick_window_start_s: 0.15,
+            unit: Unit::Second,
+            fixed_dt: [2e-5, 1e-5, 5e-6],
+            output_interval_s: 1e-3,
+            closed_form: None,
+        },
+        Case {
+            name: "double pendulum",
+            file: "double_pendulum.ron",
+            set: vec![],
+            hinge: "elbow",
+            probe: "link2",
+            end_s: 1.0,
+            quick_end_s: 0.25,
+            window_start_s: 0.25,
+            quick_window_start_s: 0.125,
+            unit: Unit::Second,
+            fixed_dt: [4e-6, 2e-6, 1e-6],
+            output_interval_s: 1e-4,
+            closed_form: None,
+        },
+    ]
+}
+
+/// How a case is stepped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Stepping {
+    /// The library's defaults: adaptive, `tolerance` 0.0075, `max_dt_s` 1e-3 s.
+    Default,
+    /// A fixed step, s.
+    Fixed(f64),
+}
+
+impl Stepping {
+    /// `default` or the step.
+    pub fn label(&self) -> String {
+        match self {
+            Stepping::Default => "default".into(),
+            Stepping::Fixed(dt) => format!("fixed {dt:e}"),
+        }
+    }
+}
+
+/// One run of a case.
+#[derive(Clone, Debug)]
+pub struct Outcome {
+    /// How it was stepped.
+    pub stepping: Stepping,
+    /// The run's error, if it failed (nothing else is then meaningful).
+    pub error: Option<String>,
+    /// Guard violations in words (empty: clean).
+    pub violations: Vec<String>,
+    /// Internal steps.
+    pub steps: u64,
+    /// Wall time of the run (both twins in one world), s.
+    pub wall_s: f64,
+    /// The measured hinge's contacts, recorded at every internal step.
+    pub impacts: Vec<Impact>,
+    /// Simulated time, s.
+    pub end_s: f64,
+    /// Largest joint force and penetration over the whole run, N and um.
+    pub peak_force_n: f64,
+    /// Largest penetration over the whole run, um.
+    pub max_penetration_um: f64,
+    /// RMS over the window's rows of the probe body's acceleration, clearance minus ideal twin
+    /// (vector difference), m/s^2.
+    pub rms_acc_diff: f64,
+    /// Largest difference of the ideal twin's probe acceleration along x from the closed form,
+    /// over the largest closed-form acceleration (all rows).
+    pub closed_form_error: Option<f64>,
+}
+
+impl Outcome {
+    /// Ran to the end with no guard violation.
+    pub fn clean(&self) -> bool {
+        self.error.is_none() && self.violations.is_empty()
+    }
+}
+
+/// The repository's `assets/` folder.
+pub fn assets() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets")
+}
+
+/// The case's scene with its variant, `end_s` and the stepping applied.
+pub fn scene(case: &Case, stepping: Stepping, end_s: f64) -> Scene {
+    let base = Scene::load(&assets().join(case.file)).expect("the matrix's scenes load");
+    let mut set = case.set.clone();
+    set.extend(
+        [
+            format!("run.end_s={end_s}"),
+            format!("run.output_interval_s={}", case.output_interval_s),
+            "run.body_motion=true".into(),
+            "run.strict=false".into(),
+        ]
+        .into_iter(),
+    );
+    match stepping {
+        Stepping::Default => set.extend(
+            [
+                "run.step=Adaptive",
+                "run.tolerance=0.0075",
+                "run.max_dt_s=0.001",
+            ]
+            .map(String::from),
+        ),
+        Stepping::Fixed(dt) => {
+            set.extend(["run.step=Fixed".into(), format!("run.dt_s={dt}")]);
+        }
+    }
+    base.with_overrides(&set)
+        .expect("the matrix's overrides apply")
+}
+
+/// Runs a case (both twins) and measures it; `window_start_s` starts the acceleration window. A
+/// run still going after `cap_s` of wall time is abandoned and reported as such (a stalling run
+/// would otherwise hold the whole matrix up).
+pub fn run(
+    case: &Case,
+    stepping: Stepping,
+    end_s: f64,
+    window_start_s: f64,
+    cap_s: f64,
+) -> Outcome {
+    let scene = scene(case, stepping, end_s);
+    let mut out = Outcome {
+        stepping,
+        error: None,
+        violations: Vec::new(),
+        steps: 0,
+        wall_s: 0.0,
+        impacts: Vec::new(),
+        end_s,
+        peak_force_n: 0.0,
+        max_penetration_um: 0.0,
+        rms_acc_diff: f64::NAN,
+        closed_form_error: None,
+    };
+    let start = Instant::now();
+    let reached = std::cell::Cell::new(0.0);
+    let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        Simulation::new(
+            &scene,
+            RunOptions {
+                twins: Twins::Both,
+                skip_rows: false,
+            },
+        )
+        .and_then(|sim| {
+            sim.run_with_progress(|p| {
+                reached.set(p.t);
+                if p.steps % 1024 == 0 && start.elapsed().as_secs_f64() > cap_s {
+                    std::panic::panic_any(Abandoned);
+                }
+            })
+        })
+    }));
+    out.wall_s = start.elapsed().as_secs_f64();
+    let r = match result {
+        Ok(Ok(r)) => r,
+        Ok(Err(e)) => {
+            out.error = Some(e.to_string());
+            return out;
+        }
+        Err(p) if p.is::<Abandoned>() => {
+            out.error = Some(format!(
+                "abandoned after {cap_s} s of wall time at t = {:.6} s",
+                reached.get()
+            ));
+            return out;
+        }
+        Err(p) => std::panic::resume_unwind(p),
+    };
+    out.steps = r.steps;
+    out.violations = r.guards.violations.clone();
+    let (ideal, clear) = (
+        r.twin(TwinKind::Ideal).unwrap(),
+        r.twin(TwinKind::Clearance).unwrap(),
+    );
+    let rec = clear.hinge_recorders()[case.hinge];
+    out.impacts = rec.impacts().to_vec();
+    out.peak_force_n = rec.metrics().peak_force_n;
+    out.max_penetration_um = rec.metrics().max_penetration_um;
+    let t = ideal.table.column("t_s").unwrap();
+    let acc = |table: &clearance_joint::table::Table, axis: &str| {
+        table
+            .column(&format!("{}_a{axis}_m_s2", case.probe))
+            .unwrap()
+    };
+    let (ix, iy, cx, cy) = (
+        acc(&ideal.table, "x"),
+        acc(&ideal.table, "y"),
+        acc(&clear.table, "x"),
+        acc(&clear.table, "y"),
+    );
+    let (iz, cz) = (acc(&ideal.table, "z"), acc(&clear.table, "z"));
+    let (mut sum, mut n) = (0.0, 0usize);
+    for k in 0..t.len() {
+        if t[k] >= window_start_s - 1e-12 {
+            sum += (cx[k] - ix[k]).powi(2) + (cy[k] - iy[k]).powi(2) + (cz[k] - iz[k]).powi(2);
+            n += 1;
+        }
+    }
+    out.rms_acc_diff = if n > 0 {
+        (sum / n as f64).sqrt()
+    } else {
+        f64::NAN
+    };
+    if let Some(form) = case.closed_form {
+        let mut worst: f64 = 0.0;
+        let mut scale: f64 = 0.0;
+        for k in 0..t.len() {
+            let a = form.acceleration(form.omega * t[k]);
+            worst = worst.max((ix[k] - a).abs());
+            scale = scale.max(a.abs());
+        }
+        out.closed_form_error = Some(worst / scale);
+    }
+    out
+}
+
+/// The payload of the panic that abandons a run over its wall-time cap.
+struct Abandoned;
+
+/// Silences the report of the panic that abandons a run (other panics are reported as usual).
+pub fn quiet_abandon() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        if !info.payload().is::<Abandoned>() {
+            default(info);
+        }
+    }));
+}
+
+/// Statistics of a window `[start, end]` of an impact list.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct WindowStats {
+    /// Largest peak force of the contacts that overlap the window, N.
+    pub largest_force_n: f64,
+    /// Deepest penetration of the contacts that overlap the window, um.
+    pub deepest_um: f64,
+    /// Contact onsets in the window, per turn or per second.
+    pub onsets_per_unit: f64,
+    /// Fraction of the window in contact (contacts clipped at its bounds).
+    pub contact_fraction: f64,
+}
+
+/// The window statistics of `impacts` over `[start, end]`.
+pub fn window(impacts: &[Impact], start: f64, end: f64, unit: Unit) -> WindowStats {
+    let mut w = WindowStats::default();
+    let mut onsets = 0usize;
+    let mut contact = 0.0;
+    for i in impacts {
+        let (a, b) = (i.onset_t_s, i.onset_t_s + i.duration_s);
+        if b < start || a > end {
+            continue;
+        }
+        w.largest_force_n = w.largest_force_n.max(i.peak_force_n);
+        w.deepest_um = w.deepest_um.max(i.max_penetration_um);
+        if a >= start {
+            onsets += 1;
+        }
+        contact += (b.min(end) - a.max(start)).max(0.0);
+    }
+    let len = end - start;
+    let units = match unit {
+        Unit::Turn(turn) => len / turn,
+        Unit::Second => len,
+    };
+    w.onsets_per_unit = onsets as f64 / units;
+    w.contact_fraction = contact / len;
+    w
+}
+
+/// How many of the first impacts of `a` match those of `b` in sequence: onsets within 1 us and
+/// peaks within 1 %.
+pub fn matched(a: &[Impact], b: &[Impact]) -> usize {
+    a.iter()
+        .zip(b)
+        .take_while(|(x, y)| {
+            (x.onset_t_s - y.onset_t_s).abs() <= 1e-6
+                && (x.peak_force_n / y.peak_force_n - 1.0).abs() <= 0.01
+        })
+        .count()
+}
+
+/// Relative difference `a/b - 1`.
+pub fn rel(a: f64, b: f64) -> f64 {
+    a / b - 1.0
+}

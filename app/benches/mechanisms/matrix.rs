@@ -119,7 +119,7 @@ pub fn cases() -> Vec<Case> {
         window_start_s: 1.0,
         quick_window_start_s: 0.125,
         unit: Unit::Second,
-        fixed_dt: [4e-6, 2e-6, 1e-6],
+        fixed_dt: [8e-6, 4e-6, 2e-6],
         output_interval_s: 1e-4,
         closed_form: None,
     };
@@ -455,4 +455,30 @@ pub fn matched(a: &[Impact], b: &[Impact]) -> usize {
 /// Relative difference `a/b - 1`.
 pub fn rel(a: f64, b: f64) -> f64 {
     a / b - 1.0
+}
+
+/// A guard violation's kind: its words before the first number, `(` or `:` (the values and the
+/// time differ between runs, the kind does not).
+pub fn violation_kind(text: &str) -> String {
+    text.split(|c: char| c == '(' || c == ':' || c.is_ascii_digit())
+        .next()
+        .unwrap_or("")
+        .trim()
+        .to_string()
+}
+
+/// The violations of `run` of a kind the `converged` run does not show: what the defaults
+/// flagged beyond the converged physics itself (e.g. a first impact deeper than the contact
+/// law's validity limit is flagged in every run, converged or not).
+pub fn new_violations(run: &Outcome, converged: &Outcome) -> Vec<String> {
+    let known: Vec<String> = converged
+        .violations
+        .iter()
+        .map(|v| violation_kind(v))
+        .collect();
+    run.violations
+        .iter()
+        .filter(|v| !known.contains(&violation_kind(v)))
+        .cloned()
+        .collect()
 }

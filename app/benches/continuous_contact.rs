@@ -41,7 +41,7 @@ struct Variant {
 
 fn main() {
     let mut variants = Vec::new();
-    for dt in [1e-6, 5e-7, 2.5e-7] {
+    for dt in [1e-6, 5e-7, 2.5e-7, 1.25e-7] {
         variants.push(Variant {
             label: format!("fixed {dt:e}"),
             dt,
@@ -66,9 +66,9 @@ fn main() {
     println!(
         "| run | onsets after turn 1 | of which after a gap >= 0.1 um | widest gap of those free \
          flights (um) | their longest flight (us) | crank-pin error, max (um) | guide error, max \
-         (um) |"
+         (um) | late onsets: crank angle (deg), approach speed (mm/s) |"
     );
-    println!("|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|");
     for v in &variants {
         println!("{}", measure(v));
     }
@@ -113,7 +113,7 @@ fn measure(v: &Variant) -> String {
     }
     let r = match sim.run() {
         Ok(r) => r,
-        Err(e) => return format!("| {} | failed: {e} | | | | | |", v.label),
+        Err(e) => return format!("| {} | failed: {e} | | | | | | |", v.label),
     };
     let twin = r.twin(TwinKind::Clearance).unwrap();
     let rec = twin.hinge_recorders()["slider_pin"];
@@ -160,8 +160,18 @@ fn measure(v: &Variant) -> String {
         pin = pin.max((end.0 - crank.0).hypot(end.1 - crank.1));
         guide = guide.max(sy[n].abs());
     }
+    let angles: Vec<String> = late
+        .iter()
+        .map(|i| {
+            format!(
+                "{:.0}, {:.0}",
+                (OMEGA * i.onset_t_s).to_degrees() % 360.0,
+                i.approach_speed_m_s * 1e3
+            )
+        })
+        .collect();
     format!(
-        "| {} | {} ({:.1} per turn) | {} | {:.3} | {:.1} | {:.4} | {:.4} |",
+        "| {} | {} ({:.1} per turn) | {} | {:.3} | {:.1} | {:.4} | {:.4} | {} |",
         v.label,
         late.len(),
         late.len() as f64 / 2.0,
@@ -169,6 +179,7 @@ fn measure(v: &Variant) -> String {
         widest * 1e6,
         longest * 1e6,
         pin * 1e6,
-        guide * 1e6
+        guide * 1e6,
+        angles.join("; ")
     )
 }

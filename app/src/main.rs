@@ -256,7 +256,7 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     let mut progress = RunProgress::new(progress_mode(&args.progress));
     let result = job.execute(|p| progress.update(p));
     progress.finish();
-    let result = result?;
+    let mut result = result?;
     let summary = result.write(&job.out)?;
     println!("{}", comparison_table(&summary));
     println!(
@@ -275,7 +275,11 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
             other => other?,
         }
     }
-    Ok(())
+    // A stalled run: its set is written (marked incomplete) and the command fails.
+    match result.stopped.take() {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
 }
 
 fn sweep(args: &SweepArgs) -> clearance_joint::Result<()> {

@@ -133,6 +133,10 @@ pub struct Clearance {
     pub min_impact_speed: f64,
     /// Gap a free flight must open for the next contact to count as an impact, m (default 0.1 um).
     pub min_separation: f64,
+    /// The deepest penetration at which the contact law is trusted, m; deeper contacts are guard
+    /// violations ([`ClearanceJointBuilder::max_valid_penetration`]). `None` (the default): 1 % of
+    /// the journal radius ([`crate::rapier::joint::default_max_valid_penetration`]).
+    pub max_valid_penetration: Option<f64>,
     /// What holds the out-of-plane degrees of freedom (default [`OutOfPlaneLock::Joint`]).
     pub lock: OutOfPlaneLock,
     /// Name used in errors and reports (default: the builder's default name).
@@ -154,6 +158,7 @@ impl Clearance {
             friction: FrictionModel::None,
             min_impact_speed: crate::rapier::joint::DEFAULT_MIN_IMPACT_SPEED,
             min_separation: crate::rapier::joint::DEFAULT_MIN_SEPARATION,
+            max_valid_penetration: None,
             lock: OutOfPlaneLock::Joint,
             name: None,
             model: ClearanceModel::Compliant,
@@ -223,6 +228,13 @@ impl Clearance {
         self
     }
 
+    /// Sets the deepest penetration at which the contact law is trusted, m (checked when the
+    /// joint is built: positive, at most the journal radius).
+    pub fn max_valid_penetration(mut self, depth: f64) -> Self {
+        self.max_valid_penetration = Some(depth);
+        self
+    }
+
     /// Sets what holds the out-of-plane degrees of freedom.
     pub fn lock(mut self, lock: OutOfPlaneLock) -> Self {
         self.lock = lock;
@@ -272,6 +284,9 @@ impl Clearance {
             .min_impact_speed(self.min_impact_speed)
             .min_separation(self.min_separation)
             .lock(self.lock);
+        if let Some(depth) = self.max_valid_penetration {
+            b = b.max_valid_penetration(depth);
+        }
         if let Some(name) = &self.name {
             b = b.name(name.clone());
         }

@@ -111,10 +111,11 @@ impl ClearanceJointBuilder {
         self.joint.min_separation = gap;
         self
     }
-    /// The deepest penetration at which the contact law is still trusted, m (default: a tenth
-    /// of the radial clearance). Compliant laws assume a contact small against the bodies'
-    /// curvature: a journal pressed deeper is outside the model. The steppers report it as a
-    /// guard violation ([`crate::rapier::stepper::GuardReport`]); it is not a force limit.
+    /// The deepest penetration at which the contact law is still trusted, m (default
+    /// [`DEFAULT_VALID_STRAIN`] times the journal radius, see
+    /// [`default_max_valid_penetration`]). A journal pressed deeper is outside the model; the
+    /// steppers report it as a guard violation ([`crate::rapier::stepper::GuardReport`]), with
+    /// the worst depth, when and how often. It is not a force limit.
     pub fn max_valid_penetration(mut self, depth: f64) -> Self {
         self.joint.max_valid_penetration = Some(depth);
         self
@@ -145,7 +146,7 @@ impl ClearanceJointBuilder {
         crate::error::positive("min_impact_speed", j.min_impact_speed)?;
         crate::error::non_negative("min_separation", j.min_separation)?;
         if let Some(d) = j.max_valid_penetration {
-            crate::error::positive("max_valid_penetration", d)?;
+            validate_max_valid_penetration("max_valid_penetration", d, &j.geometry)?;
         }
         Ok(self.joint)
     }
@@ -237,6 +238,44 @@ pub const DEFAULT_MIN_IMPACT_SPEED: f64 = 1e-4;
 /// Default of [`ClearanceJointBuilder::min_separation`], m.
 pub const DEFAULT_MIN_SEPARATION: f64 = 1e-7;
 
+/// The nominal compressive strain `delta/R_j` up to which the contact laws are trusted by
+/// default: 1 %. Every law here is linear elastic (small strain); at a strain `e` the
+/// Green-Lagrange strain `e + e^2/2` differs from the linear one by `e/2`, 0.5 % at 1 %, and
+/// the approach `delta` spreads over a depth of the order of the journal radius `R_j`.
+/// docs/MODEL.md ("Validity") gives the argument and what it does not cover.
+pub const DEFAULT_VALID_STRAIN: f64 = 0.01;
+
+/// The default validity limit of a joint's penetration, m: [`DEFAULT_VALID_STRAIN`] times the
+/// journal radius (95 um for a 10 mm bearing with 0.5 mm of clearance).
+pub fn default_max_valid_penetration(geometry: &BearingGeometry) -> f64 {
+    DEFAULT_VALID_STRAIN * geometry.journal_radius()
+}
+
+/// Checks a validity limit `depth` (m) for `field`: positive, finite, and at most the journal
+/// radius (a deeper "penetration" is no contact of two cylinders).
+pub fn validate_max_valid_penetration(
+    field: &str,
+    depth: f64,
+    geometry: &BearingGeometry,
+) -> Result<f64> {
+    crate::error::positive(field, depth)?;
+    let r = geometry.journal_radius();
+    if depth > r {
+        return Err(Error::invalid(
+            field,
+            format!(
+                "must be at most the journal radius {} m (got {} m): the limit is a depth of \
+                 contact, small against the journal (default {} m, {} % of its radius)",
+                crate::error::sig4(r),
+                crate::error::sig4(depth),
+                crate::error::sig4(default_max_valid_penetration(geometry)),
+                DEFAULT_VALID_STRAIN * 100.0
+            ),
+        ));
+    }
+    Ok(depth)
+}
+
 /// Fraction of the predicted time to contact that one free-flight step may cover, so that a
 /// contact is approached in shrinking steps and starts near a step boundary.
 const APPROACH_FRACTION: f64 = 0.5;
@@ -312,10 +351,16 @@ impl ClearanceJoint {
         &self.report
     }
     /// The deepest penetration at which the contact law is trusted, m
-    /// ([`ClearanceJointBuilder::max_valid_penetration`]; default a tenth of the clearance).
+    /// ([`ClearanceJointBuilder::max_valid_penetration`]; default
+    /// [`default_max_valid_penetration`]).
     pub fn max_valid_penetration(&self) -> f64 {
         self.max_valid_penetration
-            .unwrap_or(0.1 * self.geometry.clearance())
+            .unwrap_or_else(|| default_max_valid_penetration(&self.geometry))
+    }
+    /// The floor on the impact velocity `delta_dot0` of the hysteresis laws, m/s
+    /// ([`ClearanceJointBuilder::min_impact_speed`]).
+    pub fn min_impact_speed_floor(&self) -> f64 {
+        self.min_impact_speed
     }
     /// Whether the joint was in contact at its last application.
     pub fn in_contact(&self) -> bool {

@@ -5,6 +5,8 @@
 //! - [`large_step`]: the same play as a constraint inside Rapier's solver, for 1/60 s and 1 kHz.
 //! - [`convert`]: a clearance joint from a Rapier revolute joint, with the bearing side chosen.
 //! - [`stepper`]: the one step control (variable-step Störmer-Verlet, acceptance, guards).
+//! - [`guards`]: what the run-time guards saw, the worst of each kind per joint; [`stall`]: why
+//!   the step control stalled, from the numbers of the contact that stopped it.
 //! - [`drive`]: torsion springs and torques; [`prescribed`]: prescribed (kinematic) motions.
 //! - [`reaction`]: exact ideal-joint reactions from the constrained equations.
 //! - [`metrics`]: impact lists, contact fraction and per-turn statistics.
@@ -14,10 +16,12 @@
 
 pub mod convert;
 pub mod drive;
+pub mod guards;
 pub mod joint;
 pub mod large_step;
 pub mod ledger;
 pub mod metrics;
 pub mod prescribed;
 pub mod reaction;
+pub mod stall;
 pub mod stepper;

@@ -71,6 +71,8 @@ use rapier3d_f64::math::{Pose, Vector};
 use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle};
 use serde::{Deserialize, Serialize};
 
+pub use crate::rapier::guards::{GuardKind, GuardReport, Violation};
+
 /// Something that exerts forces on the bodies of a world, computed from their state:
 /// [`ClearanceJointSet`] and [`DriveSet`] are ones. The [`Stepper`] evaluates it at the state
 /// before each step and adds its wrenches to the bodies for the duration of that step only, so
@@ -259,40 +261,6 @@ impl StepControl {
             }
         }
         Ok(())
-    }
-}
-
-/// What the guards saw over all steps so far.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
-pub struct GuardReport {
-    /// Steps rejected and retried shorter.
-    pub rejected_steps: u64,
-    /// Deepest penetration over its joint's validity limit seen, as a ratio (0 when none
-    /// exceeded it; above 1 is a violation).
-    pub worst_penetration_ratio: f64,
-    /// Joint and time of the first penetration beyond the validity limit.
-    pub first_invalid_penetration: Option<(String, f64)>,
-    /// Steps taken at the floor `min_dt`.
-    pub floor_steps: u64,
-    /// Violations in words, in the order they were first seen (the first of each kind and
-    /// joint).
-    pub violations: Vec<String>,
-    #[serde(skip)]
-    keys: Vec<String>,
-}
-
-impl GuardReport {
-    /// No violation recorded.
-    pub fn is_clean(&self) -> bool {
-        self.violations.is_empty()
-    }
-
-    /// Records `text` unless a violation with the same `key` was recorded.
-    pub fn violation(&mut self, key: &str, text: impl FnOnce() -> String) {
-        if !self.keys.iter().any(|k| k == key) {
-            self.keys.push(key.to_string());
-            self.violations.push(text());
-        }
     }
 }
 
@@ -588,24 +556,27 @@ impl Stepper {
                         }
                     }
                     self.check_health(world, sources, dt)?;
-                    self.count_floor(dt)?;
+                    self.count_floor(world, sources, dt)?;
                     return Ok(info);
                 }
                 Some(shorter) => {
                     rejected += 1;
-                    self.restore(world, sources);
                     let next = shorter.min(0.5 * dt).max(self.control.min_dt);
-                    if rejected > MAX_REJECTIONS || next >= dt {
-                        return Err(Error::Stalled {
-                            t: self.t,
-                            reason: format!(
+                    // Diagnosed at the state the rejected step reached, before it is undone.
+                    let stalled = (rejected > MAX_REJECTIONS || next >= dt).then(|| {
+                        self.stall_reason(
+                            world,
+                            sources,
+                            &format!(
                                 "the step was rejected {rejected} times down to {} s: no step \
-                                 resolves the contact (a contact law parameter out of its physical \
-                                 range, a step floor `min_dt` too high, or a body moved by hand or \
-                                 by a kinematic position target, which any step reaches at once)",
+                                 resolves the contact",
                                 crate::error::sig4(dt)
                             ),
-                        });
+                        )
+                    });
+                    self.restore(world, sources);
+                    if let Some(reason) = stalled {
+                        return Err(Error::Stalled { t: self.t, reason });
                     }
                     dt = next;
                 }
@@ -685,28 +656,44 @@ impl Stepper {
         }
     }
 
-    fn count_floor(&mut self, dt: f64) -> Result<()> {
+    /// The stall message for `seen`: the contact that stops the steps, its state and its cause
+    /// ([`crate::rapier::stall`]).
+    fn stall_reason(
+        &self,
+        world: &PhysicsWorld,
+        sources: &[&mut dyn ForceSource],
+        seen: &str,
+    ) -> String {
+        let contact = crate::rapier::stall::stalled_contact(
+            sources.iter().filter_map(|s| s.clearance_joints()),
+            &world.bodies,
+        );
+        crate::rapier::stall::explain(seen, contact.as_ref(), self.control.min_dt)
+    }
+
+    fn count_floor(
+        &mut self,
+        world: &PhysicsWorld,
+        sources: &[&mut dyn ForceSource],
+        dt: f64,
+    ) -> Result<()> {
         if self.control.mode == StepMode::Adaptive && dt <= self.control.min_dt * (1.0 + 1e-9) {
             self.guards.floor_steps += 1;
             self.floor_run += 1;
-            let (floor, t) = (self.control.min_dt, self.t);
-            self.guards.violation("floor", || {
-                format!(
-                    "steps at the floor {} s (first at t = {} s): contacts resolved no better \
-                     than the floor allows",
-                    crate::error::sig4(floor),
-                    crate::error::sig4(t)
-                )
-            });
+            // One state counted; the worst is the longest run in a row (closest to a stall).
+            let v = Violation::new(
+                GuardKind::Floor,
+                self.floor_run as f64,
+                STALL_STEPS as f64,
+                self.t,
+            )
+            .note(format!("{} s", crate::error::sig4(self.control.min_dt)));
+            self.guards.record(v);
             if self.floor_run >= STALL_STEPS {
+                let seen = format!("{} steps in a row at the floor", self.floor_run);
                 return Err(Error::Stalled {
                     t: self.t,
-                    reason: format!(
-                        "{} steps in a row at the floor {} s: the contact is too stiff or too \
-                         damped for any step (a contact law parameter out of its physical range?)",
-                        self.floor_run,
-                        crate::error::sig4(self.control.min_dt)
-                    ),
+                    reason: self.stall_reason(world, sources, &seen),
                 });
             }
         } else {
@@ -742,48 +729,36 @@ impl Stepper {
             let Some(set) = s.clearance_joints() else {
                 continue;
             };
-            for (_, j) in set.iter() {
+            for (handle, j) in set.iter() {
                 let limit = j.report().friction_stable_dt;
                 if fixed && dt > limit {
-                    self.guards
-                        .violation(&format!("friction:{}", j.name()), || {
-                            format!(
-                                "joint `{}`: the fixed step {} s is longer than friction's limit \
-                                 {} s near zero slip (first at t = {} s): stiction is a numerical \
-                                 chatter there; adaptive steps resolve it",
-                                j.name(),
+                    self.guards.record(
+                        Violation::new(GuardKind::Friction, dt / limit, 1.0, t)
+                            .joint(j.name(), Some(handle))
+                            .note(format!(
+                                "step {} s, friction's limit {} s",
                                 crate::error::sig4(dt),
-                                crate::error::sig4(limit),
-                                crate::error::sig4(t)
-                            )
-                        });
+                                crate::error::sig4(limit)
+                            )),
+                    );
                 }
-                let ratio = j.report().state.penetration / j.max_valid_penetration();
+                let (depth, valid) = (j.report().state.penetration, j.max_valid_penetration());
+                let ratio = depth / valid;
                 if ratio > self.guards.worst_penetration_ratio {
                     self.guards.worst_penetration_ratio = ratio;
                 }
                 if ratio > 1.0 {
-                    if self.guards.first_invalid_penetration.is_none() {
-                        self.guards.first_invalid_penetration = Some((j.name().to_string(), t));
-                    }
-                    self.guards
-                        .violation(&format!("penetration:{}", j.name()), || {
-                            format!(
-                                "joint `{}` penetrated beyond its law's validity ({} um > {} um, \
-                                 first at t = {} s)",
-                                j.name(),
-                                crate::error::sig4(j.report().state.penetration * 1e6),
-                                crate::error::sig4(j.max_valid_penetration() * 1e6),
-                                crate::error::sig4(t)
-                            )
-                        });
+                    self.guards.record(
+                        Violation::new(GuardKind::Penetration, depth, valid, t)
+                            .joint(j.name(), Some(handle)),
+                    );
                 }
             }
         }
         if self.control.strict && !self.guards.is_clean() {
             return Err(Error::Guard {
                 t: self.t,
-                violations: self.guards.violations.join("; "),
+                violations: self.guards.messages().join("; "),
             });
         }
         Ok(())

@@ -14,8 +14,15 @@ pub struct Summary {
     pub scene: String,
     /// Step, s.
     pub dt_s: f64,
-    /// Simulated time, s.
+    /// Simulated time asked for, s.
     pub end_s: f64,
+    /// Whether the run reached `end_s`. `false`: the step control stopped it (`error` says why)
+    /// and every file of the set holds what was computed up to `reached_s`.
+    pub complete: bool,
+    /// Simulated time of the last state recorded, s (`end_s` when complete).
+    pub reached_s: f64,
+    /// What stopped an incomplete run (null when complete).
+    pub error: Option<String>,
     /// Per twin (`ideal`, `clearance`).
     pub twins: BTreeMap<String, TwinSummary>,
     /// Clearance twin against ideal twin (null unless both ran).
@@ -95,6 +102,9 @@ impl RunResult {
             scene: self.scene.name.clone(),
             dt_s: self.scene.run.dt_s,
             end_s: self.scene.run.end_s,
+            complete: self.stopped.is_none(),
+            reached_s: self.reached_s,
+            error: self.stopped.as_ref().map(|e| e.to_string()),
             twins: self
                 .twins
                 .iter()
@@ -124,7 +134,9 @@ impl RunResult {
     /// [`per_period`](crate::rapier::metrics::per_period))
     /// and `summary.json` into `dir` as one set
     /// ([`write_set`]): the tables are streamed (and checked finite) into temporary files, then
-    /// renamed into place, `summary.json` last.
+    /// renamed into place, `summary.json` last. An incomplete run ([`RunResult::stopped`])
+    /// writes the same files, each up to the time it reached, and says so in `summary.json`
+    /// (`"complete": false`, `reached_s`, `error`).
     pub fn write(&self, dir: &Path) -> Result<Summary> {
         let summary = self.summary();
         let json = summary_json(&summary)?;
@@ -135,7 +147,8 @@ impl RunResult {
             .flat_map(|t| {
                 let recorders = t.hinge_recorders();
                 let period = self.scene.drive_period();
-                let end = self.scene.run.end_s;
+                // An incomplete run's turns end where it stopped.
+                let end = self.reached_s;
                 t.clearance_hinges()
                     .into_iter()
                     .flat_map(|h| {
@@ -217,12 +230,12 @@ pub fn summary_json(summary: &Summary) -> Result<String> {
     // serde_json writes a non-finite float as null: a null is allowed only where a metric is
     // legitimately absent (no impact yet, only one twin), so a NaN anywhere else is caught here.
     const MAY_BE_NULL: [&str; 9] = [
+        "error",
         "first_impact_t_s",
         "first_impact_peak_n",
         "comparison",
         "linear_momentum_drift",
         "angular_momentum_drift",
-        "first_invalid_penetration",
         "energy_growth",
         "energy_error",
         "motor_speed_error",
@@ -342,9 +355,17 @@ pub fn comparison_table(summary: &Summary) -> String {
             summary.guards.rejected_steps, summary.guards.worst_penetration_ratio
         ));
     } else {
-        for v in &summary.guards.violations {
+        for v in summary.guards.messages() {
             s.push_str(&format!("WARNING: {v}\n"));
         }
+    }
+    if let Some(e) = &summary.error {
+        s.push_str(&format!(
+            "INCOMPLETE: the run stopped at t = {} s of {} s; every file holds what was computed \
+             up to it (summary.json: \"complete\": false): {e}\n",
+            crate::error::sig4(summary.reached_s),
+            crate::error::sig4(summary.end_s)
+        ));
     }
     s
 }

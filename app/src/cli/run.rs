@@ -33,10 +33,11 @@ impl SceneRun {
     }
 
     /// Runs both twins, calling `progress` after every step; a step-size error advises for the
-    /// scene's step mode.
+    /// scene's step mode. A run the step control stalls returns what it computed up to the
+    /// stall ([`RunResult::stopped`] holds the error): write it, then fail.
     pub fn execute(&self, progress: impl FnMut(&Progress)) -> Result<RunResult> {
         Simulation::new(&self.scene, RunOptions::default())?
-            .run_with_progress(progress)
+            .run_keeping_partial(progress)
             .map_err(|e| e.with_step_mode(self.scene.run.step == StepMode::Adaptive))
     }
 

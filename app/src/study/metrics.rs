@@ -146,7 +146,7 @@ impl RunMetrics {
             steps: sc.steps,
             wall_s: sc.wall_s,
             rejected_steps: summary.guards.rejected_steps,
-            guard_violations: summary.guards.violations.clone(),
+            guard_violations: summary.guards.messages(),
             ..Default::default()
         };
         for b in scene.bodies.iter().filter(|b| !b.fixed) {

@@ -36,6 +36,11 @@ pub struct ClearanceSpec {
     /// Gap a free flight must open for the next contact to count as an impact, um (default 0.1).
     #[serde(default = "default_min_separation")]
     pub min_separation_um: f64,
+    /// The deepest penetration at which the contact law is trusted, um: a deeper contact is a
+    /// guard violation (default `None`: 1 % of the journal radius, see docs/MODEL.md
+    /// "Validity").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_valid_penetration_um: Option<f64>,
     /// What holds the out-of-plane degrees of freedom.
     #[serde(default)]
     pub lock: OutOfPlaneLock,
@@ -202,6 +207,8 @@ pub struct ClearanceParams {
     pub min_impact_speed: f64,
     /// Gap that separates two impacts, m.
     pub min_separation: f64,
+    /// The validity limit of the penetration, m (`None`: the joint's default).
+    pub max_valid_penetration: Option<f64>,
 }
 
 impl ClearanceSpec {
@@ -212,6 +219,7 @@ impl ClearanceSpec {
         Ok(Clearance {
             min_impact_speed: p.min_impact_speed,
             min_separation: p.min_separation,
+            max_valid_penetration: p.max_valid_penetration,
             ..Clearance::new(p.geometry, p.normal)
                 .friction(p.friction)
                 .lock(self.lock)
@@ -390,12 +398,39 @@ impl ClearanceSpec {
             speed_mm_s("min_impact_speed_mm_s", self.min_impact_speed_mm_s)? * mm;
         let min_separation =
             in_range("min_separation_um", self.min_separation_um, 0.0, 1e4, "um")? * 1e-6;
+        let max_valid_penetration = self
+            .max_valid_penetration_um
+            .map(|um| {
+                crate::rapier::joint::validate_max_valid_penetration(
+                    "max_valid_penetration_um",
+                    um * 1e-6,
+                    &geometry,
+                )
+            })
+            .transpose()
+            .map_err(|e| match e {
+                // The scene's unit: micrometres.
+                Error::Invalid { field, .. } => Error::invalid(
+                    field,
+                    format!(
+                        "must be positive, finite and at most the journal radius {} um (got {}); \
+                         default {} um, 1 % of the journal radius",
+                        sig4(geometry.journal_radius() * 1e6),
+                        sig4(self.max_valid_penetration_um.unwrap_or(f64::NAN)),
+                        sig4(
+                            crate::rapier::joint::default_max_valid_penetration(&geometry) * 1e6
+                        )
+                    ),
+                ),
+                other => other,
+            })?;
         Ok(ClearanceParams {
             geometry,
             normal,
             friction,
             min_impact_speed,
             min_separation,
+            max_valid_penetration,
         })
     }
 }

@@ -46,6 +46,13 @@ pub struct Invariants {
     /// The velocity motor where `motor_speed_error` was largest, and when, s.
     #[serde(skip)]
     pub motor_speed_error_at: Option<(String, f64)>,
+    /// States at which a velocity motor missed its speed by more than
+    /// [`MOTOR_SPEED_ERROR_LIMIT`].
+    #[serde(skip)]
+    pub motor_speed_violations: u64,
+    /// When the energy balance grew the most, s.
+    #[serde(skip)]
+    pub energy_growth_at: f64,
     #[serde(skip)]
     free_floating: bool,
     #[serde(skip)]
@@ -129,7 +136,10 @@ impl Twin {
         let (p0, l0, e0, pe0) = *inv.p0.get_or_insert((p, l, e, pe));
         inv.max_dp = inv.max_dp.max((p - p0).length());
         inv.max_dl = inv.max_dl.max((l - l0).length());
-        inv.max_de = inv.max_de.max(e - e0);
+        if e - e0 > inv.max_de {
+            inv.max_de = e - e0;
+            inv.energy_growth_at = info.t0;
+        }
         inv.max_abs_de = inv.max_abs_de.max((e - e0).abs());
         inv.max_dpe = inv.max_dpe.max((pe - pe0).abs());
         inv.peak_kinetic_energy_j = inv.peak_kinetic_energy_j.max(ke);

@@ -11,7 +11,7 @@ pub use invariants::{ENERGY_GROWTH_LIMIT, Invariants, MOTOR_SPEED_ERROR_LIMIT};
 pub use twin::{Twin, TwinKind};
 
 use crate::error::Result;
-use crate::rapier::stepper::{ForceSource, GuardReport, Stepper};
+use crate::rapier::stepper::{ForceSource, GuardKind, GuardReport, Stepper, Violation};
 use crate::scene::Scene;
 use comparison::ComparisonSums;
 use rapier3d_f64::math::Vector;
@@ -58,6 +58,8 @@ pub struct Simulation {
     rows_done: bool,
     skip_rows: bool,
     comparison: ComparisonSums,
+    /// Time of the last state the twins read (the start of the step under way), s.
+    last_read: f64,
 }
 
 pub use crate::rapier::stepper::left_physical_range;
@@ -88,6 +90,19 @@ pub struct RunResult {
     pub comparison: Option<Comparison>,
     /// What the run-time guards saw (the stepper's, plus energy growth).
     pub guards: GuardReport,
+    /// `None` for a run that reached its end; for one the step control stopped
+    /// ([`Simulation::run_keeping_partial`]), the error that stopped it: everything above then
+    /// holds what was computed up to [`reached_s`](Self::reached_s).
+    pub stopped: Option<crate::Error>,
+    /// Simulated time of the last state recorded, s: `run.end_s` for a complete run.
+    pub reached_s: f64,
+}
+
+impl RunResult {
+    /// Whether the run reached its end (no [`stopped`](Self::stopped) error).
+    pub fn is_complete(&self) -> bool {
+        self.stopped.is_none()
+    }
 }
 
 impl Simulation {
@@ -123,6 +138,7 @@ impl Simulation {
             rows_done: false,
             skip_rows: options.skip_rows,
             comparison: ComparisonSums::default(),
+            last_read: 0.0,
         })
     }
 
@@ -178,58 +194,56 @@ impl Simulation {
     }
 
     /// Runs to `run.end_s`, calling `progress` after every internal step (e.g. to show simulated
-    /// time, steps per second and an ETA on a terminal; the call should be cheap).
-    pub fn run_with_progress(mut self, mut progress: impl FnMut(&Progress)) -> Result<RunResult> {
+    /// time, steps per second and an ETA on a terminal; the call should be cheap). Any error
+    /// stops it and is returned; [`run_keeping_partial`](Self::run_keeping_partial) keeps what a
+    /// stalled run computed.
+    pub fn run_with_progress(self, progress: impl FnMut(&Progress)) -> Result<RunResult> {
+        let mut result = self.run_keeping_partial(progress)?;
+        match result.stopped.take() {
+            Some(e) => Err(e),
+            None => Ok(result),
+        }
+    }
+
+    /// Like [`run_with_progress`](Self::run_with_progress), but a run the step control stops
+    /// ([`Error::Stalled`](crate::Error::Stalled)) returns what was computed up to the last
+    /// state it recorded: its rows, impacts, metrics and guards, with the error in
+    /// [`RunResult::stopped`] and the time reached in [`RunResult::reached_s`]. Other errors
+    /// (bad input, a diverged body, a strict guard, a fixed step too long) are returned as
+    /// errors.
+    pub fn run_keeping_partial(mut self, mut progress: impl FnMut(&Progress)) -> Result<RunResult> {
         let start = Instant::now();
+        let mut stopped = None;
         while !self.done() {
-            self.step()?;
+            match self.step() {
+                Ok(()) => {}
+                Err(e @ crate::Error::Stalled { .. }) => {
+                    stopped = Some(e);
+                    break;
+                }
+                Err(e) => return Err(e),
+            }
             progress(&Progress {
                 t: self.time(),
                 end: self.scene.run.end_s,
                 steps: self.stepper.steps(),
             });
         }
-        self.finish()?;
+        let reached = if stopped.is_none() {
+            self.finish()?;
+            self.time()
+        } else {
+            self.finish_partial()
+        };
         let comparison = match self.twins.as_slice() {
-            [ideal, _] => Some(self.comparison.finish(ideal, self.time())),
+            [ideal, _] => Some(self.comparison.finish(ideal, reached)),
             _ => None,
         };
-        let mut guards = self.stepper.guards().clone();
-        for twin in &self.twins {
-            let g = twin.invariants.energy_growth.unwrap_or(0.0);
-            if g > ENERGY_GROWTH_LIMIT {
-                guards.violation(&format!("energy:{}", twin.kind.name()), || {
-                    format!(
-                        "the {} twin gained energy: {} of its energy scale (limit {})",
-                        twin.kind.name(),
-                        crate::error::sig4(g),
-                        ENERGY_GROWTH_LIMIT
-                    )
-                });
-            }
-        }
-        for twin in &self.twins {
-            let inv = &twin.invariants;
-            if let (Some(e), Some((name, t))) = (inv.motor_speed_error, &inv.motor_speed_error_at)
-                && e > MOTOR_SPEED_ERROR_LIMIT
-            {
-                guards.violation(&format!("motor:{}", twin.kind.name()), || {
-                    format!(
-                        "the {} twin's velocity motor `{name}` missed its speed by {} of its \
-                         target at t = {} s (limit {}): its torque and the reactions assume it \
-                         holds it; raise its `factor` or shorten the steps (`run.max_dt_s`)",
-                        twin.kind.name(),
-                        crate::error::sig4(e),
-                        crate::error::sig4(*t),
-                        MOTOR_SPEED_ERROR_LIMIT
-                    )
-                });
-            }
-        }
-        if self.scene.run.strict && !guards.is_clean() {
+        let guards = self.guards();
+        if stopped.is_none() && self.scene.run.strict && !guards.is_clean() {
             return Err(crate::Error::Guard {
                 t: self.time(),
-                violations: guards.violations.join("; "),
+                violations: guards.messages().join("; "),
             });
         }
         Ok(RunResult {
@@ -239,7 +253,40 @@ impl Simulation {
             steps: self.stepper.steps(),
             wall_s: start.elapsed().as_secs_f64(),
             guards,
+            stopped,
+            reached_s: reached,
         })
+    }
+
+    /// What the guards saw so far: the stepper's, plus the twins' energy balance and velocity
+    /// motors (judged over the states recorded so far).
+    pub fn guards(&self) -> GuardReport {
+        let mut guards = self.stepper.guards().clone();
+        for twin in &self.twins {
+            let inv = &twin.invariants;
+            let g = inv.energy_growth.unwrap_or(0.0);
+            if g > ENERGY_GROWTH_LIMIT {
+                guards.record(
+                    Violation::new(
+                        GuardKind::Energy,
+                        g,
+                        ENERGY_GROWTH_LIMIT,
+                        inv.energy_growth_at,
+                    )
+                    .twin(twin.kind.name()),
+                );
+            }
+            if let (Some(e), Some((name, t))) = (inv.motor_speed_error, &inv.motor_speed_error_at)
+                && e > MOTOR_SPEED_ERROR_LIMIT
+            {
+                let mut v = Violation::new(GuardKind::MotorSpeed, e, MOTOR_SPEED_ERROR_LIMIT, *t)
+                    .twin(twin.kind.name());
+                v.joint = Some(name.clone());
+                v.count = inv.motor_speed_violations.max(1);
+                guards.record(v);
+            }
+        }
+        guards
     }
 
     /// Advances one accepted internal step: records the state before it (invariants, a row when
@@ -258,6 +305,7 @@ impl Simulation {
         for twin in &mut self.twins {
             twin.before_step(&self.world.bodies, gravity, t, lag, rows);
         }
+        self.last_read = t;
         let target = self.target();
         let info = {
             let mut sources = sources(&mut self.twins);
@@ -280,6 +328,23 @@ impl Simulation {
                 .record(ideal, clear, &self.world.bodies, info.t0, info.dt);
         }
         Ok(())
+    }
+
+    /// Closes a run the step control stopped, at the last state [`step`](Self::step) read
+    /// (the start of the step that failed: a step taken but not completed is not counted): its
+    /// rows, the recorders' final figures. Returns that state's time, s.
+    fn finish_partial(&mut self) -> f64 {
+        let t = self.last_read;
+        self.write_rows(t);
+        self.t_prev = t;
+        for twin in &mut self.twins {
+            for h in &mut twin.hinges {
+                let obs = h.observation();
+                h.recorder.finish(t, &obs);
+                h.recorder.set_final_angle_deg(h.angle.value().to_degrees());
+            }
+        }
+        t
     }
 
     /// Records the final state: invariants, a last row at `end_s` (its reactions, velocities and

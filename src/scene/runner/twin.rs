@@ -291,15 +291,18 @@ impl Twin {
                     let p = spec
                         .build()
                         .map_err(|e| e.within(&format!("hinges[{}].clearance", h.name)))?;
-                    let j = ClearanceJointBuilder::new(axis, p.geometry, p.normal)
+                    let mut b = ClearanceJointBuilder::new(axis, p.geometry, p.normal)
                         .local_anchor1(a1)
                         .local_anchor2(a2)
                         .friction(p.friction)
                         .min_impact_speed(p.min_impact_speed)
                         .min_separation(p.min_separation)
                         .lock(spec.lock)
-                        .name(h.name.clone())
-                        .build()?;
+                        .name(h.name.clone());
+                    if let Some(depth) = p.max_valid_penetration {
+                        b = b.max_valid_penetration(depth);
+                    }
+                    let j = b.build()?;
                     HingeJoint::Clearance(clearance.insert(b1, b2, j, &mut world.impulse_joints))
                 }
                 _ => {
@@ -645,6 +648,9 @@ impl Twin {
             if let Some(rate) = self.reactions.motor_rate(n + k) {
                 let e = (rate - target).abs() / target.abs().max(1e-3);
                 let inv = &mut self.invariants;
+                if e > super::MOTOR_SPEED_ERROR_LIMIT {
+                    inv.motor_speed_violations += 1;
+                }
                 if inv.motor_speed_error.is_none_or(|w| e > w) {
                     inv.motor_speed_error = Some(e);
                     inv.motor_speed_error_at = Some((name.clone(), info.t0));

@@ -1,0 +1,427 @@
+//! Why the step control stalled, read from the numbers of the contact that stopped it: the
+//! message of [`Error::Stalled`](crate::Error::Stalled) names the joint, its contact state
+//! (penetration, approach speed `delta_dot0`, damping ratio, stable step) and the cause, chosen by
+//! [`diagnose`] from those numbers rather than guessed:
+//!
+//! 1. a body whose inertia makes the effective mass at the contact tiny;
+//! 2. an approach speed that presses the contact past its law's validity;
+//! 3. a slow re-contact of a hysteresis law (its damping grows as `1/delta_dot0`, floored at
+//!    `min_impact_speed`);
+//! 4. a damping parameter that over-damps the contact;
+//! 5. a friction law too steep near zero slip for the normal force;
+//! 6. a stiffness too high for the bodies' masses.
+
+use crate::error::sig4;
+use crate::model::laws::{LawKind, NormalContact, NormalForceLaw, penetration_for_energy};
+use crate::model::kinematics::stable_step;
+use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle};
+use crate::rapier::ledger::world_center_of_mass;
+use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
+
+/// One body's share of the inverse effective mass along the contact normal.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BodyShare {
+    /// The body.
+    pub handle: RigidBodyHandle,
+    /// Its mass, kg.
+    pub mass: f64,
+    /// Its smallest principal moment of inertia, kg m^2.
+    pub inertia: f64,
+    /// `(r x n) . I^-1 (r x n)`, 1/kg: the rotational part of its inverse mass at the contact.
+    pub rotational_inverse_mass: f64,
+}
+
+/// The numbers of the contact the step control could not resolve.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StalledContact {
+    /// The joint's name.
+    pub joint: String,
+    /// Its handle in its set.
+    pub handle: ClearanceJointHandle,
+    /// The normal law.
+    pub law: LawKind,
+    /// Penetration, m (negative: a gap).
+    pub penetration: f64,
+    /// Penetration rate, m/s.
+    pub rate: f64,
+    /// The approach speed the hysteresis laws divide by, `delta_dot0`, m/s (0 in free flight).
+    pub impact_rate: f64,
+    /// The joint's floor on it, m/s.
+    pub min_impact_speed: f64,
+    /// Linearised damping ratio.
+    pub zeta: f64,
+    /// Linearised natural frequency, rad/s.
+    pub omega: f64,
+    /// Damped stability limit of the step, s.
+    pub stable_dt: f64,
+    /// Friction's step limit, s.
+    pub friction_dt: f64,
+    /// Normal force, N.
+    pub normal_force: f64,
+    /// Effective mass along the normal, kg.
+    pub effective_mass: f64,
+    /// Each movable body's share (fixed and kinematic bodies have none).
+    pub bodies: Vec<BodyShare>,
+    /// The law's validity limit, m.
+    pub max_valid_penetration: f64,
+    /// The deepest penetration the contact can reach from its state (elastic energy plus the
+    /// kinetic energy of the approach), m.
+    pub reachable_penetration: f64,
+    /// The stable step of the contact at the validity limit, s (what a contact that stays valid
+    /// needs).
+    pub stable_dt_at_valid: f64,
+}
+
+/// The cause [`diagnose`] finds.
+#[derive(Clone, Debug, PartialEq)]
+pub enum StallCause {
+    /// A body's inertia makes the effective mass at the contact tiny against its mass.
+    TinyInertia(BodyShare),
+    /// The approach presses the contact past its law's validity.
+    Speed,
+    /// A hysteresis law's damping `~ 1/delta_dot0` at a re-contact as slow as the floor.
+    SlowRecontact,
+    /// The law's damping over-damps the contact.
+    Damping,
+    /// Friction's slope near zero slip under this normal force.
+    Friction,
+    /// The contact is too stiff for the bodies' masses.
+    Stiffness,
+    /// No joint was in contact: nothing the contact laws do explains it.
+    NoContact,
+}
+
+impl StalledContact {
+    /// The numbers of `joint` (with handle `handle`) in `bodies` at its last evaluation.
+    pub fn of(handle: ClearanceJointHandle, joint: &ClearanceJoint, bodies: &RigidBodySet) -> Self {
+        let r = joint.report();
+        let s = &r.state;
+        let law = joint.normal_law();
+        let m = r.effective_mass;
+        let shares = [joint.body1(), joint.body2()]
+            .into_iter()
+            .filter_map(|h| {
+                let rb = bodies.get(h).filter(|rb| rb.is_dynamic())?;
+                let mp = &rb.mass_properties().local_mprops;
+                let rn = (s.contact_point - world_center_of_mass(rb)).cross(s.normal);
+                let p = mp.principal_inertia();
+                Some(BodyShare {
+                    handle: h,
+                    mass: mp.mass(),
+                    inertia: p.x.min(p.y).min(p.z),
+                    rotational_inverse_mass: rn.dot(mp.world_inv_inertia(rb.rotation()) * rn),
+                })
+            })
+            .collect();
+        let energy = 0.5 * m * s.penetration_rate.max(0.0).powi(2)
+            + law.elastic_energy(s.penetration.max(0.0));
+        let reach = penetration_for_energy(law, energy, 1e-6).max(s.penetration);
+        let valid = joint.max_valid_penetration();
+        let at_valid = NormalContact {
+            penetration: valid,
+            penetration_rate: s.penetration_rate.max(0.0),
+            impact_rate: r.impact_rate.max(joint.min_impact_speed_floor()),
+        };
+        let (stable_dt_at_valid, _, _) = stable_step(
+            law.tangent_stiffness(valid),
+            law.damping_coefficient(&at_valid),
+            m,
+        );
+        StalledContact {
+            joint: joint.name().to_string(),
+            handle,
+            law: law.kind(),
+            penetration: s.penetration,
+            rate: s.penetration_rate,
+            impact_rate: r.impact_rate,
+            min_impact_speed: joint.min_impact_speed_floor(),
+            zeta: r.zeta,
+            omega: r.omega,
+            stable_dt: r.max_stable_dt,
+            friction_dt: r.friction_stable_dt,
+            normal_force: r.force.normal_force,
+            effective_mass: m,
+            bodies: shares,
+            max_valid_penetration: valid,
+            reachable_penetration: reach,
+            stable_dt_at_valid,
+        }
+    }
+
+    /// The contact state in words.
+    pub fn state(&self) -> String {
+        format!(
+            "joint `{}` ({:?}): penetration {} um, rate {} m/s, delta_dot0 {} m/s, damping ratio \
+             {}, stable step {} s (friction's {} s), effective mass {} kg",
+            self.joint,
+            self.handle,
+            sig4(self.penetration * 1e6),
+            sig4(self.rate),
+            sig4(self.impact_rate),
+            sig4(self.zeta),
+            sig4(self.stable_dt),
+            sig4(self.friction_dt),
+            sig4(self.effective_mass)
+        )
+    }
+}
+
+/// Below this fraction of the lighter moving body's mass, an effective mass is the sign of a
+/// body whose inertia is out of proportion (a rotation too easy to excite).
+const TINY_MASS_FRACTION: f64 = 1e-3;
+
+/// The cause of a stall at contact `c`, from its numbers (see the module docs for the order).
+pub fn diagnose(c: &StalledContact) -> StallCause {
+    if !(c.penetration > 0.0) {
+        return StallCause::NoContact;
+    }
+    let lightest = c.bodies.iter().map(|b| b.mass).fold(f64::INFINITY, f64::min);
+    if c.effective_mass < TINY_MASS_FRACTION * lightest
+        && let Some(b) = c
+            .bodies
+            .iter()
+            .filter(|b| b.rotational_inverse_mass > 1.0 / b.mass)
+            .max_by(|a, b| a.rotational_inverse_mass.total_cmp(&b.rotational_inverse_mass))
+    {
+        return StallCause::TinyInertia(*b);
+    }
+    if c.reachable_penetration > c.max_valid_penetration {
+        return StallCause::Speed;
+    }
+    if c.friction_dt < c.stable_dt {
+        return StallCause::Friction;
+    }
+    if c.zeta > 1.0 {
+        let hysteresis = matches!(
+            c.law,
+            LawKind::HuntCrossley
+                | LawKind::LankaraniNikravesh
+                | LawKind::FloresEtAl
+                | LawKind::GonthierEtAl
+        );
+        if hysteresis && c.impact_rate <= 1.01 * c.min_impact_speed {
+            return StallCause::SlowRecontact;
+        }
+        return StallCause::Damping;
+    }
+    StallCause::Stiffness
+}
+
+/// The stall message: what was seen (`seen`), the contact state, the cause and what to change.
+/// `min_dt` is the step floor, s.
+pub fn explain(seen: &str, contact: Option<&StalledContact>, min_dt: f64) -> String {
+    let Some(c) = contact else {
+        return format!(
+            "{seen}, with no clearance joint in contact: no contact law explains it (a body moved \
+             by hand or by a kinematic position target, which any step reaches at once, or a step \
+             floor `min_dt` = {} s too high)",
+            sig4(min_dt)
+        );
+    };
+    let cause = match diagnose(c) {
+        StallCause::NoContact => format!(
+            "no contact law explains it (the joint is not in contact: a body moved by hand or by \
+             a kinematic position target, which any step reaches at once, or a step floor \
+             `min_dt` = {} s too high)",
+            sig4(min_dt)
+        ),
+        StallCause::TinyInertia(b) => format!(
+            "body {:?} has a smallest moment of inertia of {} kg m^2 for a mass of {} kg: turning \
+             it about its centre of mass at the contact is so easy that the effective mass there is \
+             {} kg, and any contact stiffness oscillates faster than the floor {} s resolves; \
+             check its inertia (kg m^2, about its centre of mass)",
+            b.handle.into_raw_parts(),
+            sig4(b.inertia),
+            sig4(b.mass),
+            sig4(c.effective_mass),
+            sig4(min_dt)
+        ),
+        StallCause::Speed => format!(
+            "the approach is out of the contact law's range: at {} m/s the contact would be pressed \
+             to {} um, {} times its validity limit {} um (a contact that stayed valid would need \
+             steps of {} s); check the bodies' initial velocities and the loads that drive them",
+            sig4(c.rate.max(c.impact_rate)),
+            sig4(c.reachable_penetration * 1e6),
+            sig4(c.reachable_penetration / c.max_valid_penetration),
+            sig4(c.max_valid_penetration * 1e6),
+            sig4(c.stable_dt_at_valid)
+        ),
+        StallCause::SlowRecontact => format!(
+            "a slow re-contact: its approach speed delta_dot0 = {} m/s sits at the floor \
+             `min_impact_speed` = {} m/s, and this hysteresis law's damping grows as \
+             1/delta_dot0, so the contact is over-damped (damping ratio {}) and stable only below \
+             {} s; raise `min_impact_speed`",
+            sig4(c.impact_rate),
+            sig4(c.min_impact_speed),
+            sig4(c.zeta),
+            sig4(c.stable_dt)
+        ),
+        StallCause::Damping => format!(
+            "the contact is over-damped: damping ratio {} (the damping is {} times the critical \
+             damping 2 sqrt(K m) of the effective mass {} kg), so it is stable only below {} s; \
+             lower the law's damping ({})",
+            sig4(c.zeta),
+            sig4(c.zeta),
+            sig4(c.effective_mass),
+            sig4(c.stable_dt),
+            damping_field(c.law)
+        ),
+        StallCause::Friction => format!(
+            "friction: under a normal force of {} N its law is so steep near zero slip that a step \
+             must stay below {} s; use a friction law with a larger stiction speed",
+            sig4(c.normal_force),
+            sig4(c.friction_dt)
+        ),
+        StallCause::Stiffness => format!(
+            "the contact is too stiff for the effective mass {} kg: natural frequency {} rad/s, \
+             stable only below {} s; check the law's stiffness (or the materials' Young's moduli)",
+            sig4(c.effective_mass),
+            sig4(c.omega),
+            sig4(c.stable_dt)
+        ),
+    };
+    format!(
+        "{seen} (the floor `min_dt` is {} s); {}. Cause: {cause}",
+        sig4(min_dt),
+        c.state()
+    )
+}
+
+/// The parameter that sets a law's damping, in words.
+fn damping_field(law: LawKind) -> &'static str {
+    match law {
+        LawKind::KelvinVoigt => "`damping`, N s/m",
+        LawKind::ImprovedLiu => "`eta_s`, or `d_max_n_s_per_m`",
+        LawKind::HuntCrossley
+        | LawKind::LankaraniNikravesh
+        | LawKind::FloresEtAl
+        | LawKind::GonthierEtAl => "a higher `restitution` damps less",
+        _ => "its damping parameter",
+    }
+}
+
+/// The joint of `sets` in contact whose step limit is the shortest (the one that stops the
+/// step control), with its numbers; `None` when no joint is in contact.
+pub fn stalled_contact<'a>(
+    sets: impl IntoIterator<Item = &'a crate::rapier::joint::ClearanceJointSet>,
+    bodies: &RigidBodySet,
+) -> Option<StalledContact> {
+    sets.into_iter()
+        .flat_map(|s| s.iter())
+        .filter(|(_, j)| j.report().state.penetration > 0.0)
+        .min_by(|(_, a), (_, b)| {
+            let limit = |j: &ClearanceJoint| j.report().max_stable_dt.min(j.report().friction_stable_dt);
+            limit(a).total_cmp(&limit(b))
+        })
+        .map(|(h, j)| StalledContact::of(h, j, bodies))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn contact() -> StalledContact {
+        StalledContact {
+            joint: "pin".into(),
+            handle: ClearanceJointHandle(0),
+            law: LawKind::LankaraniNikravesh,
+            penetration: 1e-6,
+            rate: 1e-3,
+            impact_rate: 0.1,
+            min_impact_speed: 1e-4,
+            zeta: 0.1,
+            omega: 1e6,
+            stable_dt: 2e-10 * 0.5,
+            friction_dt: f64::INFINITY,
+            normal_force: 10.0,
+            effective_mass: 0.1,
+            bodies: vec![BodyShare {
+                handle: RigidBodyHandle::from_raw_parts(1, 0),
+                mass: 0.14,
+                inertia: 1e-4,
+                rotational_inverse_mass: 2.0,
+            }],
+            max_valid_penetration: 95e-6,
+            reachable_penetration: 2e-6,
+            stable_dt_at_valid: 1e-7,
+        }
+    }
+
+    #[test]
+    fn each_cause_from_its_numbers() {
+        assert_eq!(diagnose(&contact()), StallCause::Stiffness);
+        let c = StalledContact {
+            zeta: 50.0,
+            impact_rate: 1e-4,
+            ..contact()
+        };
+        assert_eq!(diagnose(&c), StallCause::SlowRecontact);
+        assert_eq!(
+            diagnose(&StalledContact {
+                law: LawKind::KelvinVoigt,
+                ..c.clone()
+            }),
+            StallCause::Damping
+        );
+        assert_eq!(
+            diagnose(&StalledContact {
+                impact_rate: 0.5,
+                ..c
+            }),
+            StallCause::Damping
+        );
+        assert_eq!(
+            diagnose(&StalledContact {
+                friction_dt: 1e-12,
+                ..contact()
+            }),
+            StallCause::Friction
+        );
+        assert_eq!(
+            diagnose(&StalledContact {
+                reachable_penetration: 7e-3,
+                ..contact()
+            }),
+            StallCause::Speed
+        );
+        let tiny = StalledContact {
+            effective_mass: 6e-12,
+            bodies: vec![BodyShare {
+                inertia: 1e-12,
+                rotational_inverse_mass: 1.6e11,
+                ..contact().bodies[0]
+            }],
+            ..contact()
+        };
+        assert!(matches!(diagnose(&tiny), StallCause::TinyInertia(b) if b.inertia == 1e-12));
+        assert_eq!(
+            diagnose(&StalledContact {
+                penetration: -1e-6,
+                ..contact()
+            }),
+            StallCause::NoContact
+        );
+    }
+
+    #[test]
+    fn the_message_names_the_joint_the_state_and_the_cause() {
+        let c = StalledContact {
+            zeta: 50.0,
+            impact_rate: 1e-4,
+            ..contact()
+        };
+        let m = explain("no step resolves the contact", Some(&c), 1e-10);
+        for part in [
+            "joint `pin`",
+            "penetration 1 um",
+            "delta_dot0 1e-4 m/s",
+            "damping ratio 50",
+            "stable step 1e-10 s",
+            "slow re-contact",
+            "raise `min_impact_speed`",
+        ] {
+            assert!(m.contains(part), "{part:?} not in {m}");
+        }
+        assert!(!m.contains("out of its physical range"), "{m}");
+    }
+}

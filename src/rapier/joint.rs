@@ -6,7 +6,8 @@ use crate::model::kinematics::{
     BodyMotion, ContactMode, ForcePair, JournalState, contact_force, journal_state, stable_step,
 };
 use crate::model::laws::{
-    crossing_fraction, loaded_impact_rate, speed_at_crossing, BearingGeometry, FrictionLaw, FrictionModel, NormalContact, NormalForceLaw, NormalModel,
+    BearingGeometry, FrictionLaw, FrictionModel, NormalContact, NormalForceLaw, NormalModel,
+    crossing_fraction, loaded_impact_rate, speed_at_crossing,
 };
 use crate::rapier::ledger::{
     ForceLedger, Wrench, ensure_mass_properties, inverse_mass_along, world_center_of_mass,

@@ -10,7 +10,9 @@
 //!   gravity are scaled by `(h_prev + h)/(2 h)` for the step and restored after it. The first
 //!   step from a given state is a half kick (`h_prev = 0`): velocities then live at half steps,
 //!   and positions are second-order accurate from the start.
-//! - **Step choice** ([`StepControl`]): fixed, or adaptive from the contacts (the joints'
+//! - **Step choice** ([`StepControl`]): fixed, or adaptive from the motion (no body turns more
+//!   than `tolerance` rad in a step: [`motion_step`](crate::rapier::motion_step)) and the
+//!   contacts (the joints'
 //!   [`adaptive_step`](crate::rapier::joint::ClearanceJoint::adaptive_step)), growing by at most
 //!   [`StepControl::max_growth`] per step and landing exactly on the time given to
 //!   [`Stepper::step`].
@@ -139,9 +141,11 @@ impl ForceSource for DriveSet {
 pub enum StepMode {
     /// A constant step (the paper's way); the last step is shortened to land on the end.
     Fixed,
-    /// The step changes between Rapier steps: at most the largest step in free flight, shorter as
-    /// a contact approaches and inside it (`tolerance` of the contact's natural period, within
-    /// its damped and friction stability limits), with rejected steps retried. The default.
+    /// The step changes between Rapier steps: no body turns more than `tolerance` rad in a step
+    /// ([`motion_step`](crate::rapier::motion_step::motion_step)), shorter as a contact
+    /// approaches and inside it (`tolerance` of the contact's natural period, within its damped
+    /// and friction stability limits), at most the largest step (a safety cap), with rejected
+    /// steps retried. The default.
     #[default]
     Adaptive,
 }
@@ -160,7 +164,8 @@ pub struct StepControl {
     pub mode: StepMode,
     /// The fixed step, or the largest adaptive step, s.
     pub max_dt: f64,
-    /// Adaptive: the fraction of a contact's natural period one step may cover.
+    /// Adaptive: the fraction of a contact's natural period one step may cover, and the angle
+    /// (rad) a body may turn in one step.
     pub tolerance: f64,
     /// Adaptive: the smallest step, s (the floor; see [`STALL_STEPS`]).
     pub min_dt: f64,
@@ -185,7 +190,8 @@ impl StepControl {
     }
 
     /// Adaptive steps of at most `max_dt` seconds, `tolerance` of a contact period inside
-    /// contacts; floor 1e-10 s, growth at most 2 per step, not strict.
+    /// contacts and `tolerance` rad of any body's turn; floor 1e-10 s, growth at most 2 per step,
+    /// not strict.
     pub fn adaptive(max_dt: f64, tolerance: f64) -> Self {
         StepControl {
             mode: StepMode::Adaptive,
@@ -197,7 +203,8 @@ impl StepControl {
         }
     }
 
-    /// Sets the adaptive tolerance, the fraction of a contact period one step may cover.
+    /// Sets the adaptive tolerance, the fraction of a contact period one step may cover (and the
+    /// angle in rad a body may turn in one step).
     pub fn with_tolerance(mut self, tolerance: f64) -> Self {
         self.tolerance = tolerance;
         self

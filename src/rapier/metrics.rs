@@ -66,6 +66,13 @@ pub struct ContactObservation {
     pub penetration: f64,
     /// Penetration rate, m/s (positive approaching).
     pub rate: f64,
+    /// At an onset, the approach speed at the crossing of delta = 0, m/s
+    /// ([`ClearanceReport::approach_speed`](crate::rapier::joint::ClearanceReport::approach_speed)).
+    pub approach_speed: f64,
+    /// At an onset, the fraction of the step before this state at which delta crossed 0
+    /// ([`ClearanceReport::onset_fraction`](crate::rapier::joint::ClearanceReport::onset_fraction));
+    /// 1 (or the default 0, read as 1) otherwise.
+    pub onset_fraction: f64,
 }
 
 impl ContactObservation {
@@ -79,6 +86,8 @@ impl ContactObservation {
             impact: r.impact,
             penetration: r.state.penetration,
             rate: r.state.penetration_rate,
+            approach_speed: r.approach_speed,
+            onset_fraction: r.onset_fraction,
         }
     }
 
@@ -100,9 +109,11 @@ impl ContactObservation {
 /// One contact of a clearance joint, from its onset to the first state out of contact.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Impact {
-    /// Time of the first state in contact, s.
+    /// Time of the crossing of delta = 0, s: interpolated inside the step that led to the first
+    /// state in contact ([`crossing_fraction`](crate::model::laws::crossing_fraction)).
     pub onset_t_s: f64,
-    /// Penetration rate at that state, m/s (positive approaching).
+    /// Penetration rate at the crossing, m/s (positive approaching;
+    /// [`speed_at_crossing`](crate::model::laws::speed_at_crossing)).
     pub approach_speed_m_s: f64,
     /// Largest joint force during the contact, N.
     pub peak_force_n: f64,
@@ -159,6 +170,8 @@ pub struct ImpactRecorder {
     in_first_contact: bool,
     /// Whether the last impact of the list is still open.
     open: bool,
+    /// The step that led to the state being recorded (the last recorded `dt`), s.
+    last_dt: f64,
     finished: bool,
 }
 
@@ -178,8 +191,18 @@ impl ImpactRecorder {
         if obs.impact {
             m.separated_impacts += 1;
         }
+        // The crossing of delta = 0 inside the step that led here.
+        let (onset_t, approach) = if obs.onset && obs.onset_fraction > 0.0 {
+            (
+                t - (1.0 - obs.onset_fraction.min(1.0)) * self.last_dt,
+                obs.approach_speed,
+            )
+        } else {
+            (t, obs.rate)
+        };
+        self.last_dt = dt;
         if obs.onset {
-            self.onset_rate = obs.rate;
+            self.onset_rate = approach;
         }
         if self.was_in_contact && !in_contact && self.onset_rate > RESTITUTION_MIN_SPEED {
             m.max_restitution = m.max_restitution.max(-obs.rate / self.onset_rate);
@@ -191,14 +214,16 @@ impl ImpactRecorder {
         if obs.onset {
             m.impacts += 1;
             if m.first_impact_t_s.is_none() {
-                m.first_impact_t_s = Some(t);
+                m.first_impact_t_s = Some(onset_t);
                 m.first_impact_peak_n = Some(0.0);
                 self.in_first_contact = true;
             }
             self.impacts.push(Impact {
-                onset_t_s: t,
-                approach_speed_m_s: obs.rate,
+                onset_t_s: onset_t,
+                approach_speed_m_s: approach,
                 separated: obs.impact,
+                // From the crossing: the part of the step before this state spent in contact.
+                duration_s: t - onset_t,
                 ..Impact::default()
             });
             self.open = true;
@@ -386,6 +411,8 @@ mod tests {
             impact: onset,
             penetration: pen_um * 1e-6,
             rate,
+            approach_speed: rate,
+            onset_fraction: 1.0,
         }
     }
 

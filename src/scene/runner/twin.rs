@@ -99,6 +99,8 @@ impl HingeTrack {
                 impact: self.sample.impact,
                 penetration: self.sample.penetration,
                 rate: self.sample.rate,
+                approach_speed: self.sample.approach_speed,
+                onset_fraction: self.sample.onset_fraction,
             },
         }
     }
@@ -112,6 +114,9 @@ struct ContactSample {
     penetration: f64,
     /// Penetration rate, m/s (positive approaching).
     rate: f64,
+    /// At an onset: the approach speed at the crossing, m/s, and where in the step it was.
+    approach_speed: f64,
+    onset_fraction: f64,
     /// The damping part of the normal force (total minus elastic), N.
     damping_force: f64,
     /// Friction force magnitude, N.
@@ -601,6 +606,8 @@ impl Twin {
                     impact: r.impact,
                     penetration: r.state.penetration,
                     rate: r.state.penetration_rate,
+                    approach_speed: r.approach_speed,
+                    onset_fraction: r.onset_fraction,
                     damping_force: if f.normal_force > 0.0 {
                         f.normal_force - elastic
                     } else {

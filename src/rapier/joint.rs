@@ -6,7 +6,7 @@ use crate::model::kinematics::{
     BodyMotion, ContactMode, ForcePair, JournalState, contact_force, journal_state, stable_step,
 };
 use crate::model::laws::{
-    BearingGeometry, FrictionLaw, FrictionModel, NormalContact, NormalForceLaw, NormalModel,
+    crossing_fraction, loaded_impact_rate, speed_at_crossing, BearingGeometry, FrictionLaw, FrictionModel, NormalContact, NormalForceLaw, NormalModel,
 };
 use crate::rapier::ledger::{
     ForceLedger, Wrench, ensure_mass_properties, inverse_mass_along, world_center_of_mass,
@@ -185,8 +185,18 @@ pub struct ClearanceReport {
     /// a gap of at least the joint's `min_separation`. Re-contacts after smaller separations are
     /// chatter of a journal following the wall, not new impacts.
     pub impact: bool,
-    /// `delta_dot0` of the current contact (0 in free flight), m/s.
+    /// `delta_dot0` the normal law used at this application (0 in free flight), m/s: the
+    /// approach speed at the crossing of delta = 0, floored by the joint's `min_impact_speed`
+    /// and, for a contact loaded deeper than its approach explains, raised to the speed of a
+    /// free impact reaching the same depth ([`loaded_impact_rate`]).
     pub impact_rate: f64,
+    /// At an onset, the penetration rate interpolated at the crossing of delta = 0 inside the
+    /// step that led here ([`speed_at_crossing`]), m/s; 0 otherwise.
+    pub approach_speed: f64,
+    /// At an onset, the fraction of the step that led here at which delta crossed 0
+    /// ([`crossing_fraction`]; the onset time is the step's end minus `(1 - fraction)` steps);
+    /// 1 otherwise.
+    pub onset_fraction: f64,
     /// The force pair applied.
     pub force: ForcePair,
     /// Largest stable step for the contact as linearised now (infinite in free flight), s:
@@ -391,11 +401,14 @@ impl ClearanceJoint {
         if !(stiffness > 0.0) {
             return f64::INFINITY;
         }
-        let impact_rate = if self.contact.in_contact {
+        let mut impact_rate = if self.contact.in_contact {
             self.contact.impact_rate
         } else {
             approach_speed.max(self.min_impact_speed)
         };
+        if self.normal_law.uses_impact_rate() {
+            impact_rate = impact_rate.max(loaded_impact_rate(energy, m));
+        }
         let c = NormalContact {
             penetration: peak,
             penetration_rate: approach_speed,
@@ -463,16 +476,28 @@ impl ClearanceJoint {
         let p_j = *rb2.position() * self.local_anchor2;
         let state = journal_state(&self.geometry, p_i, p_j, axis, &m1, &m2);
 
-        // Contact history: record delta_dot0 at onset (MODEL.md §2), classify the mode.
+        // Contact history: record delta_dot0 at onset (MODEL.md §2), located at the crossing of
+        // delta = 0 inside the step that led here (the previous application is the state
+        // before it), and classify the mode.
         let onset = state.penetration > 0.0 && !self.contact.in_contact;
         let impact = onset && self.contact.max_gap >= self.min_separation;
+        let before = &self.report.state;
+        let (onset_fraction, approach_speed) = match onset {
+            true if self.prepared_report() && before.penetration <= 0.0 => {
+                let s = crossing_fraction(-before.penetration, state.penetration);
+                let rate = speed_at_crossing(before.penetration_rate, state.penetration_rate, s);
+                (s, rate)
+            }
+            true => (1.0, state.penetration_rate),
+            false => (1.0, 0.0),
+        };
         if state.penetration > 0.0 {
             if onset {
                 self.contact = ContactHistory {
                     in_contact: true,
                     max_gap: 0.0,
                     compressing: true,
-                    impact_rate: state.penetration_rate.max(self.min_impact_speed),
+                    impact_rate: approach_speed.max(self.min_impact_speed),
                 };
             } else if state.penetration_rate <= 0.0 {
                 self.contact.compressing = false;
@@ -494,22 +519,18 @@ impl ClearanceJoint {
             (true, true) => ContactMode::Impact,
             (true, false) => ContactMode::Continuous,
         };
-        let force = contact_force(
-            &state,
-            self.contact.impact_rate,
-            &self.normal_law,
-            &self.friction_law,
-        );
-
-        // Linearised contact for the step-size limit.
         let effective_mass = 1.0
             / (inverse_mass_along(rb1, state.contact_point, state.normal)
                 + inverse_mass_along(rb2, state.contact_point, state.normal));
+        let impact_rate = self.law_impact_rate(state.penetration, effective_mass);
+        let force = contact_force(&state, impact_rate, &self.normal_law, &self.friction_law);
+
+        // Linearised contact for the step-size limit.
         let (max_stable_dt, omega, zeta) = if state.penetration > 0.0 {
             let c = NormalContact {
                 penetration: state.penetration,
                 penetration_rate: state.penetration_rate,
-                impact_rate: self.contact.impact_rate,
+                impact_rate,
             };
             // dF/d delta = K_tangent + (dD/d delta) delta_dot (MODEL.md §2 laws, linearised).
             let stiffness = self.normal_law.tangent_stiffness(state.penetration)
@@ -546,7 +567,9 @@ impl ClearanceJoint {
             mode,
             onset,
             impact,
-            impact_rate: self.contact.impact_rate,
+            impact_rate,
+            approach_speed,
+            onset_fraction,
             force,
             max_stable_dt,
             friction_stable_dt,
@@ -570,6 +593,23 @@ impl ClearanceJoint {
 }
 
 impl ClearanceJoint {
+    /// `delta_dot0` for the law in the current contact at `depth` (m): the contact's own,
+    /// raised for a hysteresis law to [`loaded_impact_rate`] at that depth (0 in free flight).
+    fn law_impact_rate(&self, depth: f64, effective_mass: f64) -> f64 {
+        if !self.contact.in_contact {
+            return self.contact.impact_rate;
+        }
+        let rate = self.contact.impact_rate;
+        if self.normal_law.uses_impact_rate() {
+            rate.max(loaded_impact_rate(
+                self.normal_law.elastic_energy(depth),
+                effective_mass,
+            ))
+        } else {
+            rate
+        }
+    }
+
     /// Whether a report from an earlier application exists.
     fn prepared_report(&self) -> bool {
         self.report.effective_mass > 0.0

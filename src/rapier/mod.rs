@@ -4,7 +4,8 @@
 //! - [`joint`]: the clearance joint (compliant contact and friction as a per-step force), its set.
 //! - [`large_step`]: the same play as a constraint inside Rapier's solver, for 1/60 s and 1 kHz.
 //! - [`convert`]: a clearance joint from a Rapier revolute joint, with the bearing side chosen.
-//! - [`stepper`]: the one step control (variable-step Störmer-Verlet, acceptance, guards).
+//! - [`stepper`]: the one step control (variable-step Störmer-Verlet, acceptance, guards);
+//!   [`motion_step`]: the step the bodies' own motion needs.
 //! - [`drive`]: torsion springs and torques; [`prescribed`]: prescribed (kinematic) motions.
 //! - [`reaction`]: exact ideal-joint reactions from the constrained equations.
 //! - [`metrics`]: impact lists, contact fraction and per-turn statistics.
@@ -18,6 +19,7 @@ pub mod joint;
 pub mod large_step;
 pub mod ledger;
 pub mod metrics;
+pub mod motion_step;
 pub mod prescribed;
 pub mod reaction;
 pub mod stepper;

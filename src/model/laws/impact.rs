@@ -62,6 +62,41 @@ pub fn impact_restitution(
     0.0
 }
 
+/// The impact speed that would bring a contact of `effective_mass` (kg) to a depth storing
+/// `elastic_energy` (J): `sqrt(2 E/m)`, m/s.
+///
+/// The hysteresis laws' damping `chi K delta^n/delta_dot0` is calibrated on a free impact, in
+/// which the depth reached follows from the approach speed (`E(delta) <= m delta_dot0^2/2`). A
+/// contact that began slowly (a re-contact at a few um/s) and is then loaded deeper by the rest
+/// of the mechanism is no such impact: with its own `delta_dot0` its damping would grow without
+/// bound (`1/delta_dot0`) and its stable step would fall to nothing. The joint takes the larger
+/// of the approach speed and this speed as `delta_dot0`: the damping of a contact never exceeds
+/// that of a free impact reaching the same depth, and a real impact is left untouched.
+pub fn loaded_impact_rate(elastic_energy: f64, effective_mass: f64) -> f64 {
+    if elastic_energy > 0.0 && effective_mass > 0.0 && effective_mass.is_finite() {
+        (2.0 * elastic_energy / effective_mass).sqrt()
+    } else {
+        0.0
+    }
+}
+
+/// Where between two states the surfaces met: the fraction of the step from the state before
+/// (a gap `gap_before` >= 0, m) to the state after (`depth_after` > 0, m) at which the
+/// penetration crossed 0, linear in time (positions move linearly over a step), in (0, 1].
+pub fn crossing_fraction(gap_before: f64, depth_after: f64) -> f64 {
+    let (g, d) = (gap_before.max(0.0), depth_after.max(0.0));
+    if g + d > 0.0 { g / (g + d) } else { 1.0 }
+}
+
+/// The approach speed at the crossing of `fraction` ([`crossing_fraction`]) into a step, from the
+/// penetration rates read at the states before and after it (m/s). A state's velocities are the
+/// ones of the step that led to it, so the two readings are the speeds at the middles of the
+/// step before and of this one: interpolated linearly in time between them (equal steps
+/// assumed), `r_after + (r_after - r_before)(fraction - 1/2)`.
+pub fn speed_at_crossing(rate_before: f64, rate_after: f64, fraction: f64) -> f64 {
+    rate_after + (rate_after - rate_before) * (fraction - 0.5)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

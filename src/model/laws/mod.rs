@@ -12,7 +12,7 @@ mod normal;
 mod step;
 
 pub use friction::*;
-pub use impact::impact_restitution;
+pub use impact::{crossing_fraction, impact_restitution, loaded_impact_rate, speed_at_crossing};
 pub use material::*;
 pub use normal::*;
 pub use step::step;

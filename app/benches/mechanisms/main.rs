@@ -155,18 +155,23 @@ fn pct(x: f64) -> String {
 
 fn guards(o: &Outcome) -> String {
     match &o.error {
-        Some(e) => format!("**failed**: {}", e.chars().take(160).collect::<String>()),
+        Some(e) => format!("**failed**: {}", shorten(e, 110)),
         None if o.violations.is_empty() => "clean".into(),
-        None => format!(
-            "{} violation(s): {}",
-            o.violations.len(),
-            o.violations
-                .iter()
-                .map(|v| v.chars().take(90).collect::<String>())
-                .collect::<Vec<_>>()
-                .join("; ")
-        ),
+        None => {
+            let kinds: Vec<String> = o.violations.iter().map(|v| violation_kind(v)).collect();
+            format!("flagged: {}", kinds.join("; "))
+        }
     }
+}
+
+/// `text` cut at a word boundary after at most `n` characters, with an ellipsis when cut.
+fn shorten(text: &str, n: usize) -> String {
+    if text.chars().count() <= n {
+        return text.into();
+    }
+    let cut: String = text.chars().take(n).collect();
+    let cut = cut.rsplit_once(' ').map_or(cut.as_str(), |(a, _)| a);
+    format!("{cut} ...")
 }
 
 fn detail_row(case: &Case, r: &Row, reference: &Row) -> String {

@@ -254,15 +254,12 @@ pub fn assets() -> PathBuf {
 pub fn scene(case: &Case, stepping: Stepping, end_s: f64) -> Scene {
     let base = Scene::load(&assets().join(case.file)).expect("the matrix's scenes load");
     let mut set = case.set.clone();
-    set.extend(
-        [
-            format!("run.end_s={end_s}"),
-            format!("run.output_interval_s={}", case.output_interval_s),
-            "run.body_motion=true".into(),
-            "run.strict=false".into(),
-        ]
-        .into_iter(),
-    );
+    set.extend([
+        format!("run.end_s={end_s}"),
+        format!("run.output_interval_s={}", case.output_interval_s),
+        "run.body_motion=true".into(),
+        "run.strict=false".into(),
+    ]);
     match stepping {
         Stepping::Default => set.extend(
             [

@@ -151,10 +151,10 @@ impl StalledContact {
     /// The contact state in words.
     pub fn state(&self) -> String {
         format!(
-            "joint `{}` ({:?}): penetration {} um, rate {} m/s, delta_dot0 {} m/s, damping ratio \
+            "joint `{}` (handle {}): penetration {} um, rate {} m/s, delta_dot0 {} m/s, damping ratio \
              {}, stable step {} s (friction's {} s), effective mass {} kg",
             self.joint,
-            self.handle,
+            self.handle.0,
             sig4(self.penetration * 1e6),
             sig4(self.rate),
             sig4(self.impact_rate),
@@ -170,8 +170,9 @@ impl StalledContact {
 /// body whose inertia is out of proportion (a rotation too easy to excite).
 const TINY_MASS_FRACTION: f64 = 1e-3;
 
-/// The cause of a stall at contact `c`, from its numbers (see the module docs for the order).
-pub fn diagnose(c: &StalledContact) -> StallCause {
+/// The cause of a stall at contact `c` under the step floor `min_dt` (s), from its numbers (see
+/// the module docs for the order).
+pub fn diagnose(c: &StalledContact, min_dt: f64) -> StallCause {
     if !(c.penetration > 0.0) {
         return StallCause::NoContact;
     }
@@ -188,10 +189,10 @@ pub fn diagnose(c: &StalledContact) -> StallCause {
     if c.reachable_penetration > c.max_valid_penetration {
         return StallCause::Speed;
     }
-    if c.friction_dt < c.stable_dt {
-        return StallCause::Friction;
-    }
-    if c.zeta > 1.0 {
+    // Damping that alone needs steps below the floor comes first: its force also loads
+    // friction, whose limit then falls with it.
+    let damped = c.zeta > 1.0;
+    if damped && (c.stable_dt < min_dt || c.friction_dt >= c.stable_dt) {
         let hysteresis = matches!(
             c.law,
             LawKind::HuntCrossley
@@ -203,6 +204,9 @@ pub fn diagnose(c: &StalledContact) -> StallCause {
             return StallCause::SlowRecontact;
         }
         return StallCause::Damping;
+    }
+    if c.friction_dt < c.stable_dt {
+        return StallCause::Friction;
     }
     StallCause::Stiffness
 }
@@ -218,7 +222,7 @@ pub fn explain(seen: &str, contact: Option<&StalledContact>, min_dt: f64) -> Str
             sig4(min_dt)
         );
     };
-    let cause = match diagnose(c) {
+    let cause = match diagnose(c, min_dt) {
         StallCause::NoContact => format!(
             "no contact law explains it (the joint is not in contact: a body moved by hand or by \
              a kinematic position target, which any step reaches at once, or a step floor \
@@ -349,39 +353,39 @@ mod tests {
 
     #[test]
     fn each_cause_from_its_numbers() {
-        assert_eq!(diagnose(&contact()), StallCause::Stiffness);
+        assert_eq!(diagnose(&contact(), 1e-10), StallCause::Stiffness);
         let c = StalledContact {
             zeta: 50.0,
             impact_rate: 1e-4,
             ..contact()
         };
-        assert_eq!(diagnose(&c), StallCause::SlowRecontact);
+        assert_eq!(diagnose(&c, 1e-10), StallCause::SlowRecontact);
         assert_eq!(
             diagnose(&StalledContact {
                 law: LawKind::KelvinVoigt,
                 ..c.clone()
-            }),
+            }, 1e-10),
             StallCause::Damping
         );
         assert_eq!(
             diagnose(&StalledContact {
                 impact_rate: 0.5,
                 ..c
-            }),
+            }, 1e-10),
             StallCause::Damping
         );
         assert_eq!(
             diagnose(&StalledContact {
                 friction_dt: 1e-12,
                 ..contact()
-            }),
+            }, 1e-10),
             StallCause::Friction
         );
         assert_eq!(
             diagnose(&StalledContact {
                 reachable_penetration: 7e-3,
                 ..contact()
-            }),
+            }, 1e-10),
             StallCause::Speed
         );
         let tiny = StalledContact {
@@ -393,12 +397,24 @@ mod tests {
             }],
             ..contact()
         };
-        assert!(matches!(diagnose(&tiny), StallCause::TinyInertia(b) if b.inertia == 1e-12));
+        assert!(matches!(diagnose(&tiny, 1e-10), StallCause::TinyInertia(b) if b.inertia == 1e-12));
+        // Damping that needs steps below the floor is the cause even when friction's limit,
+        // loaded by the damping force, is lower still.
+        assert_eq!(
+            diagnose(&StalledContact {
+                law: LawKind::KelvinVoigt,
+                zeta: 1e7,
+                stable_dt: 4e-12,
+                friction_dt: 4e-15,
+                ..contact()
+            }, 1e-10),
+            StallCause::Damping
+        );
         assert_eq!(
             diagnose(&StalledContact {
                 penetration: -1e-6,
                 ..contact()
-            }),
+            }, 1e-10),
             StallCause::NoContact
         );
     }

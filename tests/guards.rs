@@ -88,7 +88,10 @@ fn penetration_guard_reports_the_worst_depth_when_and_how_often() {
     assert_eq!(v.limit, 0.2e-6);
     assert_eq!((v.worst, v.t_s, v.first_t_s, v.count), seen.pen);
     // The worst, not the first: far deeper than the limit, later than the first violation.
-    assert!(v.worst > 3.0 * v.limit && v.t_s > v.first_t_s && v.count > 10, "{v:?}");
+    assert!(
+        v.worst > 3.0 * v.limit && v.t_s > v.first_t_s && v.count > 10,
+        "{v:?}"
+    );
     assert!((g.worst_penetration_ratio - v.worst / v.limit).abs() < 1e-12);
     let m = &g.messages()[0];
     assert!(
@@ -127,7 +130,10 @@ fn friction_guard_reports_the_worst_ratio_of_a_fixed_step_too_long() {
         .expect("the guard fires");
     assert_eq!(v.joint.as_deref(), Some("pin"));
     assert_eq!((v.worst, v.t_s, v.first_t_s, v.count), seen.fric);
-    assert!(v.worst > 1.0 && v.count > 1 && v.t_s >= v.first_t_s, "{v:?}");
+    assert!(
+        v.worst > 1.0 && v.count > 1 && v.t_s >= v.first_t_s,
+        "{v:?}"
+    );
 }
 
 /// The paper's scene (or the pendulum) with `from` replaced by `to` in its file.
@@ -179,10 +185,9 @@ fn a_soft_law_that_penetrates_too_deep_is_flagged_with_its_deepest_state() {
         )),
         "{table}"
     );
-    let json: serde_json::Value = serde_json::from_str(
-        &clearance_joint::scene::report::summary_json(&summary).unwrap(),
-    )
-    .unwrap();
+    let json: serde_json::Value =
+        serde_json::from_str(&clearance_joint::scene::report::summary_json(&summary).unwrap())
+            .unwrap();
     let g = json["guards"]["violations"]
         .as_array()
         .unwrap()
@@ -222,7 +227,11 @@ fn the_validity_limit_is_checked_with_its_field() {
             env!("CARGO_MANIFEST_DIR")
         ))
         .unwrap()
-        .replacen(LIU, &format!("{LIU} max_valid_penetration_um: Some({bad}),"), 1);
+        .replacen(
+            LIU,
+            &format!("{LIU} max_valid_penetration_um: Some({bad}),"),
+            1,
+        );
         let err = Scene::from_ron(&text, "test")
             .and_then(|s| Simulation::new(&s, RunOptions::default()).map(|_| ()))
             .unwrap_err()

@@ -12,8 +12,8 @@
 //! 6. a stiffness too high for the bodies' masses.
 
 use crate::error::sig4;
-use crate::model::laws::{LawKind, NormalContact, NormalForceLaw, penetration_for_energy};
 use crate::model::kinematics::stable_step;
+use crate::model::laws::{LawKind, NormalContact, NormalForceLaw, penetration_for_energy};
 use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle};
 use crate::rapier::ledger::world_center_of_mass;
 use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
@@ -176,13 +176,20 @@ pub fn diagnose(c: &StalledContact, min_dt: f64) -> StallCause {
     if !(c.penetration > 0.0) {
         return StallCause::NoContact;
     }
-    let lightest = c.bodies.iter().map(|b| b.mass).fold(f64::INFINITY, f64::min);
+    let lightest = c
+        .bodies
+        .iter()
+        .map(|b| b.mass)
+        .fold(f64::INFINITY, f64::min);
     if c.effective_mass < TINY_MASS_FRACTION * lightest
         && let Some(b) = c
             .bodies
             .iter()
             .filter(|b| b.rotational_inverse_mass > 1.0 / b.mass)
-            .max_by(|a, b| a.rotational_inverse_mass.total_cmp(&b.rotational_inverse_mass))
+            .max_by(|a, b| {
+                a.rotational_inverse_mass
+                    .total_cmp(&b.rotational_inverse_mass)
+            })
     {
         return StallCause::TinyInertia(*b);
     }
@@ -314,7 +321,8 @@ pub fn stalled_contact<'a>(
         .flat_map(|s| s.iter())
         .filter(|(_, j)| j.report().state.penetration > 0.0)
         .min_by(|(_, a), (_, b)| {
-            let limit = |j: &ClearanceJoint| j.report().max_stable_dt.min(j.report().friction_stable_dt);
+            let limit =
+                |j: &ClearanceJoint| j.report().max_stable_dt.min(j.report().friction_stable_dt);
             limit(a).total_cmp(&limit(b))
         })
         .map(|(h, j)| StalledContact::of(h, j, bodies))
@@ -361,31 +369,43 @@ mod tests {
         };
         assert_eq!(diagnose(&c, 1e-10), StallCause::SlowRecontact);
         assert_eq!(
-            diagnose(&StalledContact {
-                law: LawKind::KelvinVoigt,
-                ..c.clone()
-            }, 1e-10),
+            diagnose(
+                &StalledContact {
+                    law: LawKind::KelvinVoigt,
+                    ..c.clone()
+                },
+                1e-10
+            ),
             StallCause::Damping
         );
         assert_eq!(
-            diagnose(&StalledContact {
-                impact_rate: 0.5,
-                ..c
-            }, 1e-10),
+            diagnose(
+                &StalledContact {
+                    impact_rate: 0.5,
+                    ..c
+                },
+                1e-10
+            ),
             StallCause::Damping
         );
         assert_eq!(
-            diagnose(&StalledContact {
-                friction_dt: 1e-12,
-                ..contact()
-            }, 1e-10),
+            diagnose(
+                &StalledContact {
+                    friction_dt: 1e-12,
+                    ..contact()
+                },
+                1e-10
+            ),
             StallCause::Friction
         );
         assert_eq!(
-            diagnose(&StalledContact {
-                reachable_penetration: 7e-3,
-                ..contact()
-            }, 1e-10),
+            diagnose(
+                &StalledContact {
+                    reachable_penetration: 7e-3,
+                    ..contact()
+                },
+                1e-10
+            ),
             StallCause::Speed
         );
         let tiny = StalledContact {
@@ -401,20 +421,26 @@ mod tests {
         // Damping that needs steps below the floor is the cause even when friction's limit,
         // loaded by the damping force, is lower still.
         assert_eq!(
-            diagnose(&StalledContact {
-                law: LawKind::KelvinVoigt,
-                zeta: 1e7,
-                stable_dt: 4e-12,
-                friction_dt: 4e-15,
-                ..contact()
-            }, 1e-10),
+            diagnose(
+                &StalledContact {
+                    law: LawKind::KelvinVoigt,
+                    zeta: 1e7,
+                    stable_dt: 4e-12,
+                    friction_dt: 4e-15,
+                    ..contact()
+                },
+                1e-10
+            ),
             StallCause::Damping
         );
         assert_eq!(
-            diagnose(&StalledContact {
-                penetration: -1e-6,
-                ..contact()
-            }, 1e-10),
+            diagnose(
+                &StalledContact {
+                    penetration: -1e-6,
+                    ..contact()
+                },
+                1e-10
+            ),
             StallCause::NoContact
         );
     }

@@ -417,9 +417,7 @@ impl ClearanceSpec {
                          default {} um, 1 % of the journal radius",
                         sig4(geometry.journal_radius() * 1e6),
                         sig4(self.max_valid_penetration_um.unwrap_or(f64::NAN)),
-                        sig4(
-                            crate::rapier::joint::default_max_valid_penetration(&geometry) * 1e6
-                        )
+                        sig4(crate::rapier::joint::default_max_valid_penetration(&geometry) * 1e6)
                     ),
                 ),
                 other => other,

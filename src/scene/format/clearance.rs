@@ -39,7 +39,7 @@ pub struct ClearanceSpec {
     /// The deepest penetration at which the contact law is trusted, um: a deeper contact is a
     /// guard violation (default `None`: 1 % of the journal radius, see docs/MODEL.md
     /// "Validity").
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default)]
     pub max_valid_penetration_um: Option<f64>,
     /// What holds the out-of-plane degrees of freedom.
     #[serde(default)]

@@ -478,7 +478,7 @@ fn four_bar(
     .unwrap();
     (
         result.twin(TwinKind::Ideal).unwrap().table.clone(),
-        result.guards.violations.clone(),
+        result.guards.messages(),
     )
 }
 

@@ -281,10 +281,7 @@ impl Serialize for GuardReport {
                 .iter()
                 .map(|v| ViolationView {
                     kind: v.kind,
-                    joint: v
-                        .joint
-                        .as_deref()
-                        .filter(|_| v.kind != GuardKind::Other),
+                    joint: v.joint.as_deref().filter(|_| v.kind != GuardKind::Other),
                     twin: v.twin.as_deref(),
                     worst: v.worst,
                     limit: v.limit,
@@ -316,10 +313,19 @@ mod tests {
         g.record(pen(60e-6, 0.009));
         assert_eq!(g.violations.len(), 1);
         let v = &g.violations[0];
-        assert_eq!((v.worst, v.t_s, v.first_t_s, v.count), (325e-6, 0.004, 0.001, 3));
+        assert_eq!(
+            (v.worst, v.t_s, v.first_t_s, v.count),
+            (325e-6, 0.004, 0.001, 3)
+        );
         let m = v.message();
-        assert!(m.contains("325 um") && m.contains("6.5 times") && m.contains("3 states"), "{m}");
-        assert!(m.contains("t = 0.004 s") && m.contains("first at t = 0.001 s"), "{m}");
+        assert!(
+            m.contains("325 um") && m.contains("6.5 times") && m.contains("3 states"),
+            "{m}"
+        );
+        assert!(
+            m.contains("t = 0.004 s") && m.contains("first at t = 0.001 s"),
+            "{m}"
+        );
     }
 
     #[test]
@@ -334,7 +340,10 @@ mod tests {
         g.violation("mine", || "my own guard".into());
         g.violation("mine", || unreachable!("recorded once"));
         assert_eq!(g.violations.len(), 4);
-        assert_eq!(g.worst(GuardKind::Penetration).unwrap().joint.as_deref(), Some("other"));
+        assert_eq!(
+            g.worst(GuardKind::Penetration).unwrap().joint.as_deref(),
+            Some("other")
+        );
         assert_eq!(g.violations[3].count, 2);
         assert_eq!(g.messages()[3], "my own guard");
         let json = serde_json::to_value(&g).unwrap();

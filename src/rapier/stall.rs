@@ -12,8 +12,8 @@
 //! 6. a stiffness too high for the bodies' masses.
 
 use crate::error::sig4;
-use crate::model::laws::{LawKind, NormalContact, NormalForceLaw, penetration_for_energy};
 use crate::model::kinematics::stable_step;
+use crate::model::laws::{LawKind, NormalContact, NormalForceLaw, penetration_for_energy};
 use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle};
 use crate::rapier::ledger::world_center_of_mass;
 use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
@@ -151,10 +151,10 @@ impl StalledContact {
     /// The contact state in words.
     pub fn state(&self) -> String {
         format!(
-            "joint `{}` ({:?}): penetration {} um, rate {} m/s, delta_dot0 {} m/s, damping ratio \
+            "joint `{}` (handle {}): penetration {} um, rate {} m/s, delta_dot0 {} m/s, damping ratio \
              {}, stable step {} s (friction's {} s), effective mass {} kg",
             self.joint,
-            self.handle,
+            self.handle.0,
             sig4(self.penetration * 1e6),
             sig4(self.rate),
             sig4(self.impact_rate),
@@ -170,28 +170,36 @@ impl StalledContact {
 /// body whose inertia is out of proportion (a rotation too easy to excite).
 const TINY_MASS_FRACTION: f64 = 1e-3;
 
-/// The cause of a stall at contact `c`, from its numbers (see the module docs for the order).
-pub fn diagnose(c: &StalledContact) -> StallCause {
+/// The cause of a stall at contact `c` under the step floor `min_dt` (s), from its numbers (see
+/// the module docs for the order).
+pub fn diagnose(c: &StalledContact, min_dt: f64) -> StallCause {
     if !(c.penetration > 0.0) {
         return StallCause::NoContact;
     }
-    let lightest = c.bodies.iter().map(|b| b.mass).fold(f64::INFINITY, f64::min);
+    let lightest = c
+        .bodies
+        .iter()
+        .map(|b| b.mass)
+        .fold(f64::INFINITY, f64::min);
     if c.effective_mass < TINY_MASS_FRACTION * lightest
         && let Some(b) = c
             .bodies
             .iter()
             .filter(|b| b.rotational_inverse_mass > 1.0 / b.mass)
-            .max_by(|a, b| a.rotational_inverse_mass.total_cmp(&b.rotational_inverse_mass))
+            .max_by(|a, b| {
+                a.rotational_inverse_mass
+                    .total_cmp(&b.rotational_inverse_mass)
+            })
     {
         return StallCause::TinyInertia(*b);
     }
     if c.reachable_penetration > c.max_valid_penetration {
         return StallCause::Speed;
     }
-    if c.friction_dt < c.stable_dt {
-        return StallCause::Friction;
-    }
-    if c.zeta > 1.0 {
+    // Damping that alone needs steps below the floor comes first: its force also loads
+    // friction, whose limit then falls with it.
+    let damped = c.zeta > 1.0;
+    if damped && (c.stable_dt < min_dt || c.friction_dt >= c.stable_dt) {
         let hysteresis = matches!(
             c.law,
             LawKind::HuntCrossley
@@ -203,6 +211,9 @@ pub fn diagnose(c: &StalledContact) -> StallCause {
             return StallCause::SlowRecontact;
         }
         return StallCause::Damping;
+    }
+    if c.friction_dt < c.stable_dt {
+        return StallCause::Friction;
     }
     StallCause::Stiffness
 }
@@ -218,7 +229,7 @@ pub fn explain(seen: &str, contact: Option<&StalledContact>, min_dt: f64) -> Str
             sig4(min_dt)
         );
     };
-    let cause = match diagnose(c) {
+    let cause = match diagnose(c, min_dt) {
         StallCause::NoContact => format!(
             "no contact law explains it (the joint is not in contact: a body moved by hand or by \
              a kinematic position target, which any step reaches at once, or a step floor \
@@ -310,7 +321,8 @@ pub fn stalled_contact<'a>(
         .flat_map(|s| s.iter())
         .filter(|(_, j)| j.report().state.penetration > 0.0)
         .min_by(|(_, a), (_, b)| {
-            let limit = |j: &ClearanceJoint| j.report().max_stable_dt.min(j.report().friction_stable_dt);
+            let limit =
+                |j: &ClearanceJoint| j.report().max_stable_dt.min(j.report().friction_stable_dt);
             limit(a).total_cmp(&limit(b))
         })
         .map(|(h, j)| StalledContact::of(h, j, bodies))
@@ -349,39 +361,51 @@ mod tests {
 
     #[test]
     fn each_cause_from_its_numbers() {
-        assert_eq!(diagnose(&contact()), StallCause::Stiffness);
+        assert_eq!(diagnose(&contact(), 1e-10), StallCause::Stiffness);
         let c = StalledContact {
             zeta: 50.0,
             impact_rate: 1e-4,
             ..contact()
         };
-        assert_eq!(diagnose(&c), StallCause::SlowRecontact);
+        assert_eq!(diagnose(&c, 1e-10), StallCause::SlowRecontact);
         assert_eq!(
-            diagnose(&StalledContact {
-                law: LawKind::KelvinVoigt,
-                ..c.clone()
-            }),
+            diagnose(
+                &StalledContact {
+                    law: LawKind::KelvinVoigt,
+                    ..c.clone()
+                },
+                1e-10
+            ),
             StallCause::Damping
         );
         assert_eq!(
-            diagnose(&StalledContact {
-                impact_rate: 0.5,
-                ..c
-            }),
+            diagnose(
+                &StalledContact {
+                    impact_rate: 0.5,
+                    ..c
+                },
+                1e-10
+            ),
             StallCause::Damping
         );
         assert_eq!(
-            diagnose(&StalledContact {
-                friction_dt: 1e-12,
-                ..contact()
-            }),
+            diagnose(
+                &StalledContact {
+                    friction_dt: 1e-12,
+                    ..contact()
+                },
+                1e-10
+            ),
             StallCause::Friction
         );
         assert_eq!(
-            diagnose(&StalledContact {
-                reachable_penetration: 7e-3,
-                ..contact()
-            }),
+            diagnose(
+                &StalledContact {
+                    reachable_penetration: 7e-3,
+                    ..contact()
+                },
+                1e-10
+            ),
             StallCause::Speed
         );
         let tiny = StalledContact {
@@ -393,12 +417,30 @@ mod tests {
             }],
             ..contact()
         };
-        assert!(matches!(diagnose(&tiny), StallCause::TinyInertia(b) if b.inertia == 1e-12));
+        assert!(matches!(diagnose(&tiny, 1e-10), StallCause::TinyInertia(b) if b.inertia == 1e-12));
+        // Damping that needs steps below the floor is the cause even when friction's limit,
+        // loaded by the damping force, is lower still.
         assert_eq!(
-            diagnose(&StalledContact {
-                penetration: -1e-6,
-                ..contact()
-            }),
+            diagnose(
+                &StalledContact {
+                    law: LawKind::KelvinVoigt,
+                    zeta: 1e7,
+                    stable_dt: 4e-12,
+                    friction_dt: 4e-15,
+                    ..contact()
+                },
+                1e-10
+            ),
+            StallCause::Damping
+        );
+        assert_eq!(
+            diagnose(
+                &StalledContact {
+                    penetration: -1e-6,
+                    ..contact()
+                },
+                1e-10
+            ),
             StallCause::NoContact
         );
     }

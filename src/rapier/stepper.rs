@@ -581,8 +581,9 @@ impl Stepper {
                             world,
                             sources,
                             &format!(
-                                "the step was rejected {rejected} times down to {} s: no step \
+                                "the step was rejected {rejected} time{} down to {} s: no step \
                                  resolves the contact",
+                                if rejected == 1 { "" } else { "s" },
                                 crate::error::sig4(dt)
                             ),
                         )

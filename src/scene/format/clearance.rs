@@ -39,7 +39,7 @@ pub struct ClearanceSpec {
     /// The deepest penetration at which the contact law is trusted, um: a deeper contact is a
     /// guard violation (default `None`: 1 % of the journal radius, see docs/MODEL.md
     /// "Validity").
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[serde(default)]
     pub max_valid_penetration_um: Option<f64>,
     /// What holds the out-of-plane degrees of freedom.
     #[serde(default)]
@@ -417,9 +417,7 @@ impl ClearanceSpec {
                          default {} um, 1 % of the journal radius",
                         sig4(geometry.journal_radius() * 1e6),
                         sig4(self.max_valid_penetration_um.unwrap_or(f64::NAN)),
-                        sig4(
-                            crate::rapier::joint::default_max_valid_penetration(&geometry) * 1e6
-                        )
+                        sig4(crate::rapier::joint::default_max_valid_penetration(&geometry) * 1e6)
                     ),
                 ),
                 other => other,

@@ -311,7 +311,7 @@ impl Simulation {
             let mut sources = sources(&mut self.twins);
             self.stepper
                 .step(&mut self.world, &mut sources, target)
-                .map_err(|e| name_step_field(e, "run.dt_s"))?
+                .map_err(|e| name_bodies(name_step_field(e, "run.dt_s"), &self.twins))?
         };
         for twin in &mut self.twins {
             twin.after_step(
@@ -386,6 +386,24 @@ fn sources(twins: &mut [Twin]) -> Vec<&mut dyn ForceSource> {
         }
     }
     v
+}
+
+/// Names the scene's bodies in a stall's message (the stepper knows only Rapier handles).
+fn name_bodies(mut e: crate::Error, twins: &[Twin]) -> crate::Error {
+    if let crate::Error::Stalled { reason, .. } = &mut e {
+        for twin in twins {
+            for b in &twin.bodies {
+                let handle = format!("body {:?}", b.handle.into_raw_parts());
+                if reason.contains(&handle) {
+                    *reason = reason.replace(
+                        &handle,
+                        &format!("body `{}` (of the {} twin)", b.name, twin.kind.name()),
+                    );
+                }
+            }
+        }
+    }
+    e
 }
 
 /// Names the scene's step field in a step-limit error (the stepper knows only `dt`).

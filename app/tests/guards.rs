@@ -1,0 +1,149 @@
+//! The command line and the run-time guards: a stalled run writes what it computed, marked
+//! incomplete, and fails; a violated guard is printed with its worst value and, under
+//! `--strict`, fails the command.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
+}
+
+fn temp(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("cj-guards-{name}-{}", std::process::id()))
+}
+
+/// The paper's scene with `from` replaced by `to`, written to a file in `dir`.
+fn scene_file(dir: &Path, asset: &str, from: &str, to: &str) -> PathBuf {
+    let text = std::fs::read_to_string(format!("{}/../assets/{asset}", env!("CARGO_MANIFEST_DIR")))
+        .unwrap();
+    assert!(text.contains(from));
+    std::fs::create_dir_all(dir).unwrap();
+    let path = dir.join(asset);
+    std::fs::write(&path, text.replacen(from, to, 1)).unwrap();
+    path
+}
+
+fn text(out: &Output) -> (String, String) {
+    (
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+#[test]
+fn a_stalled_run_writes_an_incomplete_set_and_fails() {
+    let dir = temp("stall");
+    let scene = scene_file(
+        &dir,
+        "solar_panel.ron",
+        "contact: ImprovedLiu(exponent: 1.0, delta_max_mm: 0.1, eta_s: 0.01),",
+        "contact: KelvinVoigt(stiffness: 1e9, damping: 1e12),",
+    );
+    let out_dir = dir.join("out");
+    let out = bin()
+        .arg("--scene")
+        .arg(&scene)
+        .args([
+            "--end",
+            "0.3",
+            "--no-figures",
+            "--progress",
+            "quiet",
+            "--out",
+        ])
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    let (stdout, stderr) = text(&out);
+    assert!(!out.status.success(), "{stdout}{stderr}");
+    assert!(
+        stderr.contains("stalled") && stderr.contains("over-damped"),
+        "{stderr}"
+    );
+    assert!(
+        stdout.contains("INCOMPLETE: the run stopped at t = "),
+        "{stdout}"
+    );
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
+            .unwrap();
+    assert_eq!(summary["complete"], false);
+    assert!(summary["error"].as_str().unwrap().contains("stalled"));
+    let reached = summary["reached_s"].as_f64().unwrap();
+    assert!(reached > 0.05 && reached < 0.3, "{reached}");
+    // Each table runs up to the stall, not beyond, and holds no non-finite number.
+    for twin in ["ideal", "clearance"] {
+        let csv = std::fs::read_to_string(out_dir.join(format!("{twin}.csv"))).unwrap();
+        let last: f64 = csv
+            .lines()
+            .last()
+            .unwrap()
+            .split(',')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap();
+        assert!(
+            last <= reached && last > reached - 2e-4,
+            "{last} vs {reached}"
+        );
+        assert!(!csv.contains("NaN") && !csv.contains("inf"));
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn the_console_shows_the_worst_violation_and_strict_fails() {
+    // The pendulum at its fixed 2e-5 s step: friction's limit near zero slip is far shorter.
+    let pendulum = format!("{}/../assets/pendulum.ron", env!("CARGO_MANIFEST_DIR"));
+    let dir = temp("worst");
+    let out = bin()
+        .args([
+            "--scene",
+            &pendulum,
+            "--end",
+            "0.1",
+            "--no-figures",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stdout}{stderr}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    let v = &summary["guards"]["violations"][0];
+    assert_eq!(v["kind"], "friction");
+    assert_eq!(v["joint"], "pivot");
+    let (worst, count) = (v["worst"].as_f64().unwrap(), v["count"].as_u64().unwrap());
+    assert!(worst > 1.0 && count > 1, "{v}");
+    assert!(
+        stdout.contains(&format!(
+            "worst {} times it at t = ",
+            clearance_joint::error::sig4(worst)
+        )) && stdout.contains(&format!("{count} states")),
+        "{stdout}"
+    );
+    let out = bin()
+        .args([
+            "--scene",
+            &pendulum,
+            "--end",
+            "0.1",
+            "--no-figures",
+            "--strict",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let (stdout, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1), "{stdout}{stderr}");
+    assert!(
+        stderr.contains("guard violated (strict)") && stderr.contains("joint `pivot`"),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).ok();
+}

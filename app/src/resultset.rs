@@ -101,7 +101,9 @@ impl ResultSet {
                 format!("`{}` exists and is not a folder", target.display()),
             ));
         }
+        std::fs::create_dir_all(&parent).map_err(io("cannot create the output folder", target))?;
         let lock = DirLock::acquire_named(&parent, &format!(".{name}.lock"))?;
+        clean_stale_temps(target);
         let stage = parent.join(format!(".{name}.new-{}", std::process::id()));
         let keep: Vec<String> = keep.iter().map(|k| k.to_string()).collect();
         // Leftovers of runs killed mid-way: we hold the lock, so nobody else is writing them.

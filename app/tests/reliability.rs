@@ -758,7 +758,11 @@ fn concurrent_runs_and_interrupts() {
         .stdout(Stdio::null())
         .spawn()
         .unwrap();
-    let lock = dir.join(".lock");
+    // The claim is beside the folder: it outlives the renames that put the set in place.
+    let lock = dir.with_file_name(format!(
+        ".{}.lock",
+        dir.file_name().unwrap().to_string_lossy()
+    ));
     let start = Instant::now();
     // The lock is taken when the file holds the owner's pid.
     while std::fs::read_to_string(&lock).unwrap_or_default() != first.id().to_string() {
@@ -786,6 +790,11 @@ fn concurrent_runs_and_interrupts() {
     let status = first.wait().unwrap();
     assert_eq!(status.code(), Some(130));
     assert!(files_in(&dir).is_empty(), "left {:?}", files_in(&dir));
+    assert!(
+        !lock.exists() && stages(&dir).is_empty(),
+        "{:?}",
+        stages(&dir)
+    );
     // The folder is free again.
     let o = bin()
         .args(["--end", "0.01", "--no-figures", "--out"])
@@ -1170,5 +1179,46 @@ fn killed_reruns_leave_no_mixed_sets() {
         old_run.into_iter().map(|m| m.0).collect::<Vec<_>>(),
         "the new set has the old one's members"
     );
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// Issue 17, item 9: `study --strict` fails a case that leaves the model's validity (as `run`
+/// and `sweep` do): exit 1, the failure in the table, no report; without it the study passes
+/// with the warning.
+#[test]
+fn study_strict_fails_on_a_guard() {
+    let root = scratch("study-strict");
+    let study = |strict: bool| {
+        let mut cmd = bin();
+        cmd.args(["study", "clearance", "--no-figures", "--progress", "quiet"])
+            .args([
+                "--set",
+                "drive.stiffness_nm_per_deg=1e6",
+                "--set",
+                "run.end_s=0.05",
+            ])
+            .arg("--out")
+            .arg(&root);
+        if strict {
+            cmd.arg("--strict");
+        }
+        cmd.output().unwrap()
+    };
+    let o = study(false);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(root.join("clearance/report.md").exists());
+    let o = study(true);
+    let e = stderr(&o);
+    assert!(!o.status.success(), "--strict passed: {e}");
+    assert!(
+        e.contains("guard violated (strict)") && e.contains("gained energy"),
+        "{e}"
+    );
+    assert!(
+        !root.join("clearance/report.md").exists(),
+        "a report for a failed study"
+    );
+    let table = std::fs::read_to_string(root.join("clearance/metrics.json")).unwrap();
+    assert!(table.contains("guard violated (strict)"), "{table}");
     let _ = std::fs::remove_dir_all(&root);
 }

@@ -315,12 +315,12 @@ impl BinExtremes {
         } else {
             let at = self.rows.len();
             let mut wins = false;
-            for k in 0..self.columns {
-                if row[k] < self.rows[self.lo[k]].1[k] {
+            for (k, &x) in row.iter().enumerate() {
+                if x < self.rows[self.lo[k]].1[k] {
                     self.lo[k] = at;
                     wins = true;
                 }
-                if row[k] > self.rows[self.hi[k]].1[k] {
+                if x > self.rows[self.hi[k]].1[k] {
                     self.hi[k] = at;
                     wins = true;
                 }

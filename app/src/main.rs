@@ -5,7 +5,7 @@ use clap::{Args, Parser, Subcommand};
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::report::comparison_table;
 use clearance_joint_app::cli::{self, merge::Merged, run::SceneRun, sweep::SweepJob};
-use clearance_joint_app::figures::run::draw_run_figures;
+use clearance_joint_app::figures::run::{can_draw, draw_run_figures};
 use clearance_joint_app::progress::RunProgress;
 use clearance_joint_app::study::report::Verdict;
 use clearance_joint_app::study::sweep::{ExecOptions, MetricsTable, Progress};
@@ -41,8 +41,8 @@ enum Command {
 #[derive(Args, Debug, Clone, Default)]
 struct ExecArgs {
     /// Worker threads; default one per core (or RAYON_NUM_THREADS), at most one per core.
-    #[arg(long)]
-    jobs: Option<usize>,
+    #[arg(long, allow_hyphen_values = true)]
+    jobs: Option<i64>,
     #[command(flatten)]
     memory: MemoryArgs,
     /// Recompute every point, even those finished by an earlier run.
@@ -57,7 +57,7 @@ impl ExecArgs {
     /// The options (saying so when the thread count was capped at the cores).
     fn options(&self) -> clearance_joint::Result<ExecOptions> {
         let (options, note) = cli::exec_options(
-            self.jobs,
+            cli::jobs(self.jobs)?,
             progress_mode(&self.progress),
             self.rerun,
             self.memory.max_memory.as_deref(),
@@ -83,7 +83,7 @@ fn progress_mode(name: &str) -> Progress {
 struct MemoryArgs {
     /// Memory the runs may hold (e.g. 4G, 512M, 2GiB); default 80 % of what the system has
     /// available. A run that would need more is refused before it starts.
-    #[arg(long, value_name = "SIZE")]
+    #[arg(long, value_name = "SIZE", allow_hyphen_values = true)]
     max_memory: Option<String>,
 }
 
@@ -136,6 +136,11 @@ struct StudyArgs {
     /// Skip the figures.
     #[arg(long)]
     no_figures: bool,
+    /// Fail (exit code 1) when a case leaves the model's validity (a run-time guard; same as
+    /// `--set run.strict=true`): the case fails and the study writes no report. Without it
+    /// they are warnings in each case's `summary.json` and in the metrics table.
+    #[arg(long)]
+    strict: bool,
     #[command(flatten)]
     exec: ExecArgs,
 }
@@ -241,6 +246,17 @@ fn warn(scene: &Scene) {
 fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     let scene = args.scene()?;
     warn(&scene);
+    // Whether the figures can be drawn is known before the run.
+    let figures = match can_draw(&scene) {
+        Ok(()) => !args.no_figures,
+        Err(e) if args.figures => return Err(e),
+        Err(e) => {
+            if !args.no_figures {
+                eprintln!("no figures: {e}");
+            }
+            false
+        }
+    };
     let out = args
         .out
         .clone()
@@ -257,23 +273,27 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     let result = job.execute(|p| progress.update(p));
     progress.finish();
     let mut result = result?;
-    let summary = result.write(&job.out)?;
+    // The whole set (tables, summary, figures) goes to the staging folder, then into place.
+    let summary = result.write(job.set.dir())?;
+    let mut drawn = Vec::new();
+    if figures {
+        // A figure that cannot be written fails the command; the old set stays whole.
+        draw_run_figures(scene, &result, job.set.dir(), |p| {
+            drawn.push(job.set.final_path(p))
+        })?;
+    }
+    let files = job.files(&result);
+    let out = job.commit()?;
     println!("{}", comparison_table(&summary));
     println!(
         "{} steps in {:.2} s wall; wrote {}/{{{}}}",
         result.steps,
         result.wall_s,
-        job.out.display(),
-        job.files(&result).join(", ")
+        out.display(),
+        files.join(", ")
     );
-    if !args.no_figures {
-        let drawn = draw_run_figures(scene, &result, &job.out, |p| {
-            println!("wrote {}", p.display())
-        });
-        match drawn {
-            Err(e) if !args.figures => eprintln!("no figures: {e}"),
-            other => other?,
-        }
+    for p in drawn {
+        println!("wrote {}", p.display());
     }
     // A stalled run: its set is written (marked incomplete) and the command fails.
     match result.stopped.take() {
@@ -352,7 +372,12 @@ fn study(args: &StudyArgs) -> clearance_joint::Result<()> {
         .unwrap_or_else(|| PathBuf::from("out/studies"));
     let options = StudyOptions {
         exec: args.exec.options()?,
-        extra_overrides: args.overrides.clone(),
+        extra_overrides: args
+            .overrides
+            .iter()
+            .cloned()
+            .chain(args.strict.then(|| "run.strict=true".to_string()))
+            .collect(),
         no_figures: args.no_figures,
     };
     let start = Instant::now();
@@ -407,9 +432,10 @@ fn merge(args: &MergeArgs) -> clearance_joint::Result<()> {
 
 fn main() -> ExitCode {
     // Ctrl-C (or a kill with SIGTERM/SIGHUP): remove our temporaries and lock files, then exit.
-    // A set being renamed into place is finished first; finished points of a sweep stay.
+    // A set being renamed into place is finished first; finished points of a sweep or study stay.
     if let Err(e) = ctrlc::set_handler(|| {
         clearance_joint::scene::output::remove_inflight();
+        clearance_joint_app::resultset::abandon_all();
         eprintln!("\ninterrupted: temporary files removed");
         std::process::exit(130);
     }) {

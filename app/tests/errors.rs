@@ -232,3 +232,37 @@ fn unlocked_out_of_plane_motion_in_a_scene() {
     let e = override_err(&["hinge.lock=None"]);
     assert!(e.contains("hinges[hinge].clearance.lock"), "{e}");
 }
+
+/// Issue 17, item 8: `merge` of two sweeps that differ only in `--end` says which setting
+/// differs, not two identical dumps of the axes.
+#[test]
+fn merge_names_the_setting_that_differs() {
+    let dir = std::env::temp_dir().join(format!("cj-merge-diff-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    for (shard, end) in [("0/2", "0.01"), ("1/2", "0.02")] {
+        let o = bin()
+            .args([
+                "sweep",
+                "--set",
+                "hinge.clearance_mm=0.25,0.5",
+                "--end",
+                end,
+            ])
+            .args(["--shard", shard, "--progress", "quiet", "--out"])
+            .arg(&dir)
+            .output()
+            .unwrap();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let o = bin().arg("merge").arg(&dir).output().unwrap();
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success());
+    assert!(
+        e.contains("fixed settings")
+            && e.contains("run.end_s=1e-2")
+            && e.contains("run.end_s=2e-2"),
+        "{e}"
+    );
+    assert!(!e.contains("Axis {"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

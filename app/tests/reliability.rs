@@ -547,6 +547,61 @@ fn bad_command_lines() {
             "--jobs",
             "at least 1",
         ),
+        // Issue 17, item 8: negative numbers reach our checks, not clap's "unexpected argument".
+        (
+            vec!["sweep", "--jobs", "-1", "--set", "hinge.clearance_mm=0.1"],
+            "--jobs",
+            "at least 1 (got -1)",
+        ),
+        (vec!["--max-memory", "-1G"], "--max-memory", "positive size"),
+        // Item 5: two axes naming one field by different paths.
+        (
+            vec![
+                "sweep",
+                "--set",
+                "hinge.clearance_mm=0.1,0.2",
+                "--set",
+                "hinges[hinge].clearance.clearance_mm=0.3,0.4",
+            ],
+            "names the same field as axis `hinge.clearance_mm`",
+            "hinges[hinge].clearance.clearance_mm",
+        ),
+        // Item 2: a value given twice in one axis (as the scene reads it).
+        (
+            vec!["sweep", "--set", "hinge.clearance_mm=0.1,0.2,0.10"],
+            "sweep axis `hinge.clearance_mm`",
+            "twice",
+        ),
+        // Item 8: the override that breaks the scene is named, not every override with it.
+        (
+            vec!["--set", "hinge.friction=Bogus", "--end", "0.1"],
+            "override `hinge.friction=Bogus`",
+            "Bogus",
+        ),
+        // Item 8: a study whose settings make its hinge ideal is refused before it runs.
+        (
+            vec![
+                "study",
+                "torque",
+                "--set",
+                "hinge.clearance=null",
+                "--no-figures",
+            ],
+            "study torque",
+            "without clearance",
+        ),
+        // Item 8: `--figures` on a scene without a clearance hinge, before the run.
+        (
+            vec![
+                "--set",
+                "hinge.clearance=null",
+                "--figures",
+                "--end",
+                "0.01",
+            ],
+            "--figures",
+            "no hinge with clearance",
+        ),
     ];
     for (args, field, word) in &table {
         let mut cmd = bin();
@@ -559,6 +614,10 @@ fn bad_command_lines() {
         let e = stderr(&o);
         assert!(!o.status.success(), "{args:?} accepted");
         assert!(e.contains(field) && e.contains(word), "{args:?}: {e}");
+        assert!(
+            !e.contains("run.end_s=1e-1"),
+            "{args:?} lists every override: {e}"
+        );
         assert!(
             !e.contains("panicked") && !e.contains("running `"),
             "{args:?}: {e}"
@@ -699,7 +758,11 @@ fn concurrent_runs_and_interrupts() {
         .stdout(Stdio::null())
         .spawn()
         .unwrap();
-    let lock = dir.join(".lock");
+    // The claim is beside the folder: it outlives the renames that put the set in place.
+    let lock = dir.with_file_name(format!(
+        ".{}.lock",
+        dir.file_name().unwrap().to_string_lossy()
+    ));
     let start = Instant::now();
     // The lock is taken when the file holds the owner's pid.
     while std::fs::read_to_string(&lock).unwrap_or_default() != first.id().to_string() {
@@ -727,6 +790,11 @@ fn concurrent_runs_and_interrupts() {
     let status = first.wait().unwrap();
     assert_eq!(status.code(), Some(130));
     assert!(files_in(&dir).is_empty(), "left {:?}", files_in(&dir));
+    assert!(
+        !lock.exists() && stages(&dir).is_empty(),
+        "{:?}",
+        stages(&dir)
+    );
     // The folder is free again.
     let o = bin()
         .args(["--end", "0.01", "--no-figures", "--out"])
@@ -924,5 +992,248 @@ fn short_studies_give_no_verdict() {
             && e.contains("Clearance(hinge: \"pivot\")"),
         "{e}"
     );
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// Files of `dir` (recursively, `points` left out) with their modification times.
+fn members(dir: &Path) -> Vec<(String, std::time::SystemTime)> {
+    let mut v: Vec<(String, std::time::SystemTime)> = std::fs::read_dir(dir)
+        .map(|rd| {
+            rd.filter_map(|e| e.ok())
+                .filter(|e| e.file_name() != "points")
+                .filter_map(|e| {
+                    let m = e.metadata().ok()?;
+                    Some((
+                        e.file_name().to_string_lossy().into_owned(),
+                        m.modified().ok()?,
+                    ))
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+/// The latest modification time of any file below `dir`.
+fn newest(dir: &Path) -> std::time::SystemTime {
+    let mut latest = std::time::SystemTime::UNIX_EPOCH;
+    for e in std::fs::read_dir(dir).into_iter().flatten().flatten() {
+        let t = if e.file_type().is_ok_and(|t| t.is_dir()) {
+            newest(&e.path())
+        } else {
+            e.metadata().and_then(|m| m.modified()).unwrap_or(latest)
+        };
+        latest = latest.max(t);
+    }
+    latest
+}
+
+/// Leftover staging folders (`.<name>.new-*`, `.<name>.old-*`) beside `dir`.
+fn stages(dir: &Path) -> Vec<String> {
+    let name = dir.file_name().unwrap().to_string_lossy().into_owned();
+    files_in(dir.parent().unwrap())
+        .into_iter()
+        .filter(|f| {
+            f.starts_with(&format!(".{name}.new-")) || f.starts_with(&format!(".{name}.old-"))
+        })
+        .collect()
+}
+
+/// Asserts that the set in `dir` is one unit: every member older than `rerun` (the old set
+/// whole) or every member newer (the new set whole).
+fn assert_one_set(dir: &Path, rerun: std::time::SystemTime, what: &str) {
+    let m = members(dir);
+    let old = m.iter().filter(|(_, t)| *t < rerun).count();
+    assert!(
+        old == 0 || old == m.len(),
+        "{what}: mixed set, {old} of {} members older than the rerun: {m:?}",
+        m.len()
+    );
+}
+
+/// Issue 17, item 4: kill -9 during a rerun with different physics into a folder holding a
+/// complete set, at several moments: the folder holds the old set whole or the new set whole,
+/// never a mix; a study's finished points are kept and reused; and the next run completes.
+#[test]
+fn killed_reruns_leave_no_mixed_sets() {
+    let root = scratch("kill-rerun");
+    let run_dir = root.join("run");
+    let study_root = root.join("studies");
+    let study_dir = study_root.join("clearance");
+    let sweep_dir = root.join("sweep");
+    let run_args = |c: &str, end: &str| -> Vec<String> {
+        [
+            "--set",
+            &format!("hinge.clearance_mm={c}"),
+            "--end",
+            end,
+            "--progress",
+            "quiet",
+            "--out",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .chain([run_dir.to_string_lossy().into_owned()])
+        .collect()
+    };
+    let study_args = |c: &str| -> Vec<String> {
+        [
+            "study",
+            "clearance",
+            "--set",
+            "run.end_s=0.3",
+            "--set",
+            &format!("hinge.eta_s={c}"),
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .chain([
+            "--progress".into(),
+            "quiet".into(),
+            "--jobs".into(),
+            "1".into(),
+        ])
+        .chain(["--out".into(), study_root.to_string_lossy().into_owned()])
+        .collect()
+    };
+    let sweep_args = |end: &str| -> Vec<String> {
+        [
+            "sweep",
+            "--set",
+            "hinge.clearance_mm=0.1,0.25,0.5",
+            "--end",
+            end,
+            "--jobs",
+            "1",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .chain(["--progress".into(), "quiet".into(), "--out".into()])
+        .chain([sweep_dir.to_string_lossy().into_owned()])
+        .collect()
+    };
+    let complete = |args: Vec<String>| {
+        let o = bin().args(&args).output().unwrap();
+        assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    };
+    complete(run_args("0.5", "0.05"));
+    complete(study_args("0.01"));
+    complete(sweep_args("0.02"));
+    let old_run = members(&run_dir);
+    assert!(
+        old_run.iter().any(|(n, _)| n.ends_with(".png")),
+        "{old_run:?}"
+    );
+    assert!(study_dir.join("report.md").exists());
+    let delays = [50u64, 300, 700, 1200, 2000];
+    for (trial, &delay) in delays.iter().enumerate() {
+        std::thread::sleep(Duration::from_millis(20));
+        let start = std::time::SystemTime::now();
+        std::thread::sleep(Duration::from_millis(20));
+        let end = format!("{}", 0.1 + 0.05 * trial as f64);
+        for (what, args, dir) in [
+            ("run", run_args("0.3", &end), &run_dir),
+            (
+                "study",
+                study_args(&format!("0.0{}", trial + 2)),
+                &study_dir,
+            ),
+            (
+                "sweep",
+                sweep_args(&format!("0.0{}", trial + 3)),
+                &sweep_dir,
+            ),
+        ] {
+            let mut child = bin()
+                .args(&args)
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .spawn()
+                .unwrap();
+            std::thread::sleep(Duration::from_millis(delay));
+            let _ = child.kill();
+            let _ = child.wait();
+            if what == "sweep" {
+                // A sweep's points are finished or not one by one; its table is the set.
+                let points_changed = newest(&dir.join("points")) > start;
+                for stem in ["metrics.csv", "metrics.json"] {
+                    if let Ok(m) = std::fs::metadata(dir.join(stem)) {
+                        assert!(
+                            m.modified().unwrap() > start || !points_changed,
+                            "sweep, {delay} ms: the old {stem} beside new points"
+                        );
+                    }
+                }
+            } else {
+                assert_one_set(dir, start, &format!("{what} killed after {delay} ms"));
+            }
+        }
+    }
+    // The next runs complete, reuse the study's finished points, and leave no staging folder.
+    complete(run_args("0.3", "0.05"));
+    let o = bin().args(study_args("0.02")).output().unwrap();
+    assert!(o.status.success(), "{}", stderr(&o));
+    complete(sweep_args("0.03"));
+    let o = bin().args(study_args("0.02")).output().unwrap();
+    assert!(
+        String::from_utf8_lossy(&o.stdout)
+            .matches("[reused]")
+            .count()
+            == 3,
+        "{}",
+        String::from_utf8_lossy(&o.stdout)
+    );
+    for dir in [&run_dir, &study_dir, &sweep_dir] {
+        assert!(stages(dir).is_empty(), "{:?}", stages(dir));
+    }
+    assert!(study_dir.join("report.md").exists() && sweep_dir.join("metrics.csv").exists());
+    let names: Vec<String> = members(&run_dir).into_iter().map(|m| m.0).collect();
+    assert_eq!(
+        names,
+        old_run.into_iter().map(|m| m.0).collect::<Vec<_>>(),
+        "the new set has the old one's members"
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// Issue 17, item 9: `study --strict` fails a case that leaves the model's validity (as `run`
+/// and `sweep` do): exit 1, the failure in the table, no report; without it the study passes
+/// with the warning.
+#[test]
+fn study_strict_fails_on_a_guard() {
+    let root = scratch("study-strict");
+    let study = |strict: bool| {
+        let mut cmd = bin();
+        cmd.args(["study", "clearance", "--no-figures", "--progress", "quiet"])
+            .args([
+                "--set",
+                "drive.stiffness_nm_per_deg=1e6",
+                "--set",
+                "run.end_s=0.05",
+            ])
+            .arg("--out")
+            .arg(&root);
+        if strict {
+            cmd.arg("--strict");
+        }
+        cmd.output().unwrap()
+    };
+    let o = study(false);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(root.join("clearance/report.md").exists());
+    let o = study(true);
+    let e = stderr(&o);
+    assert!(!o.status.success(), "--strict passed: {e}");
+    assert!(
+        e.contains("guard violated (strict)") && e.contains("gained energy"),
+        "{e}"
+    );
+    assert!(
+        !root.join("clearance/report.md").exists(),
+        "a report for a failed study"
+    );
+    let table = std::fs::read_to_string(root.join("clearance/metrics.json")).unwrap();
+    assert!(table.contains("guard violated (strict)"), "{table}");
     let _ = std::fs::remove_dir_all(&root);
 }

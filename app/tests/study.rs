@@ -67,7 +67,7 @@ fn grid_expands_in_nested_loop_order_with_unique_stable_folders() {
     ])
     .unwrap();
     assert_eq!(grid.len(), 6);
-    let points = grid.points();
+    let points: Vec<_> = grid.points().collect();
     let seen: Vec<(String, String)> = points
         .iter()
         .map(|p| (p.assignments[0].1.clone(), p.assignments[1].1.clone()))
@@ -97,7 +97,11 @@ fn grid_expands_in_nested_loop_order_with_unique_stable_folders() {
     );
     let dirs: BTreeSet<&str> = points.iter().map(|p| p.dir.as_str()).collect();
     assert_eq!(dirs.len(), 6, "folder names are unique");
-    assert_eq!(grid.points(), points, "expansion is deterministic");
+    assert_eq!(
+        grid.points().collect::<Vec<_>>(),
+        points,
+        "expansion is deterministic"
+    );
     assert_eq!(Grid::default().len(), 1, "no axis: the base scene alone");
 }
 
@@ -116,6 +120,7 @@ fn shards_cover_every_point_exactly_once() {
                 assert!(shard.contains(p.index));
                 count[p.index] += 1;
             }
+            assert_eq!(shard.len(&grid), shard.points(&grid).count());
         }
         assert!(count.iter().all(|&c| c == 1), "n = {n}: {count:?}");
     }
@@ -660,6 +665,200 @@ fn a_field_study_varies_any_path() {
         report.starts_with("# mass study: Influence of `arm.mass_kg`")
             && report.contains("| arm.mass_kg = 1 |")
             && report.contains("this preset is not one of them"),
+        "{report}"
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// Issue 17, item 2: a grid too large for the memory budget is refused before any point is
+/// built, with the numbers. Four axes of 100 values (1e8 points) would take GBs if the points
+/// were built; under a 64 MB budget the refusal returns at once and nothing is written.
+#[test]
+fn a_huge_grid_is_refused_without_allocating() {
+    let values: Vec<String> = (1..=100).map(|i| format!("{}", i as f64 * 1e-3)).collect();
+    let axes = vec![
+        Axis::new("hinge.clearance_mm", values.clone()),
+        Axis::new("hinge.eta_s", values.clone()),
+        Axis::new("drive.torque_scale", values.iter().map(|v| format!("1{v}"))),
+        Axis::new("run.end_s", values.clone()),
+    ];
+    let sweep = Sweep::new(
+        "huge",
+        Scene::solar_panel(),
+        vec![],
+        Grid::new(axes).unwrap(),
+    );
+    assert_eq!(sweep.grid.len(), 100_000_000);
+    let out = scratch("huge");
+    let e = sweep
+        .run(
+            &out,
+            Shard::ALL,
+            ExecOptions {
+                max_memory: Some(64 << 20),
+                ..quiet()
+            },
+        )
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("sweep grid")
+            && e.contains("100000000 points")
+            && e.contains("--shard")
+            && e.contains("budget"),
+        "{e}"
+    );
+    assert!(!out.join("points").exists(), "nothing ran");
+    // A value given twice (as the scene reads it) is refused.
+    let e = Grid::new(vec![Axis::new(
+        "hinge.clearance_mm",
+        ["0.1", "0.25", "0.10"],
+    )])
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("`0.1` and `0.10`"), "{e}");
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// Issue 17, item 5: two axes naming one field by different paths are refused; paths resolve
+/// to the field they name.
+#[test]
+fn two_paths_to_one_field_are_one_axis() {
+    let scene = Scene::solar_panel();
+    assert_eq!(
+        scene.override_field("hinge.clearance_mm").unwrap(),
+        scene
+            .override_field("hinges[hinge].clearance.clearance_mm")
+            .unwrap()
+    );
+    assert_eq!(
+        scene.override_field("hinge.clearance_mm").unwrap(),
+        "hinges[hinge].clearance.clearance_mm"
+    );
+    let sweep = Sweep::new(
+        "twice",
+        scene,
+        vec![],
+        Grid::new(vec![
+            Axis::new("hinge.clearance_mm", ["0.1", "0.2"]),
+            Axis::new("hinges[hinge].clearance.clearance_mm", ["0.3", "0.4"]),
+        ])
+        .unwrap(),
+    );
+    let e = sweep.check().unwrap_err().to_string();
+    assert!(
+        e.contains("hinges[hinge].clearance.clearance_mm") && e.contains("same field"),
+        "{e}"
+    );
+}
+
+/// Issue 17, item 3: a case read back in one pass keeps every extreme of every time series
+/// (per bin), the first and last rows, and counts every contact onset of the full series.
+#[test]
+fn streamed_cases_keep_peaks_and_onsets() {
+    use clearance_joint_app::figures::series::read_csv;
+    let out = scratch("stream");
+    let sweep = Sweep::new(
+        "stream",
+        Scene::solar_panel(),
+        vec![
+            "run.step=Fixed".into(),
+            "run.dt_s=1e-5".into(),
+            "run.output_interval_s=1e-5".into(),
+            "run.end_s=0.3".into(),
+        ],
+        Grid::default(),
+    );
+    let done = sweep.run(&out, Shard::ALL, quiet()).unwrap();
+    let dir = &done.points[0].dir;
+    let scene = Scene::solar_panel()
+        .with_overrides(&sweep.base_overrides)
+        .unwrap();
+    let full = CaseSeries::load_hinge("c", &scene, "hinge", dir).unwrap();
+    let s = CaseSeries::stream("c", &scene, "hinge", dir).unwrap();
+    let n = full.t_s.len();
+    assert_eq!(s.rows, n);
+    assert!(n > 20_000, "{n} rows");
+    let kept = s.series.t_s.len();
+    assert!(kept < n / 2, "kept {kept} of {n}");
+    assert!(
+        s.series.t_s.windows(2).all(|w| w[0] < w[1]),
+        "rows in order"
+    );
+    assert_eq!(s.series.t_s.first(), full.t_s.first());
+    assert_eq!(s.series.t_s.last(), full.t_s.last());
+    let extremes = |v: &[f64]| {
+        v.iter()
+            .fold((f64::MAX, f64::MIN), |(a, b), &x| (a.min(x), b.max(x)))
+    };
+    assert_eq!(extremes(&s.series.force_n), extremes(&full.force_n));
+    assert_eq!(
+        extremes(&s.series.force_ideal_n),
+        extremes(&full.force_ideal_n)
+    );
+    for (a, b) in s.series.bodies.iter().zip(&full.bodies) {
+        assert_eq!(
+            extremes(&a.rate_deg_s),
+            extremes(&b.rate_deg_s),
+            "{}",
+            a.name
+        );
+        assert_eq!(extremes(&a.angle_deg), extremes(&b.angle_deg), "{}", a.name);
+    }
+    let onsets = onset_times(&full.t_s, &full.contact);
+    assert!(!onsets.is_empty());
+    assert_eq!(s.onsets_s, onsets);
+    // The path: its ends kept, no point dropped farther than c / 800 from a kept one.
+    assert_eq!(s.series.ecc_u_mm.first(), full.ecc_u_mm.first());
+    assert_eq!(s.series.ecc_u_mm.last(), full.ecc_u_mm.last());
+    assert!(s.series.ecc_u_mm.len() < n);
+    // Unused here but the reader of the full tables still reads them whole.
+    assert!(read_csv(&dir.join("ideal.csv")).is_ok());
+    let _ = std::fs::remove_dir_all(&out);
+}
+
+/// Issue 17, items 8 and 9: labels with `|` or a line break do not break the report's
+/// tables, and `--strict` fails a study whose case leaves the model's validity.
+#[test]
+fn report_labels_are_escaped() {
+    let root = scratch("labels");
+    let mut scene = Scene::solar_panel();
+    let spec = scene
+        .studies
+        .iter_mut()
+        .find(|s| s.name == "clearance")
+        .unwrap();
+    spec.labels = vec!["c | small".into(), "two\nlines".into(), "c = 0.5|".into()];
+    let options = StudyOptions {
+        exec: quiet(),
+        extra_overrides: vec!["run.end_s=0.02".into()],
+        no_figures: true,
+    };
+    let o = run_studies(
+        &select(&scene, "clearance").unwrap(),
+        &scene,
+        &root,
+        &options,
+    )
+    .unwrap();
+    let report = std::fs::read_to_string(&o[0].report).unwrap();
+    let cells = |line: &str| line.replace("\\|", "").matches('|').count();
+    let mut tables = 0;
+    let mut header = 0;
+    for line in report.lines() {
+        if !line.starts_with('|') {
+            header = 0;
+            continue;
+        }
+        if header == 0 {
+            header = cells(line);
+            tables += 1;
+        }
+        assert_eq!(cells(line), header, "{line}\n{report}");
+    }
+    assert!(tables >= 2, "{report}");
+    assert!(
+        report.contains("c \\| small") && report.contains("two lines"),
         "{report}"
     );
     let _ = std::fs::remove_dir_all(&root);

@@ -12,7 +12,7 @@ pub mod run;
 pub mod sweep;
 
 use crate::study::sweep::{ExecOptions, Progress, thread_count};
-use clearance_joint::error::Result;
+use clearance_joint::error::{Error, Result};
 use clearance_joint::scene::Scene;
 use std::path::Path;
 
@@ -26,9 +26,27 @@ pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
 
 /// The memory budget `--max-memory SIZE` (e.g. `4G`), if given.
 pub fn memory_budget(max_memory: Option<&str>) -> Result<Option<u64>> {
+    if let Some(m) = max_memory.filter(|m| m.trim_start().starts_with('-')) {
+        return Err(Error::invalid(
+            "--max-memory",
+            format!("must be a positive size such as 4G, 512M or 2GiB (got `{m}`)"),
+        ));
+    }
     max_memory
         .map(clearance_joint::scene::output::parse_bytes)
         .transpose()
+}
+
+/// The thread count `--jobs N` as given (possibly negative), refused below 1.
+pub fn jobs(jobs: Option<i64>) -> Result<Option<usize>> {
+    jobs.map(|n| match usize::try_from(n) {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(Error::invalid(
+            "--jobs",
+            format!("must be at least 1 (got {n})"),
+        )),
+    })
+    .transpose()
 }
 
 /// Execution options of the parallel commands. The thread count is the request (else

@@ -1,8 +1,9 @@
 //! The `run` command (and the default job): one scene's ideal and clearance twins, run into a
-//! result set in a folder claimed for it.
+//! result set (data and figures, one unit: see [`crate::resultset`]) for a folder claimed for it.
 
+use crate::resultset::ResultSet;
 use clearance_joint::error::Result;
-use clearance_joint::scene::output::{DirLock, MemoryEstimate, available_memory};
+use clearance_joint::scene::output::{MemoryEstimate, available_memory};
 use clearance_joint::scene::runner::{Progress, RunOptions, RunResult, Simulation};
 use clearance_joint::scene::{Scene, StepMode};
 use std::path::PathBuf;
@@ -14,22 +15,25 @@ pub struct SceneRun {
     pub scene: Scene,
     /// The output folder.
     pub out: PathBuf,
-    _lock: DirLock,
+    /// The result set: every file of the run goes into [`ResultSet::dir`], and
+    /// [`SceneRun::commit`] puts them in `out` together.
+    pub set: ResultSet,
 }
 
 impl SceneRun {
     /// Before any work: the run fits `max_memory` (default: what the system has available), and
-    /// the folder exists, is writable and is ours alone until the set is written.
+    /// the folder is ours alone until the set is in place, its staging folder writable.
     pub fn prepare(scene: Scene, out: PathBuf, max_memory: Option<u64>) -> Result<SceneRun> {
         if let Some(budget) = max_memory.or_else(available_memory) {
             MemoryEstimate::of(&scene).check(&scene, 1, budget)?;
         }
-        let lock = DirLock::acquire(&out)?;
-        Ok(SceneRun {
-            scene,
-            out,
-            _lock: lock,
-        })
+        let set = ResultSet::begin(&out, &[])?;
+        Ok(SceneRun { scene, out, set })
+    }
+
+    /// Puts the set written into [`ResultSet::dir`] in place in `out`, replacing the old one whole.
+    pub fn commit(self) -> Result<PathBuf> {
+        self.set.commit()
     }
 
     /// Runs both twins, calling `progress` after every step; a step-size error advises for the

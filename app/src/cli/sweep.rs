@@ -40,6 +40,8 @@ impl SweepJob {
             None => Shard::ALL,
         };
         let sweep = Sweep::new("sweep", base, fixed, Grid::new(axes)?);
+        // Bad values and two axes naming one field are refused before the folder is touched.
+        sweep.check()?;
         let stem = if shard.is_all() {
             "metrics".to_string()
         } else {
@@ -56,7 +58,7 @@ impl SweepJob {
 
     /// Points this run covers (run or reused).
     pub fn points(&self) -> usize {
-        self.shard.points(&self.sweep.grid).len()
+        self.shard.len(&self.sweep.grid)
     }
 
     /// Runs the points and writes the table.

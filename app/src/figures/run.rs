@@ -10,6 +10,18 @@ use clearance_joint::scene::{MotionSpec, Scene};
 use clearance_joint::table::Table;
 use std::path::Path;
 
+/// Whether `scene`'s runs can have figures (a clearance hinge to plot): the reason if not.
+pub fn can_draw(scene: &Scene) -> Result<()> {
+    if scene.hinges.iter().any(|h| h.clearance.is_some()) {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            "--figures",
+            "the scene has no hinge with clearance: nothing to plot (the figures show a clearance hinge)",
+        ))
+    }
+}
+
 /// Draws the figures of `result` (a run of `scene`) into `out`, PNG and SVG, calling `written`
 /// with each file as soon as it is written. Fails when the run lacks a twin or the scene has no
 /// clearance hinge to plot.
@@ -25,6 +37,7 @@ pub fn draw_run_figures(
     ) else {
         return Err(Error::invalid("--figures", "needs both twins"));
     };
+    can_draw(scene)?;
     let series = [CaseSeries::from_tables(
         scene.name.clone(),
         scene,

@@ -47,6 +47,31 @@ impl Axis {
     }
 }
 
+impl Axis {
+    /// Refuses a value given twice (as the scene reads it: `0.1` and `0.10` are one value):
+    /// the grid would run the same point twice under two names.
+    pub fn check_distinct(&self) -> Result<()> {
+        let read = |v: &str| {
+            serde_json::from_str::<serde_json::Value>(v)
+                .unwrap_or_else(|_| serde_json::Value::String(v.to_string()))
+        };
+        let mut seen: Vec<(serde_json::Value, &str)> = Vec::with_capacity(self.values.len());
+        for v in &self.values {
+            let value = read(v);
+            if let Some((_, first)) = seen.iter().find(|(s, _)| *s == value) {
+                return Err(Error::invalid(
+                    format!("sweep axis `{}`", self.path),
+                    format!(
+                        "has the value `{v}` twice (`{first}` and `{v}`): give each value once"
+                    ),
+                ));
+            }
+            seen.push((value, v));
+        }
+        Ok(())
+    }
+}
+
 /// Splits at commas that are not inside `[]`, `{}` or a double-quoted string; trims each part.
 fn split_top_level(raw: &str) -> std::result::Result<Vec<String>, String> {
     let mut parts = Vec::new();
@@ -136,6 +161,7 @@ impl Grid {
                     "is given twice: put all its values in one `--set path=v1,v2,...`",
                 ));
             }
+            a.check_distinct()?;
         }
         let g = Grid { axes };
         g.checked_len()?;
@@ -144,8 +170,19 @@ impl Grid {
 
     fn checked_len(&self) -> Result<usize> {
         self.axes.iter().try_fold(1usize, |n, a| {
-            n.checked_mul(a.values.len())
-                .ok_or_else(|| Error::invalid("sweep grid", "has more points than fit in memory"))
+            n.checked_mul(a.values.len()).ok_or_else(|| {
+                Error::invalid(
+                    "sweep grid",
+                    format!(
+                        "has more points than can be counted ({}): sweep fewer values",
+                        self.axes
+                            .iter()
+                            .map(|a| a.values.len().to_string())
+                            .collect::<Vec<_>>()
+                            .join(" x ")
+                    ),
+                )
+            })
         })
     }
 
@@ -193,9 +230,9 @@ impl Grid {
         }
     }
 
-    /// Every point, in order.
-    pub fn points(&self) -> Vec<Point> {
-        (0..self.len()).map(|i| self.point(i)).collect()
+    /// Every point, in order (built one by one: a large grid is never held whole).
+    pub fn points(&self) -> impl Iterator<Item = Point> + '_ {
+        (0..self.len()).map(|i| self.point(i))
     }
 }
 
@@ -301,12 +338,19 @@ impl Shard {
         self.n == 1
     }
 
-    /// The points of `grid` in this shard, in grid order.
-    pub fn points(&self, grid: &Grid) -> Vec<Point> {
-        (self.k..grid.len())
-            .step_by(self.n)
-            .map(|i| grid.point(i))
-            .collect()
+    /// The indices of `grid`'s points in this shard, in grid order.
+    pub fn indices(&self, grid: &Grid) -> std::iter::StepBy<std::ops::Range<usize>> {
+        (self.k..grid.len().max(self.k)).step_by(self.n)
+    }
+
+    /// The number of `grid`'s points in this shard.
+    pub fn len(&self, grid: &Grid) -> usize {
+        grid.len().saturating_sub(self.k).div_ceil(self.n)
+    }
+
+    /// The points of `grid` in this shard, in grid order, built one by one.
+    pub fn points<'g>(&self, grid: &'g Grid) -> impl Iterator<Item = Point> + 'g {
+        self.indices(grid).map(|i| grid.point(i))
     }
 }
 

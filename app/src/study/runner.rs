@@ -6,8 +6,9 @@ use super::grid::Shard;
 use super::preset::Study;
 use super::report;
 use super::sweep::{ExecOptions, Failure, Job, MetricsTable, Sweep, TableRow, execute};
-use crate::figures::series::CaseSeries;
+use crate::figures::series::{CaseSeries, StreamedCase};
 use crate::figures::{Figure, FigureKind};
+use crate::resultset::ResultSet;
 use clearance_joint::error::{Error, Result};
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::output::write_atomic;
@@ -49,29 +50,39 @@ pub struct StudyOutcome {
 /// Runs `studies` (presets of `base`, see [`super::preset::select`]) into `root/<name>/`: all
 /// their points in one parallel batch (one progress display), then per study the metrics table,
 /// figures and `report.md`; with more than one study, also `root/report.md` gathering their key
-/// tables and verdicts. Studies whose cases all finished are written even if another study
-/// failed; then the first failure is returned.
+/// tables and verdicts. Each study's folder is one result set ([`ResultSet`], its `points`
+/// carried over so finished cases are reused): while it runs the folder is absent (its points
+/// wait in the staging folder `.<name>.new-<pid>`), and it reappears whole. Studies whose cases
+/// all finished are written even if another study failed; then the first failure is returned.
+/// Refused before anything runs: a case whose settings leave the study's hinge without
+/// clearance (nothing to compare or plot).
 pub fn run_studies(
     studies: &[Study],
     base: &Scene,
     root: &Path,
     options: &StudyOptions,
 ) -> Result<Vec<StudyOutcome>> {
-    let mut plans: Vec<(&Study, PathBuf, Sweep, Vec<Job>)> = Vec::new();
-    // Each study's folder is claimed (created, checked writable, locked) before any case runs.
-    let mut locks = Vec::new();
+    // Every case is built and checked before any folder is touched.
+    let mut checked: Vec<(&Study, Sweep)> = Vec::new();
     for study in studies {
-        let dir = root.join(study.name());
-        locks.push(clearance_joint::scene::output::DirLock::acquire(&dir)?);
         let sweep = study.sweep(base, &options.extra_overrides);
-        let jobs = sweep.jobs(&dir, Shard::ALL)?;
-        plans.push((study, dir, sweep, jobs));
+        check_cases(study, &sweep.jobs(Path::new(""), Shard::ALL)?)?;
+        checked.push((study, sweep));
+    }
+    // The summary of an earlier `study all` must not pass for this run's.
+    let index_path = root.join("report.md");
+    remove_file(&index_path)?;
+    let mut plans: Vec<(&Study, ResultSet, Sweep, Vec<Job>)> = Vec::new();
+    for (study, sweep) in checked {
+        let set = ResultSet::begin(&root.join(study.name()), &["points"])?;
+        let jobs = sweep.jobs(set.dir(), Shard::ALL)?;
+        plans.push((study, set, sweep, jobs));
     }
     let all_jobs: Vec<Job> = plans.iter().flat_map(|p| p.3.iter().cloned()).collect();
     let mut results = execute(&all_jobs, options.exec)?.into_iter();
     let mut outcomes = Vec::new();
     let mut first_error: Option<Error> = None;
-    for (study, dir, sweep, jobs) in plans {
+    for (study, set, sweep, jobs) in plans {
         let mut rows = Vec::new();
         let mut cases = Vec::new();
         let mut failures = Vec::new();
@@ -120,22 +131,13 @@ pub fn run_studies(
             failures,
             missing: Vec::new(),
         };
-        table.write(&dir)?;
+        table.write(set.dir())?;
         if !table.failures.is_empty() {
-            // No report for an incomplete study; an older one must not pass for this run's.
-            let stale = dir.join("report.md");
-            if let Err(e) = std::fs::remove_file(&stale)
-                && e.kind() != std::io::ErrorKind::NotFound
-            {
-                return Err(Error::Io {
-                    action: "cannot remove",
-                    path: stale,
-                    source: e,
-                });
-            }
+            // An incomplete study: its points and the table listing the failures, no report.
+            set.commit()?;
             continue;
         }
-        outcomes.push(finish_study(study, dir, &sweep, cases, table, options)?);
+        outcomes.push(finish_study(study, set, &sweep, cases, table, options)?);
     }
     if outcomes.len() > 1 {
         let entries: Vec<report::IndexEntry> = outcomes
@@ -148,7 +150,7 @@ pub fn run_studies(
             })
             .collect();
         let index = report::index_report(&entries);
-        write_atomic(&root.join("report.md"), index.as_bytes())?;
+        write_atomic(&index_path, index.as_bytes())?;
     }
     match first_error {
         Some(e) => Err(e),
@@ -156,22 +158,74 @@ pub fn run_studies(
     }
 }
 
-/// Figures and report of a study whose cases all finished.
+/// Refuses a study one of whose cases has no clearance at the hinge it shows (its `set`, a
+/// `--set` or its own value made the hinge ideal): there is nothing to compare or plot.
+fn check_cases(study: &Study, jobs: &[Job]) -> Result<()> {
+    for job in jobs {
+        let hinge = job.scene.hinges.iter().find(|h| h.name == study.hinge);
+        if hinge.is_none_or(|h| h.clearance.is_none()) {
+            return Err(Error::invalid(
+                format!("study {}", study.name()),
+                format!(
+                    "case `{}` leaves hinge `{}` without clearance ({}): a study compares a clearance hinge \
+                     with its ideal twin, so it would have nothing to compare or plot; drop the setting that \
+                     makes it ideal (`clearance=null` in the preset's `set` or a `--set`)",
+                    job.point.dir,
+                    study.hinge,
+                    if hinge.is_none() {
+                        "no such hinge"
+                    } else {
+                        "an ideal hinge"
+                    }
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+fn remove_file(path: &Path) -> Result<()> {
+    match std::fs::remove_file(path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(Error::Io {
+            action: "cannot remove",
+            path: path.to_path_buf(),
+            source: e,
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// Figures and report of a study whose cases all finished, written into its set, which is
+/// then put in place.
 fn finish_study(
     study: &Study,
-    dir: PathBuf,
+    set: ResultSet,
     sweep: &Sweep,
-    cases: Vec<StudyCase>,
+    mut cases: Vec<StudyCase>,
     table: MetricsTable,
     options: &StudyOptions,
 ) -> Result<StudyOutcome> {
+    let dir = set.dir().to_path_buf();
     let mut figures = Vec::new();
     let mut figure_stems = Vec::new();
-    let series: Vec<CaseSeries> = cases
+    // One case at a time per worker, each read in one pass and kept reduced: the memory of this
+    // step stays below that of the runs, whatever the number of cases.
+    let streamed: Vec<StreamedCase> = cases
         .par_iter()
-        .map(|c| CaseSeries::load_hinge(c.label.clone(), &c.scene, &study.hinge, &c.dir))
+        .map(|c| CaseSeries::stream(c.label.clone(), &c.scene, &study.hinge, &c.dir))
         .collect::<Result<_>>()?;
-    let timeline = report::Timeline::of(&series);
+    let timeline = report::Timeline::of_onsets(
+        &streamed
+            .iter()
+            .map(|c| {
+                (
+                    c.onsets_s.clone(),
+                    c.series.t_s.last().copied().unwrap_or(0.0),
+                )
+            })
+            .collect::<Vec<_>>(),
+    );
+    let series: Vec<CaseSeries> = streamed.into_iter().map(|c| c.series).collect();
     if !options.no_figures {
         let nums = study.paper_figures();
         let titles: Vec<String> = FigureKind::ALL
@@ -191,6 +245,7 @@ fn finish_study(
                 }
             })
             .collect();
+        // A figure that cannot be written fails the study; its old set stays as it was.
         let written: Vec<[PathBuf; 2]> = FigureKind::ALL
             .par_iter()
             .zip(titles.par_iter())
@@ -205,7 +260,7 @@ fn finish_study(
             .collect::<Result<_>>()?;
         for (f, paths) in FigureKind::ALL.iter().zip(written) {
             figure_stems.push((*f, f.stem().to_string()));
-            figures.extend(paths);
+            figures.extend(paths.iter().map(|p| set.final_path(p)));
         }
     }
     let setup = report::Setup::of(study, sweep, &cases);
@@ -223,8 +278,12 @@ fn finish_study(
         &conclusions,
         Some(&timeline),
     );
+    write_atomic(&dir.join("report.md"), text.as_bytes())?;
+    for c in &mut cases {
+        c.dir = set.final_path(&c.dir);
+    }
+    let dir = set.commit()?;
     let report_path = dir.join("report.md");
-    write_atomic(&report_path, text.as_bytes())?;
     Ok(StudyOutcome {
         study: study.clone(),
         dir,

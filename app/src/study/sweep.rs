@@ -13,7 +13,9 @@ use super::grid::{Axis, Grid, Point, Shard};
 use super::metrics::RunMetrics;
 use clearance_joint::error::{Error, Result};
 use clearance_joint::scene::Scene;
-use clearance_joint::scene::output::{DirLock, MemoryEstimate, write_all_atomic, write_atomic};
+use clearance_joint::scene::output::{
+    DirLock, MemoryEstimate, bytes_text, write_all_atomic, write_atomic,
+};
 use clearance_joint::scene::runner::{RunOptions, Simulation};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -164,34 +166,130 @@ impl Sweep {
     }
 
     /// The jobs of `shard` with folders under `out/points/`. Every point's scene is built and
-    /// validated first, so a bad value fails before anything runs, naming the point.
+    /// validated first, so a bad value fails before anything runs, naming the point (for a
+    /// study's few cases; a sweep builds its points one by one, see [`Sweep::run`]).
     pub fn jobs(&self, out: &Path, shard: Shard) -> Result<Vec<Job>> {
-        let base = self.base.with_overrides(&self.base_overrides)?;
+        let base = self.check()?;
         shard
             .points(&self.grid)
-            .into_iter()
-            .map(|point| {
-                let scene = base
-                    .with_overrides(&point.overrides())
-                    .map_err(|e| match e {
-                        Error::Invalid { field, reason } => Error::Invalid {
-                            field,
-                            reason: format!("{reason} (sweep point `{}`)", point.dir),
-                        },
-                        Error::Parse { what, reason } => Error::Parse {
-                            what: format!("{what} (sweep point `{}`)", point.dir),
-                            reason,
-                        },
-                        other => other,
-                    })?;
-                Ok(Job {
-                    dir: out.join("points").join(&point.dir),
-                    base_overrides: self.base_overrides.clone(),
-                    point,
-                    scene,
-                })
-            })
+            .map(|point| self.job(&base, out, point))
             .collect()
+    }
+
+    /// The job of `point`, from the base scene with the fixed overrides applied.
+    fn job(&self, base: &Scene, out: &Path, point: Point) -> Result<Job> {
+        let scene = base
+            .with_overrides(&point.overrides())
+            .map_err(|e| in_point(e, &point))?;
+        Ok(Job {
+            dir: out.join("points").join(&point.dir),
+            base_overrides: self.base_overrides.clone(),
+            point,
+            scene,
+        })
+    }
+
+    /// Checks the sweep before any point runs, and returns the base scene with the fixed
+    /// overrides applied: two axes naming one field by different paths are refused (the later
+    /// would silently win), and every value of every axis is applied once, the other axes at
+    /// their first value, so a bad value fails naming its point without building the whole grid.
+    pub fn check(&self) -> Result<Scene> {
+        let base = self.base.with_overrides(&self.base_overrides)?;
+        let first = self.grid.point(0);
+        let reference = base
+            .with_overrides(&first.overrides())
+            .unwrap_or(base.clone());
+        let mut fields: Vec<(String, &str)> = Vec::new();
+        for a in &self.grid.axes {
+            let field = reference
+                .override_field(&a.path)
+                .unwrap_or_else(|_| a.path.clone());
+            if let Some((_, other)) = fields.iter().find(|(f, _)| *f == field) {
+                return Err(Error::invalid(
+                    format!("sweep axis `{}`", a.path),
+                    format!(
+                        "names the same field as axis `{other}` ({field}): put all its values in one \
+                         `--set {field}=v1,v2,...`"
+                    ),
+                ));
+            }
+            fields.push((field, &a.path));
+        }
+        for index in self.axis_value_points() {
+            self.job(&base, Path::new(""), self.grid.point(index))?;
+        }
+        Ok(base)
+    }
+
+    /// Indices of the points that set each value of each axis once, the other axes at their
+    /// first value (the first point included once).
+    fn axis_value_points(&self) -> Vec<usize> {
+        let mut indices = vec![0];
+        let mut stride = 1usize;
+        for a in self.grid.axes.iter().rev() {
+            indices.extend((1..a.values.len()).map(|j| j * stride));
+            stride = stride.saturating_mul(a.values.len());
+        }
+        indices
+    }
+
+    /// Refuses, before any point runs, a shard of `points` points that cannot fit `budget`
+    /// (default: what the system has available): the rows the table keeps per point, plus the
+    /// parallel runs (the largest estimate among the points of [`Sweep::check`]). Returns the
+    /// budget left for the runs.
+    fn check_memory(
+        &self,
+        base: &Scene,
+        points: usize,
+        threads: usize,
+        budget: Option<u64>,
+    ) -> Result<Option<u64>> {
+        let Some(budget) = budget.or_else(clearance_joint::scene::output::available_memory) else {
+            return Ok(None);
+        };
+        let per_point = self.kept_bytes_per_point(base)?;
+        let kept = per_point.saturating_mul(points as u64);
+        if kept >= budget / 2 {
+            return Err(Error::invalid(
+                "sweep grid",
+                format!(
+                    "{points} points would keep about {} in memory for the table (about {} each), more than \
+                     half the {} budget (--max-memory, default 80 % of the available memory): sweep fewer \
+                     values, or split the grid with --shard K/N (each shard keeps its share) and `merge`",
+                    bytes_text(kept),
+                    bytes_text(per_point),
+                    bytes_text(budget)
+                ),
+            ));
+        }
+        let left = budget - kept;
+        let samples = self
+            .axis_value_points()
+            .into_iter()
+            .map(|i| self.job(base, Path::new(""), self.grid.point(i)))
+            .collect::<Result<Vec<_>>>()?;
+        check_memory(&samples, threads.min(points.max(1)), Some(left))?;
+        Ok(Some(left))
+    }
+
+    /// Memory the sweep keeps per finished point until its table is written: the row and the
+    /// outcome, and the table's CSV and JSON forms, allowed as eight times the point's row in JSON.
+    fn kept_bytes_per_point(&self, base: &Scene) -> Result<u64> {
+        let mut metrics = RunMetrics::default();
+        for b in base.bodies.iter().filter(|b| !b.fixed) {
+            metrics.bodies.insert(b.name.clone(), Default::default());
+        }
+        for h in &base.hinges {
+            metrics.hinges.insert(h.name.clone(), Default::default());
+        }
+        metrics.guard_violations = vec!["x".repeat(200)];
+        let point = self.grid.point(self.grid.len() - 1);
+        let row = TableRow {
+            dir: format!("points/{}", point.dir),
+            point,
+            metrics,
+        };
+        Ok(8 * json_bytes(&row, "metrics table")?.len() as u64)
     }
 
     /// The table header describing this sweep.
@@ -210,19 +308,30 @@ impl Sweep {
     /// that fail are listed in the table's `failures` and returned with the outcome; the error
     /// is only for problems that stop the whole sweep (bad overrides, unwritable folder).
     pub fn run(&self, out: &Path, shard: Shard, options: ExecOptions) -> Result<SweepOutcome> {
-        let jobs = self.jobs(out, shard)?;
-        let results = execute(&jobs, options)?;
+        let base = self.check()?;
+        let (threads, _) = thread_count(options.threads)?;
+        let count = shard.len(&self.grid);
+        let run_budget = self.check_memory(&base, count, threads, options.max_memory)?;
+        // The table of an earlier run must not pass for this one's while the points change.
+        remove_tables(out, shard)?;
+        let index = |k: usize| shard.index() + k * shard.count();
+        let results = execute_with(
+            count,
+            |k| self.job(&base, out, self.grid.point(index(k))),
+            options,
+            run_budget,
+        )?;
         let mut rows = Vec::new();
         let mut failures = Vec::new();
         let mut outcomes = Vec::new();
-        for (job, r) in jobs.iter().zip(results) {
+        for (k, r) in results.into_iter().enumerate() {
             match r {
                 Ok(o) => {
-                    rows.push(TableRow::of(&o.manifest, &job.dir, out));
+                    rows.push(TableRow::of(&o.manifest, &o.dir, out));
                     outcomes.push(o);
                 }
                 Err(e) => failures.push(Failure {
-                    point: job.point.clone(),
+                    point: self.grid.point(index(k)),
                     error: e.to_string(),
                 }),
             }
@@ -239,6 +348,41 @@ impl Sweep {
             points: outcomes,
             table,
         })
+    }
+}
+
+/// Removes the tables a run of `shard` into `out` replaces: its own, and the merged table of
+/// the whole grid (a shard's new points make it stale).
+fn remove_tables(out: &Path, shard: Shard) -> Result<()> {
+    let mut stems = vec!["metrics".to_string()];
+    if !shard.is_all() {
+        stems.push(format!(
+            "metrics.shard-{}-of-{}",
+            shard.index(),
+            shard.count()
+        ));
+    }
+    for stem in stems {
+        // The JSON (which `merge` reads) first: a table without it is no table.
+        for ext in ["json", "csv"] {
+            remove_if_present(&out.join(format!("{stem}.{ext}")))?;
+        }
+    }
+    Ok(())
+}
+
+/// An error of building `point`'s scene, naming the point.
+fn in_point(e: Error, point: &Point) -> Error {
+    match e {
+        Error::Invalid { field, reason } => Error::Invalid {
+            field,
+            reason: format!("{reason} (sweep point `{}`)", point.dir),
+        },
+        Error::Parse { what, reason } => Error::Parse {
+            what: format!("{what} (sweep point `{}`)", point.dir),
+            reason,
+        },
+        other => other,
     }
 }
 
@@ -335,28 +479,55 @@ pub(crate) fn json_bytes<T: Serialize>(value: &T, what: &str) -> Result<Vec<u8>>
 }
 
 /// Runs `jobs` (reusing finished ones unless `rerun`) in parallel; results in job order.
-/// Fails only if the thread pool cannot be built; each job has its own result.
+/// Fails only if the batch cannot fit the memory budget or the thread pool cannot be built;
+/// each job has its own result.
 pub fn execute(jobs: &[Job], options: ExecOptions) -> Result<Vec<Result<PointOutcome>>> {
     let (threads, _) = thread_count(options.threads)?;
     check_memory(jobs, threads, options.max_memory)?;
-    let progress = Reporter::new(jobs.len(), options.progress);
+    execute_with(jobs.len(), |k| Ok(jobs[k].clone()), options, None)
+}
+
+/// Runs `count` jobs, job `k` built by `job_at(k)` when a worker takes it (a large grid is
+/// never held whole), in parallel; results in job order. With `run_budget`, a point whose runs
+/// in parallel would exceed it fails before it starts. The outcomes keep no scene text.
+fn execute_with(
+    count: usize,
+    job_at: impl Fn(usize) -> Result<Job> + Sync,
+    options: ExecOptions,
+    run_budget: Option<u64>,
+) -> Result<Vec<Result<PointOutcome>>> {
+    let (threads, _) = thread_count(options.threads)?;
+    let concurrent = threads.min(count).max(1) as u64;
+    let progress = Reporter::new(count, options.progress);
+    let run = |job: &Job| -> Result<PointOutcome> {
+        if let Some(budget) = run_budget {
+            MemoryEstimate::of(&job.scene)
+                .check(&job.scene, concurrent, budget)
+                .map_err(|e| in_point(e, &job.point))?;
+        }
+        let (manifest, reused) = match (!options.rerun).then(|| job.finished()).flatten() {
+            Some(manifest) => (manifest, true),
+            None => (job.run()?, false),
+        };
+        Ok(PointOutcome {
+            manifest: Manifest {
+                scene_ron: String::new(),
+                ..manifest
+            },
+            dir: job.dir.clone(),
+            reused,
+        })
+    };
     let work = || -> Vec<Result<PointOutcome>> {
-        jobs.par_iter()
-            .map(|job| {
+        (0..count)
+            .into_par_iter()
+            .map(|k| {
                 let start = Instant::now();
-                let outcome = match (!options.rerun).then(|| job.finished()).flatten() {
-                    Some(manifest) => Ok(PointOutcome {
-                        manifest,
-                        dir: job.dir.clone(),
-                        reused: true,
-                    }),
-                    None => job.run().map(|manifest| PointOutcome {
-                        manifest,
-                        dir: job.dir.clone(),
-                        reused: false,
-                    }),
+                let (name, outcome) = match job_at(k) {
+                    Ok(job) => (job.point.dir.clone(), run(&job)),
+                    Err(e) => (format!("point {k}"), Err(e)),
                 };
-                progress.done(job, &outcome, start.elapsed().as_secs_f64());
+                progress.done(&name, &outcome, start.elapsed().as_secs_f64());
                 outcome
             })
             .collect()
@@ -428,7 +599,7 @@ impl Reporter {
         }
     }
 
-    fn done(&self, job: &Job, outcome: &Result<PointOutcome>, seconds: f64) {
+    fn done(&self, name: &str, outcome: &Result<PointOutcome>, seconds: f64) {
         let n = self.done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
         let what = match outcome {
             Ok(o) if o.reused => "reused (finished earlier)".to_string(),
@@ -441,14 +612,14 @@ impl Reporter {
             },
             Err(e) => format!("FAILED: {e}"),
         };
-        let line = format!("[{n}/{}] {}: {what}", self.total, job.point.dir);
+        let line = format!("[{n}/{}] {name}: {what}", self.total);
         if let Some(bar) = &self.bar {
             let warned =
                 matches!(outcome, Ok(o) if !o.manifest.metrics.guard_violations.is_empty());
             if outcome.is_err() || warned {
                 bar.println(&line);
             }
-            bar.set_message(job.point.dir.clone());
+            bar.set_message(name.to_string());
             bar.inc(1);
         } else if self.lines {
             eprintln!("{line}");
@@ -477,6 +648,63 @@ pub struct SweepInfo {
     pub axes: Vec<Axis>,
     /// Number of points of the whole grid.
     pub points: usize,
+}
+
+impl SweepInfo {
+    /// What differs between this sweep and `other`, a phrase per setting (empty when equal),
+    /// e.g. ``fixed settings: `run.end_s=1e0` in table 1, `run.end_s=2e0` here``.
+    pub fn differences(&self, other: &SweepInfo) -> Vec<String> {
+        let mut d = Vec::new();
+        let mut differ = |what: &str, a: String, b: String| {
+            if a != b {
+                d.push(format!("{what}: {a} in table 1, {b} here"));
+            }
+        };
+        differ("format", self.format.to_string(), other.format.to_string());
+        differ(
+            "name",
+            format!("`{}`", self.name),
+            format!("`{}`", other.name),
+        );
+        differ(
+            "scene",
+            format!("`{}`", self.scene),
+            format!("`{}`", other.scene),
+        );
+        let only = |a: &[String], b: &[String]| -> String {
+            let v: Vec<String> = a
+                .iter()
+                .filter(|x| !b.contains(x))
+                .map(|x| format!("`{x}`"))
+                .collect();
+            if v.is_empty() {
+                "nothing else".into()
+            } else {
+                v.join(", ")
+            }
+        };
+        if self.base_overrides != other.base_overrides {
+            differ(
+                "fixed settings (--set, --end, --dt, ...)",
+                only(&self.base_overrides, &other.base_overrides),
+                only(&other.base_overrides, &self.base_overrides),
+            );
+        }
+        let axes = |v: &[Axis]| -> Vec<String> {
+            v.iter()
+                .map(|a| format!("{}={}", a.path, a.values.join(",")))
+                .collect()
+        };
+        if self.axes != other.axes {
+            differ(
+                "axes",
+                only(&axes(&self.axes), &axes(&other.axes)),
+                only(&axes(&other.axes), &axes(&self.axes)),
+            );
+        }
+        differ("points", self.points.to_string(), other.points.to_string());
+        d
+    }
 }
 
 /// One row of the metrics table: a finished point.
@@ -652,8 +880,8 @@ pub fn merge(tables: &[MetricsTable]) -> Result<MetricsTable> {
             return Err(Error::invalid(
                 format!("merge: table {}", i + 1),
                 format!(
-                    "belongs to another sweep (`{}` with {} points, {:?}) than table 1 (`{}` with {} points, {:?})",
-                    t.sweep.name, t.sweep.points, t.sweep.axes, info.name, info.points, info.axes
+                    "belongs to another sweep than table 1: {}",
+                    info.differences(&t.sweep).join("; ")
                 ),
             ));
         }

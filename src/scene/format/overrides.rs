@@ -27,17 +27,65 @@ impl Scene {
             check_group(path, slot, &new)?;
             *slot = new;
         }
-        let scene: Scene = serde_json::from_value(value).map_err(|e| {
-            Error::parse(
-                format!(
-                    "overrides {:?}",
-                    overrides.iter().map(|s| s.as_ref()).collect::<Vec<_>>()
-                ),
-                e.to_string(),
-            )
-        })?;
+        let scene: Scene = match serde_json::from_value(value) {
+            Ok(scene) => scene,
+            Err(e) => return Err(self.first_unreadable(overrides, e)),
+        };
         scene.validate()?;
         Ok(scene)
+    }
+
+    /// The error of overrides whose result is not a scene: names the first override after which
+    /// the scene no longer reads (applied in order), not the whole list.
+    fn first_unreadable<S: AsRef<str>>(&self, overrides: &[S], all: serde_json::Error) -> Error {
+        let Ok(mut value) = serde_json::to_value(self) else {
+            return Error::parse("overrides", all.to_string());
+        };
+        for o in overrides {
+            let o = o.as_ref();
+            let Some((path, raw)) = o.split_once('=') else {
+                continue;
+            };
+            let new: serde_json::Value = serde_json::from_str(raw.trim())
+                .unwrap_or_else(|_| serde_json::Value::String(raw.trim().to_string()));
+            if let Ok(slot) = locate(&mut value, path.trim()) {
+                *slot = new;
+            }
+            if let Err(e) = serde_json::from_value::<Scene>(value.clone()) {
+                return Error::parse(format!("override `{o}`"), e.to_string());
+            }
+        }
+        Error::parse("overrides", all.to_string())
+    }
+
+    /// The field an override path names, written in full (`hinge.clearance_mm` is
+    /// `hinges[hinge].clearance.clearance_mm`): two paths naming one field give the same text.
+    /// Refused as [`Scene::with_overrides`] refuses the path.
+    pub fn override_field(&self, path: &str) -> Result<String> {
+        let value =
+            serde_json::to_value(self).map_err(|e| Error::invalid("scene", e.to_string()))?;
+        let steps = locate_steps(&value, path.trim())?;
+        let mut text = String::new();
+        let mut cur = &value;
+        for step in &steps {
+            match step {
+                Step::Key(k) => {
+                    if !text.is_empty() {
+                        text.push('.');
+                    }
+                    text.push_str(k);
+                    cur = &cur[k.as_str()];
+                }
+                Step::Index(i) => {
+                    cur = &cur[*i];
+                    match cur.get("name").and_then(|n| n.as_str()) {
+                        Some(name) => text.push_str(&format!("[{name}]")),
+                        None => text.push_str(&format!("[{i}]")),
+                    }
+                }
+            }
+        }
+        Ok(text)
     }
 }
 
@@ -79,6 +127,20 @@ enum Step {
 /// `hinges[name]`, `joints[name]`, `drives[name]` (the form error messages use). A name that is also a
 /// top-level field (a body called `run`) is taken where the rest of the path exists.
 fn locate<'a>(root: &'a mut serde_json::Value, path: &str) -> Result<&'a mut serde_json::Value> {
+    let steps = locate_steps(root, path)?;
+    let mut cur = root;
+    for step in &steps {
+        cur = match step {
+            Step::Key(k) => cur.get_mut(k.as_str()),
+            Step::Index(i) => cur.get_mut(*i),
+        }
+        .expect("path just resolved");
+    }
+    Ok(cur)
+}
+
+/// The steps from the root to the slot an override path names (see [`locate`]).
+fn locate_steps(root: &serde_json::Value, path: &str) -> Result<Vec<Step>> {
     let unknown = |reason: String| Error::invalid(path, reason);
     let mut segments = path.split('.');
     let first = segments
@@ -172,15 +234,7 @@ fn locate<'a>(root: &'a mut serde_json::Value, path: &str) -> Result<&'a mut ser
             )));
         }
     };
-    let mut cur = root;
-    for step in &steps {
-        cur = match step {
-            Step::Key(k) => cur.get_mut(k.as_str()),
-            Step::Index(i) => cur.get_mut(*i),
-        }
-        .expect("path just resolved");
-    }
-    Ok(cur)
+    Ok(steps)
 }
 
 fn root_at<'a>(root: &'a serde_json::Value, steps: &[Step]) -> &'a serde_json::Value {

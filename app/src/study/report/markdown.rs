@@ -58,6 +58,7 @@ pub fn study_report(
     conclusions: &[Conclusion],
     timeline: Option<&Timeline>,
 ) -> String {
+    let cases = &escaped(cases);
     let mut s = String::new();
     let name = study.name();
     let _ = writeln!(s, "# {name} study: {}\n", study.title());
@@ -247,7 +248,7 @@ pub fn index_report(entries: &[IndexEntry]) -> String {
             name
         );
         let _ = writeln!(s, "{}, {} s simulated.\n", o.setup.stepping, o.setup.end_s);
-        s.push_str(&key_tables(o.cases, o.setup));
+        s.push_str(&key_tables(&escaped(o.cases), o.setup));
         s.push('\n');
         for c in o
             .conclusions
@@ -265,4 +266,23 @@ pub fn index_report(entries: &[IndexEntry]) -> String {
         s.push('\n');
     }
     s
+}
+
+/// Text safe in a Markdown table cell or list item: `|` escaped, line breaks as spaces.
+pub fn md_cell(text: &str) -> String {
+    text.replace("\r\n", " ")
+        .replace(['\n', '\r'], " ")
+        .replace('|', "\\|")
+}
+
+/// The cases with labels and values safe in the report's tables ([`md_cell`]).
+fn escaped(cases: &[StudyCase]) -> Vec<StudyCase> {
+    cases
+        .iter()
+        .map(|c| StudyCase {
+            label: md_cell(&c.label),
+            value: md_cell(&c.value),
+            ..c.clone()
+        })
+        .collect()
 }

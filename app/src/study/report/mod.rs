@@ -16,7 +16,7 @@ pub mod tables;
 pub mod timeline;
 pub mod verdict;
 
-pub use markdown::{IndexEntry, index_report, study_report};
+pub use markdown::{IndexEntry, index_report, md_cell, study_report};
 pub use paper::{PAPER, conclusions};
 pub use setup::Setup;
 pub use tables::{key_tables, num};

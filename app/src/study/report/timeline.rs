@@ -18,10 +18,22 @@ pub struct Timeline {
 impl Timeline {
     /// Windows of 1 s when the run lasts at least 2 s, else a fifth of the run.
     pub fn of(series: &[CaseSeries]) -> Timeline {
-        let end = series
+        let cases: Vec<(Vec<f64>, f64)> = series
             .iter()
-            .filter_map(|c| c.t_s.last().copied())
-            .fold(0.0, f64::max);
+            .map(|c| {
+                (
+                    onset_times(&c.t_s, &c.contact),
+                    c.t_s.last().copied().unwrap_or(0.0),
+                )
+            })
+            .collect();
+        Self::of_onsets(&cases)
+    }
+
+    /// The same from each case's onset times and last row time (cases read in one pass, see
+    /// [`crate::figures::series::CaseSeries::stream`]).
+    pub fn of_onsets(cases: &[(Vec<f64>, f64)]) -> Timeline {
+        let end = cases.iter().map(|c| c.1).fold(0.0, f64::max);
         let window = if end >= 2.0 {
             1.0
         } else {
@@ -30,9 +42,9 @@ impl Timeline {
         let n = ((end / window) - 1e-9).ceil().max(1.0) as usize;
         Timeline {
             window_s: window,
-            counts: series
+            counts: cases
                 .iter()
-                .map(|c| count_in_windows(&onset_times(&c.t_s, &c.contact), window, n))
+                .map(|(onsets, _)| count_in_windows(onsets, window, n))
                 .collect(),
         }
     }

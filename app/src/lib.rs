@@ -7,6 +7,7 @@
 //!   named sweeps a scene file declares (the paper's three for its scene), with their reports.
 //! - [`figures`]: the figures of a run and of the studies (PNG and SVG).
 //! - [`progress`]: progress of a long run on a terminal.
+//! - [`replay`]: the self-contained `replay.html` of a run (3D, journal insets, timeline).
 //!
 //! The binary (`src/main.rs`) parses arguments, calls these, prints and sets the exit code. The
 //! library crate `clearance_joint` knows nothing of this crate: depending on it builds none of
@@ -18,4 +19,5 @@
 pub mod cli;
 pub mod figures;
 pub mod progress;
+pub mod replay;
 pub mod study;

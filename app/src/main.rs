@@ -111,6 +111,9 @@ struct SweepArgs {
     /// Run only the points with index % N == K (K from 0): `--shard 0/4` ... `--shard 3/4`.
     #[arg(long, value_name = "K/N")]
     shard: Option<String>,
+    /// Write each point's replay (`points/<dir>/replay.html`, the table's `dir`); off by default.
+    #[arg(long)]
+    replay: bool,
     #[command(flatten)]
     exec: ExecArgs,
 }
@@ -136,6 +139,9 @@ struct StudyArgs {
     /// Skip the figures.
     #[arg(long)]
     no_figures: bool,
+    /// Skip the replays (each case's `replay.html`, linked from the report; written by default).
+    #[arg(long)]
+    no_replay: bool,
     #[command(flatten)]
     exec: ExecArgs,
 }
@@ -222,6 +228,10 @@ struct RunArgs {
     /// Skip the figures.
     #[arg(long)]
     no_figures: bool,
+    /// Skip the replay (`replay.html`: the run in 3D with the journal magnified in its bearing,
+    /// written beside the CSVs by default).
+    #[arg(long)]
+    no_replay: bool,
 }
 
 impl RunArgs {
@@ -254,9 +264,9 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
         clearance_joint::error::sig4(scene.run.end_s)
     );
     let mut progress = RunProgress::new(progress_mode(&args.progress));
-    let result = job.execute(|p| progress.update(p));
+    let result = job.execute_recorded(|p| progress.update(p), !args.no_replay);
     progress.finish();
-    let result = result?;
+    let (result, recording) = result?;
     let summary = result.write(&job.out)?;
     println!("{}", comparison_table(&summary));
     println!(
@@ -275,13 +285,18 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
             other => other?,
         }
     }
+    if let Some(recording) = &recording {
+        let path = clearance_joint_app::replay::write_run_replay(scene, &result, recording, &job.out)?;
+        println!("wrote {}", path.display());
+    }
     Ok(())
 }
 
 fn sweep(args: &SweepArgs) -> clearance_joint::Result<()> {
     let base = cli::load_scene(args.scene.as_deref())?;
     warn(&base);
-    let exec = args.exec.options()?;
+    let mut exec = args.exec.options()?;
+    exec.replay = args.replay;
     let out = args
         .out
         .clone()
@@ -346,8 +361,10 @@ fn study(args: &StudyArgs) -> clearance_joint::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out/studies"));
+    let mut exec = args.exec.options()?;
+    exec.replay = !args.no_replay;
     let options = StudyOptions {
-        exec: args.exec.options()?,
+        exec,
         extra_overrides: args.overrides.clone(),
         no_figures: args.no_figures,
     };

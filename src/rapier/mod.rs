@@ -9,6 +9,7 @@
 //! - [`reaction`]: exact ideal-joint reactions from the constrained equations.
 //! - [`metrics`]: impact lists, contact fraction and per-turn statistics.
 //! - [`ledger`]: the forces and torques each source applied in a step.
+//! - [`replay`]: bodies' poses and journals' states, thinned by time, for a replay of a run.
 //!
 //! Depends on [`crate::model`] only (and on Rapier); knows nothing of scenes or the ECS.
 
@@ -20,4 +21,5 @@ pub mod ledger;
 pub mod metrics;
 pub mod prescribed;
 pub mod reaction;
+pub mod replay;
 pub mod stepper;

@@ -223,6 +223,7 @@ fn finish_study(
         &conclusions,
         Some(&timeline),
     );
+    let text = text + &crate::replay::report_section(&dir, &cases);
     let report_path = dir.join("report.md");
     write_atomic(&report_path, text.as_bytes())?;
     Ok(StudyOutcome {

@@ -14,7 +14,6 @@ use super::metrics::RunMetrics;
 use clearance_joint::error::{Error, Result};
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::output::{DirLock, MemoryEstimate, write_all_atomic, write_atomic};
-use clearance_joint::scene::runner::{RunOptions, Simulation};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -117,6 +116,9 @@ pub struct ExecOptions {
     /// Memory the parallel runs may hold, bytes (`None`: 80 % of what the system reports
     /// available, see [`clearance_joint::scene::output::available_memory`]).
     pub max_memory: Option<u64>,
+    /// Write each point's replay (`replay.html`, see [`crate::replay`]); a finished point
+    /// without one is run again.
+    pub replay: bool,
 }
 
 /// The number of worker threads for `requested` (`None`: one per core), at most one per core:
@@ -272,16 +274,23 @@ impl Job {
     /// Runs the point and writes its files, the manifest last. An old manifest is removed
     /// first, so an interrupted rerun never looks finished.
     pub fn run(&self) -> Result<Manifest> {
+        self.run_replay(false)
+    }
+
+    /// As [`run`](Self::run), also writing the point's replay (`replay.html`) when `replay`.
+    pub fn run_replay(&self, replay: bool) -> Result<Manifest> {
         // One process per point folder: a second sweep running the same point is refused
         // rather than mixing its files with ours.
         let _lock = DirLock::acquire(&self.dir)?;
         remove_if_present(&self.dir.join(MANIFEST))?;
         let adaptive = self.scene.run.step == clearance_joint::scene::StepMode::Adaptive;
-        let result = Simulation::new(&self.scene, RunOptions::default())?
-            .run()
+        let (result, recording) = crate::replay::run_recorded(&self.scene, |_| {}, replay)
             .map_err(|e| e.with_step_mode(adaptive))?;
         let metrics = RunMetrics::of(&result)?;
         result.write(&self.dir)?;
+        if let Some(recording) = &recording {
+            crate::replay::write_run_replay(&self.scene, &result, recording, &self.dir)?;
+        }
         let mut files = Vec::new();
         for twin in &result.twins {
             files.push(format!("{}.csv", twin.kind.name()));
@@ -344,13 +353,17 @@ pub fn execute(jobs: &[Job], options: ExecOptions) -> Result<Vec<Result<PointOut
         jobs.par_iter()
             .map(|job| {
                 let start = Instant::now();
-                let outcome = match (!options.rerun).then(|| job.finished()).flatten() {
+                let finished = (!options.rerun)
+                    .then(|| job.finished())
+                    .flatten()
+                    .filter(|_| !options.replay || job.dir.join(crate::replay::FILE).is_file());
+                let outcome = match finished {
                     Some(manifest) => Ok(PointOutcome {
                         manifest,
                         dir: job.dir.clone(),
                         reused: true,
                     }),
-                    None => job.run().map(|manifest| PointOutcome {
+                    None => job.run_replay(options.replay).map(|manifest| PointOutcome {
                         manifest,
                         dir: job.dir.clone(),
                         reused: false,

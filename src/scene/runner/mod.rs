@@ -11,6 +11,7 @@ pub use invariants::{ENERGY_GROWTH_LIMIT, Invariants, MOTOR_SPEED_ERROR_LIMIT};
 pub use twin::{Twin, TwinKind};
 
 use crate::error::Result;
+use crate::rapier::replay::ReplayRecorder;
 use crate::rapier::stepper::{ForceSource, GuardReport, Stepper};
 use crate::scene::Scene;
 use comparison::ComparisonSums;
@@ -179,8 +180,44 @@ impl Simulation {
 
     /// Runs to `run.end_s`, calling `progress` after every internal step (e.g. to show simulated
     /// time, steps per second and an ETA on a terminal; the call should be cheap).
-    pub fn run_with_progress(mut self, mut progress: impl FnMut(&Progress)) -> Result<RunResult> {
+    pub fn run_with_progress(self, progress: impl FnMut(&Progress)) -> Result<RunResult> {
+        self.run_observed(progress, |_| {})
+    }
+
+    /// A recorder tracking both twins' bodies and hinges for a replay (groups `ideal` and
+    /// `clearance`), keeping a state per `interval` s in free flight and per
+    /// `contact_interval` s in contact; feed it with [`record_replay`](Self::record_replay),
+    /// e.g. from [`run_observed`](Self::run_observed).
+    pub fn replay_recorder(&self, interval: f64, contact_interval: f64) -> Result<ReplayRecorder> {
+        let mut recorder = ReplayRecorder::new(interval, contact_interval)?;
+        for (i, twin) in self.twins.iter().enumerate() {
+            twin.track_replay(&self.scene, &self.world, i, &mut recorder)?;
+        }
+        Ok(recorder)
+    }
+
+    /// Records the current state into a recorder from [`replay_recorder`](Self::replay_recorder).
+    pub fn record_replay(&self, recorder: &mut ReplayRecorder) {
+        let sets: Vec<&crate::rapier::joint::ClearanceJointSet> =
+            self.twins.iter().map(|t| &t.clearance).collect();
+        recorder.record(self.time(), &self.world.bodies, &sets);
+    }
+
+    /// As [`run_with_progress`](Self::run_with_progress), also calling `observe` with the
+    /// simulation at the initial state, after every internal step and at the end (the force
+    /// sources evaluated at each of those states), e.g. to
+    /// [`record_replay`](Self::record_replay).
+    pub fn run_observed(
+        mut self,
+        mut progress: impl FnMut(&Progress),
+        mut observe: impl FnMut(&Simulation),
+    ) -> Result<RunResult> {
         let start = Instant::now();
+        {
+            let mut sources = sources(&mut self.twins);
+            self.stepper.prepare(&mut self.world, &mut sources)?;
+        }
+        observe(&self);
         while !self.done() {
             self.step()?;
             progress(&Progress {
@@ -188,6 +225,7 @@ impl Simulation {
                 end: self.scene.run.end_s,
                 steps: self.stepper.steps(),
             });
+            observe(&self);
         }
         self.finish()?;
         let comparison = match self.twins.as_slice() {

@@ -11,7 +11,8 @@
 //!
 //! **Size.** Frames: one per `end_s / FRAMES` of free flight, one per `end_s / CONTACT_FRAMES`
 //! while a journal is in contact, and every contact onset with the state before it (the
-//! recorder's thinning rule); numbers are written with 7 significant digits (times in full).
+//! recorder's thinning rule); journal values with 7 significant digits, positions to 0.1 um and
+//! rotations to 1e-7 (times in full).
 //! Series: the table's rows cut into [`SERIES_BUCKETS`] buckets of time, each keeping its
 //! smallest and largest value (so every impact's force peak stays).
 
@@ -31,7 +32,7 @@ pub const FILE: &str = "replay.html";
 /// Free-flight frames over a run: one per `end_s / FRAMES`.
 pub const FRAMES: f64 = 2000.0;
 /// In-contact frame density: one per `end_s / CONTACT_FRAMES` while a journal is in contact.
-pub const CONTACT_FRAMES: f64 = 200_000.0;
+pub const CONTACT_FRAMES: f64 = 100_000.0;
 /// Time buckets of the plotted series (each keeps its smallest and largest value).
 pub const SERIES_BUCKETS: usize = 1500;
 
@@ -135,6 +136,11 @@ fn round_sig(x: f64, digits: usize) -> f64 {
     format!("{:.*e}", digits - 1, x).parse().unwrap_or(x)
 }
 
+/// `x` rounded to `decimals` decimal places.
+fn round_decimals(x: f64, decimals: usize) -> f64 {
+    format!("{x:.decimals$}").parse().unwrap_or(x)
+}
+
 /// A replay page: a recording, impacts, plotted series and captions.
 #[derive(Clone, Debug)]
 pub struct ReplayPage<'a> {
@@ -197,8 +203,9 @@ impl ReplayPage<'_> {
         };
         for f in &r.frames {
             data.t.push(f.t);
+            // Positions to 0.1 um and quaternions to 1e-7 (a rotation of 0.2 urad).
             for p in &f.poses {
-                data.poses.extend(p.iter().map(|&x| round_sig(x, 7)));
+                data.poses.extend(p.iter().map(|&x| round_decimals(x, 7)));
             }
             for (k, j) in f.journals.iter().enumerate() {
                 data.jf.extend(

@@ -29,7 +29,9 @@ pub fn run(end: f64) -> clearance_joint::Result<Recording> {
     let collider = ColliderBuilder::cuboid(0.02, 0.3, 0.01)
         .density(7800.0)
         .collision_groups(InteractionGroups::none());
-    world.colliders.insert_with_parent(collider, arm, &mut world.bodies);
+    world
+        .colliders
+        .insert_with_parent(collider, arm, &mut world.bodies);
     let hinge = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0));
     let hinge = world.impulse_joints.insert(base, arm, hinge, true);
     let mut clearance = ClearanceJointSet::new();
@@ -72,7 +74,11 @@ fn main() -> clearance_joint::Result<()> {
         v,
     };
     let journal = |f: &dyn Fn(&clearance_joint::rapier::replay::JournalFrame) -> f64| {
-        recording.frames.iter().map(|fr| f(&fr.journals[0])).collect()
+        recording
+            .frames
+            .iter()
+            .map(|fr| f(&fr.journals[0]))
+            .collect()
     };
     let series = vec![
         Series {

@@ -286,7 +286,8 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
         }
     }
     if let Some(recording) = &recording {
-        let path = clearance_joint_app::replay::write_run_replay(scene, &result, recording, &job.out)?;
+        let path =
+            clearance_joint_app::replay::write_run_replay(scene, &result, recording, &job.out)?;
         println!("wrote {}", path.display());
     }
     Ok(())

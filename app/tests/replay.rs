@@ -67,12 +67,7 @@ fn console_errors(stderr: &str) -> Vec<&str> {
 fn csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
     let text = std::fs::read_to_string(path).unwrap();
     let mut lines = text.lines();
-    let header: Vec<String> = lines
-        .next()
-        .unwrap()
-        .split(',')
-        .map(String::from)
-        .collect();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
     let rows = lines
         .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
         .collect();
@@ -97,7 +92,14 @@ fn replay_opens_in_chromium_at_an_impact_and_matches_the_csv() {
     let dir = std::env::temp_dir().join(format!("cj-replay-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     let status = Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
-        .args(["--end", "0.12", "--no-figures", "--progress", "quiet", "--out"])
+        .args([
+            "--end",
+            "0.12",
+            "--no-figures",
+            "--progress",
+            "quiet",
+            "--out",
+        ])
         .arg(&dir)
         .status()
         .unwrap();
@@ -134,7 +136,11 @@ fn replay_opens_in_chromium_at_an_impact_and_matches_the_csv() {
     assert!(errors.is_empty(), "console errors: {errors:?}");
     let status = status_of(&dom);
     assert_eq!(status["ready"], true, "{status}");
-    assert_eq!(status["errors"].as_array().map(Vec::len), Some(0), "{status}");
+    assert_eq!(
+        status["errors"].as_array().map(Vec::len),
+        Some(0),
+        "{status}"
+    );
     assert!(status["impacts"].as_u64().unwrap() >= 1, "{status}");
     let shown_t = status["t"].as_f64().unwrap();
     assert!((shown_t - t).abs() < 1e-12, "page time {shown_t} vs {t}");
@@ -192,7 +198,10 @@ fn replay_opens_in_chromium_at_an_impact_and_matches_the_csv() {
         &["--dump-dom"],
         &profile,
     );
-    assert!(!console_errors(&log).is_empty(), "no console error seen: {log}");
+    assert!(
+        !console_errors(&log).is_empty(),
+        "no console error seen: {log}"
+    );
     let status = status_of(&dom);
     assert!(
         status["errors"].as_array().is_some_and(|e| !e.is_empty()),

@@ -8,10 +8,12 @@
 //! (serde); the app turns it into a self-contained `replay.html`.
 //!
 //! **Thinning rule.** A state is kept when at least `interval` has passed since the last kept
-//! state; while any tracked journal is in contact (and at the state where a contact ends), when
-//! at least `contact_interval` has passed; always at a contact's onset and at the state just
-//! before it, and the last state recorded. So every impact's samples are kept at the contact's
-//! own resolution while the free flight between impacts costs one frame per `interval`.
+//! state; during the first [`DENSE_FRAMES`] `contact_interval`s after a contact's onset (while
+//! in contact, and at the state where that contact ends), when at least `contact_interval` has
+//! passed; always at a contact's onset and at the state just before it, and the last state
+//! recorded. So every impact is kept at the contact's own resolution while free flight and
+//! sustained contact (a journal sliding along the wall) cost one frame per `interval`: at most
+//! `duration / interval + impacts x (DENSE_FRAMES + 2)` frames.
 //!
 //! ```
 //! use clearance_joint::prelude::*;
@@ -54,6 +56,9 @@ use crate::rapier::joint::{ClearanceJointHandle, ClearanceJointSet};
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::*;
 use serde::{Deserialize, Serialize};
+
+/// Frames of a contact kept at `contact_interval` after its onset (see the module docs).
+pub const DENSE_FRAMES: f64 = 100.0;
 
 /// A shape drawn for a body, in the body's frame.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -204,6 +209,8 @@ pub struct ReplayRecorder {
     /// The last state recorded, when not kept (kept if a contact starts next).
     pending: Option<ReplayFrame>,
     in_contact: bool,
+    /// Time of the last contact onset.
+    onset: f64,
     last_kept: f64,
 }
 
@@ -231,6 +238,7 @@ impl ReplayRecorder {
             joints: Vec::new(),
             pending: None,
             in_contact: false,
+            onset: f64::NEG_INFINITY,
             last_kept: f64::NEG_INFINITY,
         })
     }
@@ -328,7 +336,11 @@ impl ReplayRecorder {
         let frame = self.frame(t, bodies, sets);
         let contact = frame.journals.iter().any(|j| j.contact);
         let onset = contact && !self.in_contact;
-        let spacing = if contact || self.in_contact {
+        if onset {
+            self.onset = t;
+        }
+        let dense = t - self.onset <= DENSE_FRAMES * self.recording.contact_interval_s;
+        let spacing = if (contact || self.in_contact) && dense {
             self.recording.contact_interval_s
         } else {
             self.recording.interval_s

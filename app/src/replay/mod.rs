@@ -9,9 +9,10 @@
 //! from the run's tables. The viewer is a hand-written canvas-2D renderer (a few hundred lines,
 //! no library, no WebGL: it draws wherever a canvas does, headless browsers included).
 //!
-//! **Size.** Frames: one per `end_s / FRAMES` of free flight, one per `end_s / CONTACT_FRAMES`
-//! while a journal is in contact, and every contact onset with the state before it (the
-//! recorder's thinning rule); journal values with 7 significant digits, positions to 0.1 um and
+//! **Size.** Frames: one per `end_s / FRAMES` of free flight and sustained contact, one per
+//! `end_s / CONTACT_FRAMES` over the first 100 of those after each contact's onset, and every
+//! onset with the state before it (the recorder's thinning rule,
+//! [`clearance_joint::rapier::replay`]); journal values with 7 significant digits, positions to 0.1 um and
 //! rotations to 1e-7 (times in full).
 //! Series: the table's rows cut into [`SERIES_BUCKETS`] buckets of time, each keeping its
 //! smallest and largest value (so every impact's force peak stays).
@@ -20,9 +21,7 @@ use clearance_joint::error::{Error, Result};
 use clearance_joint::rapier::replay::Recording;
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::output::write_atomic;
-use clearance_joint::scene::runner::{
-    Progress, RunOptions, RunResult, Simulation, TwinKind,
-};
+use clearance_joint::scene::runner::{Progress, RunOptions, RunResult, Simulation, TwinKind};
 use clearance_joint::table::Table;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -227,11 +226,14 @@ impl ReplayPage<'_> {
         }
         // Speed: the whole run in about 20 s of wall time (a preset of the menu).
         let span = r.frames[r.frames.len() - 1].t - r.frames[0].t;
-        data.default_speed = [0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0]
-            .into_iter()
-            .find(|&s| span / s <= 25.0)
-            .unwrap_or(2.0);
-        let json = serde_json::to_string(&data).map_err(|e| Error::invalid("replay", e.to_string()))?;
+        data.default_speed = [
+            0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0,
+        ]
+        .into_iter()
+        .find(|&s| span / s <= 25.0)
+        .unwrap_or(2.0);
+        let json =
+            serde_json::to_string(&data).map_err(|e| Error::invalid("replay", e.to_string()))?;
         // Inside <script>, `</` must not appear (JSON allows `<\/`).
         let json = json.replace("</", "<\\/");
         Ok(TEMPLATE
@@ -248,7 +250,9 @@ impl ReplayPage<'_> {
 }
 
 fn escape_html(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
 }
 
 /// The replay page of a scene run: the recording, and for each clearance hinge its angle, rate
@@ -293,8 +297,8 @@ pub fn run_page<'a>(scene: &Scene, result: &RunResult, recording: &'a Recording)
             run.stepping()
         ),
         notes: format!(
-            "Frames: {} kept of the run's states: one per {} s in free flight, one per {} s while a \
-             journal is in contact, and every contact onset with the state before it; in between, \
+            "Frames: {} kept of the run's states: one per {} s, one per {} s over the first {} s of \
+             each contact, and every contact onset with the state before it; in between, \
              positions and journal values are interpolated linearly. Plots: the CSV rows, thinned to \
              {SERIES_BUCKETS} time buckets keeping each bucket's smallest and largest value. Bodies: \
              their colliders, else the uniform box with their mass and inertia; grey: a fixed body, \
@@ -302,6 +306,9 @@ pub fn run_page<'a>(scene: &Scene, result: &RunResult, recording: &'a Recording)
             recording.frames.len(),
             clearance_joint::error::sig4(recording.interval_s),
             clearance_joint::error::sig4(recording.contact_interval_s),
+            clearance_joint::error::sig4(
+                clearance_joint::rapier::replay::DENSE_FRAMES * recording.contact_interval_s
+            ),
         ),
         recording,
         series,

@@ -918,8 +918,8 @@ impl Twin {
                     recorder.track_journal(&h.name, group, set_index, c, &self.clearance)?
                 }
                 HingeJoint::Ideal => {
-                    let anchor = Vector::from(spec.point_m)
-                        - Vector::from(scene.body_origin(h.bearing));
+                    let anchor =
+                        Vector::from(spec.point_m) - Vector::from(scene.body_origin(h.bearing));
                     recorder.track_pin(&h.name, group, b1, b2, anchor, h.local_axis1)?
                 }
             }

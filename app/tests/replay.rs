@@ -113,7 +113,7 @@ fn replay_opens_in_chromium_at_an_impact_and_matches_the_csv() {
 
     // A row inside the first impact: the first row after its onset.
     let (ih, impacts) = csv(&dir.join("clearance_hinge_impacts.csv"));
-    let onset_col = ih.iter().position(|c| c.starts_with("t_")).unwrap();
+    let onset_col = ih.iter().position(|c| c == "onset_t_s").unwrap();
     let onset = impacts[0][onset_col];
     let (header, rows) = csv(&dir.join("clearance.csv"));
     let col = |name: &str| header.iter().position(|c| c == name).unwrap();

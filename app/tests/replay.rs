@@ -101,9 +101,13 @@ fn replay_opens_in_chromium_at_an_impact_and_matches_the_csv() {
             "--out",
         ])
         .arg(&dir)
-        .status()
+        .output()
         .unwrap();
-    assert!(status.success());
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
     let page = dir.join("replay.html");
     let html = std::fs::read_to_string(&page).expect("replay.html written beside the CSVs");
     assert!(

@@ -41,6 +41,8 @@ pub fn run(end: f64) -> clearance_joint::Result<Recording> {
 
     let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.0075));
     stepper.prepare(&mut world, &mut [&mut clearance])?;
+    // Mass properties before the first step (Rapier computes them in it).
+    clearance_joint::rapier::reaction::prepare_mass_properties(&mut world.bodies);
     // A frame per ms in free flight, per 10 us in contact (every onset and the state before it).
     let mut recorder = ReplayRecorder::new(1e-3, 1e-5)?;
     recorder.track_body("base", "clearance", base, &world.bodies, &world.colliders);

@@ -17,7 +17,7 @@
 //!
 //! ```
 //! use clearance_joint::prelude::*;
-//! use clearance_joint::rapier::replay::ReplayRecorder;
+//! use clearance_joint::rapier::replay::{ReplayRecorder, ReplayShape};
 //! use rapier3d_f64::prelude::*;
 //!
 //! let mut world = PhysicsWorld::new();
@@ -34,6 +34,8 @@
 //! let play = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?;
 //! let hinge = clearance.convert_revolute(hinge, BearingSide::Body1, play, &mut world.impulse_joints)?;
 //!
+//! // Mass properties now (Rapier computes them in the first step): the arm's box comes from them.
+//! clearance_joint::rapier::reaction::prepare_mass_properties(&mut world.bodies);
 //! // One frame per ms in free flight, one per 10 us in contact.
 //! let mut recorder = ReplayRecorder::new(1e-3, 1e-5)?;
 //! recorder.track_body("base", "clearance", base, &world.bodies, &world.colliders);
@@ -48,6 +50,7 @@
 //! }
 //! let recording = recorder.finish();
 //! assert_eq!(recording.frames.last().unwrap().t, stepper.time());
+//! assert!(matches!(recording.bodies[1].shapes[0], ReplayShape::Box { .. }));
 //! # Ok::<(), clearance_joint::Error>(())
 //! ```
 
@@ -244,8 +247,10 @@ impl ReplayRecorder {
     }
 
     /// Tracks a body (in group `group`), its shapes from its colliders or its mass properties
-    /// (see [`ReplayBody::shapes`]; call after the mass properties are known, e.g. after
-    /// [`Stepper::prepare`](crate::rapier::stepper::Stepper::prepare)). Returns its index.
+    /// (see [`ReplayBody::shapes`]; call after the mass properties are known: Rapier computes
+    /// them in the first step,
+    /// [`prepare_mass_properties`](crate::rapier::reaction::prepare_mass_properties) before it).
+    /// Returns its index.
     pub fn track_body(
         &mut self,
         name: &str,

@@ -285,10 +285,13 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
             other => other?,
         }
     }
-    if let Some(recording) = &recording {
-        let path =
-            clearance_joint_app::replay::write_run_replay(scene, &result, recording, &job.out)?;
-        println!("wrote {}", path.display());
+    match &recording {
+        Some(recording) => {
+            let path =
+                clearance_joint_app::replay::write_run_replay(scene, &result, recording, &job.out)?;
+            println!("wrote {}", path.display());
+        }
+        None => clearance_joint_app::replay::remove_stale(&job.out)?,
     }
     Ok(())
 }

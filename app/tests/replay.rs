@@ -211,6 +211,28 @@ fn replay_opens_in_chromium_at_an_impact_and_matches_the_csv() {
         status["errors"].as_array().is_some_and(|e| !e.is_empty()),
         "the page's error list misses it: {status}"
     );
+    // Recording changes nothing in the run; without it no replay is left behind.
+    let clear = std::fs::read(dir.join("clearance.csv")).unwrap();
+    let run = Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
+        .args([
+            "--end",
+            "0.12",
+            "--no-figures",
+            "--no-replay",
+            "--progress",
+            "quiet",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert_eq!(std::fs::read(dir.join("clearance.csv")).unwrap(), clear);
+    assert!(!page.exists(), "a stale replay.html stayed");
     // Kept for a look (target/replay-test.png).
     let keep = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/replay-test.png");
     let _ = std::fs::copy(&shot, keep);

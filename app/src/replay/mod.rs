@@ -325,6 +325,20 @@ pub fn write_run_replay(
     run_page(scene, result, recording).write(dir)
 }
 
+/// Removes `dir/replay.html` if present: a result set written without a replay must not keep
+/// an older run's.
+pub fn remove_stale(dir: &Path) -> Result<()> {
+    let path = dir.join(FILE);
+    match std::fs::remove_file(&path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(Error::Io {
+            action: "cannot remove",
+            path,
+            source: e,
+        }),
+        _ => Ok(()),
+    }
+}
+
 /// The `## Replays` section of a study's report: a link per case whose folder holds a replay
 /// (empty when none does).
 pub fn report_section(dir: &Path, cases: &[crate::study::case::StudyCase]) -> String {

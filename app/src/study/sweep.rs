@@ -288,8 +288,11 @@ impl Job {
             .map_err(|e| e.with_step_mode(adaptive))?;
         let metrics = RunMetrics::of(&result)?;
         result.write(&self.dir)?;
-        if let Some(recording) = &recording {
-            crate::replay::write_run_replay(&self.scene, &result, recording, &self.dir)?;
+        match &recording {
+            Some(recording) => {
+                crate::replay::write_run_replay(&self.scene, &result, recording, &self.dir)?;
+            }
+            None => crate::replay::remove_stale(&self.dir)?,
         }
         let mut files = Vec::new();
         for twin in &result.twins {

@@ -238,3 +238,56 @@ fn replay_opens_in_chromium_at_an_impact_and_matches_the_csv() {
     let _ = std::fs::copy(&shot, keep);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A study writes each case's replay in its folder and links it from its report; a rerun
+/// without replays removes them and the links.
+#[test]
+fn study_cases_have_replays_linked_from_the_report() {
+    use clearance_joint::scene::Scene;
+    use clearance_joint_app::study::sweep::{ExecOptions, Progress};
+    use clearance_joint_app::study::{StudyOptions, run_studies, select};
+    let root = std::env::temp_dir().join(format!("cj-replay-study-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    let paper = Scene::solar_panel();
+    let run = |replay: bool| {
+        let options = StudyOptions {
+            exec: ExecOptions {
+                progress: Progress::Quiet,
+                replay,
+                rerun: true,
+                ..Default::default()
+            },
+            extra_overrides: vec!["run.end_s=0.1".into()],
+            no_figures: true,
+        };
+        run_studies(
+            &select(&paper, "friction").unwrap(),
+            &paper,
+            &root,
+            &options,
+        )
+        .unwrap()
+    };
+    let outcomes = run(true);
+    let report = std::fs::read_to_string(&outcomes[0].report).unwrap();
+    assert!(report.contains("## Replays"), "{report}");
+    for case in &outcomes[0].cases {
+        assert!(case.dir.join("replay.html").is_file(), "{:?}", case.dir);
+        let link = case
+            .dir
+            .strip_prefix(&outcomes[0].dir)
+            .unwrap()
+            .join("replay.html");
+        assert!(report.contains(&*link.to_string_lossy()), "{report}");
+    }
+    let outcomes = run(false);
+    let report = std::fs::read_to_string(&outcomes[0].report).unwrap();
+    assert!(!report.contains("## Replays"), "{report}");
+    assert!(
+        outcomes[0]
+            .cases
+            .iter()
+            .all(|c| !c.dir.join("replay.html").exists())
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}

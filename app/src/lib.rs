@@ -7,7 +7,8 @@
 //!   named sweeps a scene file declares (the paper's three for its scene), with their reports.
 //! - [`figures`]: the figures of a run and of the studies (PNG and SVG).
 //! - [`progress`]: progress of a long run on a terminal.
-//! - [`resultset`]: a result set (data, figures, report) written as one unit.
+//! - [`replay`]: the self-contained `replay.html` of a run (3D, journal insets, timeline).
+//! - [`resultset`]: a result set (data, figures, report, replay) written as one unit.
 //!
 //! The binary (`src/main.rs`) parses arguments, calls these, prints and sets the exit code. The
 //! library crate `clearance_joint` knows nothing of this crate: depending on it builds none of
@@ -19,5 +20,6 @@
 pub mod cli;
 pub mod figures;
 pub mod progress;
+pub mod replay;
 pub mod resultset;
 pub mod study;

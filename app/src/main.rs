@@ -111,6 +111,9 @@ struct SweepArgs {
     /// Run only the points with index % N == K (K from 0): `--shard 0/4` ... `--shard 3/4`.
     #[arg(long, value_name = "K/N")]
     shard: Option<String>,
+    /// Write each point's replay (`points/<dir>/replay.html`, the table's `dir`); off by default.
+    #[arg(long)]
+    replay: bool,
     #[command(flatten)]
     exec: ExecArgs,
 }
@@ -141,6 +144,9 @@ struct StudyArgs {
     /// they are warnings in each case's `summary.json` and in the metrics table.
     #[arg(long)]
     strict: bool,
+    /// Skip the replays (each case's `replay.html`, linked from the report; written by default).
+    #[arg(long)]
+    no_replay: bool,
     #[command(flatten)]
     exec: ExecArgs,
 }
@@ -227,6 +233,10 @@ struct RunArgs {
     /// Skip the figures.
     #[arg(long)]
     no_figures: bool,
+    /// Skip the replay (`replay.html`: the run in 3D with the journal magnified in its bearing,
+    /// written beside the CSVs by default).
+    #[arg(long)]
+    no_replay: bool,
 }
 
 impl RunArgs {
@@ -270,10 +280,11 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
         clearance_joint::error::sig4(scene.run.end_s)
     );
     let mut progress = RunProgress::new(progress_mode(&args.progress));
-    let result = job.execute(|p| progress.update(p));
+    let result = job.execute_recorded(|p| progress.update(p), !args.no_replay);
     progress.finish();
-    let mut result = result?;
-    // The whole set (tables, summary, figures) goes to the staging folder, then into place.
+    let (mut result, recording) = result?;
+    // The whole set (tables, summary, figures, replay) goes to the staging folder, then into
+    // place.
     let summary = result.write(job.set.dir())?;
     let mut drawn = Vec::new();
     if figures {
@@ -281,6 +292,15 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
         draw_run_figures(scene, &result, job.set.dir(), |p| {
             drawn.push(job.set.final_path(p))
         })?;
+    }
+    if let Some(recording) = &recording {
+        let path = clearance_joint_app::replay::write_run_replay(
+            scene,
+            &result,
+            recording,
+            job.set.dir(),
+        )?;
+        drawn.push(job.set.final_path(&path));
     }
     let files = job.files(&result);
     let out = job.commit()?;
@@ -305,7 +325,8 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
 fn sweep(args: &SweepArgs) -> clearance_joint::Result<()> {
     let base = cli::load_scene(args.scene.as_deref())?;
     warn(&base);
-    let exec = args.exec.options()?;
+    let mut exec = args.exec.options()?;
+    exec.replay = args.replay;
     let out = args
         .out
         .clone()
@@ -370,8 +391,10 @@ fn study(args: &StudyArgs) -> clearance_joint::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out/studies"));
+    let mut exec = args.exec.options()?;
+    exec.replay = !args.no_replay;
     let options = StudyOptions {
-        exec: args.exec.options()?,
+        exec,
         extra_overrides: args
             .overrides
             .iter()

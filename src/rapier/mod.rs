@@ -12,6 +12,7 @@
 //! - [`reaction`]: exact ideal-joint reactions from the constrained equations.
 //! - [`metrics`]: impact lists, contact fraction and per-turn statistics.
 //! - [`ledger`]: the forces and torques each source applied in a step.
+//! - [`replay`]: bodies' poses and journals' states, thinned by time, for a replay of a run.
 //!
 //! Depends on [`crate::model`] only (and on Rapier); knows nothing of scenes or the ECS.
 
@@ -25,5 +26,6 @@ pub mod metrics;
 pub mod motion_step;
 pub mod prescribed;
 pub mod reaction;
+pub mod replay;
 pub mod stall;
 pub mod stepper;

@@ -74,6 +74,7 @@ pub fn exec_options(
         threads: Some(threads),
         rerun,
         max_memory: memory_budget(max_memory)?,
+        replay: false,
     };
     Ok((options, note))
 }

@@ -45,6 +45,20 @@ impl SceneRun {
             .map_err(|e| e.with_step_mode(self.scene.run.step == StepMode::Adaptive))
     }
 
+    /// As [`execute`](Self::execute), also recording the replay when `replay` (see
+    /// [`crate::replay`]).
+    pub fn execute_recorded(
+        &self,
+        progress: impl FnMut(&Progress),
+        replay: bool,
+    ) -> Result<(
+        RunResult,
+        Option<clearance_joint::rapier::replay::Recording>,
+    )> {
+        crate::replay::run_recorded(&self.scene, progress, replay)
+            .map_err(|e| e.with_step_mode(self.scene.run.step == StepMode::Adaptive))
+    }
+
     /// The files `result` writes (see [`RunResult::write`]), in the order they are listed.
     pub fn files(&self, result: &RunResult) -> Vec<String> {
         let mut files = vec!["ideal.csv".to_string(), "clearance.csv".to_string()];

@@ -278,6 +278,7 @@ fn finish_study(
         &conclusions,
         Some(&timeline),
     );
+    let text = text + &crate::replay::report_section(&dir, &cases);
     write_atomic(&dir.join("report.md"), text.as_bytes())?;
     for c in &mut cases {
         c.dir = set.final_path(&c.dir);

@@ -16,7 +16,6 @@ use clearance_joint::scene::Scene;
 use clearance_joint::scene::output::{
     DirLock, MemoryEstimate, bytes_text, write_all_atomic, write_atomic,
 };
-use clearance_joint::scene::runner::{RunOptions, Simulation};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -119,6 +118,9 @@ pub struct ExecOptions {
     /// Memory the parallel runs may hold, bytes (`None`: 80 % of what the system reports
     /// available, see [`clearance_joint::scene::output::available_memory`]).
     pub max_memory: Option<u64>,
+    /// Write each point's replay (`replay.html`, see [`crate::replay`]); a finished point
+    /// without one is run again.
+    pub replay: bool,
 }
 
 /// The number of worker threads for `requested` (`None`: one per core), at most one per core:
@@ -416,16 +418,30 @@ impl Job {
     /// Runs the point and writes its files, the manifest last. An old manifest is removed
     /// first, so an interrupted rerun never looks finished.
     pub fn run(&self) -> Result<Manifest> {
+        self.run_replay(false)
+    }
+
+    /// As [`run`](Self::run), also writing the point's replay (`replay.html`) when `replay`.
+    pub fn run_replay(&self, replay: bool) -> Result<Manifest> {
         // One process per point folder: a second sweep running the same point is refused
         // rather than mixing its files with ours.
         let _lock = DirLock::acquire(&self.dir)?;
         remove_if_present(&self.dir.join(MANIFEST))?;
         let adaptive = self.scene.run.step == clearance_joint::scene::StepMode::Adaptive;
-        let result = Simulation::new(&self.scene, RunOptions::default())?
-            .run()
+        let (mut result, recording) = crate::replay::run_recorded(&self.scene, |_| {}, replay)
             .map_err(|e| e.with_step_mode(adaptive))?;
+        // A point the step control stalled is an error of the sweep, not a result.
+        if let Some(e) = result.stopped.take() {
+            return Err(e.with_step_mode(adaptive));
+        }
         let metrics = RunMetrics::of(&result)?;
         result.write(&self.dir)?;
+        match &recording {
+            Some(recording) => {
+                crate::replay::write_run_replay(&self.scene, &result, recording, &self.dir)?;
+            }
+            None => crate::replay::remove_stale(&self.dir)?,
+        }
         let mut files = Vec::new();
         for twin in &result.twins {
             files.push(format!("{}.csv", twin.kind.name()));
@@ -505,9 +521,14 @@ fn execute_with(
                 .check(&job.scene, concurrent, budget)
                 .map_err(|e| in_point(e, &job.point))?;
         }
-        let (manifest, reused) = match (!options.rerun).then(|| job.finished()).flatten() {
+        // A finished point is reused unless a replay is asked for and it has none.
+        let finished = (!options.rerun)
+            .then(|| job.finished())
+            .flatten()
+            .filter(|_| !options.replay || job.dir.join(crate::replay::FILE).is_file());
+        let (manifest, reused) = match finished {
             Some(manifest) => (manifest, true),
-            None => (job.run()?, false),
+            None => (job.run_replay(options.replay)?, false),
         };
         Ok(PointOutcome {
             manifest: Manifest {

@@ -11,6 +11,7 @@ pub use invariants::{ENERGY_GROWTH_LIMIT, Invariants, MOTOR_SPEED_ERROR_LIMIT};
 pub use twin::{Twin, TwinKind};
 
 use crate::error::Result;
+use crate::rapier::replay::ReplayRecorder;
 use crate::rapier::stepper::{ForceSource, GuardKind, GuardReport, Stepper, Violation};
 use crate::scene::Scene;
 use comparison::ComparisonSums;
@@ -211,9 +212,45 @@ impl Simulation {
     /// [`RunResult::stopped`] and the time reached in [`RunResult::reached_s`]. Other errors
     /// (bad input, a diverged body, a strict guard, a fixed step too long) are returned as
     /// errors.
-    pub fn run_keeping_partial(mut self, mut progress: impl FnMut(&Progress)) -> Result<RunResult> {
+    pub fn run_keeping_partial(self, progress: impl FnMut(&Progress)) -> Result<RunResult> {
+        self.run_observed(progress, |_| {})
+    }
+
+    /// A recorder tracking both twins' bodies and hinges for a replay (groups `ideal` and
+    /// `clearance`), keeping a state per `interval` s in free flight and per
+    /// `contact_interval` s in contact; feed it with [`record_replay`](Self::record_replay),
+    /// e.g. from [`run_observed`](Self::run_observed).
+    pub fn replay_recorder(&self, interval: f64, contact_interval: f64) -> Result<ReplayRecorder> {
+        let mut recorder = ReplayRecorder::new(interval, contact_interval)?;
+        for (i, twin) in self.twins.iter().enumerate() {
+            twin.track_replay(&self.scene, &self.world, i, &mut recorder)?;
+        }
+        Ok(recorder)
+    }
+
+    /// Records the current state into a recorder from [`replay_recorder`](Self::replay_recorder).
+    pub fn record_replay(&self, recorder: &mut ReplayRecorder) {
+        let sets: Vec<&crate::rapier::joint::ClearanceJointSet> =
+            self.twins.iter().map(|t| &t.clearance).collect();
+        recorder.record(self.time(), &self.world.bodies, &sets);
+    }
+
+    /// As [`run_keeping_partial`](Self::run_keeping_partial) (a stalled run returns what it
+    /// computed, with the error in [`RunResult::stopped`]), also calling `observe` with the
+    /// simulation at the initial state and after every internal step (the force sources
+    /// evaluated at each of those states), e.g. to [`record_replay`](Self::record_replay).
+    pub fn run_observed(
+        mut self,
+        mut progress: impl FnMut(&Progress),
+        mut observe: impl FnMut(&Simulation),
+    ) -> Result<RunResult> {
         let start = Instant::now();
         let mut stopped = None;
+        {
+            let mut sources = sources(&mut self.twins);
+            self.stepper.prepare(&mut self.world, &mut sources)?;
+        }
+        observe(&self);
         while !self.done() {
             match self.step() {
                 Ok(()) => {}
@@ -228,6 +265,7 @@ impl Simulation {
                 end: self.scene.run.end_s,
                 steps: self.stepper.steps(),
             });
+            observe(&self);
         }
         let reached = if stopped.is_none() {
             self.finish()?;

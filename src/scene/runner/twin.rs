@@ -15,6 +15,7 @@ use crate::rapier::reaction::{
     IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, KinematicState,
     ReactionSolver, SoftMotor,
 };
+use crate::rapier::replay::{ReplayRecorder, in_plane_u};
 use crate::rapier::stepper::StepInfo;
 use crate::scene::{JointKindSpec, MotionSpec, MotorSpec, Scene};
 use crate::table::Table;
@@ -908,15 +909,34 @@ fn motor_of(spec: Option<&MotorSpec>) -> Option<Motor> {
     })
 }
 
-/// The in-plane `u` direction of a hinge: the world axis least aligned with `axis`, made
-/// orthogonal to it (world x for the paper's hinge; then `v = axis x u` is world z).
-fn in_plane_u(axis: Vector) -> Vector {
-    let candidates = [Vector::X, Vector::Y, Vector::Z];
-    let mut best = candidates[0];
-    for c in candidates {
-        if c.dot(axis).abs() < best.dot(axis).abs() - 1e-12 {
-            best = c;
+impl Twin {
+    /// Tracks this twin's bodies and hinges in `recorder` (group: the twin's name): clearance
+    /// hinges as journals of the clearance set passed `set_index`-th to
+    /// [`ReplayRecorder::record`], ideal hinges as pins at their scene point.
+    pub fn track_replay(
+        &self,
+        scene: &Scene,
+        world: &PhysicsWorld,
+        set_index: usize,
+        recorder: &mut ReplayRecorder,
+    ) -> Result<()> {
+        let group = self.kind.name();
+        for b in &self.bodies {
+            recorder.track_body(&b.name, group, b.handle, &world.bodies, &world.colliders);
         }
+        for (h, spec) in self.hinges.iter().zip(&scene.hinges) {
+            let (b1, b2) = (self.bodies[h.bearing].handle, self.bodies[h.journal].handle);
+            match h.joint {
+                HingeJoint::Clearance(c) => {
+                    recorder.track_journal(&h.name, group, set_index, c, &self.clearance)?
+                }
+                HingeJoint::Ideal => {
+                    let anchor =
+                        Vector::from(spec.point_m) - Vector::from(scene.body_origin(h.bearing));
+                    recorder.track_pin(&h.name, group, b1, b2, anchor, h.local_axis1)?
+                }
+            }
+        }
+        Ok(())
     }
-    (best - best.dot(axis) * axis).normalize()
 }

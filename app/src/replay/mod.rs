@@ -1,0 +1,392 @@
+//! The replay of a run: one self-contained `replay.html` (data and code inside, opened from disk
+//! with no network and no server) showing the bodies in 3D, the ideal and clearance twins side by
+//! side or overlaid, each clearance journal magnified in its bearing with its contact force, a
+//! timeline with every impact, play/pause/speed (slow motion near impacts), a scrubber, and the
+//! hinge's angle, rate and force plotted under it with a cursor that follows.
+//!
+//! The data comes from the library's [`ReplayRecorder`](clearance_joint::rapier::replay::ReplayRecorder)
+//! (any Rapier loop can feed one; [`ReplayPage`] writes its [`Recording`]), the plotted series
+//! from the run's tables. The viewer is a hand-written canvas-2D renderer (a few hundred lines,
+//! no library, no WebGL: it draws wherever a canvas does, headless browsers included).
+//!
+//! **Size.** Frames: one per `end_s / FRAMES` of free flight and sustained contact, one per
+//! `end_s / CONTACT_FRAMES` over the first 100 of those after each contact's onset, and every
+//! onset with the state before it (the recorder's thinning rule,
+//! [`clearance_joint::rapier::replay`]); journal values with 7 significant digits, positions to 0.1 um and
+//! rotations to 1e-7 (times in full).
+//! Series: the table's rows cut into [`SERIES_BUCKETS`] buckets of time, each keeping its
+//! smallest and largest value (so every impact's force peak stays).
+
+use clearance_joint::error::{Error, Result};
+use clearance_joint::rapier::replay::Recording;
+use clearance_joint::scene::Scene;
+use clearance_joint::scene::output::write_atomic;
+use clearance_joint::scene::runner::{Progress, RunOptions, RunResult, Simulation, TwinKind};
+use clearance_joint::table::Table;
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// File name of the replay in a result set.
+pub const FILE: &str = "replay.html";
+/// Free-flight frames over a run: one per `end_s / FRAMES`.
+pub const FRAMES: f64 = 2000.0;
+/// In-contact frame density: one per `end_s / CONTACT_FRAMES` while a journal is in contact.
+pub const CONTACT_FRAMES: f64 = 100_000.0;
+/// Time buckets of the plotted series (each keeps its smallest and largest value).
+pub const SERIES_BUCKETS: usize = 1500;
+
+const TEMPLATE: &str = include_str!("../../assets/replay/replay.html");
+
+/// Runs `scene` (both twins) like [`Simulation::run_with_progress`], recording a replay when
+/// `replay` (see the module docs for the frame rule).
+pub fn run_recorded(
+    scene: &Scene,
+    progress: impl FnMut(&Progress),
+    replay: bool,
+) -> Result<(RunResult, Option<Recording>)> {
+    let sim = Simulation::new(scene, RunOptions::default())?;
+    if !replay {
+        return Ok((sim.run_keeping_partial(progress)?, None));
+    }
+    let end = scene.run.end_s;
+    let mut recorder = sim.replay_recorder(end / FRAMES, end / CONTACT_FRAMES)?;
+    let result = sim.run_observed(progress, |s| s.record_replay(&mut recorder))?;
+    Ok((result, Some(recorder.finish())))
+}
+
+/// One plotted quantity: a panel with a line per twin.
+#[derive(Clone, Debug, Serialize)]
+pub struct Series {
+    /// Panel title (with unit).
+    pub title: String,
+    /// Its lines.
+    pub lines: Vec<Line>,
+}
+
+/// One line of a [`Series`].
+#[derive(Clone, Debug, Serialize)]
+pub struct Line {
+    /// Legend.
+    pub label: String,
+    /// Colour group (`ideal`, `clearance`, ...).
+    pub group: String,
+    /// Times, s.
+    pub t: Vec<f64>,
+    /// Values.
+    pub v: Vec<f64>,
+}
+
+impl Line {
+    /// Column `column` of `table` against its `t_s`, thinned to [`SERIES_BUCKETS`] buckets of
+    /// time keeping each bucket's smallest and largest value (in time order).
+    pub fn from_table(label: &str, group: &str, table: &Table, column: &str) -> Option<Line> {
+        let (t, v) = (table.column("t_s")?, table.column(column)?);
+        let (t, v) = min_max_thin(&t, &v, SERIES_BUCKETS);
+        Some(Line {
+            label: label.into(),
+            group: group.into(),
+            t,
+            v: v.into_iter().map(|x| round_sig(x, 7)).collect(),
+        })
+    }
+}
+
+/// Keeps, per bucket of `buckets` equal time spans, the samples with the smallest and the
+/// largest value (in time order): peaks survive any thinning.
+pub fn min_max_thin(t: &[f64], v: &[f64], buckets: usize) -> (Vec<f64>, Vec<f64>) {
+    let n = t.len().min(v.len());
+    if n <= 2 * buckets || n < 2 {
+        return (t[..n].to_vec(), v[..n].to_vec());
+    }
+    let (t0, t1) = (t[0], t[n - 1]);
+    let span = (t1 - t0).max(f64::MIN_POSITIVE);
+    let mut keep = Vec::with_capacity(2 * buckets + 2);
+    let mut i = 0;
+    while i < n {
+        let b = (((t[i] - t0) / span) * buckets as f64).floor() as usize;
+        let (mut lo, mut hi) = (i, i);
+        let mut j = i;
+        while j < n && ((((t[j] - t0) / span) * buckets as f64).floor() as usize) == b {
+            if v[j] < v[lo] {
+                lo = j;
+            }
+            if v[j] > v[hi] {
+                hi = j;
+            }
+            j += 1;
+        }
+        keep.push(lo.min(hi));
+        if hi != lo {
+            keep.push(lo.max(hi));
+        }
+        i = j;
+    }
+    (
+        keep.iter().map(|&k| t[k]).collect(),
+        keep.iter().map(|&k| v[k]).collect(),
+    )
+}
+
+/// `x` rounded to `digits` significant digits (shorter JSON).
+fn round_sig(x: f64, digits: usize) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    format!("{:.*e}", digits - 1, x).parse().unwrap_or(x)
+}
+
+/// `x` rounded to `decimals` decimal places.
+fn round_decimals(x: f64, decimals: usize) -> f64 {
+    format!("{x:.decimals$}").parse().unwrap_or(x)
+}
+
+/// A replay page: a recording, impacts, plotted series and captions.
+#[derive(Clone, Debug)]
+pub struct ReplayPage<'a> {
+    /// Page title.
+    pub title: String,
+    /// Line under the title (settings).
+    pub subtitle: String,
+    /// Notes under the plots (thinning rule, sources).
+    pub notes: String,
+    /// What was recorded.
+    pub recording: &'a Recording,
+    /// Plotted series.
+    pub series: Vec<Series>,
+}
+
+#[derive(Serialize)]
+struct Impact {
+    t: f64,
+    journal: usize,
+}
+
+#[derive(Serialize)]
+struct PageData<'a> {
+    title: &'a str,
+    subtitle: &'a str,
+    notes: &'a str,
+    bodies: &'a [clearance_joint::rapier::replay::ReplayBody],
+    journals: &'a [clearance_joint::rapier::replay::ReplayJournal],
+    pins: &'a [clearance_joint::rapier::replay::ReplayPin],
+    t: Vec<f64>,
+    poses: Vec<f64>,
+    jf: Vec<f64>,
+    contact: Vec<u8>,
+    impacts: Vec<Impact>,
+    series: &'a [Series],
+    default_speed: f64,
+}
+
+impl ReplayPage<'_> {
+    /// The page's HTML: the viewer with the data inside (no external resource).
+    pub fn html(&self) -> Result<String> {
+        let r = self.recording;
+        if r.frames.is_empty() {
+            return Err(Error::invalid("replay", "the recording holds no frame"));
+        }
+        let mut data = PageData {
+            title: &self.title,
+            subtitle: &self.subtitle,
+            notes: &self.notes,
+            bodies: &r.bodies,
+            journals: &r.journals,
+            pins: &r.pins,
+            t: Vec::with_capacity(r.frames.len()),
+            poses: Vec::new(),
+            jf: Vec::new(),
+            contact: Vec::new(),
+            impacts: Vec::new(),
+            series: &self.series,
+            default_speed: 0.0,
+        };
+        for f in &r.frames {
+            data.t.push(f.t);
+            // Positions to 0.1 um and quaternions to 1e-7 (a rotation of 0.2 urad).
+            for p in &f.poses {
+                data.poses.extend(p.iter().map(|&x| round_decimals(x, 7)));
+            }
+            for (k, j) in f.journals.iter().enumerate() {
+                data.jf.extend(
+                    [
+                        j.ecc_u_m,
+                        j.ecc_v_m,
+                        j.force_u_n,
+                        j.force_v_n,
+                        j.force_n,
+                        j.penetration_m,
+                    ]
+                    .map(|x| round_sig(x, 7)),
+                );
+                data.contact.push(j.contact as u8);
+                if j.impact {
+                    data.impacts.push(Impact { t: f.t, journal: k });
+                }
+            }
+        }
+        // Speed: the whole run in about 20 s of wall time (a preset of the menu).
+        let span = r.frames[r.frames.len() - 1].t - r.frames[0].t;
+        data.default_speed = [
+            0.001, 0.002, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1.0, 2.0,
+        ]
+        .into_iter()
+        .find(|&s| span / s <= 25.0)
+        .unwrap_or(2.0);
+        let json =
+            serde_json::to_string(&data).map_err(|e| Error::invalid("replay", e.to_string()))?;
+        // Inside <script>, `</` must not appear (JSON allows `<\/`).
+        let json = json.replace("</", "<\\/");
+        Ok(TEMPLATE
+            .replacen("__TITLE__", &escape_html(&self.title), 1)
+            .replacen("__DATA__", &json, 1))
+    }
+
+    /// Writes the page to `dir/replay.html` (atomically) and returns its path.
+    pub fn write(&self, dir: &Path) -> Result<PathBuf> {
+        let path = dir.join(FILE);
+        write_atomic(&path, self.html()?.as_bytes())?;
+        Ok(path)
+    }
+}
+
+fn escape_html(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// The replay page of a scene run: the recording, and for each clearance hinge its angle, rate
+/// and force, ideal against clearance, from the run's tables.
+pub fn run_page<'a>(scene: &Scene, result: &RunResult, recording: &'a Recording) -> ReplayPage<'a> {
+    let twins: Vec<(&str, &Table)> = result
+        .twins
+        .iter()
+        .map(|t| (t.kind.name(), &t.table))
+        .collect();
+    let hinges: Vec<String> = result
+        .twin(TwinKind::Clearance)
+        .map(|t| t.clearance_hinges().iter().map(|h| h.to_string()).collect())
+        .unwrap_or_default();
+    let mut series = Vec::new();
+    for h in &hinges {
+        for (what, column) in [
+            ("angle (deg)", "angle_deg"),
+            ("relative rate (deg/s)", "rate_deg_s"),
+            ("joint force (N)", "force_n"),
+        ] {
+            let lines: Vec<Line> = twins
+                .iter()
+                .filter_map(|(name, table)| {
+                    Line::from_table(name, name, table, &format!("{h}_{column}"))
+                })
+                .collect();
+            if !lines.is_empty() {
+                series.push(Series {
+                    title: format!("hinge `{h}`: {what}"),
+                    lines,
+                });
+            }
+        }
+    }
+    let run = &scene.run;
+    ReplayPage {
+        title: format!("{}: replay", scene.name),
+        subtitle: format!(
+            "{} s simulated, {}; ideal and clearance twins",
+            clearance_joint::error::sig4(run.end_s),
+            run.stepping()
+        ),
+        notes: format!(
+            "Frames: {} kept of the run's states: one per {} s, one per {} s over the first {} s of \
+             each contact, and every contact onset with the state before it; in between, \
+             positions and journal values are interpolated linearly. Plots: the CSV rows, thinned to \
+             {SERIES_BUCKETS} time buckets keeping each bucket's smallest and largest value. Bodies: \
+             their colliders, else the uniform box with their mass and inertia; grey: a fixed body, \
+             drawn around its joint points. Open at a time with #t=SECONDS.",
+            recording.frames.len(),
+            clearance_joint::error::sig4(recording.interval_s),
+            clearance_joint::error::sig4(recording.contact_interval_s),
+            clearance_joint::error::sig4(
+                clearance_joint::rapier::replay::DENSE_FRAMES * recording.contact_interval_s
+            ),
+        ),
+        recording,
+        series,
+    }
+}
+
+/// Writes the replay of a scene run into `dir` (see [`run_page`]); returns its path.
+pub fn write_run_replay(
+    scene: &Scene,
+    result: &RunResult,
+    recording: &Recording,
+    dir: &Path,
+) -> Result<PathBuf> {
+    run_page(scene, result, recording).write(dir)
+}
+
+/// Removes `dir/replay.html` if present: a result set written without a replay must not keep
+/// an older run's.
+pub fn remove_stale(dir: &Path) -> Result<()> {
+    let path = dir.join(FILE);
+    match std::fs::remove_file(&path) {
+        Err(e) if e.kind() != std::io::ErrorKind::NotFound => Err(Error::Io {
+            action: "cannot remove",
+            path,
+            source: e,
+        }),
+        _ => Ok(()),
+    }
+}
+
+/// The `## Replays` section of a study's report: a link per case whose folder holds a replay
+/// (empty when none does).
+pub fn report_section(dir: &Path, cases: &[crate::study::case::StudyCase]) -> String {
+    let links: Vec<String> = cases
+        .iter()
+        .filter(|c| c.dir.join(FILE).is_file())
+        .map(|c| {
+            let rel = c.dir.strip_prefix(dir).unwrap_or(&c.dir).join(FILE);
+            let size = std::fs::metadata(c.dir.join(FILE)).map_or(0, |m| m.len());
+            format!(
+                "- [{}]({}) ({:.1} MB)",
+                c.label,
+                rel.to_string_lossy().replace('\\', "/"),
+                size as f64 / 1e6
+            )
+        })
+        .collect();
+    if links.is_empty() {
+        return String::new();
+    }
+    format!(
+        "\n## Replays\n\nEach case's run in 3D, ideal and clearance twins side by side, the journal \
+         magnified in its bearing, every impact on the timeline (one self-contained file; open it in \
+         a browser):\n\n{}\n",
+        links.join("\n")
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn min_max_thinning_keeps_the_peak() {
+        let t: Vec<f64> = (0..10_000).map(|i| i as f64 * 1e-3).collect();
+        let mut v = vec![0.0; 10_000];
+        v[4321] = 7.0;
+        v[8000] = -3.0;
+        let (tt, vv) = min_max_thin(&t, &v, 100);
+        assert!(tt.len() <= 200, "{}", tt.len());
+        assert!(vv.contains(&7.0) && vv.contains(&-3.0));
+        assert!(tt.windows(2).all(|w| w[0] < w[1]));
+    }
+
+    #[test]
+    fn rounding_keeps_seven_digits() {
+        assert_eq!(round_sig(0.123456789, 7), 0.1234568);
+        assert_eq!(round_sig(-1.0e-5, 7), -1.0e-5);
+        assert_eq!(round_sig(0.0, 7), 0.0);
+    }
+}

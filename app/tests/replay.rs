@@ -1,0 +1,293 @@
+//! The replay page in a real browser: a short run of the paper's scene writes `replay.html`;
+//! headless Chromium opens it at the time of a row inside the first impact (`#t=...`), and the
+//! page must raise no error, report that time and the eccentricity of the CSV row, and draw a
+//! screenshot that is not blank; the same page with a script error must fail the error checks.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const INSTALL: &str = "apt-get update && apt-get install -y chromium";
+
+/// The browser: `$CHROMIUM`, else `chromium`, `chromium-browser` or `google-chrome` on the PATH.
+fn chromium() -> PathBuf {
+    let candidates: Vec<String> = std::env::var("CHROMIUM")
+        .into_iter()
+        .chain(["chromium", "chromium-browser", "google-chrome"].map(String::from))
+        .collect();
+    for c in &candidates {
+        if let Ok(out) = Command::new(c).arg("--version").output()
+            && out.status.success()
+        {
+            return PathBuf::from(c);
+        }
+    }
+    panic!(
+        "no Chromium found (tried {candidates:?}): the replay test needs a real browser; install \
+         it with `{INSTALL}` (or set CHROMIUM to a Chromium/Chrome binary)"
+    );
+}
+
+/// Runs headless Chromium on `url` with `args`; returns (stdout, stderr).
+fn headless(browser: &Path, url: &str, args: &[&str], profile: &Path) -> (String, String) {
+    let out = Command::new(browser)
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--no-first-run",
+            "--disable-extensions",
+            "--hide-scrollbars",
+            "--enable-logging=stderr",
+            "--v=0",
+            "--window-size=1400,1150",
+            "--virtual-time-budget=20000",
+        ])
+        .arg(format!("--user-data-dir={}", profile.display()))
+        .args(args)
+        .arg(url)
+        .output()
+        .expect("chromium runs");
+    let (stdout, stderr) = (
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    );
+    assert!(out.status.success(), "chromium failed: {stderr}");
+    (stdout, stderr)
+}
+
+/// Console messages in Chromium's log (`...:INFO:CONSOLE:...`, whatever the level, uncaught
+/// exceptions included): the page writes none, so any is an error.
+fn console_errors(stderr: &str) -> Vec<&str> {
+    stderr
+        .lines()
+        .filter(|l| l.contains(":CONSOLE") || l.contains("Uncaught"))
+        .collect()
+}
+
+fn csv(path: &Path) -> (Vec<String>, Vec<Vec<f64>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text.lines();
+    let header: Vec<String> = lines.next().unwrap().split(',').map(String::from).collect();
+    let rows = lines
+        .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+        .collect();
+    (header, rows)
+}
+
+/// The page's status element (JSON), from the dumped DOM.
+fn status_of(dom: &str) -> serde_json::Value {
+    let start = dom.find("<pre id=\"status\">").expect("status element") + 17;
+    let end = start + dom[start..].find("</pre>").unwrap();
+    let text = dom[start..end]
+        .replace("&quot;", "\"")
+        .replace("&lt;", "<")
+        .replace("&gt;", ">")
+        .replace("&amp;", "&");
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("status is JSON ({e}): {text}"))
+}
+
+#[test]
+fn replay_opens_in_chromium_at_an_impact_and_matches_the_csv() {
+    let browser = chromium();
+    let dir = std::env::temp_dir().join(format!("cj-replay-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let status = Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
+        .args([
+            "--end",
+            "0.12",
+            "--no-figures",
+            "--progress",
+            "quiet",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let page = dir.join("replay.html");
+    let html = std::fs::read_to_string(&page).expect("replay.html written beside the CSVs");
+    assert!(
+        !html.contains("http://") && !html.contains("https://") && !html.contains(" src="),
+        "the page must load nothing from outside"
+    );
+
+    // A row inside the first impact: the first row after its onset.
+    let (ih, impacts) = csv(&dir.join("clearance_hinge_impacts.csv"));
+    let onset_col = ih.iter().position(|c| c == "onset_t_s").unwrap();
+    let onset = impacts[0][onset_col];
+    let (header, rows) = csv(&dir.join("clearance.csv"));
+    let col = |name: &str| header.iter().position(|c| c == name).unwrap();
+    let (tc, eu, ev, contact) = (
+        col("t_s"),
+        col("hinge_ecc_u_mm"),
+        col("hinge_ecc_v_mm"),
+        col("hinge_contact"),
+    );
+    let row = rows
+        .iter()
+        .find(|r| r[tc] > onset && r[contact] == 1.0)
+        .expect("a row in contact after the first onset");
+    let t = row[tc];
+    let url = format!("file://{}#t={t}", page.display());
+    let profile = dir.join("profile");
+
+    let (dom, log) = headless(&browser, &url, &["--dump-dom"], &profile);
+    let errors = console_errors(&log);
+    assert!(errors.is_empty(), "console errors: {errors:?}");
+    let status = status_of(&dom);
+    assert_eq!(status["ready"], true, "{status}");
+    assert_eq!(
+        status["errors"].as_array().map(Vec::len),
+        Some(0),
+        "{status}"
+    );
+    assert!(status["impacts"].as_u64().unwrap() >= 1, "{status}");
+    let shown_t = status["t"].as_f64().unwrap();
+    assert!((shown_t - t).abs() < 1e-12, "page time {shown_t} vs {t}");
+    let j = &status["clearance.hinge"];
+    let (pu, pv) = (
+        j["ecc_u_mm"].as_f64().unwrap(),
+        j["ecc_v_mm"].as_f64().unwrap(),
+    );
+    // Same states, same linear interpolation; the page's numbers carry 7 digits.
+    for (page_mm, csv_mm, what) in [(pu, row[eu], "u"), (pv, row[ev], "v")] {
+        assert!(
+            (page_mm - csv_mm).abs() < 1e-5,
+            "eccentricity {what}: page {page_mm} mm vs CSV {csv_mm} mm at t = {t}"
+        );
+    }
+    assert_eq!(j["contact"], true, "{j}");
+
+    // A screenshot that is not blank: many distinct colours and a real spread of brightness.
+    let shot = dir.join("replay.png");
+    let (_, log) = headless(
+        &browser,
+        &url,
+        &[&format!("--screenshot={}", shot.display())],
+        &profile,
+    );
+    assert!(console_errors(&log).is_empty(), "console errors: {log}");
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&shot).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    let channels = info.color_type.samples();
+    let pixels: Vec<&[u8]> = buf[..info.buffer_size()].chunks(channels).collect();
+    let luma: Vec<f64> = pixels
+        .iter()
+        .map(|p| 0.299 * p[0] as f64 + 0.587 * p[1] as f64 + 0.114 * p[2] as f64)
+        .collect();
+    let mean = luma.iter().sum::<f64>() / luma.len() as f64;
+    let var = luma.iter().map(|l| (l - mean).powi(2)).sum::<f64>() / luma.len() as f64;
+    let colours: std::collections::HashSet<&[u8]> = pixels.iter().copied().collect();
+    assert!(
+        var > 100.0 && colours.len() > 200,
+        "blank screenshot? luma variance {var}, {} colours",
+        colours.len()
+    );
+    // The error checks fire: the same page with a script error.
+    let broken = dir.join("broken.html");
+    std::fs::write(
+        &broken,
+        html.replacen("</body>", "<script>null.boom();</script></body>", 1),
+    )
+    .unwrap();
+    let (dom, log) = headless(
+        &browser,
+        &format!("file://{}#t={t}", broken.display()),
+        &["--dump-dom"],
+        &profile,
+    );
+    assert!(
+        !console_errors(&log).is_empty(),
+        "no console error seen: {log}"
+    );
+    let status = status_of(&dom);
+    assert!(
+        status["errors"].as_array().is_some_and(|e| !e.is_empty()),
+        "the page's error list misses it: {status}"
+    );
+    // Recording changes nothing in the run; without it no replay is left behind.
+    let clear = std::fs::read(dir.join("clearance.csv")).unwrap();
+    let run = Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
+        .args([
+            "--end",
+            "0.12",
+            "--no-figures",
+            "--no-replay",
+            "--progress",
+            "quiet",
+            "--out",
+        ])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert_eq!(std::fs::read(dir.join("clearance.csv")).unwrap(), clear);
+    assert!(!page.exists(), "a stale replay.html stayed");
+    // Kept for a look (target/replay-test.png).
+    let keep = Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/replay-test.png");
+    let _ = std::fs::copy(&shot, keep);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A study writes each case's replay in its folder and links it from its report; a rerun
+/// without replays removes them and the links.
+#[test]
+fn study_cases_have_replays_linked_from_the_report() {
+    use clearance_joint::scene::Scene;
+    use clearance_joint_app::study::sweep::{ExecOptions, Progress};
+    use clearance_joint_app::study::{StudyOptions, run_studies, select};
+    let root = std::env::temp_dir().join(format!("cj-replay-study-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&root);
+    let paper = Scene::solar_panel();
+    let run = |replay: bool| {
+        let options = StudyOptions {
+            exec: ExecOptions {
+                progress: Progress::Quiet,
+                replay,
+                rerun: true,
+                ..Default::default()
+            },
+            extra_overrides: vec!["run.end_s=0.1".into()],
+            no_figures: true,
+        };
+        run_studies(
+            &select(&paper, "friction").unwrap(),
+            &paper,
+            &root,
+            &options,
+        )
+        .unwrap()
+    };
+    let outcomes = run(true);
+    let report = std::fs::read_to_string(&outcomes[0].report).unwrap();
+    assert!(report.contains("## Replays"), "{report}");
+    for case in &outcomes[0].cases {
+        assert!(case.dir.join("replay.html").is_file(), "{:?}", case.dir);
+        let link = case
+            .dir
+            .strip_prefix(&outcomes[0].dir)
+            .unwrap()
+            .join("replay.html");
+        assert!(report.contains(&*link.to_string_lossy()), "{report}");
+    }
+    let outcomes = run(false);
+    let report = std::fs::read_to_string(&outcomes[0].report).unwrap();
+    assert!(!report.contains("## Replays"), "{report}");
+    assert!(
+        outcomes[0]
+            .cases
+            .iter()
+            .all(|c| !c.dir.join("replay.html").exists())
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}

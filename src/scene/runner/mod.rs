@@ -200,10 +200,11 @@ impl Simulation {
             if g > ENERGY_GROWTH_LIMIT {
                 guards.violation(&format!("energy:{}", twin.kind.name()), || {
                     format!(
-                        "the {} twin gained energy: {} of its energy scale (limit {})",
+                        "the {} twin gained energy: {} of its energy scale (limit {}){}",
                         twin.kind.name(),
                         crate::error::sig4(g),
-                        ENERGY_GROWTH_LIMIT
+                        ENERGY_GROWTH_LIMIT,
+                        start_mismatch_note(&twin.invariants)
                     )
                 });
             }
@@ -214,14 +215,27 @@ impl Simulation {
                 && e > MOTOR_SPEED_ERROR_LIMIT
             {
                 guards.violation(&format!("motor:{}", twin.kind.name()), || {
+                    let miss = match inv.motor_speed_miss {
+                        Some((miss, target, unit)) if target == 0.0 => format!(
+                            "{} {unit} (its target is 0: the limit is {} {unit})",
+                            crate::error::sig4(miss),
+                            crate::error::sig4(MOTOR_SPEED_ERROR_LIMIT * 1e-3)
+                        ),
+                        _ => format!(
+                            "{} of its target (limit {})",
+                            crate::error::sig4(e),
+                            MOTOR_SPEED_ERROR_LIMIT
+                        ),
+                    };
+                    let advice = match &inv.motor_start_mismatch {
+                        Some(_) if *t == 0.0 => start_mismatch_note(inv),
+                        _ => "; raise its `factor` or shorten the steps (`run.max_dt_s`)".into(),
+                    };
                     format!(
-                        "the {} twin's velocity motor `{name}` missed its speed by {} of its \
-                         target at t = {} s (limit {}): its torque and the reactions assume it \
-                         holds it; raise its `factor` or shorten the steps (`run.max_dt_s`)",
+                        "the {} twin's velocity motor `{name}` missed its speed by {miss} at t = \
+                         {} s: its torque and the reactions assume it holds it{advice}",
                         twin.kind.name(),
-                        crate::error::sig4(e),
                         crate::error::sig4(*t),
-                        MOTOR_SPEED_ERROR_LIMIT
                     )
                 });
             }
@@ -256,15 +270,16 @@ impl Simulation {
         let rows = !self.skip_rows;
         let lag = 0.5 * self.stepper.last_dt();
         for twin in &mut self.twins {
-            twin.before_step(&self.world.bodies, gravity, t, lag, rows);
+            twin.before_step(&self.world.bodies, gravity, t, lag, rows)?;
         }
         let target = self.target();
-        let info = {
+        let stepped = {
             let mut sources = sources(&mut self.twins);
             self.stepper
                 .step(&mut self.world, &mut sources, target)
-                .map_err(|e| name_step_field(e, "run.dt_s"))?
+                .map_err(|e| name_step_field(e, "run.dt_s"))
         };
+        let info = stepped.map_err(|e| self.name_diverged_body(e))?;
         for twin in &mut self.twins {
             twin.after_step(
                 &self.world.bodies,
@@ -282,6 +297,75 @@ impl Simulation {
         Ok(())
     }
 
+    /// Names, in a divergence, the body that left the physical range as the scene names it (the
+    /// stepper knows only Rapier's handles), with the likely cause.
+    fn name_diverged_body(&self, e: crate::Error) -> crate::Error {
+        let crate::Error::Diverged { t, .. } = e else {
+            return e;
+        };
+        let params = &self.world.integration_parameters;
+        let found = self.twins.iter().find_map(|twin| {
+            twin.bodies.iter().find_map(|b| {
+                let rb = self.world.bodies.get(b.handle)?;
+                left_physical_range(rb, params).map(|speed| (twin.kind, b, speed))
+            })
+        });
+        let Some((kind, body, speed)) = found else {
+            return e;
+        };
+        let spec = self.scene.bodies.iter().find(|s| s.name == body.name);
+        let drives: Vec<String> = self
+            .scene
+            .bodies
+            .iter()
+            .filter(|b| b.motion.is_some())
+            .map(|b| format!("`bodies[{}].motion`", b.name))
+            .chain(
+                self.scene
+                    .joints
+                    .iter()
+                    .filter(|j| j.motor.is_some())
+                    .map(|j| format!("`joints[{}].motor`", j.name)),
+            )
+            .chain(
+                self.scene
+                    .drives
+                    .iter()
+                    .map(|d| format!("`drives[{}]`", d.name)),
+            )
+            .collect();
+        let cause = if spec.is_some_and(|s| s.motion.is_some()) {
+            format!(
+                "its prescribed motion (`bodies[{}].motion`) moves it faster than the model \
+                 carries",
+                body.name
+            )
+        } else if !drives.is_empty() {
+            format!(
+                "the drive ({}) moves the mechanism faster than it can follow, or a contact is \
+                 too stiff for the step",
+                drives.join(", ")
+            )
+        } else {
+            "an initial velocity too high, or a contact too stiff for the step".to_string()
+        };
+        let speed = if speed.is_finite() {
+            format!("speed {} m/s", crate::error::sig4(speed))
+        } else {
+            "its state is not finite".to_string()
+        };
+        crate::Error::Diverged {
+            t,
+            reason: format!(
+                "body `{}` of the {} twin left the physical range ({speed}, the guard being {} \
+                 m/s); likely cause: {cause}",
+                body.name,
+                kind.name(),
+                crate::error::sig4(0.5 * params.max_linear_velocity()),
+            ),
+        }
+    }
+
     /// Records the final state: invariants, a last row at `end_s` (its reactions, velocities and
     /// accelerations solved at that state like every other), final metrics.
     fn finish(&mut self) -> Result<()> {
@@ -294,7 +378,7 @@ impl Simulation {
         let rows = !self.skip_rows;
         let lag = 0.5 * self.stepper.last_dt();
         for twin in &mut self.twins {
-            twin.before_step(&self.world.bodies, gravity, t, lag, rows);
+            twin.before_step(&self.world.bodies, gravity, t, lag, rows)?;
         }
         self.write_rows(t);
         let duration = self.time();
@@ -307,6 +391,21 @@ impl Simulation {
             }
         }
         Ok(())
+    }
+}
+
+/// What a velocity motor that starts off its target adds to a guard's message (empty for none).
+fn start_mismatch_note(inv: &Invariants) -> String {
+    match &inv.motor_start_mismatch {
+        Some((name, rate, target, unit)) => format!(
+            "; the velocity motor `{name}` starts at {} {unit} against its target {} {unit}: the \
+             bodies' initial velocities do not match the motor, which jumps them to speed in the \
+             first steps (work the energy balance does not see); give them initial velocities \
+             consistent with it",
+            crate::error::sig4(*rate),
+            crate::error::sig4(*target)
+        ),
+        None => String::new(),
     }
 }
 

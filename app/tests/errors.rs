@@ -105,7 +105,8 @@ fn asset(name: &str) -> String {
 
 /// The slider-crank's crank, driven by `motion` instead of its spin.
 fn slider_crank_driven_by(motion: &str) -> String {
-    let spin = "Spin(axis: (0.0, 0.0, 1.0), point_m: (0.0, 0.0, 0.0), rate_rad_s: 523.5987755982989)";
+    let spin =
+        "Spin(axis: (0.0, 0.0, 1.0), point_m: (0.0, 0.0, 0.0), rate_rad_s: 523.5987755982989)";
     let text = asset("slider_crank");
     assert!(text.contains(spin));
     text.replace(spin, motion)
@@ -236,9 +237,15 @@ fn a_divergence_names_the_body_as_the_scene_does() {
     // steps bounded far below its period, still leaves the physical range: the error names
     // the body and the drive, not a Rapier handle.
     let scene = Scene::solar_panel()
-        .with_overrides(&["panel.velocity_m_s=[0, 99, 0]", "panel.angular_velocity_rad_s=[0,0,1e4]"])
+        .with_overrides(&[
+            "panel.velocity_m_s=[0, 99, 0]",
+            "panel.angular_velocity_rad_s=[0,0,1e4]",
+        ])
         .unwrap();
-    match Simulation::new(&scene, RunOptions::default()).unwrap().run() {
+    match Simulation::new(&scene, RunOptions::default())
+        .unwrap()
+        .run()
+    {
         Err(Error::Diverged { reason, .. }) => {
             assert!(
                 reason.contains("body `panel`") && !reason.contains("body ("),

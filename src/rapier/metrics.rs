@@ -43,8 +43,8 @@
 //! # Ok::<(), clearance_joint::Error>(())
 //! ```
 
-use crate::rapier::joint::ClearanceJoint;
 use crate::error::{Error, Result, sig4};
+use crate::rapier::joint::ClearanceJoint;
 use crate::table::Table;
 use serde::Serialize;
 

@@ -235,7 +235,11 @@ mod tests {
         assert!(Table::new(&[0.0, 0.0], &[1.0, 2.0]).is_err());
         // In the last segment (knot slopes 4 and 5, one-sided at the end) the rate is
         // -3 s^2 + 4 s + 4, largest at s = 2/3: 16/3, above both knots'.
-        assert!((t.max_rate() - 16.0 / 3.0).abs() < 1e-12, "{}", t.max_rate());
+        assert!(
+            (t.max_rate() - 16.0 / 3.0).abs() < 1e-12,
+            "{}",
+            t.max_rate()
+        );
         // 0, 1, 0: slopes 1, 0, -1; the first segment's rate -3 s^2 + 2 s + 1 peaks at 4/3.
         let hump = Table::new(&[0.0, 1.0, 2.0], &[0.0, 1.0, 0.0]).unwrap();
         assert!((hump.max_rate() - 4.0 / 3.0).abs() < 1e-12);

@@ -514,13 +514,16 @@ fn a_weld_between_bodies_that_do_not_move_leaves_the_other_reactions() {
     let mut bodies = RigidBodySet::new();
     let base = bodies.insert(RigidBodyBuilder::fixed());
     let bracket = bodies.insert(RigidBodyBuilder::fixed().translation(Vector::new(0.5, 0.0, 0.0)));
-    let plate = bodies.insert(
-        RigidBodyBuilder::kinematic_velocity_based().angvel(Vector::new(0.0, 0.0, 3.0)),
-    );
+    let plate = bodies
+        .insert(RigidBodyBuilder::kinematic_velocity_based().angvel(Vector::new(0.0, 0.0, 3.0)));
     let arm = bodies.insert(
         RigidBodyBuilder::dynamic()
             .translation(Vector::new(0.0, -0.3, 0.0))
-            .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02))),
+            .additional_mass_properties(MassProperties::new(
+                Vector::ZERO,
+                2.0,
+                Vector::splat(0.02),
+            )),
     );
     prepare_mass_properties(&mut bodies);
     let hinge = IdealJoint::Revolute(IdealRevolute {
@@ -547,9 +550,16 @@ fn a_weld_between_bodies_that_do_not_move_leaves_the_other_reactions() {
     for joints in [vec![hinge, weld], vec![weld, pin, hinge], vec![pin, hinge]] {
         let f = s.solve_joints(&bodies, &joints, g).unwrap().to_vec();
         let k = joints.iter().position(|j| *j == hinge).unwrap();
-        assert!((f[k] - Vector::new(0.0, 2.0 * 9.81, 0.0)).length() < 1e-9, "{f:?}");
+        assert!(
+            (f[k] - Vector::new(0.0, 2.0 * 9.81, 0.0)).length() < 1e-9,
+            "{f:?}"
+        );
         for (i, f) in f.iter().enumerate().filter(|(i, _)| *i != k) {
-            assert_eq!(*f, Vector::ZERO, "joint {i} between bodies that do not move");
+            assert_eq!(
+                *f,
+                Vector::ZERO,
+                "joint {i} between bodies that do not move"
+            );
         }
     }
 }

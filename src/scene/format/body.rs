@@ -255,7 +255,10 @@ fn speed(field: &str, v: &[f64; 3]) -> Result<()> {
 /// The speed of the centre of mass `com` turning at `rate` (rad/s) about an axis through
 /// `point`: at most `rate |com - point|`, which must not pass [`SPEED_MAX`].
 fn turning_speed(field: &str, rate: f64, point: &[f64; 3], com: &[f64; 3]) -> Result<()> {
-    let r = (0..3).map(|i| (com[i] - point[i]).powi(2)).sum::<f64>().sqrt();
+    let r = (0..3)
+        .map(|i| (com[i] - point[i]).powi(2))
+        .sum::<f64>()
+        .sqrt();
     let s = rate * r;
     if s > SPEED_MAX {
         return Err(Error::invalid(

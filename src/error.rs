@@ -312,6 +312,11 @@ fn stiff_field(hinge: &str, law: crate::model::laws::LawKind, zeta: f64) -> Stri
     }
 }
 
+/// The smallest step a run takes, s: the adaptive steps' default floor (`min_dt` of
+/// [`StepControl`](crate::rapier::stepper::StepControl)); a scene's fixed step is at least
+/// 1e-9 s.
+const SMALLEST_STEP: f64 = 1e-10;
+
 /// What to do about a step beyond a contact's stability limit, fitting the step mode.
 fn step_advice(
     field: &str,
@@ -326,6 +331,12 @@ fn step_advice(
         Some(true) => format!(
             "Adaptive stepping is on and this is already its smallest step: no step the runner takes \
              resolves this contact. It is too stiff (or too damped) for the bodies' masses: check {soft}."
+        ),
+        // Below the smallest step any run takes: no step resolves it.
+        Some(false) if !(0.8 * dt_max >= SMALLEST_STEP) => format!(
+            "No step resolves this contact (the smallest a run takes is {} s): its parameters are \
+             out of reach, too stiff (or too damped) for the bodies' masses: check {soft}.",
+            sig4(SMALLEST_STEP)
         ),
         Some(false) => format!(
             "Use `{field}` below {} s (`--dt`), or adaptive stepping (`--set run.step=Adaptive`), which \

@@ -154,3 +154,113 @@ fn fixed_steps_across_the_stability_limit() {
         "passed {passed:?}, refused {refused:?}"
     );
 }
+
+/// A 2 kg arm on a clearance joint (steel, 0.2 mm play) under a fixed pivot, in a plain Rapier
+/// world: the world, the joints, the arm.
+fn api_pendulum() -> (
+    rapier3d_f64::prelude::PhysicsWorld,
+    clearance_joint::rapier::joint::ClearanceJointSet,
+    rapier3d_f64::prelude::RigidBodyHandle,
+) {
+    use rapier3d_f64::math::Vector;
+    use rapier3d_f64::prelude::*;
+    let mut world = PhysicsWorld::new();
+    world.integration_parameters.num_solver_iterations = 1;
+    let ground = world.bodies.insert(RigidBodyBuilder::fixed());
+    let arm = world.bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(Vector::new(0.0, -0.3, 0.0))
+            .additional_mass_properties(MassProperties::new(
+                Vector::ZERO,
+                2.0,
+                Vector::splat(0.02),
+            )),
+    );
+    let joint = clearance_joint::rapier::convert::Clearance::steel_improved_liu(0.01, 2e-4, 0.016)
+        .unwrap()
+        .joint(
+            Vector::ZERO,
+            Vector::new(0.0, 0.3, 0.0),
+            Vector::Z,
+            Vector::Z,
+        )
+        .unwrap();
+    let mut joints = clearance_joint::rapier::joint::ClearanceJointSet::new();
+    joints.insert(ground, arm, joint, &mut world.impulse_joints);
+    (world, joints, arm)
+}
+
+#[test]
+fn api_refuses_a_gravity_that_is_not_finite() {
+    use clearance_joint::rapier::stepper::{StepControl, Stepper};
+    let (mut world, mut joints, _) = api_pendulum();
+    world.gravity = rapier3d_f64::math::Vector::new(0.0, f64::NAN, 0.0);
+    let mut stepper = Stepper::new(StepControl::fixed(1e-5));
+    let e = stepper
+        .step(&mut world, &mut [&mut joints], 0.01)
+        .unwrap_err();
+    assert!(
+        matches!(&e, Error::Invalid { field, .. } if field == "gravity"),
+        "{e}"
+    );
+}
+
+#[test]
+fn api_names_a_journal_body_removed_after_the_joint() {
+    // The step check used to read "stable only below 0 s ... use `dt` below 0 s".
+    use clearance_joint::rapier::stepper::{StepControl, Stepper};
+    let (mut world, mut joints, arm) = api_pendulum();
+    let mut stepper = Stepper::new(StepControl::fixed(1e-5));
+    stepper.step(&mut world, &mut [&mut joints], 1e-3).unwrap();
+    world.bodies.remove(
+        arm,
+        &mut world.islands,
+        &mut world.colliders,
+        &mut world.impulse_joints,
+        &mut world.multibody_joints,
+        &mut world.soft_bodies,
+        true,
+    );
+    let e = loop {
+        match stepper.step(&mut world, &mut [&mut joints], 1e-2) {
+            Ok(_) => assert!(stepper.time() < 1e-2, "the missing body went unnoticed"),
+            Err(e) => break e.to_string(),
+        }
+    };
+    assert!(
+        e.contains("not in the body set") && !e.contains(" 0 s"),
+        "{e}"
+    );
+}
+
+#[test]
+fn api_divergence_names_the_handle_and_the_likely_cause() {
+    // A stone flung at 300 m/s beside the pendulum leaves the physical range at once.
+    use clearance_joint::rapier::stepper::{StepControl, Stepper};
+    use rapier3d_f64::prelude::{MassProperties, RigidBodyBuilder};
+    let (mut world, mut joints, _) = api_pendulum();
+    let stone = world.bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(rapier3d_f64::math::Vector::new(1.0, 0.0, 0.0))
+            .linvel(rapier3d_f64::math::Vector::new(300.0, 0.0, 0.0))
+            .additional_mass_properties(MassProperties::new(
+                rapier3d_f64::math::Vector::ZERO,
+                1.0,
+                rapier3d_f64::math::Vector::splat(0.01),
+            )),
+    );
+    let mut stepper = Stepper::new(StepControl::fixed(1e-6));
+    let e = loop {
+        match stepper.step(&mut world, &mut [&mut joints], 1e-2) {
+            Ok(_) => assert!(stepper.time() < 1e-2, "never diverged"),
+            Err(e) => break e,
+        }
+    };
+    let s = e.to_string();
+    assert!(matches!(e, Error::Diverged { .. }), "{s}");
+    let handle = format!("{:?}", stone.into_raw_parts());
+    assert!(
+        s.contains(&handle) && s.contains("likely cause") && s.contains("speed 300"),
+        "{s}"
+    );
+}

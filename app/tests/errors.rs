@@ -85,9 +85,185 @@ fn bad_laws_parameters_are_named() {
     let e = override_err(&[
         r#"hinge.friction={"Bai":{"mu_s":0.3,"mu_d":0.25,"v_s_mm_s":10,"v_d_mm_s":0.1}}"#,
     ]);
-    assert!(e.contains("hinges[hinge].clearance.friction.v_d"), "{e}");
+    // The scene's field and unit, not the law's `v_d` in m/s.
+    assert!(
+        e.contains("hinges[hinge].clearance.friction.v_d_mm_s")
+            && e.contains("`v_s_mm_s` = 10 mm/s"),
+        "{e}"
+    );
     let e = override_err(&["run.dt_s=-1e-4"]);
     assert!(e.contains("run.dt_s"), "{e}");
+}
+
+/// A shipped scene's text (`assets/<name>.ron`).
+fn asset(name: &str) -> String {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../assets")
+        .join(format!("{name}.ron"));
+    std::fs::read_to_string(path).unwrap()
+}
+
+/// The slider-crank's crank, driven by `motion` instead of its spin.
+fn slider_crank_driven_by(motion: &str) -> String {
+    let spin =
+        "Spin(axis: (0.0, 0.0, 1.0), point_m: (0.0, 0.0, 0.0), rate_rad_s: 523.5987755982989)";
+    let text = asset("slider_crank");
+    assert!(text.contains(spin));
+    text.replace(spin, motion)
+}
+
+#[test]
+fn motions_beyond_the_speed_guard_are_refused_at_load() {
+    // Each moves the crank faster than the speed range (100 m/s, half the run-time guard's
+    // 200 m/s): refused at load, naming the field, not a divergence blaming another body.
+    for (motion, field) in [
+        (
+            "TableAngle(axis: (0.0, 0.0, 1.0), point_m: (0.0, 0.0, 0.0), t_s: [0.0, 1.0], angle_rad: [0.0, 1e300])",
+            "bodies[crank].motion.angle_rad",
+        ),
+        (
+            // 2e4 rad/s at 0.025 m is 500 m/s of the crank's centre of mass.
+            "TableAngle(axis: (0.0, 0.0, 1.0), point_m: (0.0, 0.0, 0.0), t_s: [0.0, 1.0], angle_rad: [0.0, 9000.0])",
+            "bodies[crank].motion.angle_rad",
+        ),
+        (
+            "TablePosition(direction: (1.0, 0.0, 0.0), t_s: [0.0, 1.0], position_m: [0.0, 1e300])",
+            "bodies[crank].motion.position_m",
+        ),
+        (
+            "TablePosition(direction: (1.0, 0.0, 0.0), t_s: [0.0, 1.0], position_m: [-1e308, 1e308])",
+            "bodies[crank].motion.position_m",
+        ),
+        (
+            "Translate(velocity_m_s: (200.0, 0.0, 0.0))",
+            "bodies[crank].motion.velocity_m_s",
+        ),
+        (
+            // Each component in range, the speed (113 m/s) not.
+            "Translate(velocity_m_s: (80.0, 80.0, 0.0))",
+            "bodies[crank].motion.velocity_m_s",
+        ),
+        (
+            // 1e4 rad/s is in range, but turns the centre of mass at 250 m/s.
+            "Spin(axis: (0.0, 0.0, 1.0), point_m: (0.0, 0.0, 0.0), rate_rad_s: 1e4)",
+            "bodies[crank].motion.rate_rad_s",
+        ),
+    ] {
+        let e = Scene::from_ron(&slider_crank_driven_by(motion), "s.ron")
+            .expect_err(motion)
+            .to_string();
+        assert!(e.contains(field), "{motion}: {e}");
+    }
+}
+
+#[test]
+fn the_largest_speeds_in_range_run() {
+    // The largest `Translate` velocity and `LinearVelocity` target run without the speed guard
+    // taking them for a blow-up (at 200 m/s, the old limit, both failed at once).
+    let text = |kind_motor: &str, slider: &str| {
+        format!(
+            r#"Scene(name: "fast", gravity: (0.0, 0.0, 0.0), reference_axis: (0.0, 0.0, 1.0),
+            bodies: [
+                (name: "ground", mass_kg: 0.0, inertia_kg_m2: (0.0, 0.0, 0.0), center_of_mass_m: (0.0, 0.0, 0.0), fixed: true),
+                (name: "slider", mass_kg: 1.0, inertia_kg_m2: (0.01, 0.01, 0.01), center_of_mass_m: (0.0, 0.0, 0.0){slider}),
+                (name: "arm", mass_kg: 1.0, inertia_kg_m2: (0.01, 0.01, 0.01), center_of_mass_m: (0.0, -0.2, 0.0), velocity_m_s: (100.0, 0.0, 0.0)),
+            ],
+            hinges: [(name: "pin", bearing: "slider", journal: "arm", point_m: (0.0, 0.0, 0.0), axis: (0.0, 0.0, 1.0))],
+            joints: [{kind_motor}],
+            run: (dt_s: 1e-4, end_s: 0.01, output_interval_s: 1e-3, step: Fixed))"#
+        )
+    };
+    let translate = text(
+        "",
+        ", motion: Some(Translate(velocity_m_s: (100.0, 0.0, 0.0)))",
+    );
+    let motor = text(
+        r#"(name: "guide", body1: "ground", body2: "slider", point_m: (0.0, 0.0, 0.0),
+            kind: Prismatic(axis: (1.0, 0.0, 0.0)),
+            motor: Some(LinearVelocity(target_m_s: 100.0, factor: 1e8)))"#,
+        ", velocity_m_s: (100.0, 0.0, 0.0)",
+    );
+    for (case, text) in [("Translate", translate), ("LinearVelocity", motor)] {
+        let scene = Scene::from_ron(&text, "fast.ron").unwrap_or_else(|e| panic!("{case}: {e}"));
+        let r = Simulation::new(&scene, RunOptions::default())
+            .unwrap()
+            .run()
+            .unwrap_or_else(|e| panic!("{case}: {e}"));
+        assert!(r.guards.is_clean(), "{case}: {:?}", r.guards.violations);
+    }
+}
+
+#[test]
+fn initial_velocities_of_bodies_that_do_not_move_by_themselves() {
+    // A fixed body's or a driven body's velocity would be ignored: refused, naming the field.
+    let text = asset("pendulum").replace(
+        "center_of_mass_m: (0.0, 0.0, 0.0), fixed: true)",
+        "center_of_mass_m: (0.0, 0.0, 0.0), fixed: true, velocity_m_s: (1.0, 0.0, 0.0))",
+    );
+    let e = Scene::from_ron(&text, "p.ron").unwrap_err().to_string();
+    assert!(
+        e.contains("bodies[ground].velocity_m_s") && e.contains("ignored"),
+        "{e}"
+    );
+    let text = asset("slider_crank").replace(
+        "rate_rad_s: 523.5987755982989)))",
+        "rate_rad_s: 523.5987755982989)), angular_velocity_rad_s: (0.0, 0.0, 1.0))",
+    );
+    let e = Scene::from_ron(&text, "s.ron").unwrap_err().to_string();
+    assert!(
+        e.contains("bodies[crank].angular_velocity_rad_s") && e.contains("motion"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_drive_spring_too_stiff_for_the_step() {
+    let e = override_err(&["drive.stiffness_nm_per_deg=1e6"]);
+    assert!(
+        e.contains("drives[drive].stiffness_nm_per_deg")
+            && e.contains("too stiff for the step")
+            && e.contains("run.max_dt_s"),
+        "{e}"
+    );
+    // The shipped springs are far from it.
+    for name in ["solar_panel", "deployable_array"] {
+        Scene::from_ron(&asset(name), "a.ron").unwrap();
+    }
+}
+
+#[test]
+fn a_divergence_names_the_body_as_the_scene_does() {
+    // A free stone thrown down at 99 m/s (in range) under 100 g passes the guard's 200 m/s
+    // after 0.1 s: the error names it as the scene does, not by its Rapier handle.
+    let text = asset("pendulum")
+        .replace("gravity: (0.0, -9.81, 0.0)", "gravity: (0.0, -1000.0, 0.0)")
+        .replace(
+            "    ],\n    hinges:",
+            "        (name: \"stone\", mass_kg: 1.0, inertia_kg_m2: (0.01, 0.01, 0.01), center_of_mass_m: (1.0, 0.0, 0.0), velocity_m_s: (0.0, -99.0, 0.0)),\n    ],\n    hinges:",
+        );
+    assert!(text.contains("stone"));
+    let scene = Scene::from_ron(&text, "p.ron")
+        .unwrap()
+        .with_overrides(&[
+            "pivot.clearance=null",
+            "run.end_s=0.2",
+            "run.output_interval_s=0.01",
+        ])
+        .unwrap();
+    match Simulation::new(&scene, RunOptions::default())
+        .unwrap()
+        .run()
+    {
+        Err(Error::Diverged { reason, .. }) => {
+            assert!(
+                reason.contains("body `stone`")
+                    && reason.contains("likely cause")
+                    && !reason.contains("body ("),
+                "{reason}"
+            );
+        }
+        other => panic!("expected a divergence, got {:?}", other.map(|r| r.guards)),
+    }
 }
 
 #[test]

@@ -138,26 +138,39 @@ pub fn contact_force(
 /// `m x'' = -k x - d x'` is stable for `omega dt <= 2 (sqrt(1 + zeta^2) - zeta)`,
 /// `omega = sqrt(k/m)`, `zeta = d/(2 m omega)` (the eigenvalues of the one-step map).
 /// Returns `(dt_max, omega, zeta)`. Without stiffness (`k <= 0`) damping alone limits the step to
-/// `2 m/d` (reported with `omega = 0`, `zeta` infinite); without either `dt_max` is infinite.
+/// `2 m/d` (reported with `omega = 0`, `zeta` infinite); without either `dt_max` is infinite. A
+/// NaN stiffness or damping counts as none; the step is never NaN.
 pub fn stable_step(stiffness: f64, damping: f64, effective_mass: f64) -> (f64, f64, f64) {
     if !(effective_mass > 0.0) || !effective_mass.is_finite() {
         return (f64::INFINITY, 0.0, 0.0);
     }
-    if !(stiffness > 0.0) {
+    let omega = (stiffness / effective_mass).sqrt();
+    // No stiffness (or one too small against the mass to be represented).
+    if !(omega > 0.0) {
         // Pure damping `m x'' = -d x'`: `v (1 - dt d/m)` per step, stable for `dt <= 2 m/d`.
         return if damping > 0.0 {
-            (2.0 * effective_mass / damping, 0.0, f64::INFINITY)
+            (2.0 * (effective_mass / damping), 0.0, f64::INFINITY)
         } else {
             (f64::INFINITY, 0.0, 0.0)
         };
     }
-    let omega = (stiffness / effective_mass).sqrt();
-    let zeta = damping.max(0.0) / (2.0 * effective_mass * omega);
-    (
-        2.0 * ((1.0 + zeta * zeta).sqrt() - zeta) / omega,
-        omega,
-        zeta,
-    )
+    if omega.is_infinite() {
+        return (0.0, omega, 0.0);
+    }
+    let d = damping.max(0.0);
+    let zeta = match d / (2.0 * effective_mass * omega) {
+        // `2 m` overflowed against an infinite damping: divide in another order.
+        z if z.is_nan() => d / effective_mass / (2.0 * omega),
+        z => z,
+    };
+    // `sqrt(1 + zeta^2) - zeta` cancels for a huge damping ratio (and is NaN for an infinite
+    // one): its asymptote `1/(2 zeta)` there.
+    let root = if zeta > 1e8 {
+        0.5 / zeta
+    } else {
+        (1.0 + zeta * zeta).sqrt() - zeta
+    };
+    (2.0 * root / omega, omega, zeta)
 }
 
 #[cfg(test)]

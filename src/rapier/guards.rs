@@ -59,6 +59,11 @@ pub struct Violation {
     /// whole message.
     #[serde(skip)]
     pub note: String,
+    /// The unit of `worst` and `limit` where they are absolute rather than the kind's usual
+    /// measure: a velocity motor whose target is 0 reports its miss in rad/s or m/s (relative to
+    /// a zero target it has no meaning).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub unit: Option<&'static str>,
 }
 
 impl Violation {
@@ -75,6 +80,7 @@ impl Violation {
             first_t_s: t_s,
             count: 1,
             note: String::new(),
+            unit: None,
         }
     }
 
@@ -155,20 +161,38 @@ impl Violation {
             ),
             GuardKind::Energy => format!(
                 "the {twin} twin gained energy: {} of its energy scale (limit {}), the most at \
-                 t = {} s",
+                 t = {} s{}",
                 sig4(self.worst),
                 sig4(self.limit),
-                sig4(self.t_s)
-            ),
-            GuardKind::MotorSpeed => format!(
-                "the {twin} twin's velocity motor `{joint}` missed its speed by {} of its target \
-                 at worst, at t = {} s (limit {}; {}): its torque and the reactions assume it holds \
-                 it; raise its `factor` or shorten the steps (`run.max_dt_s`)",
-                sig4(self.worst),
                 sig4(self.t_s),
-                sig4(self.limit),
-                states(self.count)
+                self.note
             ),
+            GuardKind::MotorSpeed => {
+                let miss = match self.unit {
+                    Some(unit) => format!(
+                        "{} {unit} (its target is 0; limit {} {unit})",
+                        sig4(self.worst),
+                        sig4(self.limit)
+                    ),
+                    None => format!(
+                        "{} of its target (limit {})",
+                        sig4(self.worst),
+                        sig4(self.limit)
+                    ),
+                };
+                let advice = if self.note.is_empty() {
+                    "; raise its `factor` or shorten the steps (`run.max_dt_s`)"
+                } else {
+                    &self.note
+                };
+                format!(
+                    "the {twin} twin's velocity motor `{joint}` missed its speed by {miss} at \
+                     worst, at t = {} s ({}): its torque and the reactions assume it holds \
+                     it{advice}",
+                    sig4(self.t_s),
+                    states(self.count)
+                )
+            }
             GuardKind::Other => self.note.clone(),
         }
     }
@@ -207,6 +231,7 @@ impl GuardReport {
                     e.t_s = v.t_s;
                     e.limit = v.limit;
                     e.note = v.note;
+                    e.unit = v.unit;
                 }
             }
             None => self.violations.push(v),

@@ -839,6 +839,13 @@ impl ClearanceJointSet {
     /// Checks `dt` against every joint's current stability limit.
     pub fn check_step(&self, dt: f64) -> Result<()> {
         for j in &self.joints {
+            if j.prepared && j.last_wrenches.is_none() {
+                return Err(Error::invalid(
+                    format!("clearance joint `{}`", j.name),
+                    "its bearing or journal body is not in the body set (removed after the joint \
+                     was inserted?): the joint has no state to check the step against",
+                ));
+            }
             let r = &j.report;
             if dt > r.max_stable_dt {
                 return Err(Error::StepTooLarge {

@@ -43,6 +43,7 @@
 //! # Ok::<(), clearance_joint::Error>(())
 //! ```
 
+use crate::error::{Error, Result, sig4};
 use crate::rapier::joint::ClearanceJoint;
 use crate::table::Table;
 use serde::Serialize;
@@ -334,12 +335,26 @@ pub struct PeriodStats {
 /// Per-period statistics of an impact list over `[0, end)` in periods of `period` (s): impacts,
 /// peak force and time in contact per crank turn. A contact's duration is the contiguous span
 /// from its onset, so the time in contact is split exactly at the bounds; its peak counts in the
-/// period of its onset. Empty for a non-positive period or end.
-pub fn per_period(impacts: &[Impact], period: f64, end: f64) -> Vec<PeriodStats> {
+/// period of its onset. Empty for a period or end that is not positive (or NaN); an error when
+/// `end / period` is more than [`MAX_PERIODS`] (or infinite): the table would not fit in
+/// memory.
+pub fn per_period(impacts: &[Impact], period: f64, end: f64) -> Result<Vec<PeriodStats>> {
     if !(period > 0.0) || !(end > 0.0) {
-        return Vec::new();
+        return Ok(Vec::new());
     }
-    let n = (end / period).ceil().max(1.0) as usize;
+    let count = (end / period).ceil().max(1.0);
+    if !(count <= MAX_PERIODS as f64) {
+        return Err(Error::invalid(
+            "period",
+            format!(
+                "{} s over {} s is {} periods, more than {MAX_PERIODS}",
+                sig4(period),
+                sig4(end),
+                sig4(count)
+            ),
+        ));
+    }
+    let n = count as usize;
     let mut out: Vec<PeriodStats> = (0..n)
         .map(|k| {
             let start = k as f64 * period;
@@ -365,8 +380,11 @@ pub fn per_period(impacts: &[Impact], period: f64, end: f64) -> Vec<PeriodStats>
             p.contact_s += (b.min(hi) - a.max(lo)).max(0.0);
         }
     }
-    out
+    Ok(out)
 }
+
+/// Most periods [`per_period`] tabulates (a table of about 50 MB).
+pub const MAX_PERIODS: usize = 1_000_000;
 
 /// The per-period statistics as a table: `turn, start_s, impacts, separated_impacts,
 /// peak_force_n, contact_fraction`.
@@ -475,7 +493,7 @@ mod tests {
         };
         // Turns of 1 s over 2.5 s; a contact from 0.5 to 1.25 s spans the first bound.
         let list = [imp(0.2, 0.1, 5.0), imp(0.5, 0.75, 9.0), imp(2.1, 0.2, 3.0)];
-        let p = per_period(&list, 1.0, 2.5);
+        let p = per_period(&list, 1.0, 2.5).unwrap();
         assert_eq!(p.len(), 3);
         assert_eq!((p[0].impacts, p[1].impacts, p[2].impacts), (2, 0, 1));
         assert_eq!((p[0].peak_force_n, p[1].peak_force_n), (9.0, 0.0));
@@ -484,6 +502,10 @@ mod tests {
         assert!((p[2].contact_s - 0.2).abs() < 1e-12 && p[2].length_s == 0.5);
         let t = per_period_table(&p);
         assert!((t.row(2)[5] - 0.4).abs() < 1e-12);
-        assert!(per_period(&list, 0.0, 1.0).is_empty());
+        assert!(per_period(&list, 0.0, 1.0).unwrap().is_empty());
+        // Too many periods to tabulate: an error, not an allocation of the whole memory.
+        assert!(per_period(&[], 1e-300, 1.0).is_err());
+        assert!(per_period(&[], 1e-6, 1e4).is_err());
+        assert!(per_period(&[], 1.0, f64::INFINITY).is_err());
     }
 }

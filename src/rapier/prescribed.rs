@@ -51,12 +51,19 @@ impl Table {
             }
         }
         let n = times.len();
-        let m = (0..n)
+        let m: Vec<f64> = (0..n)
             .map(|i| {
                 let (a, b) = (i.saturating_sub(1), (i + 1).min(n - 1));
                 (values[b] - values[a]) / (times[b] - times[a])
             })
             .collect();
+        if let Some(i) = m.iter().position(|m| !m.is_finite()) {
+            return Err(Error::invalid(
+                format!("values[{i}]"),
+                "the rate there (the slope between its neighbours) is not finite: values or \
+                 times too far apart",
+            ));
+        }
         Ok(Table {
             t: times.to_vec(),
             v: values.to_vec(),
@@ -64,8 +71,12 @@ impl Table {
         })
     }
 
-    /// Value, rate and second derivative at `t`.
+    /// Value, rate and second derivative at `t`. A NaN `t` gives NaN for all three; an
+    /// infinite `t` is beyond the table (the value infinite, or NaN for a zero end slope).
     pub fn eval(&self, t: f64) -> (f64, f64, f64) {
+        if t.is_nan() {
+            return (f64::NAN, f64::NAN, f64::NAN);
+        }
         let n = self.t.len();
         if t <= self.t[0] {
             return (self.v[0] + self.m[0] * (t - self.t[0]), self.m[0], 0.0);
@@ -96,6 +107,27 @@ impl Table {
             + (-12.0 * s + 6.0) * p1
             + (6.0 * s - 2.0) * m1;
         (v, d / h, dd / (h * h))
+    }
+
+    /// The largest magnitude of the rate over the table (the rate is constant beyond it): at the
+    /// knots or where a segment's rate, a quadratic, turns.
+    pub fn max_rate(&self) -> f64 {
+        let mut best = self.m.iter().fold(0.0f64, |a, m| a.max(m.abs()));
+        for i in 0..self.t.len() - 1 {
+            // The rate in s is quadratic: 6 (s^2 - s)(p0 - p1) + (3s^2 - 4s + 1) m0 + (3s^2 - 2s) m1,
+            // with m0, m1 the slopes times h; it turns where its derivative vanishes.
+            let h = self.t[i + 1] - self.t[i];
+            let (p0, p1, m0, m1) = (self.v[i], self.v[i + 1], self.m[i] * h, self.m[i + 1] * h);
+            let a2 = 6.0 * (p0 - p1) + 3.0 * (m0 + m1);
+            let a1 = -6.0 * (p0 - p1) - 4.0 * m0 - 2.0 * m1;
+            if a2 != 0.0 {
+                let s = -a1 / (2.0 * a2);
+                if s > 0.0 && s < 1.0 {
+                    best = best.max(self.eval(self.t[i] + s * h).1.abs());
+                }
+            }
+        }
+        best
     }
 }
 
@@ -201,6 +233,18 @@ mod tests {
         // Beyond the end: along the end slope (5), no acceleration.
         assert_eq!(t.eval(4.0), (14.0, 5.0, 0.0));
         assert!(Table::new(&[0.0, 0.0], &[1.0, 2.0]).is_err());
+        // In the last segment (knot slopes 4 and 5, one-sided at the end) the rate is
+        // -3 s^2 + 4 s + 4, largest at s = 2/3: 16/3, above both knots'.
+        assert!(
+            (t.max_rate() - 16.0 / 3.0).abs() < 1e-12,
+            "{}",
+            t.max_rate()
+        );
+        // 0, 1, 0: slopes 1, 0, -1; the first segment's rate -3 s^2 + 2 s + 1 peaks at 4/3.
+        let hump = Table::new(&[0.0, 1.0, 2.0], &[0.0, 1.0, 0.0]).unwrap();
+        assert!((hump.max_rate() - 4.0 / 3.0).abs() < 1e-12);
+        assert!(t.eval(f64::NAN).0.is_nan());
+        assert!(Table::new(&[0.0, 1.0], &[-1e308, 1e308]).is_err());
         assert!(Table::new(&[0.0], &[1.0]).is_err());
         assert!(Table::new(&[0.0, 1.0], &[1.0]).is_err());
     }

@@ -453,6 +453,7 @@ impl Stepper {
     ) -> Result<StepInfo> {
         // Cheap, and `set_control` may have changed it since the last step.
         self.control.validate()?;
+        check_gravity(world)?;
         self.prepare(world, sources)?;
         let left = until - self.t;
         if !(left > 0.0) {
@@ -729,11 +730,7 @@ impl Stepper {
             {
                 return Err(Error::Diverged {
                     t: self.t,
-                    reason: format!(
-                        "body {:?} left the physical range (speed {} m/s)",
-                        b.handle.into_raw_parts(),
-                        crate::error::sig4(speed)
-                    ),
+                    reason: diverged_body(world, sources, b.handle, speed),
                 });
             }
         }
@@ -802,6 +799,58 @@ fn exact_kinematic_poses(world: &mut PhysicsWorld, saved: &[BodySnapshot], dt: f
             rb.set_position(pose, false);
         }
     }
+}
+
+/// The world's gravity must be finite (a NaN one would only show as a body leaving the
+/// physical range).
+fn check_gravity(world: &PhysicsWorld) -> Result<()> {
+    let g = world.gravity;
+    if !g.is_finite() {
+        return Err(Error::invalid(
+            "gravity",
+            format!("the world's gravity must be finite (got {g:?})"),
+        ));
+    }
+    Ok(())
+}
+
+/// What a divergence says of `body`: its handle, what joins it (Rapier's impulse joints, the
+/// sources' clearance joints), its speed and the likely cause.
+fn diverged_body(
+    world: &PhysicsWorld,
+    sources: &[&mut dyn ForceSource],
+    body: rapier3d_f64::prelude::RigidBodyHandle,
+    speed: f64,
+) -> String {
+    let mut joined: Vec<String> = world
+        .impulse_joints
+        .attached_joints(body)
+        .map(|(_, _, h, _)| format!("impulse joint {:?}", h.into_raw_parts()))
+        .collect();
+    for set in sources.iter().filter_map(|s| s.clearance_joints()) {
+        for (_, j) in set.iter() {
+            if j.body1() == body || j.body2() == body {
+                joined.push(format!("clearance joint `{}`", j.name()));
+            }
+        }
+    }
+    let joined = if joined.is_empty() {
+        String::new()
+    } else {
+        format!(", joined by {}", joined.join(", "))
+    };
+    let speed = if speed.is_finite() {
+        format!("speed {} m/s", crate::error::sig4(speed))
+    } else {
+        "its state is not finite".into()
+    };
+    format!(
+        "body {:?}{joined} left the physical range ({speed}, the guard being {} m/s); likely \
+         cause: a motor, drive or prescribed motion that moves it too fast, a contact too stiff \
+         for the step, or a non-finite input (gravity, a force, a mass)",
+        body.into_raw_parts(),
+        crate::error::sig4(0.5 * world.integration_parameters.max_linear_velocity())
+    )
 }
 
 /// `Some(speed)` when `rb` has left the physical range: disabled by Rapier's quarantine,

@@ -141,35 +141,28 @@ impl RunResult {
         let summary = self.summary();
         let json = summary_json(&summary)?;
         // One impact list per clearance joint, `<twin>_<joint>_impacts.csv`.
-        let impact_tables: Vec<(std::path::PathBuf, crate::table::Table)> = self
-            .twins
-            .iter()
-            .flat_map(|t| {
-                let recorders = t.hinge_recorders();
-                let period = self.scene.drive_period();
-                // An incomplete run's turns end where it stopped.
-                let end = self.reached_s;
-                t.clearance_hinges()
-                    .into_iter()
-                    .flat_map(|h| {
-                        let mut v = vec![(
-                            dir.join(format!("{}_{h}_impacts.csv", t.kind.name())),
-                            recorders[h].impacts_table(),
-                        )];
-                        // Per crank turn when a body spins.
-                        if let Some(p) = period {
-                            let turns =
-                                crate::rapier::metrics::per_period(recorders[h].impacts(), p, end);
-                            v.push((
-                                dir.join(format!("{}_{h}_turns.csv", t.kind.name())),
-                                crate::rapier::metrics::per_period_table(&turns),
-                            ));
-                        }
-                        v
-                    })
-                    .collect::<Vec<_>>()
-            })
-            .collect();
+        let mut impact_tables: Vec<(std::path::PathBuf, crate::table::Table)> = Vec::new();
+        for t in &self.twins {
+            let recorders = t.hinge_recorders();
+            let period = self.scene.drive_period();
+            // An incomplete run's turns end where it stopped.
+            let end = self.reached_s;
+            for h in t.clearance_hinges() {
+                impact_tables.push((
+                    dir.join(format!("{}_{h}_impacts.csv", t.kind.name())),
+                    recorders[h].impacts_table(),
+                ));
+                // Per crank turn when a body spins.
+                if let Some(p) = period {
+                    let turns = crate::rapier::metrics::per_period(recorders[h].impacts(), p, end)
+                        .map_err(|e| e.within("run.end_s"))?;
+                    impact_tables.push((
+                        dir.join(format!("{}_{h}_turns.csv", t.kind.name())),
+                        crate::rapier::metrics::per_period_table(&turns),
+                    ));
+                }
+            }
+        }
         let paths: Vec<std::path::PathBuf> = self
             .twins
             .iter()

@@ -100,7 +100,11 @@ impl Ambrosio {
         if v1 <= v0 {
             return Err(Error::invalid(
                 "v1",
-                format!("must be greater than v0 = {} (got {})", sig4(v0), sig4(v1)),
+                format!(
+                    "must be greater than v0 = {} m/s (got {} m/s)",
+                    sig4(v0),
+                    sig4(v1)
+                ),
             ));
         }
         Ok(Ambrosio { mu_d, v0, v1 })
@@ -159,7 +163,7 @@ impl Bai {
             return Err(Error::invalid(
                 "v_d",
                 format!(
-                    "must be greater than v_s = {} (got {})",
+                    "must be greater than v_s = {} m/s (got {} m/s)",
                     sig4(v_s),
                     sig4(v_d)
                 ),

@@ -63,25 +63,31 @@ pub trait NormalForceLaw {
 /// The penetration at which the elastic energy of `law` equals `energy`: the deepest point of an
 /// undamped impact that starts with kinetic energy `energy` (`1/2 m delta_dot0^2`). Cheap enough for
 /// every step: a fixed-point iteration on the local power law `F = C delta^p` through the current
-/// estimate (exact for Hertz-type laws, within a few per cent for Liu's), starting from `guess`.
+/// estimate (exact for Hertz-type laws, within a few per cent for Liu's), starting from `guess`
+/// (1e-6 m when it is not between 1e-15 and 1 m). 0 for an energy that is not positive (or NaN);
+/// never NaN.
 pub fn penetration_for_energy(law: &impl NormalForceLaw, energy: f64, guess: f64) -> f64 {
     if energy.is_nan() || energy <= 0.0 {
         return 0.0;
     }
-    let mut d = if guess > 0.0 && guess.is_finite() {
+    let mut d = if (1e-15..=1.0).contains(&guess) {
         guess
     } else {
         1e-6
     };
     for _ in 0..12 {
         let (f, k) = (law.elastic_force(d), law.tangent_stiffness(d));
-        if !(f > 0.0 && k > 0.0) {
+        if !(f > 0.0 && k > 0.0 && f.is_finite() && k.is_finite()) {
             d *= 10.0;
             continue;
         }
         // Local power law through d: p = k d / f; energy of F = C x^p up to x is f(x) x/(p + 1).
         let p = k * d / f;
         let next = d * ((p + 1.0) * energy / (f * d)).powf(1.0 / (p + 1.0));
+        // Beyond floating point (an energy of 1e300, a subnormal guess): the last estimate.
+        if !(next > 0.0 && next.is_finite()) {
+            break;
+        }
         let converged = (next - d).abs() <= 1e-6 * d;
         d = next;
         if converged {

@@ -1,8 +1,20 @@
 //! Dense LU factorisation and solve of the constraint matrix, regularised when singular.
 
-/// LU factors of the `n x n` row-major `a` into `lu`, with a relative regularisation of 1e-12
-/// on the diagonal when `a` is singular (redundant constraints: a least-norm share). False when
-/// even that fails.
+/// Relative size of a pivot below which a matrix is singular to working precision.
+const PIVOT_TOLERANCE: f64 = 1e-12;
+
+/// Relative regularisation added to the diagonal of a singular matrix (the least-norm share it
+/// gives is exact to about this relative size).
+const REGULARISATION: f64 = 1e-12;
+
+/// Relative pivot tolerance of the regularised matrix: well below the regularisation, since a
+/// redundant row's pivot after elimination is about the regularisation itself (the same
+/// tolerance for both made every redundant system fail).
+const REGULARISED_PIVOT_TOLERANCE: f64 = 1e-2 * REGULARISATION;
+
+/// LU factors of the `n x n` row-major `a` into `lu`, with a relative regularisation
+/// ([`REGULARISATION`]) on the diagonal when `a` is singular (redundant constraints: a
+/// least-norm share). False when even that fails (a non-finite entry).
 pub(super) fn factor_regularised(
     a: &[f64],
     lu: &mut Vec<f64>,
@@ -11,32 +23,33 @@ pub(super) fn factor_regularised(
 ) -> bool {
     lu.clear();
     lu.extend_from_slice(a);
-    if lu_factor(lu, piv, n) {
+    if lu_factor(lu, piv, n, PIVOT_TOLERANCE) {
         return true;
     }
     lu.clear();
     lu.extend_from_slice(a);
     let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     for i in 0..n {
-        lu[i * n + i] += 1e-12 * scale;
+        lu[i * n + i] += REGULARISATION * scale;
     }
-    lu_factor(lu, piv, n)
+    lu_factor(lu, piv, n, REGULARISED_PIVOT_TOLERANCE)
 }
 
 /// LU factorisation with partial pivoting of the `n x n` row-major `a` in place (`piv` the row
-/// order). False when `a` is singular to working precision.
-pub(super) fn lu_factor(a: &mut [f64], piv: &mut Vec<usize>, n: usize) -> bool {
+/// order). False when a pivot is below `tolerance` times the largest entry (singular to working
+/// precision) or an entry is not finite.
+pub(super) fn lu_factor(a: &mut [f64], piv: &mut Vec<usize>, n: usize, tolerance: f64) -> bool {
     piv.clear();
     piv.extend(0..n);
     let scale = a.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    if !(scale > 0.0) && n > 0 {
+    if !(scale > 0.0 && scale.is_finite()) && n > 0 {
         return false;
     }
     for col in 0..n {
         let pivot = (col..n)
             .max_by(|&i, &k| a[i * n + col].abs().total_cmp(&a[k * n + col].abs()))
             .unwrap_or(col);
-        if !(a[pivot * n + col].abs() > 1e-12 * scale) {
+        if !(a[pivot * n + col].abs() > tolerance * scale) {
             return false;
         }
         if pivot != col {

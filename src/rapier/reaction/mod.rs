@@ -127,7 +127,10 @@ impl ReactionSolver {
     /// current state under their user forces and torques and `gravity`. Redundant constraints (a
     /// closed loop, whose reactions rigid dynamics alone do not determine) get a least-norm
     /// share through a relative regularisation of 1e-12, used only when the system is singular.
-    /// `None` when a body is missing. Only the listed joints are constraints: contacts with
+    /// A joint between two bodies that no force moves (fixed or kinematic on both sides) carries
+    /// no unknown: its force is zero (their supports take the load) and it does not affect the
+    /// others. `None` when a body is missing or the system cannot be solved (a non-finite state
+    /// or mass): never a made-up force. Only the listed joints are constraints: contacts with
     /// colliders are not part of the solve.
     pub fn solve(
         &mut self,

@@ -32,6 +32,7 @@ impl ReactionSolver {
         self.build_rows(joints, &pairs);
         let n = self.rows.len();
         self.assemble();
+        self.decouple_inert_rows(n);
         self.pos_rows.clear();
         self.pos_rows
             .extend((0..n).filter(|&i| self.rows[i].position));
@@ -79,6 +80,30 @@ impl ReactionSolver {
         Some(())
     }
 
+    /// Whether row `r` joins two bodies that no force moves (fixed, kinematic): it carries no
+    /// unknown (its row and column of `J M^-1 J^T` are zero), and its multiplier is zero: the
+    /// bodies' supports take whatever it would carry.
+    fn inert(&self, r: &super::rows::Row) -> bool {
+        !self.entries[r.b1].dynamic && !self.entries[r.b2].dynamic
+    }
+
+    /// Puts a unit of the matrix's scale on the diagonal of every inert row (a zero row and
+    /// column), so that the factorisation does not see a singular matrix and the row's
+    /// multiplier, with a zero right-hand side, is zero.
+    fn decouple_inert_rows(&mut self, n: usize) {
+        let scale = (0..n).fold(0.0f64, |m, i| m.max(self.a[i * n + i].abs()));
+        let unit = if scale > 0.0 && scale.is_finite() {
+            scale
+        } else {
+            1.0
+        };
+        for i in 0..n {
+            if self.inert(&self.rows[i]) {
+                self.a[i * n + i] = unit;
+            }
+        }
+    }
+
     /// Makes the dynamic bodies' velocities satisfy the position rows, `J v = 0`, with the
     /// least change in the mass metric: `v -= M^-1 J^T mu`, `(J M^-1 J^T) mu = J v`.
     fn project(&mut self, n: usize) {
@@ -90,7 +115,12 @@ impl ReactionSolver {
         for &i in &self.pos_rows {
             let r = &self.rows[i];
             let (e1, e2) = (&self.entries[r.b1], &self.entries[r.b2]);
-            self.b_pos.push(r.dot((e1.v, e1.w), (e2.v, e2.w)));
+            let jv = if self.inert(r) {
+                0.0
+            } else {
+                r.dot((e1.v, e1.w), (e2.v, e2.w))
+            };
+            self.b_pos.push(jv);
         }
         if np < n {
             lu_solve(
@@ -124,8 +154,12 @@ impl ReactionSolver {
         self.b.clear();
         for r in &self.rows {
             let (e1, e2) = (&self.entries[r.b1], &self.entries[r.b2]);
-            self.b
-                .push(-(r.c + r.dot((e1.acc, e1.alpha), (e2.acc, e2.alpha))));
+            let rhs = if self.inert(r) {
+                0.0
+            } else {
+                -(r.c + r.dot((e1.acc, e1.alpha), (e2.acc, e2.alpha)))
+            };
+            self.b.push(rhs);
         }
         lu_solve(&self.lu, &self.piv, &mut self.b, &mut self.scratch, n);
         for (r, &lambda) in self.rows.iter().zip(&self.b) {

@@ -11,17 +11,17 @@ fn dense_solve_by_hand() {
     let mut a = vec![2.0, 1.0, 1.0, 3.0];
     let mut b = vec![3.0, 5.0];
     let (mut piv, mut scratch) = (Vec::new(), Vec::new());
-    assert!(lu_factor(&mut a, &mut piv, 2));
+    assert!(lu_factor(&mut a, &mut piv, 2, 1e-12));
     lu_solve(&a, &piv, &mut b, &mut scratch, 2);
     assert!((b[0] - 0.8).abs() < 1e-15 && (b[1] - 1.4).abs() < 1e-15);
     // With a row swap: y = 2, x + y = 3 -> x = 1.
     let mut a = vec![0.0, 1.0, 1.0, 1.0];
     let mut b = vec![2.0, 3.0];
-    assert!(lu_factor(&mut a, &mut piv, 2));
+    assert!(lu_factor(&mut a, &mut piv, 2, 1e-12));
     lu_solve(&a, &piv, &mut b, &mut scratch, 2);
     assert!((b[0] - 1.0).abs() < 1e-15 && (b[1] - 2.0).abs() < 1e-15);
     let mut a = vec![1.0, 2.0, 2.0, 4.0];
-    assert!(!lu_factor(&mut a, &mut piv, 2));
+    assert!(!lu_factor(&mut a, &mut piv, 2, 1e-12));
 }
 
 #[test]
@@ -503,4 +503,63 @@ fn stored_velocities_are_advanced_by_the_lag() {
     solver.solve(&bodies, &[j], g).unwrap();
     assert!((solver.acceleration(free).unwrap().0 - g).length() < 1e-12);
     assert!((solver.velocity(free).unwrap().0 - 0.01 * g).length() < 1e-12);
+}
+
+#[test]
+fn a_weld_between_bodies_that_do_not_move_leaves_the_other_reactions() {
+    // The hanging arm of the module example (2 kg, held by its pivot: 2 g up) beside a bracket
+    // welded to the ground and a kinematic plate spinning on a fixed pin: those joints join
+    // bodies no force moves, carry no unknown, and must neither zero nor disturb the arm's.
+    let g = Vector::new(0.0, -9.81, 0.0);
+    let mut bodies = RigidBodySet::new();
+    let base = bodies.insert(RigidBodyBuilder::fixed());
+    let bracket = bodies.insert(RigidBodyBuilder::fixed().translation(Vector::new(0.5, 0.0, 0.0)));
+    let plate = bodies
+        .insert(RigidBodyBuilder::kinematic_velocity_based().angvel(Vector::new(0.0, 0.0, 3.0)));
+    let arm = bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(Vector::new(0.0, -0.3, 0.0))
+            .additional_mass_properties(MassProperties::new(
+                Vector::ZERO,
+                2.0,
+                Vector::splat(0.02),
+            )),
+    );
+    prepare_mass_properties(&mut bodies);
+    let hinge = IdealJoint::Revolute(IdealRevolute {
+        body1: base,
+        body2: arm,
+        local_anchor1: Vector::ZERO,
+        local_anchor2: Vector::new(0.0, 0.3, 0.0),
+        local_axis1: Vector::Z,
+    });
+    let weld = IdealJoint::Fixed(IdealFixed {
+        body1: base,
+        body2: bracket,
+        local_anchor1: Vector::new(0.5, 0.0, 0.0),
+        local_anchor2: Vector::ZERO,
+    });
+    let pin = IdealJoint::Revolute(IdealRevolute {
+        body1: bracket,
+        body2: plate,
+        local_anchor1: Vector::new(-0.5, 0.0, 0.0),
+        local_anchor2: Vector::ZERO,
+        local_axis1: Vector::Z,
+    });
+    let mut s = ReactionSolver::default();
+    for joints in [vec![hinge, weld], vec![weld, pin, hinge], vec![pin, hinge]] {
+        let f = s.solve_joints(&bodies, &joints, g).unwrap().to_vec();
+        let k = joints.iter().position(|j| *j == hinge).unwrap();
+        assert!(
+            (f[k] - Vector::new(0.0, 2.0 * 9.81, 0.0)).length() < 1e-9,
+            "{f:?}"
+        );
+        for (i, f) in f.iter().enumerate().filter(|(i, _)| *i != k) {
+            assert_eq!(
+                *f,
+                Vector::ZERO,
+                "joint {i} between bodies that do not move"
+            );
+        }
+    }
 }

@@ -2,7 +2,7 @@
 
 use super::Scene;
 use super::limits::*;
-use crate::error::{Error, Result, in_range, non_negative};
+use crate::error::{Error, Result, in_range, non_negative, sig4};
 use serde::{Deserialize, Serialize};
 
 /// A rigid body with principal axes along the world axes at t = 0, at rest.
@@ -24,10 +24,12 @@ pub struct BodySpec {
     /// drives the mechanism; its mass and inertia are then ignored.
     #[serde(default)]
     pub motion: Option<MotionSpec>,
-    /// Initial velocity of the centre of mass, m/s (dynamic bodies; default at rest).
+    /// Initial velocity of the centre of mass, m/s (dynamic bodies only: refused on a fixed or
+    /// driven body; default at rest).
     #[serde(default)]
     pub velocity_m_s: [f64; 3],
-    /// Initial angular velocity, rad/s (dynamic bodies; default at rest).
+    /// Initial angular velocity, rad/s (dynamic bodies only, as `velocity_m_s`; default at
+    /// rest).
     #[serde(default)]
     pub angular_velocity_rad_s: [f64; 3],
 }
@@ -116,15 +118,7 @@ impl Scene {
             for (i, x) in b.center_of_mass_m.iter().enumerate() {
                 position(&format!("{p}.center_of_mass_m[{i}]"), *x)?;
             }
-            for (i, v) in b.velocity_m_s.iter().enumerate() {
-                in_range(
-                    &format!("{p}.velocity_m_s[{i}]"),
-                    *v,
-                    -SPEED_MAX,
-                    SPEED_MAX,
-                    "m/s",
-                )?;
-            }
+            speed(&format!("{p}.velocity_m_s"), &b.velocity_m_s)?;
             for (i, w) in b.angular_velocity_rad_s.iter().enumerate() {
                 in_range(
                     &format!("{p}.angular_velocity_rad_s[{i}]"),
@@ -133,6 +127,25 @@ impl Scene {
                     RATE_MAX,
                     "rad/s",
                 )?;
+            }
+            // A fixed or driven body's velocity is not its own: one given would be ignored.
+            if b.fixed || b.motion.is_some() {
+                let what = if b.fixed {
+                    "a fixed body does not move"
+                } else {
+                    "a body with a prescribed motion moves as its `motion` says"
+                };
+                for (field, v) in [
+                    ("velocity_m_s", b.velocity_m_s),
+                    ("angular_velocity_rad_s", b.angular_velocity_rad_s),
+                ] {
+                    if v != [0.0; 3] {
+                        return Err(Error::invalid(
+                            format!("{p}.{field}"),
+                            format!("{what}: an initial velocity would be ignored; remove it"),
+                        ));
+                    }
+                }
             }
             match &b.motion {
                 Some(_) if b.fixed => {
@@ -157,6 +170,12 @@ impl Scene {
                         RATE_MAX,
                         "rad/s",
                     )?;
+                    turning_speed(
+                        &format!("{p}.motion.rate_rad_s"),
+                        rate_rad_s.abs(),
+                        point_m,
+                        &b.center_of_mass_m,
+                    )?;
                 }
                 Some(MotionSpec::TableAngle {
                     axis,
@@ -168,8 +187,21 @@ impl Scene {
                     for (i, x) in point_m.iter().enumerate() {
                         position(&format!("{p}.motion.point_m[{i}]"), *x)?;
                     }
-                    crate::rapier::prescribed::Table::new(t_s, angle_rad)
+                    let table = crate::rapier::prescribed::Table::new(t_s, angle_rad)
                         .map_err(|e| table_error(e, &p, "angle_rad"))?;
+                    let field = format!("{p}.motion.angle_rad");
+                    let rate = table.max_rate();
+                    if rate > RATE_MAX {
+                        return Err(Error::invalid(
+                            field,
+                            format!(
+                                "turns at up to {} rad/s between its points, more than {} rad/s",
+                                sig4(rate),
+                                sig4(RATE_MAX)
+                            ),
+                        ));
+                    }
+                    turning_speed(&field, rate, point_m, &b.center_of_mass_m)?;
                 }
                 Some(MotionSpec::TablePosition {
                     direction,
@@ -177,25 +209,69 @@ impl Scene {
                     position_m,
                 }) => {
                     unit(direction, &format!("{p}.motion.direction"))?;
-                    crate::rapier::prescribed::Table::new(t_s, position_m)
+                    let table = crate::rapier::prescribed::Table::new(t_s, position_m)
                         .map_err(|e| table_error(e, &p, "position_m"))?;
+                    let rate = table.max_rate();
+                    if rate > SPEED_MAX {
+                        return Err(Error::invalid(
+                            format!("{p}.motion.position_m"),
+                            format!(
+                                "moves at up to {} m/s between its points, more than {} m/s",
+                                sig4(rate),
+                                sig4(SPEED_MAX)
+                            ),
+                        ));
+                    }
                 }
                 Some(MotionSpec::Translate { velocity_m_s }) => {
-                    for (i, v) in velocity_m_s.iter().enumerate() {
-                        in_range(
-                            &format!("{p}.motion.velocity_m_s[{i}]"),
-                            *v,
-                            -SPEED_MAX,
-                            SPEED_MAX,
-                            "m/s",
-                        )?;
-                    }
+                    speed(&format!("{p}.motion.velocity_m_s"), velocity_m_s)?;
                 }
                 None => {}
             }
         }
         Ok(())
     }
+}
+
+/// A velocity: finite components and a speed of at most [`SPEED_MAX`].
+fn speed(field: &str, v: &[f64; 3]) -> Result<()> {
+    for (i, x) in v.iter().enumerate() {
+        in_range(&format!("{field}[{i}]"), *x, -SPEED_MAX, SPEED_MAX, "m/s")?;
+    }
+    let s = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    if s > SPEED_MAX {
+        return Err(Error::invalid(
+            field,
+            format!(
+                "a speed of {} m/s, more than {} m/s",
+                sig4(s),
+                sig4(SPEED_MAX)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The speed of the centre of mass `com` turning at `rate` (rad/s) about an axis through
+/// `point`: at most `rate |com - point|`, which must not pass [`SPEED_MAX`].
+fn turning_speed(field: &str, rate: f64, point: &[f64; 3], com: &[f64; 3]) -> Result<()> {
+    let r = (0..3)
+        .map(|i| (com[i] - point[i]).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    let s = rate * r;
+    if s > SPEED_MAX {
+        return Err(Error::invalid(
+            field,
+            format!(
+                "turns the centre of mass, {} m from the axis, at up to {} m/s, more than {} m/s",
+                sig4(r),
+                sig4(s),
+                sig4(SPEED_MAX)
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// A table's error with the scene's field names (`t_s` and the value list's name).

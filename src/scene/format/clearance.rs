@@ -377,6 +377,7 @@ impl ClearanceSpec {
                 } => {
                     in_range("v0_mm_s", *v0_mm_s, 0.0, SPEED_MM_S_RANGE.1, "mm/s")?;
                     speed_mm_s("v1_mm_s", *v1_mm_s)?;
+                    greater("v1_mm_s", *v1_mm_s, "v0_mm_s", *v0_mm_s)?;
                     FrictionModel::Ambrosio(Ambrosio::new(*mu_d, v0_mm_s * mm, v1_mm_s * mm)?)
                 }
                 FrictionSpec::Bai {
@@ -387,6 +388,7 @@ impl ClearanceSpec {
                 } => {
                     speed_mm_s("v_s_mm_s", *v_s_mm_s)?;
                     speed_mm_s("v_d_mm_s", *v_d_mm_s)?;
+                    greater("v_d_mm_s", *v_d_mm_s, "v_s_mm_s", *v_s_mm_s)?;
                     FrictionModel::Bai(Bai::new(*mu_s, *mu_d, v_s_mm_s * mm, v_d_mm_s * mm)?)
                 }
                 FrictionSpec::Dry => FrictionModel::Bai(Bai::DRY),
@@ -464,4 +466,20 @@ mod tests {
                 .normal
         );
     }
+}
+
+/// A transition speed `field` (mm/s) must exceed the one before it, `lower` (in the scene's
+/// fields and unit: the law checks the same in m/s under its own names).
+fn greater(field: &str, value: f64, lower: &str, bound: f64) -> Result<()> {
+    if value <= bound {
+        return Err(Error::invalid(
+            field,
+            format!(
+                "must be greater than `{lower}` = {} mm/s (got {} mm/s)",
+                crate::error::sig4(bound),
+                crate::error::sig4(value)
+            ),
+        ));
+    }
+    Ok(())
 }

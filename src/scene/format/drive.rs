@@ -3,7 +3,8 @@
 use super::Scene;
 use super::clearance::one;
 use super::limits::*;
-use crate::error::{Error, Result, in_range};
+use crate::error::{Error, Result, in_range, sig4};
+use crate::model::kinematics::stable_step;
 use serde::{Deserialize, Serialize};
 
 /// A torsion spring `T = scale (T0 - k theta)` on a hinge (MODEL.md §4, eq. 20).
@@ -60,4 +61,62 @@ impl Scene {
         }
         Ok(())
     }
+
+    /// Each drive's spring must be stable at the largest step (the fixed step, or the adaptive
+    /// steps' bound): symplectic Euler turns a spring `k` on an inertia `I` unstable beyond
+    /// `dt = 2/omega`, `omega = sqrt(k/I)` ([`stable_step`]). `I` is the hinge's two moving
+    /// bodies' inertias about the hinge axis through the hinge point, in series (a fixed or
+    /// driven body adds none): exact for a body pinned to the ground. Checked after the rest.
+    pub(super) fn validate_drive_steps(&self) -> Result<()> {
+        let (field, dt) = match self.run.step {
+            crate::rapier::stepper::StepMode::Fixed => ("run.dt_s", self.run.dt_s),
+            crate::rapier::stepper::StepMode::Adaptive => ("run.max_dt_s", self.run.max_dt_s),
+        };
+        for d in &self.drives {
+            let Some(h) = self.hinges.iter().find(|h| h.name == d.hinge) else {
+                continue;
+            };
+            let inverse: f64 = [&h.bearing, &h.journal]
+                .into_iter()
+                .filter_map(|b| self.bodies.iter().find(|s| &s.name == b))
+                .filter(|b| !b.fixed && b.motion.is_none())
+                .map(|b| 1.0 / inertia_about(b, h.point_m, h.axis))
+                .sum();
+            let k = (d.torque_scale * d.stiffness_nm_per_deg).abs() * 180.0 / std::f64::consts::PI;
+            if !(inverse > 0.0) || !(k > 0.0) {
+                continue;
+            }
+            let (dt_max, omega, _) = stable_step(k, 0.0, 1.0 / inverse);
+            if dt > dt_max {
+                return Err(Error::invalid(
+                    format!("drives[{}].stiffness_nm_per_deg", d.name),
+                    format!(
+                        "the spring ({} N m/rad with `torque_scale`) is too stiff for the step: \
+                         with the bodies' inertia about hinge `{}` ({} kg m^2) its natural \
+                         frequency is {} rad/s, and the explicit step is stable only below {} s \
+                         (`{field}` = {} s)",
+                        sig4(k),
+                        h.name,
+                        sig4(1.0 / inverse),
+                        sig4(omega),
+                        sig4(dt_max),
+                        sig4(dt)
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The moment of inertia of body `b` about the axis `axis` (unit) through `point`: its
+/// principal moments (along the world axes at t = 0) projected on the axis, plus its mass times
+/// the square of its centre of mass's distance from the axis.
+fn inertia_about(b: &super::BodySpec, point: [f64; 3], axis: [f64; 3]) -> f64 {
+    let j = b.inertia_kg_m2;
+    let own = (0..3).map(|i| axis[i] * axis[i] * j[i]).sum::<f64>();
+    let r: [f64; 3] = std::array::from_fn(|i| b.center_of_mass_m[i] - point[i]);
+    let along = (0..3).map(|i| r[i] * axis[i]).sum::<f64>();
+    let d2 = (0..3).map(|i| r[i] * r[i]).sum::<f64>() - along * along;
+    own + b.mass_kg * d2.max(0.0)
 }

@@ -20,7 +20,7 @@ pub use limits::*;
 pub use load::SOLAR_PANEL_RON;
 pub use run::{RunSettings, StepMode};
 
-use crate::error::{Error, Result, in_range};
+use crate::error::{Error, Result, in_range, sig4};
 pub(super) use limits::is_plain_name;
 use serde::{Deserialize, Serialize};
 
@@ -122,6 +122,29 @@ impl Scene {
         self.validate_joints(&mut names)?;
         self.validate_planar()?;
         self.validate_drives(&mut names)?;
-        self.run.validate()
+        self.run.validate()?;
+        self.validate_drive_steps()?;
+        self.validate_periods()
+    }
+
+    /// The per-turn statistics of a driven scene must fit: at most
+    /// [`MAX_PERIODS`](crate::rapier::metrics::MAX_PERIODS) turns in `run.end_s`.
+    fn validate_periods(&self) -> Result<()> {
+        let max = crate::rapier::metrics::MAX_PERIODS as f64;
+        if let Some(p) = self.drive_period()
+            && self.run.end_s / p > max
+        {
+            return Err(Error::invalid(
+                "run.end_s",
+                format!(
+                    "{} turns of the drive (one every {} s): more than {} for the per-turn \
+                     statistics; shorten the run",
+                    sig4(self.run.end_s / p),
+                    sig4(p),
+                    sig4(max)
+                ),
+            ));
+        }
+        Ok(())
     }
 }

@@ -53,6 +53,17 @@ pub struct Invariants {
     /// When the energy balance grew the most, s.
     #[serde(skip)]
     pub energy_growth_at: f64,
+    /// There: the speed's miss `|speed - target|` and the target, in the motor's unit (rad/s
+    /// or m/s, the third field): a zero target's miss is reported as it is, not relative to the
+    /// floor.
+    #[serde(skip)]
+    pub motor_speed_miss: Option<(f64, f64, &'static str)>,
+    /// A velocity motor whose bodies start off its target (beyond the motor guard's limit): its
+    /// joint, the initial speed and the target. Rapier's motor then jumps them to speed in the
+    /// first steps, work the energy balance does not see: the initial velocities do not match
+    /// the motor.
+    #[serde(skip)]
+    pub motor_start_mismatch: Option<(String, f64, f64, &'static str)>,
     #[serde(skip)]
     free_floating: bool,
     #[serde(skip)]

@@ -311,14 +311,28 @@ impl Simulation {
                         ENERGY_GROWTH_LIMIT,
                         inv.energy_growth_at,
                     )
-                    .twin(twin.kind.name()),
+                    .twin(twin.kind.name())
+                    .note(start_mismatch_note(inv)),
                 );
             }
             if let (Some(e), Some((name, t))) = (inv.motor_speed_error, &inv.motor_speed_error_at)
                 && e > MOTOR_SPEED_ERROR_LIMIT
             {
-                let mut v = Violation::new(GuardKind::MotorSpeed, e, MOTOR_SPEED_ERROR_LIMIT, *t)
-                    .twin(twin.kind.name());
+                // A zero target's miss is reported as it is, against the limit times the floor.
+                let (worst, limit, unit) = match inv.motor_speed_miss {
+                    Some((miss, target, unit)) if target == 0.0 => {
+                        (miss, MOTOR_SPEED_ERROR_LIMIT * 1e-3, Some(unit))
+                    }
+                    _ => (e, MOTOR_SPEED_ERROR_LIMIT, None),
+                };
+                let advice = match &inv.motor_start_mismatch {
+                    Some(_) if *t == 0.0 => start_mismatch_note(inv),
+                    _ => String::new(),
+                };
+                let mut v = Violation::new(GuardKind::MotorSpeed, worst, limit, *t)
+                    .twin(twin.kind.name())
+                    .note(advice);
+                v.unit = unit;
                 v.joint = Some(name.clone());
                 v.count = inv.motor_speed_violations.max(1);
                 guards.record(v);
@@ -341,16 +355,17 @@ impl Simulation {
         let rows = !self.skip_rows;
         let lag = 0.5 * self.stepper.last_dt();
         for twin in &mut self.twins {
-            twin.before_step(&self.world.bodies, gravity, t, lag, rows);
+            twin.before_step(&self.world.bodies, gravity, t, lag, rows)?;
         }
         self.last_read = t;
         let target = self.target();
-        let info = {
+        let stepped = {
             let mut sources = sources(&mut self.twins);
             self.stepper
                 .step(&mut self.world, &mut sources, target)
-                .map_err(|e| name_bodies(name_step_field(e, "run.dt_s"), &self.twins))?
+                .map_err(|e| name_bodies(name_step_field(e, "run.dt_s"), &self.twins))
         };
+        let info = stepped.map_err(|e| self.name_diverged_body(e))?;
         for twin in &mut self.twins {
             twin.after_step(
                 &self.world.bodies,
@@ -385,6 +400,75 @@ impl Simulation {
         t
     }
 
+    /// Names, in a divergence, the body that left the physical range as the scene names it (the
+    /// stepper knows only Rapier's handles), with the likely cause.
+    fn name_diverged_body(&self, e: crate::Error) -> crate::Error {
+        let crate::Error::Diverged { t, .. } = e else {
+            return e;
+        };
+        let params = &self.world.integration_parameters;
+        let found = self.twins.iter().find_map(|twin| {
+            twin.bodies.iter().find_map(|b| {
+                let rb = self.world.bodies.get(b.handle)?;
+                left_physical_range(rb, params).map(|speed| (twin.kind, b, speed))
+            })
+        });
+        let Some((kind, body, speed)) = found else {
+            return e;
+        };
+        let spec = self.scene.bodies.iter().find(|s| s.name == body.name);
+        let drives: Vec<String> = self
+            .scene
+            .bodies
+            .iter()
+            .filter(|b| b.motion.is_some())
+            .map(|b| format!("`bodies[{}].motion`", b.name))
+            .chain(
+                self.scene
+                    .joints
+                    .iter()
+                    .filter(|j| j.motor.is_some())
+                    .map(|j| format!("`joints[{}].motor`", j.name)),
+            )
+            .chain(
+                self.scene
+                    .drives
+                    .iter()
+                    .map(|d| format!("`drives[{}]`", d.name)),
+            )
+            .collect();
+        let cause = if spec.is_some_and(|s| s.motion.is_some()) {
+            format!(
+                "its prescribed motion (`bodies[{}].motion`) moves it faster than the model \
+                 carries",
+                body.name
+            )
+        } else if !drives.is_empty() {
+            format!(
+                "the drive ({}) moves the mechanism faster than it can follow, or a contact is \
+                 too stiff for the step",
+                drives.join(", ")
+            )
+        } else {
+            "an initial velocity too high, or a contact too stiff for the step".to_string()
+        };
+        let speed = if speed.is_finite() {
+            format!("speed {} m/s", crate::error::sig4(speed))
+        } else {
+            "its state is not finite".to_string()
+        };
+        crate::Error::Diverged {
+            t,
+            reason: format!(
+                "body `{}` of the {} twin left the physical range ({speed}, the guard being {} \
+                 m/s); likely cause: {cause}",
+                body.name,
+                kind.name(),
+                crate::error::sig4(0.5 * params.max_linear_velocity()),
+            ),
+        }
+    }
+
     /// Records the final state: invariants, a last row at `end_s` (its reactions, velocities and
     /// accelerations solved at that state like every other), final metrics.
     fn finish(&mut self) -> Result<()> {
@@ -397,7 +481,7 @@ impl Simulation {
         let rows = !self.skip_rows;
         let lag = 0.5 * self.stepper.last_dt();
         for twin in &mut self.twins {
-            twin.before_step(&self.world.bodies, gravity, t, lag, rows);
+            twin.before_step(&self.world.bodies, gravity, t, lag, rows)?;
         }
         self.write_rows(t);
         let duration = self.time();
@@ -410,6 +494,21 @@ impl Simulation {
             }
         }
         Ok(())
+    }
+}
+
+/// What a velocity motor that starts off its target adds to a guard's message (empty for none).
+fn start_mismatch_note(inv: &Invariants) -> String {
+    match &inv.motor_start_mismatch {
+        Some((name, rate, target, unit)) => format!(
+            "; the velocity motor `{name}` starts at {} {unit} against its target {} {unit}: the \
+             bodies' initial velocities do not match the motor, which jumps them to speed in the \
+             first steps (work the energy balance does not see); give them initial velocities \
+             consistent with it",
+            crate::error::sig4(*rate),
+            crate::error::sig4(*target)
+        ),
+        None => String::new(),
     }
 }
 

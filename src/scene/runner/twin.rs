@@ -155,8 +155,9 @@ pub struct Twin {
     /// The joint motors in Rapier, with the index of their scene joint: their impulses over each
     /// step give their work.
     motor_joints: Vec<(ImpulseJointHandle, JointAxis, usize)>,
-    /// The velocity motors (reported as holding their speed): motor index, target, joint name.
-    held_motors: Vec<(usize, f64, String)>,
+    /// The velocity motors (reported as holding their speed): motor index, target, joint name,
+    /// unit of the target.
+    held_motors: Vec<(usize, f64, String, &'static str)>,
     pub(super) reference_axis: Vector,
     /// Output rows.
     pub table: Table,
@@ -373,7 +374,11 @@ impl Twin {
         let mut held_motors = Vec::new();
         for (k, j) in scene.joints.iter().enumerate() {
             if let Some(Motor::Held { target, .. }) = motor_of(j.motor.as_ref()) {
-                held_motors.push((k, target, j.name.clone()));
+                let unit = match j.motor {
+                    Some(MotorSpec::LinearVelocity { .. }) => "m/s",
+                    _ => "rad/s",
+                };
+                held_motors.push((k, target, j.name.clone(), unit));
             }
             let (i1, i2) = (
                 scene.body_index(&j.body1).unwrap(),
@@ -578,7 +583,7 @@ impl Twin {
         t: f64,
         lag: f64,
         rows: bool,
-    ) {
+    ) -> Result<()> {
         let axis_ref = self.reference_axis;
         for b in &mut self.bodies {
             let rb = &bodies[b.handle];
@@ -618,7 +623,7 @@ impl Twin {
                 };
             }
         }
-        self.solve_ideal_reactions(bodies, gravity, t, lag);
+        self.solve_ideal_reactions(bodies, gravity, t, lag)?;
         self.source_energy_before = self.drives.potential_energy()
             + self
                 .clearance
@@ -629,6 +634,7 @@ impl Twin {
             std::mem::swap(&mut self.row_prev, &mut self.row_cur);
             self.fill_row(t, bodies);
         }
+        Ok(())
     }
 
     /// Completes the step that started from the state [`before_step`](Self::before_step) read:
@@ -652,16 +658,24 @@ impl Twin {
             }
         }
         // How far the velocity motors hold their speed, at the state the step started from.
-        for (k, target, name) in &self.held_motors {
+        for (k, target, name, unit) in &self.held_motors {
             if let Some(rate) = self.reactions.motor_rate(n + k) {
-                let e = (rate - target).abs() / target.abs().max(1e-3);
+                let miss = (rate - target).abs();
+                let e = miss / target.abs().max(1e-3);
                 let inv = &mut self.invariants;
                 if e > super::MOTOR_SPEED_ERROR_LIMIT {
                     inv.motor_speed_violations += 1;
                 }
+                if info.t0 == 0.0
+                    && e > super::MOTOR_SPEED_ERROR_LIMIT
+                    && inv.motor_start_mismatch.is_none()
+                {
+                    inv.motor_start_mismatch = Some((name.clone(), rate, *target, unit));
+                }
                 if inv.motor_speed_error.is_none_or(|w| e > w) {
                     inv.motor_speed_error = Some(e);
                     inv.motor_speed_error_at = Some((name.clone(), info.t0));
+                    inv.motor_speed_miss = Some((miss, *target, unit));
                 }
             }
         }
@@ -684,9 +698,16 @@ impl Twin {
     /// current state, exact: the constrained rigid-body equations solved for the joint forces
     /// ([`ReactionSolver`]), whatever the step control (the stored velocities, `lag` before the
     /// state, advanced to it).
-    fn solve_ideal_reactions(&mut self, bodies: &RigidBodySet, gravity: Vector, t: f64, lag: f64) {
+    /// A solve that fails (a non-finite state) is an error: never reactions left at zero.
+    fn solve_ideal_reactions(
+        &mut self,
+        bodies: &RigidBodySet,
+        gravity: Vector,
+        t: f64,
+        lag: f64,
+    ) -> Result<()> {
         if self.ideal_joints.is_empty() && !self.body_motion {
-            return;
+            return Ok(());
         }
         self.reactions.velocity_lag = lag;
         // Tabulated drives at this state: their velocities and accelerations.
@@ -710,12 +731,22 @@ impl Twin {
             .extend_from_slice(self.drives.wrenches());
         self.source_wrenches
             .extend_from_slice(self.clearance.wrenches());
-        if let Some(forces) = self.reactions.solve_joints_with(
+        let Some(forces) = self.reactions.solve_joints_with(
             bodies,
             &self.ideal_joints,
             gravity,
             &self.source_wrenches,
-        ) {
+        ) else {
+            return Err(crate::Error::Diverged {
+                t,
+                reason: format!(
+                    "the {} twin's ideal-joint reactions cannot be solved: its state or a \
+                     body's mass is not finite",
+                    self.kind.name()
+                ),
+            });
+        };
+        {
             let n = self.ideal_hinges.len();
             for (&hi, f) in self.ideal_hinges.iter().zip(forces) {
                 self.hinges[hi].force = f.length();
@@ -729,6 +760,7 @@ impl Twin {
                 }
             }
         }
+        Ok(())
     }
 
     /// Metrics of the state before the step (its sample and force), weighted by the step.

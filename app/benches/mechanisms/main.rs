@@ -158,7 +158,7 @@ fn guards(o: &Outcome) -> String {
         Some(e) => format!("**failed**: {}", shorten(e, 110)),
         None if o.violations.is_empty() => "clean".into(),
         None => {
-            let kinds: Vec<String> = o.violations.iter().map(|v| violation_kind(v)).collect();
+            let kinds: Vec<String> = o.violations.iter().map(violation_kind).collect();
             format!("flagged: {}", kinds.join("; "))
         }
     }

@@ -8,6 +8,7 @@
 #![allow(dead_code)] // the test uses a part of it
 
 use clearance_joint::rapier::metrics::Impact;
+use clearance_joint::rapier::stepper::Violation;
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::runner::{RunOptions, Simulation, TwinKind, Twins};
 use std::path::{Path, PathBuf};
@@ -216,8 +217,8 @@ pub struct Outcome {
     pub stepping: Stepping,
     /// The run's error, if it failed (nothing else is then meaningful).
     pub error: Option<String>,
-    /// Guard violations in words (empty: clean).
-    pub violations: Vec<String>,
+    /// Guard violations, the worst of each kind per joint (empty: clean).
+    pub violations: Vec<Violation>,
     /// Internal steps.
     pub steps: u64,
     /// Wall time of the run (both twins in one world), s.
@@ -454,14 +455,15 @@ pub fn rel(a: f64, b: f64) -> f64 {
     a / b - 1.0
 }
 
-/// A guard violation's kind: its words before the first number, `(` or `:` (the values and the
-/// time differ between runs, the kind does not).
-pub fn violation_kind(text: &str) -> String {
-    text.split(|c: char| c == '(' || c == ':' || c.is_ascii_digit())
-        .next()
-        .unwrap_or("")
-        .trim()
-        .to_string()
+/// A guard violation's kind and subject: the guard, the joint and the twin (the values and the
+/// time differ between runs, these do not).
+pub fn violation_kind(v: &Violation) -> String {
+    format!(
+        "{:?} {} {}",
+        v.kind,
+        v.joint.as_deref().unwrap_or("-"),
+        v.twin.as_deref().unwrap_or("-")
+    )
 }
 
 /// The violations of `run` of a kind the `converged` run does not show: what the defaults
@@ -476,6 +478,6 @@ pub fn new_violations(run: &Outcome, converged: &Outcome) -> Vec<String> {
     run.violations
         .iter()
         .filter(|v| !known.contains(&violation_kind(v)))
-        .cloned()
+        .map(|v| v.message())
         .collect()
 }

@@ -216,7 +216,7 @@ impl Simulation {
             {
                 guards.violation(&format!("motor:{}", twin.kind.name()), || {
                     let miss = match inv.motor_speed_miss {
-                        Some((miss, target, unit)) if target == 0.0 => format!(
+                        Some((miss, 0.0, unit)) => format!(
                             "{} {unit} (its target is 0: the limit is {} {unit})",
                             crate::error::sig4(miss),
                             crate::error::sig4(MOTOR_SPEED_ERROR_LIMIT * 1e-3)

@@ -444,6 +444,22 @@ impl<T> WithinExt<T> for Result<T> {
     }
 }
 
+/// A transition speed `field` (mm/s) must exceed the one before it, `lower` (in the scene's
+/// fields and unit: the law checks the same in m/s under its own names).
+fn greater(field: &str, value: f64, lower: &str, bound: f64) -> Result<()> {
+    if value <= bound {
+        return Err(Error::invalid(
+            field,
+            format!(
+                "must be greater than `{lower}` = {} mm/s (got {} mm/s)",
+                crate::error::sig4(bound),
+                crate::error::sig4(value)
+            ),
+        ));
+    }
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -466,20 +482,4 @@ mod tests {
                 .normal
         );
     }
-}
-
-/// A transition speed `field` (mm/s) must exceed the one before it, `lower` (in the scene's
-/// fields and unit: the law checks the same in m/s under its own names).
-fn greater(field: &str, value: f64, lower: &str, bound: f64) -> Result<()> {
-    if value <= bound {
-        return Err(Error::invalid(
-            field,
-            format!(
-                "must be greater than `{lower}` = {} mm/s (got {} mm/s)",
-                crate::error::sig4(bound),
-                crate::error::sig4(value)
-            ),
-        ));
-    }
-    Ok(())
 }

@@ -320,9 +320,7 @@ impl Simulation {
             {
                 // A zero target's miss is reported as it is, against the limit times the floor.
                 let (worst, limit, unit) = match inv.motor_speed_miss {
-                    Some((miss, target, unit)) if target == 0.0 => {
-                        (miss, MOTOR_SPEED_ERROR_LIMIT * 1e-3, Some(unit))
-                    }
+                    Some((miss, 0.0, unit)) => (miss, MOTOR_SPEED_ERROR_LIMIT * 1e-3, Some(unit)),
                     _ => (e, MOTOR_SPEED_ERROR_LIMIT, None),
                 };
                 let advice = match &inv.motor_start_mismatch {

@@ -213,6 +213,8 @@ impl ImpactRecorder {
             self.open = false;
         }
         if obs.onset {
+            // In contact from the crossing on.
+            self.contact_time += t - onset_t;
             m.impacts += 1;
             if m.first_impact_t_s.is_none() {
                 m.first_impact_t_s = Some(onset_t);

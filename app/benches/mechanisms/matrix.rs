@@ -470,11 +470,7 @@ pub fn violation_kind(v: &Violation) -> String {
 /// flagged beyond the converged physics itself (e.g. a first impact deeper than the contact
 /// law's validity limit is flagged in every run, converged or not).
 pub fn new_violations(run: &Outcome, converged: &Outcome) -> Vec<String> {
-    let known: Vec<String> = converged
-        .violations
-        .iter()
-        .map(|v| violation_kind(v))
-        .collect();
+    let known: Vec<String> = converged.violations.iter().map(violation_kind).collect();
     run.violations
         .iter()
         .filter(|v| !known.contains(&violation_kind(v)))

@@ -179,7 +179,7 @@ pub struct Run {
     pub worst_acceleration_error: f64,
     /// Whether the guards stayed clean.
     pub clean: bool,
-    /// The guard violations.
+    /// The guard violations, in words (the worst of each kind).
     pub violations: Vec<String>,
 }
 
@@ -225,7 +225,7 @@ pub fn simulate(clearance: Option<Clearance>, control: StepControl, end: f64) ->
     run.steps = stepper.steps();
     run.rejected = stepper.guards().rejected_steps;
     run.clean = stepper.guards().is_clean();
-    run.violations = stepper.guards().violations.clone();
+    run.violations = stepper.guards().messages();
     Ok(run)
 }
 

@@ -9,7 +9,6 @@
 //! On main before issue 16's step control this failed: the slider-crank at c = 0.5 mm ended its
 //! first 4 ms clean at +246 % force and +128 % penetration.
 
-#[allow(dead_code)]
 #[path = "../benches/mechanisms/matrix.rs"]
 mod matrix;
 

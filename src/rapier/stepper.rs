@@ -144,7 +144,7 @@ pub enum StepMode {
     /// A constant step (the paper's way); the last step is shortened to land on the end.
     Fixed,
     /// The step changes between Rapier steps: no body turns more than `tolerance` rad in a step
-    /// ([`motion_step`](crate::rapier::motion_step::motion_step)), shorter as a contact
+    /// ([`motion_step`]), shorter as a contact
     /// approaches and inside it (`tolerance` of the contact's natural period, within its damped
     /// and friction stability limits), at most the largest step (a safety cap), with rejected
     /// steps retried. The default.

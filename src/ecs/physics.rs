@@ -548,7 +548,9 @@ impl Physics {
 
     /// The exact reaction force magnitude of each ideal hinge at the current state (the runner's
     /// piece, [`ReactionSolver`]), N; empty when the solver fails.
-    pub(super) fn ideal_forces(&mut self) -> BTreeMap<Entity, f64> {
+    /// The ideal hinges' reaction magnitudes, N, by entity. A solve that fails (a non-finite
+    /// state or mass) is an error, never a zero force.
+    pub(super) fn ideal_forces(&mut self) -> Result<BTreeMap<Entity, f64>> {
         self.ideal_joints.clear();
         let mut ideal_entities = Vec::new();
         for (e, r) in &self.hinges {
@@ -587,7 +589,12 @@ impl Physics {
                     .map(|(e, f)| (*e, f.length()))
                     .collect()
             })
-            .unwrap_or_default()
+            .ok_or_else(|| Error::Diverged {
+                t: self.stepper.time(),
+                reason: "the ideal hinges' reactions cannot be solved: the state or a body's \
+                         mass is not finite"
+                    .into(),
+            })
     }
 }
 

@@ -161,7 +161,13 @@ pub fn record(
     if physics.error().is_some() {
         return;
     }
-    let ideal_forces = physics.ideal_forces();
+    let ideal_forces = match physics.ideal_forces() {
+        Ok(f) => f,
+        Err(e) => {
+            physics.fail(e);
+            return;
+        }
+    };
     let physics = &*physics;
     let w = &physics.world;
     for (body, mut state) in bodies.iter_mut() {

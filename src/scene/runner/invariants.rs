@@ -50,6 +50,9 @@ pub struct Invariants {
     /// [`MOTOR_SPEED_ERROR_LIMIT`].
     #[serde(skip)]
     pub motor_speed_violations: u64,
+    /// When a velocity motor first missed its speed by more than the limit, s.
+    #[serde(skip)]
+    pub motor_speed_first_violation_at: Option<f64>,
     /// When the energy balance grew the most, s.
     #[serde(skip)]
     pub energy_growth_at: f64,

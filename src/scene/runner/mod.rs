@@ -333,6 +333,7 @@ impl Simulation {
                 v.unit = unit;
                 v.joint = Some(name.clone());
                 v.count = inv.motor_speed_violations.max(1);
+                v.first_t_s = inv.motor_speed_first_violation_at.unwrap_or(*t);
                 guards.record(v);
             }
         }

@@ -665,6 +665,7 @@ impl Twin {
                 let inv = &mut self.invariants;
                 if e > super::MOTOR_SPEED_ERROR_LIMIT {
                     inv.motor_speed_violations += 1;
+                    inv.motor_speed_first_violation_at.get_or_insert(info.t0);
                 }
                 if info.t0 == 0.0
                     && e > super::MOTOR_SPEED_ERROR_LIMIT

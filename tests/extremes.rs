@@ -155,6 +155,29 @@ fn fixed_steps_across_the_stability_limit() {
     );
 }
 
+#[test]
+fn a_stability_limit_below_the_smallest_step_is_out_of_reach() {
+    // Issue 17: a contact damped at 1e12 N s/m (the documented maximum) is stable only below
+    // a step far under the smallest any run takes (1e-10 s); the advice used to be "use
+    // `run.dt_s` below 6.633e-19 s". It says no step resolves it and names the parameter.
+    let contact = r#"hinge.contact={"KelvinVoigt":{"stiffness":1e8,"damping":1e12}}"#;
+    match run(&["run.step=Fixed", "run.dt_s=1e-5", contact]) {
+        Err(e @ Error::StepTooLarge { dt_max, .. }) => {
+            let msg = e.to_string();
+            println!("{msg}");
+            assert!(0.8 * dt_max < 1e-10, "{msg}");
+            assert!(
+                msg.contains("No step resolves this contact")
+                    && msg.contains("out of reach")
+                    && msg.contains("hinges[hinge].clearance.contact.damping")
+                    && !msg.contains("Use `run.dt_s` below"),
+                "{msg}"
+            );
+        }
+        other => panic!("expected StepTooLarge, got {:?}", other.map(|s| s.impacts)),
+    }
+}
+
 /// A 2 kg arm on a clearance joint (steel, 0.2 mm play) under a fixed pivot, in a plain Rapier
 /// world: the world, the joints, the arm.
 fn api_pendulum() -> (

@@ -3,6 +3,8 @@
 //! applied, the energy balance with the motors' work, the motor fields' validation, and the
 //! motor-driven four-bar under adaptive steps against a fine fixed-step run.
 
+use clearance_joint::rapier::guards::Violation;
+use clearance_joint::rapier::stepper::GuardKind;
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::runner::{RunOptions, Simulation, TwinKind, Twins};
 use rapier3d_f64::prelude::{JointAxesMask, JointAxis};
@@ -336,6 +338,85 @@ fn linear_position_motor_rests_where_its_spring_carries_the_weight() {
     // The first row: released at 0, the spring not yet stretched: free fall.
     let ay = column(&result, "body_ay_m_s2");
     assert!((ay[0] + 9.81).abs() < 1e-9, "{}", ay[0]);
+}
+
+/// The velocity motor guard's violation of a one-arm scene (1 kg, centre of mass 0.2 m out
+/// along x, about z) run with its ideal twin, fixed steps of 1e-5 s.
+fn motor_guard(motor: &str, body: &str, end_s: f64) -> Option<Violation> {
+    let text = format!(
+        r#"Scene(
+            name: "arm",
+            gravity: (0.0, -9.81, 0.0),
+            reference_axis: (0.0, 0.0, 1.0),
+            bodies: [
+                (name: "ground", mass_kg: 0.0, inertia_kg_m2: (0.0, 0.0, 0.0), center_of_mass_m: (0.0, 0.0, 0.0), fixed: true),
+                (name: "body", mass_kg: 1.0, inertia_kg_m2: (0.001, 0.004, 0.004), center_of_mass_m: (0.2, 0.0, 0.0){body}),
+            ],
+            hinges: [],
+            joints: [
+                (name: "m", body1: "ground", body2: "body", point_m: (0.0, 0.0, 0.0), kind: Revolute(axis: (0.0, 0.0, 1.0)),
+                 motor: Some({motor})),
+            ],
+            run: (dt_s: 1e-5, end_s: {end_s}, output_interval_s: 1e-3, step: Fixed, body_motion: true),
+        )"#
+    );
+    let scene = Scene::from_ron(&text, "test").unwrap();
+    let result = Simulation::new(&scene, RunOptions::default())
+        .unwrap()
+        .run()
+        .unwrap();
+    result.guards.worst(GuardKind::MotorSpeed).cloned()
+}
+
+#[test]
+fn velocity_motor_with_a_zero_target_reports_its_miss_in_its_unit() {
+    // Issue 17: a weak motor (factor 1/s) told to hold the arm still lets the weight swing it;
+    // relative to a zero target (floored at 1e-3) the miss read "26.75 of its target". It is
+    // reported as it is, in rad/s, against the limit times that floor (the same ratio).
+    let v = motor_guard("Velocity(target_rad_s: 0.0, factor: 1.0)", "", 0.05)
+        .expect("the motor guard fires");
+    let msg = v.message();
+    println!("{msg}");
+    assert_eq!(v.unit, Some("rad/s"), "{msg}");
+    assert!(v.ratio() > 1.0, "{} against {}", v.worst, v.limit);
+    // Free fall of the arm's weight over 0.05 s bounds the miss: m g l t / (I + m l^2).
+    assert!(
+        v.worst > 1e-3 && v.worst < 9.81 * 0.2 * 0.05 / 0.044,
+        "{msg}"
+    );
+    assert!(
+        msg.contains(" rad/s (its target is 0; limit 1e-5 rad/s)")
+            && !msg.contains("of its target"),
+        "{msg}"
+    );
+    // The arm started at its target: the advice is the motor's own.
+    assert!(msg.contains("raise its `factor`"), "{msg}");
+}
+
+#[test]
+fn velocity_motor_started_from_rest_blames_the_initial_velocities() {
+    // Issue 17: the arm starts at rest, its stiff motor at one turn a second: Rapier jumps it to
+    // speed in the first steps. The guard used to say "raise its factor"; the cause is the
+    // initial velocities, which do not match the motor.
+    let w = std::f64::consts::TAU;
+    let motor = format!("Velocity(target_rad_s: {w}, factor: 1e6)");
+    let v = motor_guard(&motor, "", 0.01).expect("the motor guard fires");
+    let msg = v.message();
+    println!("{msg}");
+    assert_eq!(v.t_s, 0.0, "{msg}");
+    assert!(
+        msg.contains("the velocity motor `m` starts at 0 rad/s against its target 6.283 rad/s")
+            && msg.contains("the bodies' initial velocities do not match the motor")
+            && !msg.contains("raise its `factor`"),
+        "{msg}"
+    );
+    // Started at the motor's speed, the same arm holds it: no violation.
+    let body = format!(
+        ", velocity_m_s: (0.0, {}, 0.0), angular_velocity_rad_s: (0.0, 0.0, {w})",
+        0.2 * w
+    );
+    let held = motor_guard(&motor, &body, 0.01);
+    assert!(held.is_none(), "{:?}", held.map(|v| v.message()));
 }
 
 #[test]

@@ -379,6 +379,14 @@ fn velocity_motor_with_a_zero_target_reports_its_miss_in_its_unit() {
     println!("{msg}");
     assert_eq!(v.unit, Some("rad/s"), "{msg}");
     assert!(v.ratio() > 1.0, "{} against {}", v.worst, v.limit);
+    // The arm falls away from zero speed at once: the first violating state is within the first
+    // milliseconds, the worst at the end (the first time was once reported as the worst's).
+    assert!(
+        v.first_t_s < 1e-3 && v.t_s > 0.04,
+        "first {} s, worst {} s",
+        v.first_t_s,
+        v.t_s
+    );
     // Free fall of the arm's weight over 0.05 s bounds the miss: m g l t / (I + m l^2).
     assert!(
         v.worst > 1e-3 && v.worst < 9.81 * 0.2 * 0.05 / 0.044,

@@ -325,10 +325,10 @@ fn a_driven_mechanism_at_the_default_step_control_never_enters_deeper_than_allow
         "onset at {} of the depth",
         run.onset_ratio
     );
-    assert!(
-        run.stepper.guards().rejected_steps > 0,
-        "the predictor alone sufficed"
-    );
+    // Since adaptive steps also bound the crank's turn per step (`motion_step`), the predictor no
+    // longer needs a rejection here; the rejection path is exercised in tests/step_control.rs.
+    // What must hold is that the run met contacts at all.
+    assert!(run.first > 0.0, "no contact: the test tests nothing");
     assert_eq!(run.stepper.guards().floor_steps, 0);
     // The first impact agrees with a run resolved 15 times finer.
     let fine = crank_run(control.with_tolerance(0.0005), end).unwrap();

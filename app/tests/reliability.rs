@@ -732,6 +732,7 @@ fn stale_temporaries_are_cleaned() {
             "clearance_hinge_impacts.csv".into(),
             "ideal.csv".into(),
             "notes.tmp-1".into(),
+            "replay.html".into(),
             "summary.json".into()
         ]
     );
@@ -808,6 +809,7 @@ fn concurrent_runs_and_interrupts() {
             "clearance.csv",
             "clearance_hinge_impacts.csv",
             "ideal.csv",
+            "replay.html",
             "summary.json"
         ]
     );
@@ -1207,10 +1209,12 @@ fn study_strict_fails_on_a_guard() {
         let mut cmd = bin();
         cmd.args(["study", "clearance", "--no-figures", "--progress", "quiet"])
             .args([
+                // A validity limit below every case's first impact (a drive spring too stiff
+                // for the step, used before, is now refused at load).
                 "--set",
-                "drive.stiffness_nm_per_deg=1e6",
+                "hinge.max_valid_penetration_um=0.1",
                 "--set",
-                "run.end_s=0.05",
+                "run.end_s=0.12",
             ])
             .arg("--out")
             .arg(&root);
@@ -1226,7 +1230,7 @@ fn study_strict_fails_on_a_guard() {
     let e = stderr(&o);
     assert!(!o.status.success(), "--strict passed: {e}");
     assert!(
-        e.contains("guard violated (strict)") && e.contains("gained energy"),
+        e.contains("guard violated (strict)") && e.contains("penetrated beyond its law's validity"),
         "{e}"
     );
     assert!(

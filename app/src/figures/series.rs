@@ -2,7 +2,7 @@
 //! (so finished points reused from an earlier run plot exactly like fresh ones).
 
 use clearance_joint::error::{Error, Result};
-use clearance_joint::scene::Scene;
+use clearance_joint::scene::{HingeSpec, Scene};
 use clearance_joint::table::Table;
 use std::path::Path;
 
@@ -70,16 +70,7 @@ impl CaseSeries {
         ideal: &Table,
         clear: &Table,
     ) -> Result<CaseSeries> {
-        let hinge = scene
-            .hinges
-            .iter()
-            .find(|h| h.name == hinge && h.clearance.is_some())
-            .ok_or_else(|| {
-                Error::invalid(
-                    format!("hinges[{hinge}]"),
-                    "is not a hinge with clearance: nothing to plot",
-                )
-            })?;
+        let hinge = clearance_hinge(scene, hinge)?;
         let col = |t: &Table, name: &str| {
             t.column(name)
                 .ok_or_else(|| Error::invalid("output table", format!("has no column `{name}`")))
@@ -165,16 +156,7 @@ impl CaseSeries {
         hinge: &str,
         dir: &Path,
     ) -> Result<StreamedCase> {
-        let spec = scene
-            .hinges
-            .iter()
-            .find(|h| h.name == hinge && h.clearance.is_some())
-            .ok_or_else(|| {
-                Error::invalid(
-                    format!("hinges[{hinge}]"),
-                    "is not a hinge with clearance: nothing to plot",
-                )
-            })?;
+        let spec = clearance_hinge(scene, hinge)?;
         let c = spec.clearance.as_ref().map_or(0.0, |c| c.clearance_mm);
         let mut ideal = CsvRows::open(&dir.join("ideal.csv"))?;
         let mut clear = CsvRows::open(&dir.join("clearance.csv"))?;
@@ -518,4 +500,18 @@ pub fn read_csv(path: &Path) -> Result<Table> {
         }
     }
     Ok(table)
+}
+
+/// `scene`'s hinge named `hinge`, which must have a clearance (the figures plot its journal).
+fn clearance_hinge<'a>(scene: &'a Scene, hinge: &str) -> Result<&'a HingeSpec> {
+    scene
+        .hinges
+        .iter()
+        .find(|h| h.name == hinge && h.clearance.is_some())
+        .ok_or_else(|| {
+            Error::invalid(
+                format!("hinges[{hinge}]"),
+                "is not a hinge with clearance: nothing to plot",
+            )
+        })
 }

@@ -50,6 +50,10 @@ pub struct JournalState {
     pub penetration_rate: f64,
     /// In-plane tangential slip velocity `v_t`, m/s.
     pub slip: Vector,
+    /// Rate of the eccentricity `de/dt`: the in-plane velocity of the journal's centre relative
+    /// to the bearing's, m/s (the journal's path across the gap; unlike `slip` it carries no
+    /// relative spin).
+    pub eccentricity_rate: Vector,
     /// The common application point of the force pair: midpoint of `Q_i` and `Q_j`.
     pub contact_point: Vector,
 }
@@ -77,12 +81,14 @@ pub fn journal_state(
     let v_rel = journal.velocity_at(q_j) - bearing.velocity_at(q_i);
     let penetration_rate = v_rel.dot(normal);
     let slip = v_rel - penetration_rate * normal - v_rel.dot(axis) * axis;
+    let centres = journal.velocity_at(p_j) - bearing.velocity_at(p_i);
     JournalState {
         eccentricity,
         normal,
         penetration: e - geometry.clearance(),
         penetration_rate,
         slip,
+        eccentricity_rate: centres - centres.dot(axis) * axis,
         contact_point: 0.5 * (q_i + q_j),
     }
 }
@@ -200,6 +206,8 @@ mod tests {
         assert!((s.normal - Vector::X).length() < 1e-15);
         assert!((s.penetration_rate - 0.01).abs() < 1e-15);
         assert!((s.slip - Vector::new(0.0, 0.0, 0.02)).length() < 1e-15);
+        // The journal's centre moves with its body (no spin), the bearing's is at rest.
+        assert!((s.eccentricity_rate - Vector::new(0.01, 0.0, 0.02)).length() < 1e-15);
         // Q_i = P_i + 10 mm x, Q_j = P_j + 9.5 mm x (axial offset kept): midpoint
         let expected = 0.5 * ((p_i + 0.010 * Vector::X) + (p_j + 0.0095 * Vector::X));
         assert!((s.contact_point - expected).length() < 1e-15);
@@ -226,6 +234,8 @@ mod tests {
         // Q_i = (0.010, 0, 0) moves at (0, 0.02, 0); v_rel = -(0, 0.02, 0): pure slip
         assert!(s.penetration_rate.abs() < 1e-15);
         assert!((s.slip - Vector::new(0.0, -0.02, 0.0)).length() < 1e-15);
+        // The centres do not move relative to each other: a spin is no path across the gap.
+        assert!(s.eccentricity_rate.length() < 1e-15);
     }
 
     #[test]
@@ -236,6 +246,7 @@ mod tests {
             penetration: 1e-7,
             penetration_rate: 0.0,
             slip: Vector::new(0.0, 0.0, 1.0),
+            eccentricity_rate: Vector::ZERO,
             contact_point: Vector::ZERO,
         };
         let law = Hertz::new(1e12, 1.5).unwrap();

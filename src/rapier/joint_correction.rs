@@ -159,10 +159,10 @@ mod tests {
         c.accept(1e-4);
         c.apply(&mut joints, 1e-6);
         let during = joints.get(plain).unwrap().data.softness;
-        assert_eq!(
-            during,
-            softness_for(SpringCoefficients::joint_defaults(), 1e-4, 1e-6)
-        );
+        let span = c.span_after(1e-6);
+        assert_eq!(span, SPAN_DECAY * 1e-4);
+        let expected = softness_for(SpringCoefficients::joint_defaults(), span, 1e-6);
+        assert_eq!(during, expected);
         assert_eq!(joints.get(soft).unwrap().data.softness, mine);
         c.restore(&mut joints);
         assert_eq!(

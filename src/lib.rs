@@ -143,10 +143,36 @@ pub mod scene;
 pub mod table;
 pub use error::{Error, Result};
 
-// The README's examples are compiled and run as doctests.
+// The README's examples and its chapters' (docs/, except MODEL.md, the `model` module's doc) are
+// compiled and run as doctests. `tests/doc_links.rs` checks that every chapter is listed here.
 #[cfg(doctest)]
 #[doc = include_str!("../README.md")]
 pub struct ReadmeDoctests;
+#[cfg(doctest)]
+mod chapter_doctests {
+    #[doc = include_str!("../docs/guide-plain-rapier.md")]
+    pub struct GuidePlainRapier;
+    #[doc = include_str!("../docs/guide-mechanisms.md")]
+    pub struct GuideMechanisms;
+    #[doc = include_str!("../docs/guide-scenes-and-app.md")]
+    pub struct GuideScenesAndApp;
+    #[doc = include_str!("../docs/guide-bevy-ecs.md")]
+    pub struct GuideBevyEcs;
+    #[doc = include_str!("../docs/guide-game-and-robot-rates.md")]
+    pub struct GuideGameAndRobotRates;
+    #[doc = include_str!("../docs/stepper-and-accuracy.md")]
+    pub struct StepperAndAccuracy;
+    #[doc = include_str!("../docs/large-step-model.md")]
+    pub struct LargeStepModel;
+    #[doc = include_str!("../docs/scene-format.md")]
+    pub struct SceneFormat;
+    #[doc = include_str!("../docs/validation.md")]
+    pub struct Validation;
+    #[doc = include_str!("../docs/reliability.md")]
+    pub struct Reliability;
+    #[doc = include_str!("../docs/layout-and-dependencies.md")]
+    pub struct LayoutAndDependencies;
+}
 
 /// The types most users need.
 pub mod prelude {

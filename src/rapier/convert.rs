@@ -5,7 +5,7 @@
 //! `ImpulseJointSet`, and adds the equivalent [`ClearanceJoint`] to a [`ClearanceJointSet`]:
 //!
 //! ```
-//! use clearance_joint::rapier::convert::{BearingSide, Clearance, ConvertRevolute};
+//! use clearance_joint::model::laws::{Bai, FrictionModel};
 //! use clearance_joint::prelude::*;
 //! use rapier3d_f64::prelude::*;
 //!

@@ -466,14 +466,23 @@ fn the_readouts_keep_their_documented_bounds() {
                     assert!(r.eccentricity_ratio <= 1.0 + 2.0 * DRIFT_FRACTION, "{case}");
                 }
                 if r.contact {
-                    assert!(r.normal_force > 0.0 || r.eccentricity_ratio >= 0.999, "{case}");
+                    assert!(
+                        r.normal_force > 0.0 || r.eccentricity_ratio >= 0.999,
+                        "{case}"
+                    );
                     bearing_inside += u32::from(r.eccentricity_ratio < 0.999);
                 } else {
-                    assert!(r.normal_force == 0.0 && r.eccentricity_ratio < 0.999, "{case}");
+                    assert!(
+                        r.normal_force == 0.0 && r.eccentricity_ratio < 0.999,
+                        "{case}"
+                    );
                 }
             }
         }
     }
-    assert!(resolved > 1000 && flagged > 10, "{resolved} resolved, {flagged} flagged");
+    assert!(
+        resolved > 1000 && flagged > 10,
+        "{resolved} resolved, {flagged} flagged"
+    );
     println!("{resolved} resolved, {flagged} flagged, {bearing_inside} in contact inside 0.999 c");
 }

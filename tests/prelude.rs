@@ -61,7 +61,8 @@ fn every_prelude_name_resolves_next_to_rapiers_prelude() {
     let this_test = include_str!("prelude.rs");
     for name in prelude_names() {
         assert!(
-            this_test.contains(&format!("::<{name}>()")) || this_test.contains(&format!("<T: {name}>")),
+            this_test.contains(&format!("::<{name}>()"))
+                || this_test.contains(&format!("<T: {name}>")),
             "the prelude's `{name}` is not used by this test"
         );
     }
@@ -70,7 +71,9 @@ fn every_prelude_name_resolves_next_to_rapiers_prelude() {
 /// The names `pub mod prelude` exports, read from its source (which must hold no glob).
 fn prelude_names() -> Vec<String> {
     let source = include_str!("../src/lib.rs");
-    let start = source.find("pub mod prelude {").expect("the prelude module");
+    let start = source
+        .find("pub mod prelude {")
+        .expect("the prelude module");
     let body = &source[start..];
     let body = &body[..body.find("\n}").expect("the end of the prelude")];
     let mut names = Vec::new();
@@ -99,19 +102,27 @@ fn a_hinge_in_a_rapier_loop_with_both_preludes() -> Result<(), clearance_joint::
     let arm = world.bodies.insert(
         RigidBodyBuilder::dynamic()
             .translation(Vector::new(0.0, -0.3, 0.0))
-            .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02))),
+            .additional_mass_properties(MassProperties::new(
+                Vector::ZERO,
+                2.0,
+                Vector::splat(0.02),
+            )),
     );
     let revolute = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0));
     let hinge = world.impulse_joints.insert(base, arm, revolute, true);
     let mut clearance = ClearanceJointSet::new();
-    let play = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?
-        .friction(FrictionModel::Bai(Bai::DRY));
-    let hinge = clearance.convert_revolute(hinge, BearingSide::Body1, play, &mut world.impulse_joints)?;
+    let play =
+        Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?.friction(FrictionModel::Bai(Bai::DRY));
+    let hinge =
+        clearance.convert_revolute(hinge, BearingSide::Body1, play, &mut world.impulse_joints)?;
     let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.0075));
     while stepper.time() < 0.1 {
         stepper.step(&mut world, &mut [&mut clearance], 0.1)?;
     }
-    let report = clearance.get(hinge).expect("the hinge is in the set").report();
+    let report = clearance
+        .get(hinge)
+        .expect("the hinge is in the set")
+        .report();
     assert!(report.state.penetration >= 0.0, "{report:?}");
     assert!(stepper.guards().is_clean(), "{:?}", stepper.guards());
     Ok(())

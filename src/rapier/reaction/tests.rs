@@ -573,13 +573,19 @@ fn hanging_arm(collider: bool) -> (PhysicsWorld, IdealRevolute) {
     let arm = world.bodies.insert(
         RigidBodyBuilder::dynamic()
             .translation(Vector::new(0.0, -0.3, 0.0))
-            .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02))),
+            .additional_mass_properties(MassProperties::new(
+                Vector::ZERO,
+                2.0,
+                Vector::splat(0.02),
+            )),
     );
     if collider {
         // Radius 0.1 m, density chosen for 1 kg.
         let density = 1.0 / (4.0 / 3.0 * std::f64::consts::PI * 0.1f64.powi(3));
         let ball = ColliderBuilder::ball(0.1).density(density);
-        world.colliders.insert_with_parent(ball, arm, &mut world.bodies);
+        world
+            .colliders
+            .insert_with_parent(ball, arm, &mut world.bodies);
     }
     let joint = IdealRevolute {
         body1: base,
@@ -595,11 +601,20 @@ fn hanging_arm(collider: bool) -> (PhysicsWorld, IdealRevolute) {
 fn solves_before_the_first_step_without_preparation() {
     // Rapier has not computed the arm's mass yet; the solver does, from the builder's props.
     let (world, joint) = hanging_arm(false);
-    assert_eq!(world.bodies[joint.body2].mass_properties().local_mprops.inv_mass, 0.0);
+    assert_eq!(
+        world.bodies[joint.body2]
+            .mass_properties()
+            .local_mprops
+            .inv_mass,
+        0.0
+    );
     let g = Vector::new(0.0, -9.81, 0.0);
     let mut solver = ReactionSolver::default();
     let f = solver.solve(&world.bodies, &[joint], g).unwrap()[0];
-    assert!((f - Vector::new(0.0, 2.0 * 9.81, 0.0)).length() < 1e-9, "{f:?}");
+    assert!(
+        (f - Vector::new(0.0, 2.0 * 9.81, 0.0)).length() < 1e-9,
+        "{f:?}"
+    );
     assert_eq!(solver.failure(), None);
     // Bit for bit what the prepared bodies give.
     let mut prepared = world.bodies.clone();
@@ -615,11 +630,18 @@ fn a_body_with_colliders_before_the_first_step_is_refused_with_the_fix() {
     assert!(solver.solve(&world.bodies, &[joint], g).is_none());
     let failure = solver.failure().unwrap();
     assert_eq!(failure, ReactionFailure::MassPropertiesPending(joint.body2));
-    assert!(failure.to_string().contains("recompute_mass_properties_from_colliders"));
+    assert!(
+        failure
+            .to_string()
+            .contains("recompute_mass_properties_from_colliders")
+    );
     // The fix it names: the arm then weighs 3 kg (2 kg added, 1 kg of collider).
     world.bodies[joint.body2].recompute_mass_properties_from_colliders(&world.colliders);
     let f = solver.solve(&world.bodies, &[joint], g).unwrap()[0];
-    assert!((f - Vector::new(0.0, 3.0 * 9.81, 0.0)).length() < 1e-9, "{f:?}");
+    assert!(
+        (f - Vector::new(0.0, 3.0 * 9.81, 0.0)).length() < 1e-9,
+        "{f:?}"
+    );
     assert_eq!(solver.failure(), None);
 }
 
@@ -630,7 +652,10 @@ fn a_missing_body_is_named() {
     let g = Vector::ZERO;
     // Joints of this world solved against another, empty set of bodies.
     assert!(solver.solve(&RigidBodySet::new(), &[joint], g).is_none());
-    assert_eq!(solver.failure(), Some(ReactionFailure::MissingBody(joint.body1)));
+    assert_eq!(
+        solver.failure(),
+        Some(ReactionFailure::MissingBody(joint.body1))
+    );
     // A solve that succeeds clears it.
     assert!(solver.solve(&world.bodies, &[joint], g).is_some());
     assert_eq!(solver.failure(), None);

@@ -2,6 +2,7 @@
 //! around them.
 //!
 //! - [`joint`]: the clearance joint (compliant contact and friction as a per-step force), its set.
+//! - [`joint_correction`]: Rapier's joint drift correction kept stable across changes of the step.
 //! - [`large_step`]: the same play as a constraint inside Rapier's solver, for 1/60 s and 1 kHz.
 //! - [`convert`]: a clearance joint from a Rapier revolute joint, with the bearing side chosen.
 //! - [`stepper`]: the one step control (variable-step Störmer-Verlet, acceptance, guards);
@@ -20,6 +21,7 @@ pub mod convert;
 pub mod drive;
 pub mod guards;
 pub mod joint;
+pub mod joint_correction;
 pub mod large_step;
 pub mod ledger;
 pub mod metrics;

@@ -10,6 +10,12 @@
 //!   gravity are scaled by `(h_prev + h)/(2 h)` for the step and restored after it. The first
 //!   step from a given state is a half kick (`h_prev = 0`): velocities then live at half steps,
 //!   and positions are second-order accurate from the start.
+//! - **Joint drift corrected at a consistent rate.** Rapier corrects the drift of its joints'
+//!   locked positions within each step, so a drop of the step multiplies the correcting
+//!   velocity; on slender bodies that makes the locked tilt grow at each change of the step. The
+//!   stepper gives the joints (those with Rapier's default softness, for the step only) the
+//!   correction rate of the longest recent step
+//!   ([`joint_correction`](crate::rapier::joint_correction); [`StepControl::joint_correction`]).
 //! - **Step choice** ([`StepControl`]): fixed, or adaptive from the motion (no body turns more
 //!   than `tolerance` rad in a step: [`motion_step`](crate::rapier::motion_step)) and the
 //!   contacts (the joints'
@@ -68,6 +74,7 @@
 use crate::error::{Error, Result};
 use crate::rapier::drive::DriveSet;
 use crate::rapier::joint::ClearanceJointSet;
+use crate::rapier::joint_correction::JointCorrection;
 use crate::rapier::ledger::Wrench;
 use crate::rapier::motion_step::motion_step;
 use rapier3d_f64::math::{Pose, Vector};
@@ -179,6 +186,11 @@ pub struct StepControl {
     /// Whether a guard violation ([`GuardReport::is_clean`] false) fails the step with
     /// [`Error::Guard`] instead of only being recorded.
     pub strict: bool,
+    /// Whether Rapier's joints correct their drift at the rate of the longest recent step
+    /// ([`joint_correction`](crate::rapier::joint_correction)), not within each step whatever
+    /// its length. On by default: without it a jointed chain of slender bodies can diverge when
+    /// the step changes.
+    pub joint_correction: bool,
 }
 
 impl StepControl {
@@ -202,6 +214,7 @@ impl StepControl {
             min_dt: 1e-10,
             max_growth: 2.0,
             strict: false,
+            joint_correction: true,
         }
     }
 
@@ -227,6 +240,13 @@ impl StepControl {
     /// Makes guard violations errors.
     pub fn strict(mut self, strict: bool) -> Self {
         self.strict = strict;
+        self
+    }
+
+    /// Turns the step-consistent drift correction of Rapier's joints on (the default) or off
+    /// (Rapier's own correction, the whole drift within each step).
+    pub fn joint_correction(mut self, on: bool) -> Self {
+        self.joint_correction = on;
         self
     }
 
@@ -330,6 +350,7 @@ pub struct Stepper {
     floor_run: u64,
     saved: Vec<BodySnapshot>,
     guards: GuardReport,
+    correction: JointCorrection,
 }
 
 impl Stepper {
@@ -344,6 +365,7 @@ impl Stepper {
             floor_run: 0,
             saved: Vec::new(),
             guards: GuardReport::default(),
+            correction: JointCorrection::default(),
         }
     }
 
@@ -385,6 +407,7 @@ impl Stepper {
         self.prepared = false;
         if restart_kick {
             self.last_dt = 0.0;
+            self.correction.reset();
         }
     }
 
@@ -527,7 +550,11 @@ impl Stepper {
             for s in sources.iter_mut() {
                 s.before_rapier_step(&mut world.bodies, self.t, dt);
             }
+            if self.control.joint_correction {
+                self.correction.apply(&mut world.impulse_joints, dt);
+            }
             world.step();
+            self.correction.restore(&mut world.impulse_joints);
             world.gravity = gravity;
             exact_kinematic_poses(world, &self.saved, dt);
             self.restore_forces(world);
@@ -559,6 +586,7 @@ impl Stepper {
                         self.t + dt
                     };
                     self.last_dt = dt;
+                    self.correction.accept(dt);
                     self.steps += 1;
                     self.guards.rejected_steps += u64::from(rejected);
                     if !adaptive {
@@ -610,12 +638,13 @@ impl Stepper {
         read: impl FnOnce(&PhysicsWorld, &StepInfo) -> R,
     ) -> Result<R> {
         self.prepare(world, sources)?;
-        let (t, last, steps, guards, control) = (
+        let (t, last, steps, guards, control, correction) = (
             self.t,
             self.last_dt,
             self.steps,
             self.guards.clone(),
             self.control,
+            self.correction.clone(),
         );
         let h = if last > 0.0 { last } else { dt };
         // A fixed step of `h` with the sources saved, then everything put back.
@@ -637,6 +666,7 @@ impl Stepper {
         self.steps = steps;
         self.guards = guards;
         self.control = control;
+        self.correction = correction;
         out
     }
 
@@ -730,7 +760,13 @@ impl Stepper {
             {
                 return Err(Error::Diverged {
                     t: self.t,
-                    reason: diverged_body(world, sources, b.handle, speed),
+                    reason: diverged_body(
+                        world,
+                        sources,
+                        b.handle,
+                        speed,
+                        self.control.joint_correction,
+                    ),
                 });
             }
         }
@@ -821,7 +857,9 @@ fn diverged_body(
     sources: &[&mut dyn ForceSource],
     body: rapier3d_f64::prelude::RigidBodyHandle,
     speed: f64,
+    joint_correction: bool,
 ) -> String {
+    let jointed = world.impulse_joints.attached_joints(body).next().is_some();
     let mut joined: Vec<String> = world
         .impulse_joints
         .attached_joints(body)
@@ -844,10 +882,17 @@ fn diverged_body(
     } else {
         "its state is not finite".into()
     };
+    let correction = if jointed && !joint_correction {
+        "; with the joint correction off (`StepControl::joint_correction`), also Rapier's joint \
+         drift correction under changing steps, which makes a chain of slender bodies tilt out of \
+         its plane"
+    } else {
+        ""
+    };
     format!(
         "body {:?}{joined} left the physical range ({speed}, the guard being {} m/s); likely \
          cause: a motor, drive or prescribed motion that moves it too fast, a contact too stiff \
-         for the step, or a non-finite input (gravity, a force, a mass)",
+         for the step, or a non-finite input (gravity, a force, a mass){correction}",
         body.into_raw_parts(),
         crate::error::sig4(0.5 * world.integration_parameters.max_linear_velocity())
     )

@@ -174,10 +174,27 @@ mod chapter_doctests {
     pub struct LayoutAndDependencies;
 }
 
-/// The types most users need.
+/// The types most users need to put clearance hinges in their own Rapier loop.
+///
+/// An explicit list, made to be glob-imported next to `rapier3d_f64::prelude::*`: no name here
+/// is also a different item of Rapier's prelude (a test compiles both globs with
+/// `#![deny(warnings)]`). The contact and friction laws are not in it: Rapier's prelude has its
+/// own `FrictionModel`, so import the laws by name from [`model::laws`], which also shadows
+/// Rapier's name:
+///
+/// ```
+/// use clearance_joint::model::laws::{Bai, FrictionModel};
+/// use clearance_joint::prelude::*;
+/// use rapier3d_f64::prelude::*;
+///
+/// let play = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?.friction(FrictionModel::Bai(Bai::DRY));
+/// # let _ = (play, PhysicsWorld::new());
+/// # Ok::<(), clearance_joint::Error>(())
+/// ```
 pub mod prelude {
-    pub use crate::model::laws::*;
-    pub use crate::rapier::convert::{BearingSide, Clearance, ConvertRevolute};
+    pub use crate::rapier::convert::{BearingSide, Clearance, ClearanceModel, ConvertRevolute};
+    pub use crate::rapier::drive::{DriveSet, TorsionSpring};
+    pub use crate::rapier::guards::GuardReport;
     pub use crate::rapier::joint::{
         ClearanceJoint, ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet,
         OutOfPlaneLock,
@@ -191,5 +208,6 @@ pub mod prelude {
         ReactionSolver,
     };
     pub use crate::rapier::stepper::{ForceSource, StepControl, StepInfo, Stepper};
+    /// The same item as Rapier's (`rapier3d_f64::math::Vector`), so no clash with its prelude.
     pub use rapier3d_f64::math::Vector;
 }

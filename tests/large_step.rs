@@ -442,3 +442,47 @@ fn invalid_joints_are_refused_naming_the_field() {
         "local_axis1",
     );
 }
+
+#[test]
+fn the_readouts_keep_their_documented_bounds() {
+    // `eccentricity_ratio`: a step not flagged under-resolved ends within the two 5 % budgets of
+    // the resolution (rotation drift, sliding); `contact`: the limit carried a force, or the
+    // journal is within 0.1 % of c. Checked on arms that are resolved and on arms capped at
+    // Rapier's four substeps (which flag steps), with bounces and friction.
+    use clearance_joint::rapier::large_step::resolution::DRIFT_FRACTION;
+    let (mut resolved, mut flagged, mut bearing_inside) = (0, 0, 0);
+    for clearance in [0.05e-3, 0.5e-3, 5e-3] {
+        for cap in [4, 64] {
+            let mut p = Pendulum::new(2.0, clearance, 2.5, |b| {
+                b.restitution(0.5).friction(0.2).max_substeps(cap)
+            });
+            for _ in 0..600 {
+                let r = p.step();
+                let case = format!("c {clearance} cap {cap}: {r:?}");
+                if r.under_resolved {
+                    flagged += 1;
+                } else {
+                    resolved += 1;
+                    assert!(r.eccentricity_ratio <= 1.0 + 2.0 * DRIFT_FRACTION, "{case}");
+                }
+                if r.contact {
+                    assert!(
+                        r.normal_force > 0.0 || r.eccentricity_ratio >= 0.999,
+                        "{case}"
+                    );
+                    bearing_inside += u32::from(r.eccentricity_ratio < 0.999);
+                } else {
+                    assert!(
+                        r.normal_force == 0.0 && r.eccentricity_ratio < 0.999,
+                        "{case}"
+                    );
+                }
+            }
+        }
+    }
+    assert!(
+        resolved > 1000 && flagged > 10,
+        "{resolved} resolved, {flagged} flagged"
+    );
+    println!("{resolved} resolved, {flagged} flagged, {bearing_inside} in contact inside 0.999 c");
+}

@@ -1,6 +1,7 @@
 //! Physics invariants of the clearance joint: momentum, energy, convergence, ideal limit,
 //! restitution, determinism. Runs optimised (`[profile.test] opt-level = 3`).
 
+use clearance_joint::model::laws::{BearingGeometry, LankaraniNikravesh, Material, NormalModel};
 use clearance_joint::prelude::*;
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::runner::{RunOptions, RunResult, Simulation, TwinKind, Twins};

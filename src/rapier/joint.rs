@@ -33,6 +33,7 @@ pub enum OutOfPlaneLock {
 /// Body 1 carries the bearing (hole), body 2 the journal (pin).
 ///
 /// ```
+/// use clearance_joint::model::laws::{Bai, BearingGeometry, FrictionModel, ImprovedLiu, MaxDamping, NormalModel};
 /// use clearance_joint::prelude::*;
 /// let geometry = BearingGeometry::from_clearance(0.010, 0.5e-3, 0.016).unwrap();
 /// let law = ImprovedLiu::new(1.137e11, 0.016, 0.5e-3, 1.0, 1e-4, MaxDamping::Eta(0.01)).unwrap();

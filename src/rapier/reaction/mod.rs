@@ -30,12 +30,21 @@
 //! `k (x_target - x) + c (v_target - v)`, times the row's effective mass in Rapier's
 //! acceleration-based model) is an applied wrench computed from the state.
 //!
+//! The solve works before the first step, when Rapier has not computed the bodies' mass
+//! properties yet: the solver computes those of a body without colliders from its builder's
+//! `additional_mass_properties`. A body with colliders and additional mass properties holds its
+//! colliders' mass only until Rapier's first step: call Rapier's
+//! `recompute_mass_properties_from_colliders` on it before a solve at the initial state (the
+//! solver refuses such a body when its stored mass is below the additional one, with
+//! [`ReactionSolver::failure`] naming it, but cannot tell otherwise without the colliders).
+//! All a user needs, nothing hidden:
+//!
 //! ```
 //! use clearance_joint::rapier::reaction::{IdealRevolute, ReactionSolver};
 //! use rapier3d_f64::prelude::*;
 //! use rapier3d_f64::math::Vector;
 //!
-//! // A 2 kg arm hanging at rest 0.3 m below a fixed pivot carries its weight.
+//! // A 2 kg arm hanging at rest 0.3 m below a fixed pivot carries its weight (before any step).
 //! let mut bodies = RigidBodySet::new();
 //! let base = bodies.insert(RigidBodyBuilder::fixed());
 //! let arm = bodies.insert(
@@ -43,7 +52,6 @@
 //!         .translation(Vector::new(0.0, -0.3, 0.0))
 //!         .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02))),
 //! );
-//! # clearance_joint::rapier::reaction::prepare_mass_properties(&mut bodies);
 //! let joint = IdealRevolute {
 //!     body1: base,
 //!     body2: arm,
@@ -75,7 +83,9 @@ pub use motor::SoftMotor;
 use crate::rapier::ledger::Wrench;
 use body::Entry;
 use rapier3d_f64::math::Vector;
-use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
+use rapier3d_f64::prelude::{
+    ColliderSet, RigidBody, RigidBodyAdditionalMassProps, RigidBodyHandle, RigidBodySet,
+};
 use rows::Row;
 
 /// Solves for ideal-joint reactions; keeps its buffers between calls (no allocation per step
@@ -120,7 +130,47 @@ pub struct ReactionSolver {
     motor_rates: Vec<f64>,
     revolutes: Vec<IdealJoint>,
     extra: Vec<Wrench>,
+    /// Why the last solve returned `None`.
+    failure: Option<ReactionFailure>,
 }
+
+/// Why a solve of [`ReactionSolver`] returned `None` ([`ReactionSolver::failure`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub enum ReactionFailure {
+    /// A joint's body (or a tracked one) is not in the `RigidBodySet`.
+    MissingBody(RigidBodyHandle),
+    /// A dynamic body with colliders does not have its mass properties yet: before Rapier's
+    /// first step they hold only its colliders' (the builder's `additional_mass_properties` are
+    /// added in that step), and the solver is not given the `ColliderSet`. Call
+    /// `bodies[handle].recompute_mass_properties_from_colliders(&colliders)` for it (or take
+    /// one step) before solving. A body without colliders needs nothing: the solver computes
+    /// its mass properties from the builder's `additional_mass_properties`.
+    MassPropertiesPending(RigidBodyHandle),
+    /// The constrained equations cannot be solved: a non-finite state or mass.
+    Unsolvable,
+}
+
+impl std::fmt::Display for ReactionFailure {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ReactionFailure::MissingBody(h) => {
+                write!(f, "body {h:?} of an ideal joint is not in the body set")
+            }
+            ReactionFailure::MassPropertiesPending(h) => write!(
+                f,
+                "body {h:?} has colliders but no mass properties yet (Rapier computes them at the \
+                 first step): call recompute_mass_properties_from_colliders on it before solving"
+            ),
+            ReactionFailure::Unsolvable => write!(
+                f,
+                "the ideal joints' equations cannot be solved (a non-finite state or mass)"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for ReactionFailure {}
 
 impl ReactionSolver {
     /// The force on each joint's body 2 (N, world frame), in the order of `joints`, at the bodies'
@@ -129,9 +179,11 @@ impl ReactionSolver {
     /// share through a relative regularisation of 1e-12, used only when the system is singular.
     /// A joint between two bodies that no force moves (fixed or kinematic on both sides) carries
     /// no unknown: its force is zero (their supports take the load) and it does not affect the
-    /// others. `None` when a body is missing or the system cannot be solved (a non-finite state
-    /// or mass): never a made-up force. Only the listed joints are constraints: contacts with
-    /// colliders are not part of the solve.
+    /// others. Works before the first step (see the [module](self) docs). `None`, never a
+    /// made-up force, when a body is missing, a body with colliders has no mass properties yet,
+    /// or the system cannot be solved (a non-finite state or mass): [`failure`](Self::failure)
+    /// says which. Only the listed joints are constraints: contacts with colliders are not part
+    /// of the solve.
     pub fn solve(
         &mut self,
         bodies: &RigidBodySet,
@@ -227,6 +279,11 @@ impl ReactionSolver {
             .map(|_| self.motor_rates[k])
     }
 
+    /// Why the last solve returned `None` (`None` after a solve that succeeded or before any).
+    pub fn failure(&self) -> Option<ReactionFailure> {
+        self.failure
+    }
+
     fn entry(&self, body: RigidBodyHandle) -> Option<&Entry> {
         self.entries.iter().find(|e| e.handle == body)
     }
@@ -241,7 +298,22 @@ impl ReactionSolver {
         if let Some(i) = self.entries.iter().position(|e| e.handle == handle) {
             return Some(i);
         }
-        let rb = bodies.get(handle)?;
+        let Some(rb) = bodies.get(handle) else {
+            self.failure = Some(ReactionFailure::MissingBody(handle));
+            return None;
+        };
+        let computed;
+        let rb = match pending_mass_properties(rb) {
+            Pending::No => rb,
+            Pending::WithoutColliders => {
+                computed = with_mass_properties(rb);
+                &computed
+            }
+            Pending::WithColliders => {
+                self.failure = Some(ReactionFailure::MassPropertiesPending(handle));
+                return None;
+            }
+        };
         self.entries.push(Entry::new(
             rb,
             handle,
@@ -253,8 +325,53 @@ impl ReactionSolver {
     }
 }
 
+/// Whether a body's mass properties are still those before Rapier's first step, which adds the
+/// builder's additional mass properties to the colliders' (attaching a collider adds its own at
+/// once).
+enum Pending {
+    No,
+    WithoutColliders,
+    WithColliders,
+}
+
+fn pending_mass_properties(rb: &RigidBody) -> Pending {
+    let mp = rb.mass_properties();
+    if !rb.is_dynamic() {
+        return Pending::No;
+    }
+    if rb.colliders().is_empty() {
+        return if mp.local_mprops.inv_mass == 0.0 {
+            Pending::WithoutColliders
+        } else {
+            Pending::No
+        };
+    }
+    let additional = match mp.additional_local_mprops.as_deref() {
+        Some(RigidBodyAdditionalMassProps::MassProps(p)) => p.mass(),
+        Some(RigidBodyAdditionalMassProps::Mass(m)) => *m,
+        None => 0.0,
+    };
+    // Computed, the mass is the colliders' plus the additional one: never below the latter.
+    if mp.local_mprops.inv_mass == 0.0 || mp.local_mprops.mass() < additional {
+        Pending::WithColliders
+    } else {
+        Pending::No
+    }
+}
+
+/// A copy of a body without colliders, with the mass properties Rapier computes at its first
+/// step (those of the builder's `additional_mass_properties`).
+fn with_mass_properties(rb: &RigidBody) -> RigidBody {
+    let mut rb = rb.clone();
+    rb.recompute_mass_properties_from_colliders(&ColliderSet::new());
+    rb
+}
+
 /// Computes the local mass properties of every dynamic body that has none yet (Rapier does it at
-/// the first step; the solver needs them before).
+/// the first step), from the bodies' additional mass properties: what the replay's body shapes
+/// need before the first step. Colliders' mass is not included (the `ColliderSet` is not given):
+/// for a body with colliders, call Rapier's `recompute_mass_properties_from_colliders`. The
+/// [`ReactionSolver`] does not need this call.
 pub fn prepare_mass_properties(bodies: &mut RigidBodySet) {
     let handles: Vec<RigidBodyHandle> = bodies.iter().map(|(h, _)| h).collect();
     for h in handles {

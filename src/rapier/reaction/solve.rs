@@ -1,7 +1,7 @@
 //! The solve: the state's velocities (advanced by the lag, projected), then the accelerations.
 
 use super::lu::{factor_regularised, lu_solve};
-use super::{IdealJoint, ReactionSolver};
+use super::{IdealJoint, ReactionFailure, ReactionSolver};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::RigidBodySet;
 
@@ -16,6 +16,7 @@ impl ReactionSolver {
         self.forces.clear();
         self.motors.clear();
         self.starts.clear();
+        self.failure = None;
         let mut pairs = Vec::with_capacity(joints.len());
         for j in joints {
             let (h1, h2) = j.bodies();
@@ -37,6 +38,7 @@ impl ReactionSolver {
         self.pos_rows
             .extend((0..n).filter(|&i| self.rows[i].position));
         if !factor_regularised(&self.a, &mut self.lu, &mut self.piv, n) {
+            self.failure = Some(ReactionFailure::Unsolvable);
             return None;
         }
         let np = self.pos_rows.len();
@@ -48,6 +50,7 @@ impl ReactionSolver {
                 }
             }
             if !factor_regularised(&self.a_pos, &mut self.lu_pos, &mut self.piv_pos, np) {
+                self.failure = Some(ReactionFailure::Unsolvable);
                 return None;
             }
         }

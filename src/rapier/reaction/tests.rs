@@ -3,7 +3,9 @@
 use super::lu::{lu_factor, lu_solve};
 use super::*;
 use rapier3d_f64::math::Rotation;
-use rapier3d_f64::prelude::{MassProperties, MotorModel, RigidBodyBuilder};
+use rapier3d_f64::prelude::{
+    ColliderBuilder, MassProperties, MotorModel, PhysicsWorld, RigidBodyBuilder,
+};
 
 #[test]
 fn dense_solve_by_hand() {
@@ -562,4 +564,99 @@ fn a_weld_between_bodies_that_do_not_move_leaves_the_other_reactions() {
             );
         }
     }
+}
+
+/// A hanging arm of 2 kg, 0.3 m below a fixed pivot; optionally with a 1 kg ball collider.
+fn hanging_arm(collider: bool) -> (PhysicsWorld, IdealRevolute) {
+    let mut world = PhysicsWorld::new();
+    let base = world.bodies.insert(RigidBodyBuilder::fixed());
+    let arm = world.bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(Vector::new(0.0, -0.3, 0.0))
+            .additional_mass_properties(MassProperties::new(
+                Vector::ZERO,
+                2.0,
+                Vector::splat(0.02),
+            )),
+    );
+    if collider {
+        // Radius 0.1 m, density chosen for 1 kg.
+        let density = 1.0 / (4.0 / 3.0 * std::f64::consts::PI * 0.1f64.powi(3));
+        let ball = ColliderBuilder::ball(0.1).density(density);
+        world
+            .colliders
+            .insert_with_parent(ball, arm, &mut world.bodies);
+    }
+    let joint = IdealRevolute {
+        body1: base,
+        body2: arm,
+        local_anchor1: Vector::ZERO,
+        local_anchor2: Vector::new(0.0, 0.3, 0.0),
+        local_axis1: Vector::Z,
+    };
+    (world, joint)
+}
+
+#[test]
+fn solves_before_the_first_step_without_preparation() {
+    // Rapier has not computed the arm's mass yet; the solver does, from the builder's props.
+    let (world, joint) = hanging_arm(false);
+    assert_eq!(
+        world.bodies[joint.body2]
+            .mass_properties()
+            .local_mprops
+            .inv_mass,
+        0.0
+    );
+    let g = Vector::new(0.0, -9.81, 0.0);
+    let mut solver = ReactionSolver::default();
+    let f = solver.solve(&world.bodies, &[joint], g).unwrap()[0];
+    assert!(
+        (f - Vector::new(0.0, 2.0 * 9.81, 0.0)).length() < 1e-9,
+        "{f:?}"
+    );
+    assert_eq!(solver.failure(), None);
+    // Bit for bit what the prepared bodies give.
+    let mut prepared = world.bodies.clone();
+    prepare_mass_properties(&mut prepared);
+    assert_eq!(solver.solve(&prepared, &[joint], g).unwrap()[0], f);
+}
+
+#[test]
+fn a_body_with_colliders_before_the_first_step_is_refused_with_the_fix() {
+    let (mut world, joint) = hanging_arm(true);
+    let g = Vector::new(0.0, -9.81, 0.0);
+    let mut solver = ReactionSolver::default();
+    assert!(solver.solve(&world.bodies, &[joint], g).is_none());
+    let failure = solver.failure().unwrap();
+    assert_eq!(failure, ReactionFailure::MassPropertiesPending(joint.body2));
+    assert!(
+        failure
+            .to_string()
+            .contains("recompute_mass_properties_from_colliders")
+    );
+    // The fix it names: the arm then weighs 3 kg (2 kg added, 1 kg of collider).
+    world.bodies[joint.body2].recompute_mass_properties_from_colliders(&world.colliders);
+    let f = solver.solve(&world.bodies, &[joint], g).unwrap()[0];
+    assert!(
+        (f - Vector::new(0.0, 3.0 * 9.81, 0.0)).length() < 1e-9,
+        "{f:?}"
+    );
+    assert_eq!(solver.failure(), None);
+}
+
+#[test]
+fn a_missing_body_is_named() {
+    let (world, joint) = hanging_arm(false);
+    let mut solver = ReactionSolver::default();
+    let g = Vector::ZERO;
+    // Joints of this world solved against another, empty set of bodies.
+    assert!(solver.solve(&RigidBodySet::new(), &[joint], g).is_none());
+    assert_eq!(
+        solver.failure(),
+        Some(ReactionFailure::MissingBody(joint.body1))
+    );
+    // A solve that succeeds clears it.
+    assert!(solver.solve(&world.bodies, &[joint], g).is_some());
+    assert_eq!(solver.failure(), None);
 }

@@ -476,8 +476,7 @@ pub fn revolute_to_clearance(
 /// Replaces the clearance joint `handle` of `set` by an ideal revolute joint in
 /// `impulse_joints` with the same bodies, anchors and axes (see [`revolute_from_clearance`]);
 /// the clearance joint's forces are taken back from the bodies and its out-of-plane lock is
-/// removed. As with [`ClearanceJointSet::remove`], the handles of the clearance joints inserted
-/// after it shift down by one.
+/// removed. The other handles of `set` stay valid; `handle` finds nothing ever after.
 pub fn clearance_to_revolute(
     set: &mut ClearanceJointSet,
     handle: ClearanceJointHandle,
@@ -488,7 +487,7 @@ pub fn clearance_to_revolute(
         Error::invalid(
             "clearance joint",
             format!(
-                "no joint with handle {handle:?} in the ClearanceJointSet ({} joints)",
+                "no joint with handle {handle} in the ClearanceJointSet ({} joints)",
                 set.len()
             ),
         )
@@ -530,7 +529,7 @@ pub fn large_step_to_revolute(
     let joint = set.remove(handle, bodies, impulse_joints).ok_or_else(|| {
         Error::invalid(
             "large-step joint",
-            format!("no joint with handle {handle:?} in the LargeStepJointSet"),
+            format!("no joint with handle {handle} in the LargeStepJointSet"),
         )
     })?;
     Ok(impulse_joints.insert(
@@ -911,15 +910,30 @@ mod tests {
             .unwrap_err(),
             "no joint with handle",
         );
-        check(
-            set.revert_to_revolute(
-                ClearanceJointHandle(3),
-                &mut r.world.bodies,
+        // A stale handle: its joint was converted back already.
+        let h = r
+            .world
+            .impulse_joints
+            .insert(r.base, r.arm, revolute(), true);
+        let c = set
+            .convert_revolute(
+                h,
+                BearingSide::Body1,
+                clearance(),
                 &mut r.world.impulse_joints,
             )
-            .unwrap_err(),
+            .unwrap();
+        let h = set
+            .revert_to_revolute(c, &mut r.world.bodies, &mut r.world.impulse_joints)
+            .unwrap();
+        let n = r.world.impulse_joints.len();
+        check(
+            set.revert_to_revolute(c, &mut r.world.bodies, &mut r.world.impulse_joints)
+                .unwrap_err(),
             "no joint with handle",
         );
+        assert_eq!(r.world.impulse_joints.len(), n, "nothing changed");
+        r.world.impulse_joints.remove(h, false);
         // An invalid clearance is refused by the laws, naming the field.
         check(
             Clearance::steel_improved_liu(0.010, 0.02, 0.016).unwrap_err(),

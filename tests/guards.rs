@@ -75,7 +75,7 @@ fn run_arm(
         let fric = info.dt / r.friction_stable_dt;
         track(&mut seen.fric, fric, fric, t);
     }
-    (stepper, seen)
+    (stepper, seen, pin)
 }
 
 #[test]

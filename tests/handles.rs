@@ -39,7 +39,7 @@ const ANCHOR2: Vector = Vector::new(0.0, 0.3, 0.0);
 fn clearance_handles_survive_removals_and_stale_ones_find_nothing() {
     let (mut w, base, arms) = world(4);
     let mut set = ClearanceJointSet::new();
-    let mut insert = |set: &mut ClearanceJointSet, w: &mut PhysicsWorld, i: usize, name: &str| {
+    let insert = |set: &mut ClearanceJointSet, w: &mut PhysicsWorld, i: usize, name: &str| {
         let anchor1 = Vector::new(i as f64, 0.0, 0.0);
         let joint = clearance(name)
             .joint(anchor1, ANCHOR2, Vector::Z, Vector::Z)
@@ -81,7 +81,7 @@ fn clearance_handles_survive_removals_and_stale_ones_find_nothing() {
 fn large_step_handles_survive_removals_and_stale_ones_find_nothing() {
     let (mut w, base, arms) = world(4);
     let mut set = LargeStepJointSet::new();
-    let mut insert = |set: &mut LargeStepJointSet, w: &mut PhysicsWorld, i: usize, name: &str| {
+    let insert = |set: &mut LargeStepJointSet, w: &mut PhysicsWorld, i: usize, name: &str| {
         let anchor1 = Vector::new(i as f64, 0.0, 0.0);
         let joint = clearance(name)
             .large_step_joint(anchor1, ANCHOR2, Vector::Z, Vector::Z)

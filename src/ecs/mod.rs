@@ -38,7 +38,8 @@
 //! Its contact force is evaluated once per step and held over the step; Rapier's substeps would
 //! make every impact gain energy. The setting is the whole world's: every other body then gets
 //! one solver iteration too, and stacks of resting bodies lose the stiffness Rapier's default
-//! iterations give them. A compliant [`ClearanceHinge`] in a world with more iterations is refused
+//! iterations give them (a stack of eight 0.5 m boxes at 60 Hz stands with Rapier's 4 and has
+//! fallen within 10 s with one). A compliant [`ClearanceHinge`] in a world with more iterations is refused
 //! with an error that says so; nothing is changed. A game world that keeps its iterations gives
 //! its hinges the large-step model, which works with any number.
 //!

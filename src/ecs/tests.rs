@@ -557,3 +557,81 @@ fn unchanged_hinges_are_not_reconciled_again_but_changes_are_seen() {
     let msg = run_step(&mut world, &mut schedule).unwrap_err().to_string();
     assert!(msg.contains("has no Body"), "{msg}");
 }
+
+/// The top box of an 8-box stack (0.5 m boxes on the ground) after 10 s at 60 Hz beside a sign on
+/// a large-step hinge, in a world of `iterations` solver iterations wrapped as it is.
+fn stack_beside_a_sign(iterations: usize) -> Vector {
+    use rapier3d_f64::prelude::ColliderBuilder;
+    let mut rapier = PhysicsWorld::new();
+    rapier.integration_parameters.num_solver_iterations = iterations;
+    let ground = rapier.bodies.insert(RigidBodyBuilder::fixed());
+    let ground_shape =
+        ColliderBuilder::cuboid(10.0, 0.1, 10.0).translation(Vector::new(0.0, -0.1, 0.0));
+    rapier
+        .colliders
+        .insert_with_parent(ground_shape, ground, &mut rapier.bodies);
+    let mut top = ground;
+    for i in 0..8 {
+        let y = 0.25 + 0.5 * i as f64;
+        top = rapier
+            .bodies
+            .insert(RigidBodyBuilder::dynamic().translation(Vector::new(0.0, y, 0.0)));
+        let shape = ColliderBuilder::cuboid(0.25, 0.25, 0.25);
+        rapier
+            .colliders
+            .insert_with_parent(shape, top, &mut rapier.bodies);
+    }
+    let mut world = World::new();
+    world.insert_resource(Physics::from_world(rapier));
+    let post = world
+        .spawn(Body::new(
+            RigidBodyBuilder::fixed().translation(Vector::new(3.0, 2.0, 0.0)),
+        ))
+        .id();
+    let sign = world
+        .spawn(Body::new(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(3.0, 1.7, 0.0))
+                .additional_mass_properties(MassProperties::new(
+                    Vector::ZERO,
+                    2.0,
+                    Vector::splat(0.02),
+                ))
+                .can_sleep(false),
+        ))
+        .id();
+    let hinge = world
+        .spawn((
+            Hinge::new(post, sign, Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0)),
+            ClearanceHinge(clearance().model(ClearanceModel::LargeStep)),
+        ))
+        .id();
+    let mut schedule = physics_schedule();
+    steps(&mut world, &mut schedule, 600).unwrap();
+    assert_eq!(
+        world.get::<HingeState>(hinge).unwrap().mode,
+        HingeMode::LargeStep
+    );
+    let s = world.get::<HingeState>(hinge).unwrap();
+    assert!(
+        (s.force - 19.62).abs() < 0.01,
+        "the sign hangs: {} N",
+        s.force
+    );
+    let p = world.resource::<Physics>();
+    assert_eq!(
+        p.world.integration_parameters.num_solver_iterations, iterations,
+        "the layer left the setting as it was"
+    );
+    p.world.bodies[top].translation()
+}
+
+#[test]
+fn a_game_worlds_stack_stands_because_its_iterations_are_left_alone() {
+    // Rapier's 4 iterations: the stack stands (its top box started at 3.75 m).
+    let top = stack_beside_a_sign(4);
+    assert!(top.y > 3.7 && top.x.abs() < 0.05, "{top:?}");
+    // One iteration, as the compliant model needs, for the whole world: the stack falls.
+    let top = stack_beside_a_sign(1);
+    assert!(top.y < 1.0, "{top:?}");
+}

@@ -48,7 +48,8 @@ type HingeChanges = Or<(
 /// Realises each [`Hinge`] as its mode component says (converting in place when only the mode
 /// changed), its [`Drive`], and removes the joints and drives of removed components. It works
 /// only in a step where something changed: a hinge component was added, changed or removed, a
-/// body was inserted or removed, or an error was taken; otherwise every hinge is as it was.
+/// body was inserted or removed, or an error stopped the systems; otherwise every hinge is as it
+/// was.
 #[allow(clippy::type_complexity, clippy::too_many_arguments)]
 pub fn sync_hinges(
     mut physics: ResMut<Physics>,

@@ -52,7 +52,10 @@ fn link((mass, length): (f64, f64), center: Vector, rotation: Rotation) -> Body 
 
 /// Spawns the arm; the elbow is ideal or has clearance. Returns the (shoulder, elbow) entities.
 fn spawn(world: &mut World, elbow_has_clearance: bool) -> Result<(Entity, Entity)> {
-    world.insert_resource(Physics::new(DT, Vector::new(0.0, -9.81, 0.0)));
+    let mut physics = Physics::new(DT, Vector::new(0.0, -9.81, 0.0));
+    // The compliant clearance model needs one solver iteration; the setting is the whole world's.
+    physics.world.integration_parameters.num_solver_iterations = 1;
+    world.insert_resource(physics);
     let r = Rotation::from_rotation_z(START_DEG.to_radians());
     let down = r * Vector::NEG_Y;
     let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();

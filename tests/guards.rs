@@ -10,7 +10,7 @@ use clearance_joint::scene::runner::{RunOptions, Simulation};
 use rapier3d_f64::prelude::*;
 
 /// A 2 kg arm on a steel pin (R = 10 mm, c = 0.2 mm), dry friction, released horizontal.
-fn arm(clearance: Clearance) -> (PhysicsWorld, ClearanceJointSet) {
+fn arm(clearance: Clearance) -> (PhysicsWorld, ClearanceJointSet, ClearanceJointHandle) {
     let mut world = PhysicsWorld::new();
     world.gravity = Vector::new(0.0, -9.81, 0.0);
     world.integration_parameters.num_solver_iterations = 1;
@@ -31,8 +31,8 @@ fn arm(clearance: Clearance) -> (PhysicsWorld, ClearanceJointSet) {
             Vector::Z,
         )
         .unwrap();
-    joints.insert(base, arm, pin, &mut world.impulse_joints);
-    (world, joints)
+    let pin = joints.insert(base, arm, pin, &mut world.impulse_joints);
+    (world, joints, pin)
 }
 
 /// The maxima the guards must report, tracked here after every accepted step: (worst, time,
@@ -57,13 +57,17 @@ fn track(slot: &mut (f64, f64, f64, u64), ratio: f64, value: f64, t: f64) {
     }
 }
 
-fn run_arm(clearance: Clearance, control: StepControl, end: f64) -> (Stepper, Tracked) {
-    let (mut world, mut joints) = arm(clearance);
+fn run_arm(
+    clearance: Clearance,
+    control: StepControl,
+    end: f64,
+) -> (Stepper, Tracked, ClearanceJointHandle) {
+    let (mut world, mut joints, pin) = arm(clearance);
     let mut stepper = Stepper::new(control);
     let mut seen = Tracked::default();
     while stepper.time() < end {
         let info = stepper.step(&mut world, &mut [&mut joints], end).unwrap();
-        let j = joints.get(ClearanceJointHandle(0)).unwrap();
+        let j = joints.get(pin).unwrap();
         let r = j.report();
         let t = stepper.time();
         let pen = r.state.penetration;
@@ -71,7 +75,7 @@ fn run_arm(clearance: Clearance, control: StepControl, end: f64) -> (Stepper, Tr
         let fric = info.dt / r.friction_stable_dt;
         track(&mut seen.fric, fric, fric, t);
     }
-    (stepper, seen)
+    (stepper, seen, pin)
 }
 
 #[test]
@@ -80,11 +84,11 @@ fn penetration_guard_reports_the_worst_depth_when_and_how_often() {
     let clearance = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
         .max_valid_penetration(0.2e-6);
-    let (stepper, seen) = run_arm(clearance, StepControl::adaptive(1e-3, 0.02), 0.1);
+    let (stepper, seen, pin) = run_arm(clearance, StepControl::adaptive(1e-3, 0.02), 0.1);
     let g = stepper.guards();
     let v = g.worst(GuardKind::Penetration).expect("the guard fires");
     assert_eq!(v.joint.as_deref(), Some("pin"));
-    assert_eq!(v.handle, Some(ClearanceJointHandle(0)));
+    assert_eq!(v.handle, Some(pin));
     assert_eq!(v.limit, 0.2e-6);
     assert_eq!((v.worst, v.t_s, v.first_t_s, v.count), seen.pen);
     // The worst, not the first: far deeper than the limit, later than the first violation.
@@ -102,7 +106,7 @@ fn penetration_guard_reports_the_worst_depth_when_and_how_often() {
     let clearance = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
         .max_valid_penetration(0.2e-6);
-    let (mut world, mut joints) = arm(clearance);
+    let (mut world, mut joints, _) = arm(clearance);
     let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.02).strict(true));
     let err = loop {
         match stepper.step(&mut world, &mut [&mut joints], 0.1) {
@@ -123,7 +127,7 @@ fn friction_guard_reports_the_worst_ratio_of_a_fixed_step_too_long() {
         .friction(clearance_joint::model::laws::FrictionModel::Bai(
             clearance_joint::model::laws::Bai::DRY,
         ));
-    let (stepper, seen) = run_arm(clearance, StepControl::fixed(2e-5), 0.3);
+    let (stepper, seen, _) = run_arm(clearance, StepControl::fixed(2e-5), 0.3);
     let v = stepper
         .guards()
         .worst(GuardKind::Friction)

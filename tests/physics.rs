@@ -208,12 +208,12 @@ fn lankarani_nikravesh_impact_restitution() {
         .build()
         .unwrap();
     let mut set = ClearanceJointSet::new();
-    set.insert(bearing, journal, joint, &mut world.impulse_joints);
+    let pin = set.insert(bearing, journal, joint, &mut world.impulse_joints);
     let (mut v_in, mut v_out, mut touched) = (None, None, false);
     for _ in 0..5000 {
         set.apply(&mut world.bodies, &world.integration_parameters)
             .unwrap();
-        let r = *set.get(ClearanceJointHandle(0)).unwrap().report();
+        let r = *set.get(pin).unwrap().report();
         if r.onset {
             v_in = Some(r.impact_rate);
             touched = true;

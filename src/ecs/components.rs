@@ -142,8 +142,8 @@ pub struct IdealHinge;
 
 /// Makes a [`Hinge`] a clearance joint with these laws (takes precedence over [`IdealHinge`]).
 /// [`Clearance::model`] chooses the model: the compliant contact law (the default; it needs small
-/// steps and `num_solver_iterations = 1`, as [`Physics::new`](super::Physics::new) sets) or the
-/// large-step constraint,
+/// steps and a world with `num_solver_iterations = 1`, which you set: a world with more is
+/// refused, see the [module docs](super)) or the large-step constraint,
 /// `ClearanceHinge(Clearance::steel_improved_liu(..)?.model(ClearanceModel::LargeStep))`, for 1/60 s or 1 kHz
 /// worlds with any number of solver iterations.
 #[derive(Component, Clone, Debug, PartialEq)]
@@ -213,8 +213,26 @@ pub struct HingeState {
     pub penetration: f64,
     /// Eccentricity of the journal in the bearing (clearance; world), m.
     pub eccentricity: Vector,
+    /// `|e|/c`, the eccentricity over the radial clearance (clearance; 0 for ideal hinges): 0
+    /// centred, 1 on the wall, above 1 pressed into it (compliant model; the large-step model
+    /// leaves at most a few percent above 1 on a resolved step, see
+    /// [`LargeStepReport::eccentricity_ratio`](crate::rapier::large_step::LargeStepReport::eccentricity_ratio)).
+    pub eccentricity_ratio: f64,
     /// Motion mode (clearance).
     pub contact: ContactMode,
+    /// Normal impulse of an impact in the last step, N s (large step: `m_n (1 + e) v_approach`,
+    /// see [`LargeStepReport::impact_impulse`](crate::rapier::large_step::LargeStepReport::impact_impulse));
+    /// 0 without an impact, and always 0 for the compliant model, whose impacts are resolved
+    /// as force histories in `force`, and for ideal hinges.
+    pub impulse: f64,
+    /// Rapier substeps the hinge's bodies took in the last step (large step; it chooses them,
+    /// see [`large_step`](crate::rapier::large_step)); 0 for the other modes, whose substeps are
+    /// the world's `num_solver_iterations`.
+    pub substeps: usize,
+    /// Whether the last step needed more substeps than the large-step joint allows, so that its
+    /// eccentricity and force may be off by more than the model's resolution promises (large
+    /// step; `false` for the other modes).
+    pub under_resolved: bool,
     /// The unwrapped relative angle, referenced where the hinge was first realised.
     pub(super) angle_tracker: HingeAngle,
 }

@@ -7,13 +7,16 @@
 //! [`convert`](crate::rapier::convert)). The systems reconcile the Rapier world with the components
 //! every step: spawning, changing or removing a component is all a user does.
 //!
-//! - [`Physics`] (resource): the Rapier `PhysicsWorld`, the clearance joints and the drives.
+//! - [`Physics`] (resource): the Rapier `PhysicsWorld`, the clearance joints and the drives;
+//!   [`Physics::new`] makes a new world, [`Physics::from_world`] wraps yours.
 //! - [`Body`]: a rigid body, from a Rapier description (`RigidBodyBuilder`) or an existing handle.
 //! - [`Hinge`]: which two bodies a hinge joins, its anchors and axes; with a mode component:
 //!   [`IdealHinge`] (Rapier's revolute joint) or [`ClearanceHinge`] (radial clearance, contact and
 //!   friction laws). A hinge with neither joins nothing. When both are present, the clearance wins.
 //! - [`Drive`]: a torsion spring `T = T0 - k theta` on a hinge (on the hinge's entity).
-//! - [`HingeState`] and [`BodyState`] (added automatically): what the last step did.
+//! - [`HingeState`] and [`BodyState`] (added automatically): what the last step did (a hinge's
+//!   force, eccentricity and `|e|/c`, contact, impacts and impulse, the substeps of a
+//!   large-step hinge).
 //!
 //! A `ClearanceHinge` builds the compliant model unless its
 //! [`Clearance::model`](crate::rapier::convert::Clearance::model) is
@@ -27,6 +30,19 @@
 //! [`clearance_to_revolute`](crate::rapier::convert::clearance_to_revolute) when the `ClearanceHinge`
 //! is removed again).
 //!
+//! # The world's settings are yours
+//!
+//! The layer never changes the Rapier world's settings ([`Physics::new`] keeps Rapier's
+//! defaults but `dt` and gravity; [`Physics::from_world`] keeps the world as it comes). The
+//! compliant model needs one thing of them: `integration_parameters.num_solver_iterations = 1`.
+//! Its contact force is evaluated once per step and held over the step; Rapier's substeps would
+//! make every impact gain energy. The setting is the whole world's: every other body then gets
+//! one solver iteration too, and stacks of resting bodies lose the stiffness Rapier's default
+//! iterations give them (a stack of eight 0.5 m boxes at 60 Hz stands with Rapier's 4 and has
+//! fallen within 10 s with one). A compliant [`ClearanceHinge`] in a world with more iterations is refused
+//! with an error that says so; nothing is changed. A game world that keeps its iterations gives
+//! its hinges the large-step model, which works with any number.
+//!
 //! ```
 //! use bevy_ecs::prelude::*;
 //! use clearance_joint::rapier::convert::Clearance;
@@ -35,7 +51,10 @@
 //! use rapier3d_f64::prelude::{MassProperties, RigidBodyBuilder};
 //!
 //! let mut world = World::new();
-//! world.insert_resource(Physics::new(1e-5, Vector::new(0.0, -9.81, 0.0)));
+//! let mut physics = Physics::new(1e-5, Vector::new(0.0, -9.81, 0.0));
+//! // The compliant model's one need, for the whole world (see above).
+//! physics.world.integration_parameters.num_solver_iterations = 1;
+//! world.insert_resource(physics);
 //! let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
 //! let arm = world
 //!     .spawn(Body::new(
@@ -59,6 +78,60 @@
 //! let state = world.get::<HingeState>(pivot).unwrap();
 //! assert_eq!(state.mode, HingeMode::Clearance);
 //! assert!((state.force - 19.62).abs() < 0.05, "the journal carries the arm: {} N", state.force);
+//! assert!(state.eccentricity_ratio > 1.0, "resting on the wall: |e|/c = {}", state.eccentricity_ratio);
+//! # Ok::<(), clearance_joint::Error>(())
+//! ```
+//!
+//! # Your own Rapier world
+//!
+//! [`Physics::from_world`] wraps a `PhysicsWorld` you built: its settings, bodies, colliders and
+//! joints stay, and [`Body::from_handle`] makes one of its bodies an entity's. Here a game world
+//! at 60 Hz with Rapier's 4 solver iterations (its stacks stay stiff) hangs a sign on a
+//! large-step clearance hinge; the same hinge with the compliant model is refused.
+//!
+//! ```
+//! use bevy_ecs::prelude::*;
+//! use clearance_joint::rapier::convert::{Clearance, ClearanceModel};
+//! use clearance_joint::ecs::*;
+//! use rapier3d_f64::math::Vector;
+//! use rapier3d_f64::prelude::{MassProperties, PhysicsWorld, RigidBodyBuilder};
+//!
+//! let mut rapier = PhysicsWorld::new(); // 1/60 s, 4 solver iterations, gravity -9.81 along y
+//! let post = rapier.bodies.insert(RigidBodyBuilder::fixed());
+//! let sign = rapier.bodies.insert(
+//!     RigidBodyBuilder::dynamic()
+//!         .translation(Vector::new(0.0, -0.3, 0.0))
+//!         .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02))),
+//! );
+//! let mut world = World::new();
+//! world.insert_resource(Physics::from_world(rapier));
+//! let (post, sign) = (
+//!     world.spawn(Body::from_handle(post)).id(),
+//!     world.spawn(Body::from_handle(sign)).id(),
+//! );
+//! let clearance = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?;
+//! let hinge = world
+//!     .spawn((
+//!         Hinge::new(post, sign, Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0)),
+//!         ClearanceHinge(clearance.clone()),
+//!     ))
+//!     .id();
+//! let mut schedule = physics_schedule();
+//! // The compliant model needs one solver iteration; the world is left as it is.
+//! let refused = run_step(&mut world, &mut schedule).unwrap_err().to_string();
+//! assert!(refused.contains("num_solver_iterations") && refused.contains("LargeStep"), "{refused}");
+//! assert_eq!(world.resource::<Physics>().world.integration_parameters.num_solver_iterations, 4);
+//! // The large-step model steps the world as it is.
+//! world
+//!     .entity_mut(hinge)
+//!     .insert(ClearanceHinge(clearance.model(ClearanceModel::LargeStep)));
+//! for _ in 0..120 {
+//!     run_step(&mut world, &mut schedule)?;
+//! }
+//! let state = world.get::<HingeState>(hinge).unwrap();
+//! assert_eq!(state.mode, HingeMode::LargeStep);
+//! assert!((state.force - 19.62).abs() < 1e-3, "the journal carries the sign: {} N", state.force);
+//! assert!(state.substeps >= 4, "{} substeps", state.substeps);
 //! # Ok::<(), clearance_joint::Error>(())
 //! ```
 

@@ -64,25 +64,34 @@ pub struct Physics {
     /// Set when the sync systems changed joints, drives or bodies: the force sources are
     /// evaluated again before the next step.
     changed: bool,
+    /// Set when the hinges must be reconciled again although no hinge component changed: a
+    /// body was inserted or removed, or an error stopped a reconciliation halfway.
+    hinges_stale: bool,
+    /// Reconciliations of the hinges so far (the tests check that unchanged steps skip them).
+    #[cfg(test)]
+    pub(super) hinge_passes: u64,
     reactions: ReactionSolver,
     ideal_joints: Vec<IdealRevolute>,
     source_wrenches: Vec<Wrench>,
 }
 
 impl Physics {
-    /// An empty world stepping by `dt` (s) under `gravity` (m/s^2), with one solver iteration
-    /// (the clearance hook's force is constant over a step; Rapier's substeps would make every
-    /// impact gain energy).
+    /// An empty Rapier world stepping by `dt` (s) under `gravity` (m/s^2), with Rapier's
+    /// defaults otherwise (4 solver iterations): ready for ideal and large-step hinges. The
+    /// compliant clearance model needs one solver iteration; set
+    /// `world.integration_parameters.num_solver_iterations = 1` yourself before spawning such a
+    /// hinge (see the [module docs](super) for why and what it costs the world's other bodies).
     pub fn new(dt: f64, gravity: Vector) -> Self {
         let mut world = PhysicsWorld::new();
         world.integration_parameters.dt = dt;
-        world.integration_parameters.num_solver_iterations = 1;
         world.gravity = gravity;
         Self::from_world(world)
     }
 
-    /// Wraps an existing Rapier world (its bodies and joints stay; entities refer to bodies with
-    /// [`Body::from_handle`](super::Body::from_handle)).
+    /// Wraps an existing Rapier world as it is: its settings, bodies, colliders and joints stay
+    /// (entities refer to its bodies with [`Body::from_handle`](super::Body::from_handle)). The
+    /// layer never changes the world's settings; a hinge the settings cannot serve is refused
+    /// with an error (see the [module docs](super)).
     pub fn from_world(world: PhysicsWorld) -> Self {
         let dt = world.integration_parameters.dt;
         Physics {
@@ -95,6 +104,9 @@ impl Physics {
             error: None,
             stepper: Stepper::new(StepControl::fixed(dt)),
             changed: true,
+            hinges_stale: true,
+            #[cfg(test)]
+            hinge_passes: 0,
             reactions: ReactionSolver::default(),
             ideal_joints: Vec::new(),
             source_wrenches: Vec::new(),
@@ -183,9 +195,16 @@ impl Physics {
 
     /// Records `error` unless one is already set (the first error is the cause).
     pub(super) fn fail(&mut self, error: Error) {
+        self.hinges_stale = true;
         if self.error.is_none() {
             self.error = Some(error);
         }
+    }
+
+    /// Whether the hinges must be reconciled although no hinge component changed (and clears
+    /// it): see [`sync_hinges`](super::sync_hinges).
+    pub(super) fn take_hinges_stale(&mut self) -> bool {
+        std::mem::take(&mut self.hinges_stale)
     }
 
     /// The joint of hinge `entity` and the bodies it was realised between.
@@ -199,6 +218,7 @@ impl Physics {
     pub(super) fn insert_body(&mut self, entity: Entity, body: RigidBody) -> RigidBodyHandle {
         self.remove_body(entity);
         self.changed = true;
+        self.hinges_stale = true;
         let h = self.world.bodies.insert(body);
         self.bodies.insert(entity, h);
         h
@@ -215,6 +235,7 @@ impl Physics {
         }
         self.remove_body(entity);
         self.changed = true;
+        self.hinges_stale = true;
         self.bodies.insert(entity, handle);
         Ok(())
     }
@@ -231,6 +252,7 @@ impl Physics {
         let Some(handle) = self.bodies.remove(&entity) else {
             return;
         };
+        self.hinges_stale = true;
         let joins = |(a, b): BodyPair| a == handle || b == handle;
         let attached: Vec<Entity> = self
             .hinges
@@ -286,7 +308,6 @@ impl Physics {
                         &mut self.world.bodies,
                         &mut self.world.impulse_joints,
                     );
-                    self.clearance_removed(c);
                 }
                 HingeJoint::LargeStep(k) => {
                     self.large_step.remove(
@@ -295,17 +316,6 @@ impl Physics {
                         &mut self.world.impulse_joints,
                     );
                 }
-            }
-        }
-    }
-
-    /// Renumbers the clearance handles after the set removed `removed` (later handles shift down).
-    fn clearance_removed(&mut self, removed: ClearanceJointHandle) {
-        for h in self.hinges.values_mut() {
-            if let HingeJoint::Clearance(c) = &mut h.joint
-                && c.0 > removed.0
-            {
-                c.0 -= 1;
             }
         }
     }
@@ -329,6 +339,11 @@ impl Physics {
     ) -> Result<()> {
         let context = |e: Error| e.within(&format!("hinge {entity}"));
         frame.validate().map_err(context)?;
+        if let Some(Some(c)) = desired
+            && c.model != ClearanceModel::LargeStep
+        {
+            check_compliant(&self.world, entity)?;
+        }
         if let Some(r) = self.hinges.get(&entity) {
             let same_place = r.bodies == bodies && r.frame == *frame;
             let w = &mut self.world;
@@ -381,7 +396,6 @@ impl Physics {
                         .revert_to_revolute(k, &mut w.bodies, &mut w.impulse_joints)
                         .map_err(context)?;
                     self.changed = true;
-                    self.clearance_removed(k);
                     Some((HingeJoint::Ideal(j), None))
                 }
                 _ => None,
@@ -596,6 +610,26 @@ impl Physics {
                     .into(),
             })
     }
+}
+
+/// Refuses a compliant clearance hinge in a world whose settings cannot step it, naming what it
+/// needs and why; the world's settings are the user's and stay as they are.
+fn check_compliant(world: &PhysicsWorld, entity: Entity) -> Result<()> {
+    let n = world.integration_parameters.num_solver_iterations;
+    if n == 1 {
+        return Ok(());
+    }
+    Err(Error::invalid(
+        "Physics::world.integration_parameters.num_solver_iterations",
+        format!(
+            "the compliant clearance model of hinge {entity} needs 1 (the world has {n}): its \
+             contact force is evaluated once per step and held over it, and Rapier's substeps \
+             would make every impact gain energy. Set it to 1 (every body of the world then gets \
+             one iteration: stacks of resting bodies soften), or give the hinge the large-step \
+             model, `Clearance::model(ClearanceModel::LargeStep)`, which works with any number \
+             of iterations"
+        ),
+    ))
 }
 
 /// `c` with the entity as its name unless it has one.

@@ -60,7 +60,8 @@ pub fn run_step(world: &mut World, schedule: &mut Schedule) -> Result<()> {
     if !world.contains_resource::<Physics>() {
         return Err(Error::invalid(
             "Physics",
-            "no such resource in the world: insert one with `world.insert_resource(Physics::new(dt, gravity))`",
+            "no such resource in the world: insert one with `world.insert_resource(Physics::new(dt, gravity))` \
+             (or `Physics::from_world(your_rapier_world)`)",
         ));
     }
     schedule.run(world);

@@ -37,9 +37,20 @@ pub fn sync_bodies(mut physics: ResMut<Physics>, mut query: Query<(Entity, &mut 
     physics.remove_bodies_except(&seen);
 }
 
+/// The hinge components whose addition or change makes [`sync_hinges`] reconcile.
+type HingeChanges = Or<(
+    Changed<Hinge>,
+    Changed<IdealHinge>,
+    Changed<ClearanceHinge>,
+    Changed<Drive>,
+)>;
+
 /// Realises each [`Hinge`] as its mode component says (converting in place when only the mode
-/// changed), its [`Drive`], and removes the joints and drives of removed components.
-#[allow(clippy::type_complexity)]
+/// changed), its [`Drive`], and removes the joints and drives of removed components. It works
+/// only in a step where something changed: a hinge component was added, changed or removed, a
+/// body was inserted or removed, or an error stopped the systems; otherwise every hinge is as it
+/// was.
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
 pub fn sync_hinges(
     mut physics: ResMut<Physics>,
     mut query: Query<(
@@ -50,9 +61,27 @@ pub fn sync_hinges(
         Option<&Drive>,
         &mut HingeState,
     )>,
+    changed: Query<(), HingeChanges>,
+    mut removed_hinges: RemovedComponents<Hinge>,
+    mut removed_ideal: RemovedComponents<IdealHinge>,
+    mut removed_clearance: RemovedComponents<ClearanceHinge>,
+    mut removed_drives: RemovedComponents<Drive>,
 ) {
+    // Read every removal, so that none is seen again at the next step.
+    let removals = removed_hinges.read().count()
+        + removed_ideal.read().count()
+        + removed_clearance.read().count()
+        + removed_drives.read().count();
     if physics.error().is_some() {
         return;
+    }
+    let stale = physics.take_hinges_stale();
+    if !stale && removals == 0 && changed.is_empty() {
+        return;
+    }
+    #[cfg(test)]
+    {
+        physics.hinge_passes += 1;
     }
     let mut items: Vec<_> = query.iter_mut().collect();
     items.sort_by_key(|item| item.0);
@@ -197,7 +226,9 @@ pub fn record(
                 state.force = ideal_forces.get(&entity).copied().unwrap_or(0.0);
                 state.penetration = 0.0;
                 state.eccentricity = Vector::ZERO;
+                state.eccentricity_ratio = 0.0;
                 state.contact = ContactMode::FreeFlight;
+                (state.impulse, state.substeps, state.under_resolved) = (0.0, 0, false);
             }
             HingeJoint::Clearance(c) => {
                 if let Some(j) = physics.clearance().get(c) {
@@ -205,7 +236,10 @@ pub fn record(
                     state.force = rep.force.on_journal.length();
                     state.penetration = rep.state.penetration;
                     state.eccentricity = rep.state.eccentricity;
+                    state.eccentricity_ratio =
+                        rep.state.eccentricity.length() / j.geometry().clearance();
                     state.contact = rep.mode;
+                    (state.impulse, state.substeps, state.under_resolved) = (0.0, 0, false);
                     if rep.onset {
                         state.impacts += 1;
                     }
@@ -217,6 +251,10 @@ pub fn record(
                     state.force = rep.normal_force;
                     state.penetration = rep.eccentricity.length() - j.clearance();
                     state.eccentricity = rep.eccentricity;
+                    state.eccentricity_ratio = rep.eccentricity_ratio;
+                    state.impulse = rep.impact_impulse;
+                    state.substeps = rep.substeps;
+                    state.under_resolved = rep.under_resolved;
                     state.contact = match (rep.contact, rep.onset) {
                         (false, _) => ContactMode::FreeFlight,
                         (true, true) => ContactMode::Impact,

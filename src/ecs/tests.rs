@@ -26,10 +26,13 @@ fn arm_at(x: f64) -> Body {
     )
 }
 
-/// A 2 kg arm hanging 0.3 m below a fixed base on an ideal hinge about z.
+/// A 2 kg arm hanging 0.3 m below a fixed base on an ideal hinge about z, in a world with one
+/// solver iteration (ready for the compliant model).
 fn pendulum(dt: f64) -> (World, Schedule, Entity, Entity) {
     let mut world = World::new();
-    world.insert_resource(Physics::new(dt, Vector::new(0.0, -9.81, 0.0)));
+    let mut physics = Physics::new(dt, Vector::new(0.0, -9.81, 0.0));
+    physics.world.integration_parameters.num_solver_iterations = 1;
+    world.insert_resource(physics);
     let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
     let arm = world.spawn(arm_at(0.0)).id();
     let hinge = world
@@ -105,7 +108,7 @@ fn swapping_the_mode_converts_the_rapier_joint_both_ways() {
 
 #[test]
 fn clearance_takes_precedence_and_handles_follow_removals() {
-    // Two pendulums; removing the first clearance joint renumbers the second's handle.
+    // Two pendulums; removing the first clearance joint leaves the second's handle as it was.
     let (mut world, mut schedule, _, first) = pendulum(1e-5);
     let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
     let arm = world.spawn(arm_at(1.0)).id();
@@ -122,13 +125,23 @@ fn clearance_takes_precedence_and_handles_follow_removals() {
         .entity_mut(first)
         .insert(ClearanceHinge(clearance().name("first")));
     steps(&mut world, &mut schedule, 2).unwrap();
-    assert_eq!(world.resource::<Physics>().clearance().len(), 2);
+    let p = world.resource::<Physics>();
+    assert_eq!(p.clearance().len(), 2);
+    let Some(HingeJoint::Clearance(was_first)) = p.joint(first) else {
+        panic!("first is a clearance joint")
+    };
+    let second_handle = p.joint(second);
     world.entity_mut(first).remove::<ClearanceHinge>();
     steps(&mut world, &mut schedule, 2).unwrap();
     let p = world.resource::<Physics>();
     assert_eq!(p.clearance().len(), 1);
     assert!(matches!(p.joint(first), Some(HingeJoint::Ideal(_))));
+    assert_eq!(p.joint(second), second_handle);
     assert_eq!(p.clearance_joint(second).unwrap().name(), "second");
+    assert!(
+        p.clearance().get(was_first).is_none(),
+        "a stale handle finds nothing"
+    );
 }
 
 #[test]
@@ -388,4 +401,237 @@ fn large_step_hinge_at_game_rate_with_rapiers_defaults() {
         world.get::<HingeState>(hinge).unwrap().mode,
         HingeMode::Clearance
     );
+}
+
+#[test]
+fn the_worlds_settings_stay_the_users() {
+    // `new` keeps Rapier's defaults but dt and gravity.
+    let p = Physics::new(1e-3, Vector::new(0.0, -1.0, 0.0));
+    let defaults = PhysicsWorld::new().integration_parameters;
+    let mut expected = defaults;
+    expected.dt = 1e-3;
+    assert_eq!(p.world.integration_parameters, expected);
+    assert_eq!(p.world.integration_parameters.num_solver_iterations, 4);
+
+    // A compliant hinge in a world with 4 iterations is refused, naming the setting, why and
+    // the way out; the world and the hinge stay as they were.
+    let (mut world, mut schedule, _, hinge) = pendulum(1e-5);
+    steps(&mut world, &mut schedule, 2).unwrap();
+    world
+        .resource_mut::<Physics>()
+        .world
+        .integration_parameters
+        .num_solver_iterations = 4;
+    world.entity_mut(hinge).insert(ClearanceHinge(clearance()));
+    let msg = run_step(&mut world, &mut schedule).unwrap_err().to_string();
+    for needle in [
+        "Physics::world.integration_parameters.num_solver_iterations",
+        &format!("hinge {hinge} needs 1 (the world has 4)"),
+        "gain energy",
+        "ClearanceModel::LargeStep",
+    ] {
+        assert!(msg.contains(needle), "{needle:?} not in: {msg}");
+    }
+    let p = world.resource::<Physics>();
+    assert_eq!(p.world.integration_parameters.num_solver_iterations, 4);
+    assert!(matches!(p.joint(hinge), Some(HingeJoint::Ideal(_))));
+    assert!(p.clearance().is_empty());
+    // Set up by the user, the same hinge is realised.
+    world
+        .resource_mut::<Physics>()
+        .world
+        .integration_parameters
+        .num_solver_iterations = 1;
+    steps(&mut world, &mut schedule, 2).unwrap();
+    let p = world.resource::<Physics>();
+    assert!(matches!(p.joint(hinge), Some(HingeJoint::Clearance(_))));
+}
+
+#[test]
+fn hinge_state_carries_the_readouts() {
+    // Compliant: |e|/c above 1 when resting on the wall, no impulse, no substeps.
+    let (mut world, mut schedule, _, hinge) = pendulum(1e-5);
+    world.entity_mut(hinge).insert(ClearanceHinge(clearance()));
+    steps(&mut world, &mut schedule, 20_000).unwrap();
+    let s = *world.get::<HingeState>(hinge).unwrap();
+    let p = world.resource::<Physics>();
+    let j = p.clearance_joint(hinge).unwrap();
+    let e = j.report().state.eccentricity.length();
+    assert_eq!(s.eccentricity_ratio, e / j.geometry().clearance());
+    assert!(s.eccentricity_ratio > 1.0 && s.eccentricity_ratio < 1.01);
+    assert_eq!((s.impulse, s.substeps, s.under_resolved), (0.0, 0, false));
+
+    // Large step at 1/60 s, without gravity: the journal crosses the play at 2 mm/s and hits
+    // the wall after a few steps, an impact with its impulse.
+    let mut world = World::new();
+    world.insert_resource(Physics::new(1.0 / 60.0, Vector::ZERO));
+    let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
+    let arm = world
+        .spawn(Body::new(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(0.0, -0.3, 0.0))
+                .linvel(Vector::new(2e-3, 0.0, 0.0))
+                .additional_mass_properties(MassProperties::new(
+                    Vector::ZERO,
+                    2.0,
+                    Vector::splat(0.02),
+                ))
+                .can_sleep(false),
+        ))
+        .id();
+    let hinge = world
+        .spawn((
+            Hinge::new(base, arm, Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0)),
+            ClearanceHinge(clearance().model(ClearanceModel::LargeStep)),
+        ))
+        .id();
+    let mut schedule = physics_schedule();
+    let mut impulses = Vec::new();
+    for _ in 0..120 {
+        run_step(&mut world, &mut schedule).unwrap();
+        let s = *world.get::<HingeState>(hinge).unwrap();
+        let r = *world
+            .resource::<Physics>()
+            .large_step_joint(hinge)
+            .unwrap()
+            .report();
+        assert_eq!(s.eccentricity_ratio, r.eccentricity_ratio);
+        assert_eq!(s.impulse, r.impact_impulse);
+        assert_eq!(
+            (s.substeps, s.under_resolved),
+            (r.substeps, r.under_resolved)
+        );
+        assert!(s.substeps >= 4, "{} substeps", s.substeps);
+        if s.impulse > 0.0 {
+            impulses.push(s.impulse);
+        }
+    }
+    assert!(!impulses.is_empty(), "the journal hit the wall");
+}
+
+#[test]
+fn unchanged_hinges_are_not_reconciled_again_but_changes_are_seen() {
+    let (mut world, mut schedule, arm, hinge) = pendulum(1e-5);
+    steps(&mut world, &mut schedule, 3).unwrap();
+    let passes = |w: &World| w.resource::<Physics>().hinge_passes;
+    assert_eq!(
+        passes(&world),
+        1,
+        "the first step realises the hinge, the others skip"
+    );
+
+    // A changed frame is seen and rebuilds the joint where it now is.
+    let before = world.resource::<Physics>().joint(hinge);
+    world.get_mut::<Hinge>(hinge).unwrap().local_anchor2 = Vector::new(0.0, 0.31, 0.0);
+    steps(&mut world, &mut schedule, 2).unwrap();
+    assert_eq!(passes(&world), 2);
+    assert_ne!(world.resource::<Physics>().joint(hinge), before);
+
+    // An added drive, and its removal.
+    world
+        .entity_mut(hinge)
+        .insert(Drive::torsion_spring(0.1, 0.0));
+    steps(&mut world, &mut schedule, 2).unwrap();
+    assert!(world.resource::<Physics>().drive(hinge).is_some());
+    world.entity_mut(hinge).remove::<Drive>();
+    steps(&mut world, &mut schedule, 2).unwrap();
+    assert!(world.resource::<Physics>().drive(hinge).is_none());
+    assert_eq!(passes(&world), 4);
+
+    // A removed mode component.
+    world.entity_mut(hinge).remove::<IdealHinge>();
+    steps(&mut world, &mut schedule, 2).unwrap();
+    assert_eq!(world.resource::<Physics>().joint(hinge), None);
+    world.entity_mut(hinge).insert(IdealHinge);
+    steps(&mut world, &mut schedule, 1).unwrap();
+    assert!(matches!(
+        world.resource::<Physics>().joint(hinge),
+        Some(HingeJoint::Ideal(_))
+    ));
+
+    // A body removed without touching the hinge: the hinge is checked again and refused.
+    world.entity_mut(arm).remove::<Body>();
+    let msg = run_step(&mut world, &mut schedule).unwrap_err().to_string();
+    assert!(msg.contains("has no Body"), "{msg}");
+    // The error was taken: the next step checks again (and refuses again).
+    let msg = run_step(&mut world, &mut schedule).unwrap_err().to_string();
+    assert!(msg.contains("has no Body"), "{msg}");
+}
+
+/// The top box of an 8-box stack (0.5 m boxes on the ground) after 10 s at 60 Hz beside a sign on
+/// a large-step hinge, in a world of `iterations` solver iterations wrapped as it is.
+fn stack_beside_a_sign(iterations: usize) -> Vector {
+    use rapier3d_f64::prelude::ColliderBuilder;
+    let mut rapier = PhysicsWorld::new();
+    rapier.integration_parameters.num_solver_iterations = iterations;
+    let ground = rapier.bodies.insert(RigidBodyBuilder::fixed());
+    let ground_shape =
+        ColliderBuilder::cuboid(10.0, 0.1, 10.0).translation(Vector::new(0.0, -0.1, 0.0));
+    rapier
+        .colliders
+        .insert_with_parent(ground_shape, ground, &mut rapier.bodies);
+    let mut top = ground;
+    for i in 0..8 {
+        let y = 0.25 + 0.5 * i as f64;
+        top = rapier
+            .bodies
+            .insert(RigidBodyBuilder::dynamic().translation(Vector::new(0.0, y, 0.0)));
+        let shape = ColliderBuilder::cuboid(0.25, 0.25, 0.25);
+        rapier
+            .colliders
+            .insert_with_parent(shape, top, &mut rapier.bodies);
+    }
+    let mut world = World::new();
+    world.insert_resource(Physics::from_world(rapier));
+    let post = world
+        .spawn(Body::new(
+            RigidBodyBuilder::fixed().translation(Vector::new(3.0, 2.0, 0.0)),
+        ))
+        .id();
+    let sign = world
+        .spawn(Body::new(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(3.0, 1.7, 0.0))
+                .additional_mass_properties(MassProperties::new(
+                    Vector::ZERO,
+                    2.0,
+                    Vector::splat(0.02),
+                ))
+                .can_sleep(false),
+        ))
+        .id();
+    let hinge = world
+        .spawn((
+            Hinge::new(post, sign, Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0)),
+            ClearanceHinge(clearance().model(ClearanceModel::LargeStep)),
+        ))
+        .id();
+    let mut schedule = physics_schedule();
+    steps(&mut world, &mut schedule, 600).unwrap();
+    assert_eq!(
+        world.get::<HingeState>(hinge).unwrap().mode,
+        HingeMode::LargeStep
+    );
+    let s = world.get::<HingeState>(hinge).unwrap();
+    assert!(
+        (s.force - 19.62).abs() < 0.01,
+        "the sign hangs: {} N",
+        s.force
+    );
+    let p = world.resource::<Physics>();
+    assert_eq!(
+        p.world.integration_parameters.num_solver_iterations, iterations,
+        "the layer left the setting as it was"
+    );
+    p.world.bodies[top].translation()
+}
+
+#[test]
+fn a_game_worlds_stack_stands_because_its_iterations_are_left_alone() {
+    // Rapier's 4 iterations: the stack stands (its top box started at 3.75 m).
+    let top = stack_beside_a_sign(4);
+    assert!(top.y > 3.7 && top.x.abs() < 0.05, "{top:?}");
+    // One iteration, as the compliant model needs, for the whole world: the stack falls.
+    let top = stack_beside_a_sign(1);
+    assert!(top.y < 1.0, "{top:?}");
 }

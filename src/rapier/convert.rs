@@ -482,8 +482,8 @@ pub fn revolute_to_clearance(
 /// switches; Rapier's revolute pulls them together within its next steps, which moves the
 /// bodies: a body hanging on the bearing wall is lifted by `c`, gaining `m g c` (measured 0.96
 /// `m g c` for a 2 kg arm in 0.2 mm of play, a test of this module). Switch when the journal is
-/// near the bearing centre, or budget that energy. As with [`ClearanceJointSet::remove`], the handles of the clearance joints inserted
-/// after it shift down by one.
+/// near the bearing centre, or budget that energy. The other handles of `set` stay valid;
+/// `handle` finds nothing ever after.
 pub fn clearance_to_revolute(
     set: &mut ClearanceJointSet,
     handle: ClearanceJointHandle,
@@ -494,7 +494,7 @@ pub fn clearance_to_revolute(
         Error::invalid(
             "clearance joint",
             format!(
-                "no joint with handle {handle:?} in the ClearanceJointSet ({} joints)",
+                "no joint with handle {handle} in the ClearanceJointSet ({} joints)",
                 set.len()
             ),
         )
@@ -537,7 +537,7 @@ pub fn large_step_to_revolute(
     let joint = set.remove(handle, bodies, impulse_joints).ok_or_else(|| {
         Error::invalid(
             "large-step joint",
-            format!("no joint with handle {handle:?} in the LargeStepJointSet"),
+            format!("no joint with handle {handle} in the LargeStepJointSet"),
         )
     })?;
     Ok(impulse_joints.insert(
@@ -966,15 +966,30 @@ mod tests {
             .unwrap_err(),
             "no joint with handle",
         );
-        check(
-            set.revert_to_revolute(
-                ClearanceJointHandle(3),
-                &mut r.world.bodies,
+        // A stale handle: its joint was converted back already.
+        let h = r
+            .world
+            .impulse_joints
+            .insert(r.base, r.arm, revolute(), true);
+        let c = set
+            .convert_revolute(
+                h,
+                BearingSide::Body1,
+                clearance(),
                 &mut r.world.impulse_joints,
             )
-            .unwrap_err(),
+            .unwrap();
+        let h = set
+            .revert_to_revolute(c, &mut r.world.bodies, &mut r.world.impulse_joints)
+            .unwrap();
+        let n = r.world.impulse_joints.len();
+        check(
+            set.revert_to_revolute(c, &mut r.world.bodies, &mut r.world.impulse_joints)
+                .unwrap_err(),
             "no joint with handle",
         );
+        assert_eq!(r.world.impulse_joints.len(), n, "nothing changed");
+        r.world.impulse_joints.remove(h, false);
         // An invalid clearance is refused by the laws, naming the field.
         check(
             Clearance::steel_improved_liu(0.010, 0.02, 0.016).unwrap_err(),

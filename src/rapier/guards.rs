@@ -327,7 +327,7 @@ mod tests {
 
     fn pen(depth: f64, t: f64) -> Violation {
         Violation::new(GuardKind::Penetration, depth, 50e-6, t)
-            .joint("pin", Some(ClearanceJointHandle(0)))
+            .joint("pin", Some(ClearanceJointHandle::from_raw_parts(0, 0)))
     }
 
     #[test]
@@ -359,7 +359,7 @@ mod tests {
         g.record(pen(60e-6, 0.001));
         g.record(
             Violation::new(GuardKind::Penetration, 70e-6, 50e-6, 0.002)
-                .joint("other", Some(ClearanceJointHandle(1))),
+                .joint("other", Some(ClearanceJointHandle::from_raw_parts(1, 0))),
         );
         g.record(Violation::new(GuardKind::Energy, 0.05, 0.01, 0.3).twin("ideal"));
         g.violation("mine", || "my own guard".into());

@@ -9,9 +9,11 @@ use crate::model::laws::{
     BearingGeometry, FrictionLaw, FrictionModel, NormalContact, NormalForceLaw, NormalModel,
     crossing_fraction, loaded_impact_rate, speed_at_crossing,
 };
+use crate::rapier::arena::OrderedArena;
 use crate::rapier::ledger::{
     ForceLedger, Wrench, ensure_mass_properties, inverse_mass_along, world_center_of_mass,
 };
+use rapier3d_f64::data::Index;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, IntegrationParameters, JointAxesMask,
@@ -694,14 +696,36 @@ fn motion(rb: &RigidBody) -> BodyMotion {
     }
 }
 
-/// Handle of a joint in a [`ClearanceJointSet`].
+/// Handle of a joint in a [`ClearanceJointSet`], returned by its
+/// [`insert`](ClearanceJointSet::insert): generational, as Rapier's `ImpulseJointHandle`.
+/// Removing a joint never changes another joint's handle, and the handle of a removed joint
+/// finds nothing ever after (a later joint that reuses its slot gets a new generation). Handles
+/// order by slot, not by insertion: iterate the set for the insertion order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct ClearanceJointHandle(pub usize);
+pub struct ClearanceJointHandle(Index);
 
-/// All clearance joints of a world, and the per-step force hook.
+impl ClearanceJointHandle {
+    /// A handle from its slot and generation, for the crate's unit tests (users get handles
+    /// from [`ClearanceJointSet::insert`] only).
+    #[cfg(test)]
+    pub(crate) fn from_raw_parts(slot: u32, generation: u32) -> Self {
+        ClearanceJointHandle(Index::from_raw_parts(slot, generation))
+    }
+}
+
+/// `slot`v`generation`, as bevy's `Entity`.
+impl std::fmt::Display for ClearanceJointHandle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (slot, generation) = self.0.into_raw_parts();
+        write!(f, "{slot}v{generation}")
+    }
+}
+
+/// All clearance joints of a world, and the per-step force hook. The joints are visited (their
+/// forces evaluated and added, [`iter`](Self::iter)) in insertion order.
 #[derive(Clone, Debug, Default)]
 pub struct ClearanceJointSet {
-    joints: Vec<ClearanceJoint>,
+    joints: OrderedArena<ClearanceJoint>,
     ledger: ForceLedger,
     wrenches: Vec<Wrench>,
     saved: Vec<JointDynamics>,
@@ -738,43 +762,55 @@ impl ClearanceJointSet {
             .build();
             joint.lock_handle = Some(impulse_joints.insert(body1, body2, lock, true));
         }
-        self.joints.push(joint);
-        ClearanceJointHandle(self.joints.len() - 1)
+        ClearanceJointHandle(self.joints.insert(joint))
     }
 
     /// Removes the joint's forces from its bodies (and its lock joint from `impulse_joints`) and
-    /// returns it. Handles of the joints after it shift down by one.
+    /// returns it (`None` for a handle of no joint of this set). The other joints keep their
+    /// handles and their order; `handle` finds nothing ever after.
     pub fn remove(
         &mut self,
         handle: ClearanceJointHandle,
         bodies: &mut RigidBodySet,
         impulse_joints: &mut ImpulseJointSet,
     ) -> Option<ClearanceJoint> {
-        if handle.0 >= self.joints.len() {
-            return None;
-        }
-        let mut joint = self.joints.remove(handle.0);
+        let mut joint = self.joints.remove(handle.0)?;
         if let Some(lock) = joint.lock_handle.take() {
             impulse_joints.remove(lock, true);
         }
+        // A saved state is by position: it no longer matches the joints.
+        self.saved.clear();
         // Take back the removed joint's last forces only: the others' stay as last applied.
         self.wrenches.clear();
-        self.wrenches
-            .extend(self.joints.iter().filter_map(|j| j.last_wrenches).flatten());
+        self.wrenches.extend(
+            self.joints
+                .values()
+                .filter_map(|j| j.last_wrenches)
+                .flatten(),
+        );
         self.ledger.replace(bodies, self.wrenches.iter().copied());
         Some(joint)
     }
 
-    /// The joint behind `handle`.
+    /// Whether `handle` is a joint of this set.
+    pub fn contains(&self, handle: ClearanceJointHandle) -> bool {
+        self.joints.contains(handle.0)
+    }
+
+    /// The joint behind `handle` (`None` once it was removed).
     pub fn get(&self, handle: ClearanceJointHandle) -> Option<&ClearanceJoint> {
         self.joints.get(handle.0)
     }
 
-    /// All joints with their handles.
+    /// The joint behind `handle`, mutably (`None` once it was removed).
+    pub fn get_mut(&mut self, handle: ClearanceJointHandle) -> Option<&mut ClearanceJoint> {
+        self.joints.get_mut(handle.0)
+    }
+
+    /// All joints with their handles, in insertion order.
     pub fn iter(&self) -> impl Iterator<Item = (ClearanceJointHandle, &ClearanceJoint)> {
         self.joints
             .iter()
-            .enumerate()
             .map(|(i, j)| (ClearanceJointHandle(i), j))
     }
 
@@ -822,7 +858,7 @@ impl ClearanceJointSet {
     /// gone reports free flight and applies nothing.
     pub fn evaluate(&mut self, bodies: &mut RigidBodySet) {
         self.wrenches.clear();
-        for joint in &mut self.joints {
+        for joint in self.joints.values_mut() {
             if !joint.prepared {
                 ensure_mass_properties(bodies, None, joint.body1);
                 ensure_mass_properties(bodies, None, joint.body2);
@@ -862,7 +898,7 @@ impl ClearanceJointSet {
 
     /// Checks `dt` against every joint's current stability limit.
     pub fn check_step(&self, dt: f64) -> Result<()> {
-        for j in &self.joints {
+        for j in self.joints.values() {
             if j.prepared && j.last_wrenches.is_none() {
                 return Err(Error::invalid(
                     format!("clearance joint `{}`", j.name),
@@ -893,13 +929,14 @@ impl ClearanceJointSet {
     /// may be rejected; no allocation after the first call).
     pub fn save_state(&mut self) {
         self.saved.clear();
-        self.saved.extend(self.joints.iter().map(|j| j.dynamics()));
+        self.saved
+            .extend(self.joints.values().map(|j| j.dynamics()));
         self.saved_wrenches.clone_from(&self.wrenches);
     }
 
     /// Restores what [`save_state`](Self::save_state) saved.
     pub fn restore_state(&mut self) {
-        for (j, d) in self.joints.iter_mut().zip(&self.saved) {
+        for (j, d) in self.joints.values_mut().zip(&self.saved) {
             j.set_dynamics(*d);
         }
         self.wrenches.clone_from(&self.saved_wrenches);
@@ -909,7 +946,7 @@ impl ClearanceJointSet {
     /// [`save_state`](Self::save_state): the shortest retry step asked for, if any.
     pub fn judge_step(&self, dt: f64, tolerance: f64) -> Option<f64> {
         self.joints
-            .iter()
+            .values()
             .enumerate()
             .filter_map(|(i, j)| {
                 let was = self.saved.get(i).is_some_and(|d| d.contact.in_contact);
@@ -921,7 +958,7 @@ impl ClearanceJointSet {
     /// Smallest [`ClearanceJoint::adaptive_step`] over all joints (infinite without joints).
     pub fn adaptive_step(&self, tolerance: f64, last_dt: f64) -> f64 {
         self.joints
-            .iter()
+            .values()
             .map(|j| j.adaptive_step(tolerance, last_dt))
             .fold(f64::INFINITY, f64::min)
     }
@@ -930,7 +967,7 @@ impl ClearanceJointSet {
     /// joint is in contact), s.
     pub fn max_stable_dt(&self) -> f64 {
         self.joints
-            .iter()
+            .values()
             .map(|j| j.report.max_stable_dt)
             .fold(f64::INFINITY, f64::min)
     }

@@ -17,6 +17,7 @@
 //!
 //! Depends on [`crate::model`] only (and on Rapier); knows nothing of scenes or the ECS.
 
+pub(crate) mod arena;
 pub mod convert;
 pub mod drive;
 pub mod guards;

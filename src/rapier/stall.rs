@@ -154,7 +154,7 @@ impl StalledContact {
             "joint `{}` (handle {}): penetration {} um, rate {} m/s, delta_dot0 {} m/s, damping ratio \
              {}, stable step {} s (friction's {} s), effective mass {} kg",
             self.joint,
-            self.handle.0,
+            self.handle,
             sig4(self.penetration * 1e6),
             sig4(self.rate),
             sig4(self.impact_rate),
@@ -335,7 +335,7 @@ mod tests {
     fn contact() -> StalledContact {
         StalledContact {
             joint: "pin".into(),
-            handle: ClearanceJointHandle(0),
+            handle: ClearanceJointHandle::from_raw_parts(0, 0),
             law: LawKind::LankaraniNikravesh,
             penetration: 1e-6,
             rate: 1e-3,

@@ -76,7 +76,9 @@ pub mod resolution;
 
 use crate::error::{Error, Result, non_negative, positive, unit_vector};
 use crate::model::laws::{BearingGeometry, NormalModel, impact_restitution};
+use crate::rapier::arena::OrderedArena;
 use crate::rapier::ledger::{ensure_mass_properties, inverse_mass_along, world_center_of_mass};
+use rapier3d_f64::data::Index;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     GenericJoint, GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, IntegrationParameters,
@@ -605,10 +607,21 @@ impl LargeStepJoint {
     }
 }
 
-/// Handle of a joint in a [`LargeStepJointSet`]. Handles stay valid (and are never reused) when
-/// other joints are removed.
+/// Handle of a joint in a [`LargeStepJointSet`], returned by its
+/// [`insert`](LargeStepJointSet::insert): generational, as Rapier's `ImpulseJointHandle`.
+/// Removing a joint never changes another joint's handle, and the handle of a removed joint
+/// finds nothing ever after (a later joint that reuses its slot gets a new generation). Handles
+/// order by slot, not by insertion: iterate the set for the insertion order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct LargeStepJointHandle(pub usize);
+pub struct LargeStepJointHandle(Index);
+
+/// `slot`v`generation`, as bevy's `Entity`.
+impl std::fmt::Display for LargeStepJointHandle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let (slot, generation) = self.0.into_raw_parts();
+        write!(f, "{slot}v{generation}")
+    }
+}
 
 /// All large-step clearance joints of a world, and the per-step hooks.
 ///
@@ -618,17 +631,17 @@ pub struct LargeStepJointHandle(pub usize);
 /// a body had when its first joint was inserted, and restores that value when the body's last
 /// joint is removed. Joints that share a dynamic body share one substep count (Rapier substeps a
 /// connected component together); the force readout assumes no other body in that component asks
-/// for more.
+/// for more. The joints are visited ([`iter`](Self::iter), the hooks) in insertion order.
 #[derive(Clone, Debug, Default)]
 pub struct LargeStepJointSet {
-    joints: Vec<Option<LargeStepJoint>>,
+    joints: OrderedArena<LargeStepJoint>,
     /// `additional_solver_iterations` of each managed body before the set touched it.
     base_extra: BTreeMap<(u32, u32), usize>,
-    /// Group of each joint slot (joints sharing a dynamic body), rebuilt after insertions and
-    /// removals.
-    groups: Vec<Option<usize>>,
+    /// Group of each joint, in the joints' order (joints sharing a dynamic body), rebuilt after
+    /// insertions and removals.
+    groups: Vec<usize>,
     groups_valid: bool,
-    /// Per-step scratch: what each slot needs, and each group's largest count.
+    /// Per-step scratch: what each joint needs, and each group's largest count.
     needs: Vec<Need>,
     group_max: Vec<usize>,
 }
@@ -662,20 +675,21 @@ impl LargeStepJointSet {
         joint.state = JointState::default();
         joint.report = LargeStepReport::default();
         joint.handle = Some(impulse_joints.insert(body1, body2, joint.rapier_joint(), true));
-        self.joints.push(Some(joint));
         self.groups_valid = false;
-        LargeStepJointHandle(self.joints.len() - 1)
+        LargeStepJointHandle(self.joints.insert(joint))
     }
 
-    /// Removes the joint (and its Rapier joint) and returns it. Bodies no other joint of the set
-    /// uses get their `additional_solver_iterations` back.
+    /// Removes the joint (and its Rapier joint) and returns it (`None` for a handle of no joint
+    /// of this set). Bodies no other joint of the set uses get their
+    /// `additional_solver_iterations` back. The other joints keep their handles and their order;
+    /// `handle` finds nothing ever after.
     pub fn remove(
         &mut self,
         handle: LargeStepJointHandle,
         bodies: &mut RigidBodySet,
         impulse_joints: &mut ImpulseJointSet,
     ) -> Option<LargeStepJoint> {
-        let mut joint = self.joints.get_mut(handle.0)?.take()?;
+        let mut joint = self.joints.remove(handle.0)?;
         self.groups_valid = false;
         if let Some(h) = joint.handle.take() {
             impulse_joints.remove(h, true);
@@ -693,27 +707,36 @@ impl LargeStepJointSet {
         Some(joint)
     }
 
-    /// The joint behind `handle`.
-    pub fn get(&self, handle: LargeStepJointHandle) -> Option<&LargeStepJoint> {
-        self.joints.get(handle.0)?.as_ref()
+    /// Whether `handle` is a joint of this set.
+    pub fn contains(&self, handle: LargeStepJointHandle) -> bool {
+        self.joints.contains(handle.0)
     }
 
-    /// All joints with their handles.
+    /// The joint behind `handle` (`None` once it was removed).
+    pub fn get(&self, handle: LargeStepJointHandle) -> Option<&LargeStepJoint> {
+        self.joints.get(handle.0)
+    }
+
+    /// The joint behind `handle`, mutably (`None` once it was removed).
+    pub fn get_mut(&mut self, handle: LargeStepJointHandle) -> Option<&mut LargeStepJoint> {
+        self.joints.get_mut(handle.0)
+    }
+
+    /// All joints with their handles, in insertion order.
     pub fn iter(&self) -> impl Iterator<Item = (LargeStepJointHandle, &LargeStepJoint)> {
         self.joints
             .iter()
-            .enumerate()
-            .filter_map(|(i, j)| j.as_ref().map(|j| (LargeStepJointHandle(i), j)))
+            .map(|(i, j)| (LargeStepJointHandle(i), j))
     }
 
     /// Number of joints.
     pub fn len(&self) -> usize {
-        self.joints.iter().flatten().count()
+        self.joints.len()
     }
 
     /// Whether the set is empty.
     pub fn is_empty(&self) -> bool {
-        self.len() == 0
+        self.joints.is_empty()
     }
 
     /// Prepares the coming step (call right before `PhysicsPipeline::step`, after setting `dt`):
@@ -730,8 +753,7 @@ impl LargeStepJointSet {
         // 1. What each joint needs.
         self.needs.clear();
         self.needs.resize(self.joints.len(), Need::default());
-        for (i, slot) in self.joints.iter_mut().enumerate() {
-            let Some(joint) = slot else { continue };
+        for (i, joint) in self.joints.values_mut().enumerate() {
             if !joint.state.prepared {
                 ensure_mass_properties(bodies, None, joint.body1);
                 ensure_mass_properties(bodies, None, joint.body2);
@@ -776,16 +798,11 @@ impl LargeStepJointSet {
         }
         self.group_max.clear();
         self.group_max.resize(self.joints.len(), 0);
-        for (need, g) in self.needs.iter().zip(&self.groups) {
-            if let Some(g) = g {
-                self.group_max[*g] = self.group_max[*g].max(need.substeps);
-            }
+        for (need, &g) in self.needs.iter().zip(&self.groups) {
+            self.group_max[g] = self.group_max[g].max(need.substeps);
         }
-        for (slot, g) in self.joints.iter().zip(&self.groups) {
-            let (Some(joint), Some(g)) = (slot, g) else {
-                continue;
-            };
-            let extra = self.group_max[*g].saturating_sub(base);
+        for (joint, &g) in self.joints.values().zip(&self.groups) {
+            let extra = self.group_max[g].saturating_sub(base);
             for (body, floor) in [joint.body1, joint.body2]
                 .into_iter()
                 .zip(joint.state.floors)
@@ -800,8 +817,7 @@ impl LargeStepJointSet {
             }
         }
         // 3. Friction motors and the pre-step record.
-        for (i, slot) in self.joints.iter_mut().enumerate() {
-            let Some(joint) = slot else { continue };
+        for (i, joint) in self.joints.values_mut().enumerate() {
             let (Some(rb1), Some(rb2)) = (bodies.get(joint.body1), bodies.get(joint.body2)) else {
                 continue;
             };
@@ -845,14 +861,14 @@ impl LargeStepJointSet {
     /// Finishes the step just taken (call right after `PhysicsPipeline::step`): reads the normal
     /// force and friction torque, updates the reports, and gives each impact its bounce.
     pub fn after_step(&mut self, bodies: &mut RigidBodySet, impulse_joints: &ImpulseJointSet) {
-        for joint in self.joints.iter_mut().flatten() {
+        for joint in self.joints.values_mut() {
             joint.finish(bodies, impulse_joints);
         }
     }
 
-    /// Group index of each joint: joints sharing a dynamic body are in the same group (`None`
-    /// for empty slots).
-    fn groups(&self, bodies: &RigidBodySet) -> Vec<Option<usize>> {
+    /// Group index of each joint, in the joints' order: joints sharing a dynamic body are in the
+    /// same group.
+    fn groups(&self, bodies: &RigidBodySet) -> Vec<usize> {
         let n = self.joints.len();
         let mut parent: Vec<usize> = (0..n).collect();
         fn find(parent: &mut [usize], mut i: usize) -> usize {
@@ -863,8 +879,7 @@ impl LargeStepJointSet {
             i
         }
         let mut owner: BTreeMap<(u32, u32), usize> = BTreeMap::new();
-        for (i, slot) in self.joints.iter().enumerate() {
-            let Some(j) = slot else { continue };
+        for (i, j) in self.joints.values().enumerate() {
             for body in [j.body1, j.body2] {
                 if !bodies.get(body).is_some_and(|rb| rb.is_dynamic()) {
                     continue;
@@ -880,8 +895,6 @@ impl LargeStepJointSet {
                 }
             }
         }
-        (0..n)
-            .map(|i| self.joints[i].as_ref().map(|_| find(&mut parent, i)))
-            .collect()
+        (0..n).map(|i| find(&mut parent, i)).collect()
     }
 }

@@ -597,17 +597,15 @@ fn four_bar_reactions_under_adaptive_steps_match_a_fine_fixed_run() {
     assert!(guards.is_empty(), "{guards:?}");
     let (adaptive, guards) = four_bar(end, &[], false);
     assert!(guards.is_empty(), "{guards:?}");
-    // Steps up to 1e-4 s: where the clearance twin's first impact cuts them abruptly, Rapier's
-    // velocity motor (whose strength within a step falls with the step, while the stepper's kick
-    // still spans the long step before) lets the crank speed jump by a third; the energy balance,
-    // which counts the motor's work, says so.
-    // (With the factor the scene had before, 1e6: at 1e8 and 1e-4 s steps Rapier's motor row
-    // itself misbehaves, a different question.)
+    // Steps up to 1e-4 s with the weaker motor the scene had before (factor 1e6): Rapier's
+    // velocity motor, whose strength within a step falls with the step, does not hold the crank's
+    // speed, and a guard says so. (Before the free-flight step bound, the steps that the clearance
+    // twin's first impact cut abruptly let the crank speed jump by a third and the energy balance
+    // caught it; the steps in the gap are now short, and the motor guard catches the miss.)
     let (coarse, guards) = four_bar(end, &["run.max_dt_s=1e-4", "motor.factor=1e6"], false);
     assert!(
-        guards
-            .iter()
-            .any(|g| g.contains("ideal twin gained energy")),
+        guards.iter().any(|g| g.contains("ideal twin gained energy")
+            || g.contains("ideal twin's velocity motor `motor` missed its speed")),
         "{guards:?}"
     );
     let columns = [

@@ -330,14 +330,27 @@ fn a_driven_mechanism_at_the_default_step_control_never_enters_deeper_than_allow
     // What must hold is that the run met contacts at all.
     assert!(run.first > 0.0, "no contact: the test tests nothing");
     assert_eq!(run.stepper.guards().floor_steps, 0);
-    // The first impact agrees with a run resolved 15 times finer.
-    let fine = crank_run(control.with_tolerance(0.0005), end).unwrap();
-    let rel = (run.first - fine.first).abs() / fine.first;
+    // The first impact against converged fixed steps (5e-8 s; 1e-7 s is 1.2 % deeper), and
+    // closer to it as the tolerance tightens. This test used to compare the default with a run at
+    // tolerance 0.0005 and find them within 5 %; both were about 17 % too deep (19.0 and 18.0 um
+    // against 16.4 um), the finer run held back by Rapier's drift correction at the drops of the
+    // step. With the joint correction the finer run converges (16.5 um), and the default is left
+    // 11 % deep (18.2 um; 17.3 at 0.002): a first-order error in the tolerance on this crank with
+    // the improved Liu law, still open (the Flores-Ambrosio slider-crank's first impact, with the
+    // Lankarani-Nikravesh law, is within 0.1 % at the defaults).
+    let converged = crank_run(StepControl::fixed(5e-8), 0.004).unwrap().first;
+    let error = |tolerance: f64| {
+        let r = crank_run(control.with_tolerance(tolerance), 0.004).unwrap();
+        (r.first - converged).abs() / converged
+    };
+    let (coarse, finer, finest) = (error(0.0075), error(0.002), error(0.0005));
     assert!(
-        rel < 0.05,
-        "first impact {} um vs {} um",
-        run.first * 1e6,
-        fine.first * 1e6
+        coarse < 0.15,
+        "first impact {coarse} of the converged depth off"
+    );
+    assert!(
+        finer < 0.7 * coarse && finest < 0.3 * coarse && finest < 0.03,
+        "no convergence as the tolerance tightens: {coarse} {finer} {finest}"
     );
     // The test can fail: a fixed 1e-4 s step crosses the gap blind and is refused.
     let e = crank_run(StepControl::fixed(1e-4), end).err().unwrap();

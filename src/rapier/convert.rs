@@ -668,6 +668,23 @@ mod tests {
             .local_anchor2(Vector::new(0.01, 0.3, 0.0))
     }
 
+    /// `revolute()` between the rig's base and arm, converted with the bearing on `side`: the
+    /// set, the clearance joint and the (removed) revolute's handle.
+    fn converted(
+        r: &mut Rig,
+        side: BearingSide,
+    ) -> (ClearanceJointSet, ClearanceJointHandle, ImpulseJointHandle) {
+        let h = r
+            .world
+            .impulse_joints
+            .insert(r.base, r.arm, revolute(), true);
+        let mut set = ClearanceJointSet::new();
+        let c = set
+            .convert_revolute(h, side, clearance(), &mut r.world.impulse_joints)
+            .unwrap();
+        (set, c, h)
+    }
+
     fn clearance() -> Clearance {
         Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
             .unwrap()
@@ -678,19 +695,7 @@ mod tests {
     #[test]
     fn converts_with_the_revolute_anchors_and_axes() {
         let mut r = rig();
-        let h = r
-            .world
-            .impulse_joints
-            .insert(r.base, r.arm, revolute(), true);
-        let mut set = ClearanceJointSet::new();
-        let c = set
-            .convert_revolute(
-                h,
-                BearingSide::Body1,
-                clearance(),
-                &mut r.world.impulse_joints,
-            )
-            .unwrap();
+        let (set, c, h) = converted(&mut r, BearingSide::Body1);
         assert!(r.world.impulse_joints.get(h).is_none(), "revolute removed");
         let j = set.get(c).unwrap();
         assert_eq!(j.name(), "pivot");
@@ -713,19 +718,7 @@ mod tests {
     #[test]
     fn the_bearing_side_is_explicit() {
         let mut r = rig();
-        let h = r
-            .world
-            .impulse_joints
-            .insert(r.base, r.arm, revolute(), true);
-        let mut set = ClearanceJointSet::new();
-        let c = set
-            .convert_revolute(
-                h,
-                BearingSide::Body2,
-                clearance(),
-                &mut r.world.impulse_joints,
-            )
-            .unwrap();
+        let (mut set, c, _) = converted(&mut r, BearingSide::Body2);
         let j = set.get(c).unwrap();
         // The arm carries the bearing: it is the clearance joint's body 1, with its anchor.
         assert_eq!((j.body1(), j.body2()), (r.arm, r.base));
@@ -867,19 +860,7 @@ mod tests {
         // Resting on the bearing wall, the arm hangs c lower than on an ideal pin; the revolute
         // put back pulls its anchors together and lifts it by c: m g c of energy (3.9 mJ).
         let mut r = rig();
-        let h = r
-            .world
-            .impulse_joints
-            .insert(r.base, r.arm, revolute(), true);
-        let mut set = ClearanceJointSet::new();
-        let c = set
-            .convert_revolute(
-                h,
-                BearingSide::Body1,
-                clearance(),
-                &mut r.world.impulse_joints,
-            )
-            .unwrap();
+        let (mut set, c, _) = converted(&mut r, BearingSide::Body1);
         for _ in 0..20_000 {
             set.apply(&mut r.world.bodies, &r.world.integration_parameters)
                 .unwrap();

@@ -41,7 +41,8 @@ pub const DAMPING_RATIO: f64 = 1e3;
 #[derive(Clone, Debug, Default)]
 pub struct JointCorrection {
     span: f64,
-    saved: Vec<(ImpulseJointHandle, SpringCoefficients<f64>)>,
+    /// The joints given the step's softness by `apply` (all had Rapier's default).
+    touched: Vec<ImpulseJointHandle>,
 }
 
 impl JointCorrection {
@@ -61,32 +62,29 @@ impl JointCorrection {
     }
 
     /// Gives every joint with Rapier's default softness the softness of a step of `dt`,
-    /// remembering the default for [`restore`](Self::restore).
+    /// remembering which for [`restore`](Self::restore).
     pub fn apply(&mut self, joints: &mut ImpulseJointSet, dt: f64) {
-        self.saved.clear();
         let default = SpringCoefficients::joint_defaults();
-        let handles: Vec<ImpulseJointHandle> = joints
-            .iter()
-            .filter(|(_, j)| j.data.softness == default)
-            .map(|(h, _)| h)
-            .collect();
-        if handles.is_empty() {
-            return;
-        }
+        self.touched.clear();
+        self.touched.extend(
+            joints
+                .iter()
+                .filter(|(_, j)| j.data.softness == default)
+                .map(|(h, _)| h),
+        );
         let softness = softness_for(default, self.span_after(dt), dt);
-        for h in handles {
+        for &h in &self.touched {
             if let Some(j) = joints.get_mut(h, false) {
                 j.data.softness = softness;
-                self.saved.push((h, default));
             }
         }
     }
 
-    /// Gives the joints touched by [`apply`](Self::apply) their softness back.
+    /// Gives the joints touched by [`apply`](Self::apply) Rapier's default softness back.
     pub fn restore(&mut self, joints: &mut ImpulseJointSet) {
-        for (h, softness) in self.saved.drain(..) {
+        for h in self.touched.drain(..) {
             if let Some(j) = joints.get_mut(h, false) {
-                j.data.softness = softness;
+                j.data.softness = SpringCoefficients::joint_defaults();
             }
         }
     }

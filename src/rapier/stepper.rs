@@ -859,12 +859,13 @@ fn diverged_body(
     speed: f64,
     joint_correction: bool,
 ) -> String {
-    let jointed = world.impulse_joints.attached_joints(body).next().is_some();
     let mut joined: Vec<String> = world
         .impulse_joints
         .attached_joints(body)
         .map(|(_, _, h, _)| format!("impulse joint {:?}", h.into_raw_parts()))
         .collect();
+    // Rapier's joints: the ones whose drift correction can make it diverge.
+    let jointed = !joined.is_empty();
     for set in sources.iter().filter_map(|s| s.clearance_joints()) {
         for (_, j) in set.iter() {
             if j.body1() == body || j.body2() == body {

@@ -193,7 +193,7 @@ mod chapter_doctests {
 /// ```
 pub mod prelude {
     pub use crate::rapier::convert::{BearingSide, Clearance, ClearanceModel, ConvertRevolute};
-    pub use crate::rapier::drive::{DriveSet, TorsionSpring};
+    pub use crate::rapier::drive::{DriveHandle, DriveSet, TorsionSpring};
     pub use crate::rapier::guards::GuardReport;
     pub use crate::rapier::joint::{
         ClearanceJoint, ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet,
@@ -207,7 +207,8 @@ pub mod prelude {
         IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, KinematicState,
         ReactionSolver,
     };
-    pub use crate::rapier::stepper::{ForceSource, StepControl, StepInfo, Stepper};
+    pub use crate::rapier::stepper::{StepControl, StepHooks, StepInfo, Stepper};
+    pub use crate::rapier::world::ClearanceWorld;
     /// The same item as Rapier's (`rapier3d_f64::math::Vector`), so no clash with its prelude.
     pub use rapier3d_f64::math::Vector;
 }

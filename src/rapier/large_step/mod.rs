@@ -82,7 +82,8 @@ use rapier3d_f64::data::Index;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     GenericJoint, GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, IntegrationParameters,
-    JointAxesMask, JointAxis, RigidBody, RigidBodyHandle, RigidBodySet, RigidBodyType,
+    JointAxesMask, JointAxis, PhysicsWorld, RigidBody, RigidBodyHandle, RigidBodySet,
+    RigidBodyType,
 };
 use resolution::{quantized_substeps, rocking_frequency, substeps_needed};
 use std::collections::BTreeMap;
@@ -644,6 +645,8 @@ pub struct LargeStepJointSet {
     /// Per-step scratch: what each joint needs, and each group's largest count.
     needs: Vec<Need>,
     group_max: Vec<usize>,
+    /// The joints' states before a step the stepper may reject.
+    saved: Vec<(JointState, LargeStepReport)>,
 }
 
 /// What one joint asks of the coming step.
@@ -691,6 +694,8 @@ impl LargeStepJointSet {
     ) -> Option<LargeStepJoint> {
         let mut joint = self.joints.remove(handle.0)?;
         self.groups_valid = false;
+        // A saved state is by position: it no longer matches the joints.
+        self.saved.clear();
         if let Some(h) = joint.handle.take() {
             impulse_joints.remove(h, true);
         }
@@ -896,5 +901,41 @@ impl LargeStepJointSet {
             }
         }
         (0..n).map(|i| find(&mut parent, i)).collect()
+    }
+}
+
+/// The large-step joints take part in the stepper's steps: their substeps and friction motors
+/// before each Rapier step, their readout and bounces after it, saved and restored with a
+/// rejected step ([`crate::rapier::step_hooks`]). Under a
+/// [`Stepper`](crate::rapier::stepper::Stepper) or a
+/// [`ClearanceWorld`](crate::rapier::world::ClearanceWorld) no hook can be forgotten.
+impl crate::rapier::step_hooks::StepHooks for LargeStepJointSet {
+    fn save_state(&mut self) {
+        self.saved.clear();
+        self.saved
+            .extend(self.joints.values().map(|j| (j.state, j.report)));
+    }
+    fn restore_state(&mut self) {
+        for (j, (state, report)) in self.joints.values_mut().zip(&self.saved) {
+            j.state = *state;
+            j.report = *report;
+        }
+    }
+    fn before_rapier_step(&mut self, world: &mut PhysicsWorld, _t0: f64, _dt: f64) {
+        self.before_step(
+            &mut world.bodies,
+            &mut world.impulse_joints,
+            &world.integration_parameters,
+        );
+    }
+    fn after_rapier_step(&mut self, world: &mut PhysicsWorld) {
+        self.after_step(&mut world.bodies, &world.impulse_joints);
+    }
+    fn joints_of(&self, body: RigidBodyHandle, names: &mut Vec<String>) {
+        for (_, j) in self.iter() {
+            if j.body1() == body || j.body2() == body {
+                names.push(format!("large-step clearance joint `{}`", j.name()));
+            }
+        }
     }
 }

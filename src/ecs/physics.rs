@@ -549,7 +549,7 @@ fn check_compliant(world: &PhysicsWorld, entity: Entity) -> Result<()> {
         return Ok(());
     }
     Err(Error::invalid(
-        "Physics::world.integration_parameters.num_solver_iterations",
+        "Physics::world.rapier.integration_parameters.num_solver_iterations",
         format!(
             "the compliant clearance model of hinge {entity} needs 1 (the world has {n}): its \
              contact force is evaluated once per step and held over it, and Rapier's substeps \

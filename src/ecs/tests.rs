@@ -31,7 +31,11 @@ fn arm_at(x: f64) -> Body {
 fn pendulum(dt: f64) -> (World, Schedule, Entity, Entity) {
     let mut world = World::new();
     let mut physics = Physics::new(dt, Vector::new(0.0, -9.81, 0.0));
-    physics.world.rapier.integration_parameters.num_solver_iterations = 1;
+    physics
+        .world
+        .rapier
+        .integration_parameters
+        .num_solver_iterations = 1;
     world.insert_resource(physics);
     let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
     let arm = world.spawn(arm_at(0.0)).id();
@@ -276,7 +280,7 @@ fn errors_are_values_and_stop_the_systems() {
     let e = steps(&mut world, &mut schedule, 2_000).unwrap_err();
     match &e {
         Error::StepTooLarge { field, t, .. } => {
-            assert_eq!(field, "Physics::world.integration_parameters.dt");
+            assert_eq!(field, "Physics::world.rapier.integration_parameters.dt");
             assert!(t.is_some_and(|t| t.is_finite() && t > 0.0));
         }
         other => panic!("expected StepTooLarge, got {other}"),
@@ -388,8 +392,16 @@ fn large_step_hinge_at_game_rate_with_rapiers_defaults() {
     );
     // Compliant <-> large step: the model change rebuilds the joint.
     world.entity_mut(hinge).insert(ClearanceHinge(clearance()));
-    world.resource_mut::<Physics>().world.rapier.integration_parameters = {
-        let mut p = world.resource::<Physics>().world.rapier.integration_parameters;
+    world
+        .resource_mut::<Physics>()
+        .world
+        .rapier
+        .integration_parameters = {
+        let mut p = world
+            .resource::<Physics>()
+            .world
+            .rapier
+            .integration_parameters;
         p.num_solver_iterations = 1;
         p.dt = 1e-5;
         p
@@ -412,7 +424,10 @@ fn the_worlds_settings_stay_the_users() {
     let mut expected = defaults;
     expected.dt = 1e-3;
     assert_eq!(p.world.rapier.integration_parameters, expected);
-    assert_eq!(p.world.rapier.integration_parameters.num_solver_iterations, 4);
+    assert_eq!(
+        p.world.rapier.integration_parameters.num_solver_iterations,
+        4
+    );
 
     // A compliant hinge in a world with 4 iterations is refused, naming the setting, why and
     // the way out; the world and the hinge stay as they were.
@@ -427,7 +442,7 @@ fn the_worlds_settings_stay_the_users() {
     world.entity_mut(hinge).insert(ClearanceHinge(clearance()));
     let msg = run_step(&mut world, &mut schedule).unwrap_err().to_string();
     for needle in [
-        "Physics::world.integration_parameters.num_solver_iterations",
+        "Physics::world.rapier.integration_parameters.num_solver_iterations",
         &format!("hinge {hinge} needs 1 (the world has 4)"),
         "gain energy",
         "ClearanceModel::LargeStep",
@@ -435,7 +450,10 @@ fn the_worlds_settings_stay_the_users() {
         assert!(msg.contains(needle), "{needle:?} not in: {msg}");
     }
     let p = world.resource::<Physics>();
-    assert_eq!(p.world.rapier.integration_parameters.num_solver_iterations, 4);
+    assert_eq!(
+        p.world.rapier.integration_parameters.num_solver_iterations,
+        4
+    );
     assert!(matches!(p.joint(hinge), Some(HingeJoint::Ideal(_))));
     assert!(p.clearance().is_empty());
     // Set up by the user, the same hinge is realised.

@@ -2,7 +2,7 @@
 //! through a point, or moved by a tabulated position along a direction, interpolated smoothly
 //! (cubic Hermite, continuous slope: [`Table`]).
 //!
-//! A [`PrescribedSet`] is a [`ForceSource`] that applies no force:
+//! A [`PrescribedSet`] takes part in the stepper's steps ([`StepHooks`]) but applies no force:
 //! before each Rapier step the [`Stepper`](crate::rapier::stepper::Stepper) hands it the step's start and
 //! length, and it sets each body's next pose at the step's end (Rapier's position-based kinematic
 //! bodies then move there, their velocity being the step's mean). Poses are exact at every

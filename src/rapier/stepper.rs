@@ -1,6 +1,9 @@
 //! The step control, public: one [`Stepper`] chooses, takes, judges and (when needed) retries
-//! every Rapier step of a world that holds clearance joints. The scene runner and the bevy_ecs
-//! layer use it; a plain-Rapier user calls it in their own loop in place of `world.step()`.
+//! every Rapier step of a world that holds clearance joints. It steps whatever takes part in the
+//! step through the step protocol ([`StepHooks`]: the joint sets, the drives, the prescribed
+//! motions; called the sources here). [`ClearanceWorld`](crate::rapier::world::ClearanceWorld)
+//! bundles it with the sets (the scene runner and the bevy_ecs layer are built on it); a loop that
+//! keeps its sets apart calls [`Stepper::step`] with them in place of `world.step()`.
 //!
 //! What it adds to `PhysicsWorld::step`:
 //! - **Consistent variable steps.** With one solver iteration a Rapier step is symplectic Euler

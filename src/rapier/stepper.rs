@@ -450,53 +450,9 @@ impl Stepper {
                 s.save_state();
             }
         }
-        let gravity = world.gravity;
         let mut rejected = 0u32;
         loop {
-            let kick = 0.5 * (self.last_dt + dt);
-            let scale = kick / dt;
-            // For this step only: your forces and the sources' wrenches, scaled to the kick.
-            for b in &self.saved {
-                if let Some(rb) = world.bodies.get_mut(b.handle)
-                    && rb.is_dynamic()
-                    && scale != 1.0
-                {
-                    rb.reset_forces(false);
-                    rb.reset_torques(false);
-                    rb.add_force(b.force * scale, false);
-                    rb.add_torque(b.torque * scale, false);
-                }
-            }
-            for s in sources.iter() {
-                for w in s.wrenches() {
-                    if let Some(rb) = world.bodies.get_mut(w.body)
-                        && rb.is_dynamic()
-                    {
-                        let wake = w.force != Vector::ZERO || w.torque != Vector::ZERO;
-                        rb.add_force(w.force * scale, wake);
-                        rb.add_torque(w.torque * scale, wake);
-                    }
-                }
-            }
-            world.gravity = gravity * scale;
-            world.integration_parameters.dt = dt;
-            for s in sources.iter_mut() {
-                s.before_rapier_step(world, self.t, dt);
-            }
-            if self.control.joint_correction {
-                self.correction.apply(&mut world.impulse_joints, dt);
-            }
-            world.step();
-            self.correction.restore(&mut world.impulse_joints);
-            world.gravity = gravity;
-            exact_kinematic_poses(world, &self.saved, dt);
-            self.restore_forces(world);
-            for s in sources.iter_mut() {
-                s.after_rapier_step(world);
-            }
-            for s in sources.iter_mut() {
-                s.evaluate(&mut world.bodies);
-            }
+            let kick = self.take_rapier_step(world, sources, dt);
             let retry = if adaptive {
                 sources
                     .iter()
@@ -558,6 +514,64 @@ impl Stepper {
                 }
             }
         }
+    }
+
+    /// One Rapier step of `dt` from the saved state, with the kick `(h_prev + h)/2`: your forces,
+    /// the sources' wrenches and gravity scaled to the kick for this step only, the sources'
+    /// hooks around it, the joint correction, exact kinematic poses; then the sources evaluated
+    /// at the new state. Returns the kick, s.
+    fn take_rapier_step(
+        &mut self,
+        world: &mut PhysicsWorld,
+        sources: &mut [&mut dyn StepHooks],
+        dt: f64,
+    ) -> f64 {
+        let gravity = world.gravity;
+        let kick = 0.5 * (self.last_dt + dt);
+        let scale = kick / dt;
+        // For this step only: your forces and the sources' wrenches, scaled to the kick.
+        for b in &self.saved {
+            if let Some(rb) = world.bodies.get_mut(b.handle)
+                && rb.is_dynamic()
+                && scale != 1.0
+            {
+                rb.reset_forces(false);
+                rb.reset_torques(false);
+                rb.add_force(b.force * scale, false);
+                rb.add_torque(b.torque * scale, false);
+            }
+        }
+        for s in sources.iter() {
+            for w in s.wrenches() {
+                if let Some(rb) = world.bodies.get_mut(w.body)
+                    && rb.is_dynamic()
+                {
+                    let wake = w.force != Vector::ZERO || w.torque != Vector::ZERO;
+                    rb.add_force(w.force * scale, wake);
+                    rb.add_torque(w.torque * scale, wake);
+                }
+            }
+        }
+        world.gravity = gravity * scale;
+        world.integration_parameters.dt = dt;
+        for s in sources.iter_mut() {
+            s.before_rapier_step(world, self.t, dt);
+        }
+        if self.control.joint_correction {
+            self.correction.apply(&mut world.impulse_joints, dt);
+        }
+        world.step();
+        self.correction.restore(&mut world.impulse_joints);
+        world.gravity = gravity;
+        exact_kinematic_poses(world, &self.saved, dt);
+        self.restore_forces(world);
+        for s in sources.iter_mut() {
+            s.after_rapier_step(world);
+        }
+        for s in sources.iter_mut() {
+            s.evaluate(&mut world.bodies);
+        }
+        kick
     }
 
     /// Takes a step of the last step's size (or `dt` if none), lets `read` look at the world and

@@ -175,7 +175,7 @@ impl DriveSet {
     }
 
     /// Saves the angle trackers and applied torques (before a step that may be rejected).
-    pub fn save_state(&mut self) {
+    pub(crate) fn save_state(&mut self) {
         self.saved.clear();
         self.saved
             .extend(self.drives.values().map(|d| (d.angle, d.last_torque)));
@@ -183,7 +183,7 @@ impl DriveSet {
     }
 
     /// Restores what [`save_state`](Self::save_state) saved.
-    pub fn restore_state(&mut self) {
+    pub(crate) fn restore_state(&mut self) {
         for (d, &(angle, torque)) in self.drives.values_mut().zip(&self.saved) {
             d.angle = angle;
             d.last_torque = torque;

@@ -929,7 +929,7 @@ impl ClearanceJointSet {
 
     /// Saves every joint's contact history and report and its last wrenches (before a step that
     /// may be rejected; no allocation after the first call).
-    pub fn save_state(&mut self) {
+    pub(crate) fn save_state(&mut self) {
         self.saved.clear();
         self.saved
             .extend(self.joints.values().map(|j| j.dynamics()));
@@ -937,7 +937,7 @@ impl ClearanceJointSet {
     }
 
     /// Restores what [`save_state`](Self::save_state) saved.
-    pub fn restore_state(&mut self) {
+    pub(crate) fn restore_state(&mut self) {
         for (j, d) in self.joints.values_mut().zip(&self.saved) {
             j.set_dynamics(*d);
         }
@@ -946,7 +946,7 @@ impl ClearanceJointSet {
 
     /// [`ClearanceJoint::judge_step`] over all joints, with their contact state saved by the last
     /// [`save_state`](Self::save_state): the shortest retry step asked for, if any.
-    pub fn judge_step(&self, dt: f64, tolerance: f64) -> Option<f64> {
+    pub(crate) fn judge_step(&self, dt: f64, tolerance: f64) -> Option<f64> {
         self.joints
             .values()
             .enumerate()

@@ -53,8 +53,10 @@ use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle};
 /// A Rapier world with clearance joints, drives and prescribed motions, stepped by one
 /// [`Stepper`]. The sets are public fields, as in Rapier's `PhysicsWorld`: read them freely;
 /// add and remove joints, drives and motions with the `insert_*`/`remove_*` methods (which also
-/// add their Rapier parts and tell the step control), or, when you edit a set or move bodies
-/// by hand between steps, call [`invalidate`](Self::invalidate).
+/// add their Rapier parts and tell the step control when forces must be evaluated again). A
+/// compliant joint or a drive added or removed through the fields is noticed at the next step;
+/// after moving bodies or setting velocities by hand between steps, call
+/// [`invalidate`](Self::invalidate).
 pub struct ClearanceWorld {
     /// The Rapier world: bodies, colliders, Rapier's own joints, gravity, integration parameters.
     pub rapier: PhysicsWorld,
@@ -67,9 +69,9 @@ pub struct ClearanceWorld {
     /// The tabulated (prescribed) motions of kinematic bodies.
     pub prescribed: PrescribedSet,
     stepper: Stepper,
-    /// The counts the sets had at the last step: a change means the sources' forces must be
-    /// evaluated again before the next step.
-    counts: [usize; 6],
+    /// The sizes of the compliant joint set and the drive set at the last step: a change means
+    /// their forces must be evaluated again before the next step.
+    counts: [usize; 2],
     /// Scratch: the sources' wrenches for a reaction solve.
     wrenches: Vec<Wrench>,
 }
@@ -85,7 +87,7 @@ impl ClearanceWorld {
             drives: DriveSet::new(),
             prescribed: PrescribedSet::default(),
             stepper: Stepper::new(control),
-            counts: [usize::MAX; 6],
+            counts: [usize::MAX; 2],
             wrenches: Vec::new(),
         }
     }
@@ -121,7 +123,7 @@ impl ClearanceWorld {
         body2: RigidBodyHandle,
         joint: LargeStepJoint,
     ) -> LargeStepJointHandle {
-        self.stepper.invalidate(false);
+        // No force to evaluate: its hooks run inside each step.
         self.large_step
             .insert(body1, body2, joint, &mut self.rapier.impulse_joints)
     }
@@ -129,7 +131,6 @@ impl ClearanceWorld {
     /// Removes a large-step clearance joint (and its Rapier joint); `None` for a handle of no
     /// joint.
     pub fn remove_large_step(&mut self, handle: LargeStepJointHandle) -> Option<LargeStepJoint> {
-        self.stepper.invalidate(false);
         let w = &mut self.rapier;
         self.large_step
             .remove(handle, &mut w.bodies, &mut w.impulse_joints)
@@ -150,7 +151,6 @@ impl ClearanceWorld {
     /// Adds a prescribed motion (its body must be a position-based kinematic body); returns its
     /// index in [`PrescribedSet::motions`].
     pub fn insert_prescribed(&mut self, motion: PrescribedMotion) -> usize {
-        self.stepper.invalidate(false);
         self.prescribed.motions.push(motion);
         self.prescribed.motions.len() - 1
     }
@@ -292,16 +292,12 @@ impl ClearanceWorld {
         )
     }
 
-    /// A set edited through its public field since the last step: its forces are evaluated again.
+    /// A force source edited through its public field since the last step (a compliant joint or
+    /// a drive added or removed): its forces are evaluated again before the next step. Only
+    /// these: an evaluation at the same state again is not free (the joints' reports would lose
+    /// the onset they flagged), and the other sets carry no forces to evaluate.
     fn follow_changes(&mut self) {
-        let counts = [
-            self.clearance.len(),
-            self.large_step.len(),
-            self.drives.len(),
-            self.prescribed.motions.len(),
-            self.rapier.bodies.len(),
-            self.rapier.impulse_joints.len(),
-        ];
+        let counts = [self.clearance.len(), self.drives.len()];
         if counts != self.counts {
             if self.counts[0] != usize::MAX {
                 self.stepper.invalidate(false);

@@ -116,3 +116,50 @@ fn a_joint_added_through_the_field_is_noticed() {
     let e = world.step(2e-4).unwrap_err().to_string();
     assert!(e.contains("num_solver_iterations"), "{e}");
 }
+
+/// The reaction solve knows the large-step joints through their constraint forces: a link hanging
+/// from a large-step pin carries a second link on an ideal revolute, and the revolute's exact
+/// reaction is the lower link's weight (a solve blind to the pin would let the upper link fall
+/// freely and find no reaction).
+#[test]
+fn reactions_see_the_large_step_joints() {
+    let mut rapier = PhysicsWorld::new();
+    rapier.gravity = Vector::new(0.0, -9.81, 0.0);
+    let base = rapier.bodies.insert(RigidBodyBuilder::fixed());
+    let link = |y: f64, m: f64| {
+        RigidBodyBuilder::dynamic()
+            .translation(Vector::new(0.0, y, 0.0))
+            .additional_mass_properties(MassProperties::new(Vector::ZERO, m, Vector::splat(0.01)))
+            .can_sleep(false)
+    };
+    let upper = rapier.bodies.insert(link(-0.2, 1.0));
+    let lower = rapier.bodies.insert(link(-0.6, 3.0));
+    let elbow = RevoluteJointBuilder::new(Vector::Z)
+        .local_anchor1(Vector::new(0.0, -0.2, 0.0))
+        .local_anchor2(Vector::new(0.0, 0.2, 0.0))
+        .contacts_enabled(false);
+    rapier.impulse_joints.insert(upper, lower, elbow, true);
+    let mut world = ClearanceWorld::new(rapier, StepControl::fixed(1.0 / 60.0));
+    let geometry = BearingGeometry::from_clearance(0.010, 1e-3, 0.016).unwrap();
+    let pin = LargeStepJointBuilder::new(Vector::Z, geometry)
+        .local_anchor2(Vector::new(0.0, 0.2, 0.0))
+        .restitution(0.3)
+        .build()
+        .unwrap();
+    world.insert_large_step(base, upper, pin);
+    world.step_to(5.0).unwrap();
+    let joints = [IdealJoint::Revolute(IdealRevolute {
+        body1: upper,
+        body2: lower,
+        local_anchor1: Vector::new(0.0, -0.2, 0.0),
+        local_anchor2: Vector::new(0.0, 0.2, 0.0),
+        local_axis1: Vector::Z,
+    })];
+    let mut solver = ReactionSolver::default();
+    let f = world.solve_reactions(&mut solver, &joints).unwrap()[0];
+    let weight = 3.0 * 9.81;
+    assert!(
+        (f.length() - weight).abs() < 0.02 * weight,
+        "elbow reaction {f:?}, the lower link weighs {weight} N"
+    );
+}

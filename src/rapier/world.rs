@@ -242,7 +242,8 @@ impl ClearanceWorld {
 
     /// The force on each ideal joint's body 2 at the current state (N, world frame, in the order
     /// of `joints`; [`ReactionSolver::solve_joints_with`]), with what the step loop knows and a
-    /// bare solve would not: the joints' and drives' wrenches (they act during the steps only),
+    /// bare solve would not: the joints' and drives' wrenches (they act during the steps only;
+    /// a large-step joint's, its constraint's force over the last step),
     /// the prescribed motions' rates at this time, and the stored velocities' lag of half the
     /// last step. `None` when the solve fails ([`ReactionSolver::failure`] says why).
     pub fn solve_reactions<'s>(
@@ -266,6 +267,9 @@ impl ClearanceWorld {
         self.wrenches.clear();
         self.wrenches.extend_from_slice(self.drives.wrenches());
         self.wrenches.extend_from_slice(self.clearance.wrenches());
+        // The large-step joints' constraint forces of the last step (no ideal joints to solve).
+        self.large_step
+            .constraint_wrenches(&self.rapier.bodies, &mut self.wrenches);
         solver.solve_joints_with(
             &self.rapier.bodies,
             joints,

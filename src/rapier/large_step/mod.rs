@@ -77,7 +77,9 @@ pub mod resolution;
 use crate::error::{Error, Result, non_negative, positive, unit_vector};
 use crate::model::laws::{BearingGeometry, NormalModel, impact_restitution};
 use crate::rapier::arena::OrderedArena;
-use crate::rapier::ledger::{ensure_mass_properties, inverse_mass_along, world_center_of_mass};
+use crate::rapier::ledger::{
+    Wrench, ensure_mass_properties, inverse_mass_along, world_center_of_mass,
+};
 use rapier3d_f64::data::Index;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
@@ -868,6 +870,36 @@ impl LargeStepJointSet {
     pub fn after_step(&mut self, bodies: &mut RigidBodySet, impulse_joints: &ImpulseJointSet) {
         for joint in self.joints.values_mut() {
             joint.finish(bodies, impulse_joints);
+        }
+    }
+
+    /// Appends to `out` the forces the joints' constraints exerted over the last step, as
+    /// wrenches on both bodies (the normal force at the journal centre and the friction moment,
+    /// from the [`report`](LargeStepJoint::report)s): what an exact reaction solve
+    /// ([`ReactionSolver`](crate::rapier::reaction::ReactionSolver)) must be given to know the
+    /// joints, which are no ideal joints. Not the step protocol's
+    /// [`wrenches`](crate::rapier::step_hooks::StepHooks::wrenches): Rapier's solver applies these
+    /// forces itself.
+    pub fn constraint_wrenches(&self, bodies: &RigidBodySet, out: &mut Vec<Wrench>) {
+        for j in self.joints.values() {
+            let (Some(rb1), Some(rb2)) = (bodies.get(j.body1), bodies.get(j.body2)) else {
+                continue;
+            };
+            let r = &j.report;
+            let axis = *rb1.rotation() * j.local_axis1;
+            let p2 = *rb2.position() * j.local_anchor2;
+            let f = r.force_on_journal;
+            let moment = r.friction_torque * axis;
+            out.push(Wrench {
+                body: j.body1,
+                force: -f,
+                torque: (p2 - world_center_of_mass(rb1)).cross(-f) - moment,
+            });
+            out.push(Wrench {
+                body: j.body2,
+                force: f,
+                torque: (p2 - world_center_of_mass(rb2)).cross(f) + moment,
+            });
         }
     }
 

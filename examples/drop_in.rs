@@ -61,8 +61,9 @@ fn link(
     )
 }
 
-/// A Rapier world with the arm on two ideal revolute joints about z, gravity along -y.
-pub fn build() -> (PhysicsWorld, Arm) {
+/// The arm on two ideal revolute joints about z, gravity along -y, in a `ClearanceWorld` at
+/// fixed steps of [`DT`].
+pub fn build() -> (ClearanceWorld, Arm) {
     let mut world = PhysicsWorld::new();
     world.gravity = Vector::new(0.0, -GRAVITY, 0.0);
     world.integration_parameters.dt = DT;
@@ -90,7 +91,7 @@ pub fn build() -> (PhysicsWorld, Arm) {
         true,
     );
     (
-        world,
+        ClearanceWorld::new(world, StepControl::fixed(DT)),
         Arm {
             upper,
             lower,
@@ -123,17 +124,7 @@ pub struct Run {
 /// Steps `world` to [`END`] with `ClearanceWorld::step` in place of `world.step()`: it applies
 /// the clearance forces, keeps the kicks consistent and refuses an unstable step. The same loop
 /// for both runs.
-fn simulate(rapier: PhysicsWorld, arm: &Arm, convert_elbow: bool) -> Result<Run> {
-    let mut world = ClearanceWorld::new(rapier, StepControl::fixed(DT));
-    if convert_elbow {
-        // The whole change: the elbow's revolute joint becomes a clearance joint.
-        world.clearance.convert_revolute(
-            arm.elbow,
-            BearingSide::Body1,
-            elbow_clearance()?,
-            &mut world.rapier.impulse_joints,
-        )?;
-    }
+fn simulate(mut world: ClearanceWorld, arm: &Arm) -> Result<Run> {
     world.prepare()?; // the joints' forces at the start
     let mut run = Run::default();
     let (mut shoulder, mut elbow) = (UnwrappedAngle::default(), UnwrappedAngle::default());
@@ -178,13 +169,20 @@ pub fn elbow_clearance() -> Result<Clearance> {
 /// The arm with ideal hinges.
 pub fn ideal_run() -> Result<Run> {
     let (world, arm) = build();
-    simulate(world, &arm, false)
+    simulate(world, &arm)
 }
 
 /// The same arm with the elbow converted into a clearance joint.
 pub fn clearance_run() -> Result<Run> {
-    let (world, arm) = build();
-    simulate(world, &arm, true)
+    let (mut world, arm) = build();
+    // The whole change: the elbow's revolute joint becomes a clearance joint.
+    world.clearance.convert_revolute(
+        arm.elbow,
+        BearingSide::Body1,
+        elbow_clearance()?,
+        &mut world.rapier.impulse_joints,
+    )?;
+    simulate(world, &arm)
 }
 
 /// Both runs: ideal, then with the elbow converted.

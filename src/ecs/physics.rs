@@ -536,11 +536,14 @@ impl Physics {
         let result = stepper.step(world, &mut sources(clearance, drives), until);
         // Rapier's `dt` as the user set it (the stepper sets it per step).
         world.integration_parameters.dt = dt;
-        result.map(|_| ()).map_err(|mut e| {
-            if let Error::StepTooLarge { field, .. } = &mut e {
-                *field = "Physics::world.integration_parameters.dt".into();
-            }
-            e
+        result.map(|_| ()).map_err(|e| {
+            e.named(
+                "Physics::world.integration_parameters.dt",
+                crate::error::ParameterNames {
+                    adaptive: "Physics::set_step_control(StepControl::adaptive(..))".into(),
+                    contact: Vec::new(),
+                },
+            )
         })
     }
 

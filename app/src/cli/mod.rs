@@ -4,9 +4,11 @@
 //! - [`run`]: one scene's ideal-vs-clearance run into a result set (`run`, the default job).
 //! - [`sweep`]: a grid of runs, or a shard of it, into one folder (`sweep`).
 //! - [`merge`]: the tables of a sharded sweep gathered into one (`merge`).
+//! - [`advice`]: the library's errors with the options that act on them.
 //!
 //! `study` needs nothing here: it selects and runs presets with [`crate::study`].
 
+pub mod advice;
 pub mod merge;
 pub mod run;
 pub mod sweep;

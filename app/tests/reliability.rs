@@ -615,13 +615,15 @@ fn memory_is_estimated_before_the_run() {
         .unwrap();
     let big = MemoryEstimate::of(&long);
     let e = big.check(&long, 1, budget).unwrap_err().to_string();
+    // The library names the scene's fields, never an option of this program.
+    assert!(!e.contains("--"), "{e}");
     assert!(
         e.contains("run.output_interval_s") && e.contains("9.99e6 rows"),
         "{e}"
     );
     // The suggested interval fits the budget; parallel runs multiply the need.
     let suggested: f64 = e
-        .split("--output-interval ")
+        .split("`run.output_interval_s` = ")
         .nth(1)
         .and_then(|r| r.split_whitespace().next())
         .and_then(|v| v.parse().ok())

@@ -4,11 +4,9 @@
 //! - [`run`]: one scene's ideal-vs-clearance run into a result set (`run`, the default job).
 //! - [`sweep`]: a grid of runs, or a shard of it, into one folder (`sweep`).
 //! - [`merge`]: the tables of a sharded sweep gathered into one (`merge`).
-//! - [`advice`]: the library's errors with the options that act on them.
 //!
 //! `study` needs nothing here: it selects and runs presets with [`crate::study`].
 
-pub mod advice;
 pub mod merge;
 pub mod run;
 pub mod sweep;
@@ -37,6 +35,7 @@ pub fn memory_budget(max_memory: Option<&str>) -> Result<Option<u64>> {
     max_memory
         .map(clearance_joint::scene::output::parse_bytes)
         .transpose()
+        .map_err(|e| crate::advice::from_option(e, "--max-memory"))
 }
 
 /// The thread count `--jobs N` as given (possibly negative), refused below 1.

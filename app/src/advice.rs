@@ -50,11 +50,12 @@ pub fn memory_options(
     };
     let options = match estimate.fitting_interval(scene, concurrent, budget) {
         Some(interval) => format!(
-            "--output-interval {} or larger (or a shorter --end; --max-memory sets the budget){parallel}",
+            "`--output-interval {}` or larger (or a shorter `--end`; `--max-memory` sets the \
+             budget){parallel}",
             sig4(interval)
         ),
-        None if concurrent > 1 => "raise --max-memory or lower --jobs".into(),
-        None => "raise --max-memory".into(),
+        None if concurrent > 1 => "raise `--max-memory` or lower `--jobs`".into(),
+        None => "raise `--max-memory`".into(),
     };
     Error::Invalid {
         field,

@@ -491,7 +491,7 @@ fn bad_command_lines() {
         (
             vec!["--max-memory", "10M"],
             "run.output_interval_s",
-            "raise --max-memory",
+            "raise `--max-memory`",
         ),
         (vec!["--max-memory", "lots"], "--max-memory", "4G"),
         (vec!["--out", &f], "--out", "not a folder"),

@@ -479,11 +479,23 @@ mod tests {
     fn step_limit_messages_speak_the_api() {
         use ContactParameter as P;
         let cases = [
-            (P::ModulusAndWidth, Some(false), "`Material::youngs_modulus_pa` and `length`"),
-            (P::MaxDamping, Some(false), "`MaxDamping::Eta` (or `MaxDamping::Explicit`)"),
+            (
+                P::ModulusAndWidth,
+                Some(false),
+                "`Material::youngs_modulus_pa` and `length`",
+            ),
+            (
+                P::MaxDamping,
+                Some(false),
+                "`MaxDamping::Eta` (or `MaxDamping::Explicit`)",
+            ),
             (P::Stiffness, Some(true), "`stiffness` (or the materials'"),
             (P::Damping, Some(true), "check `damping`"),
-            (P::Restitution, None, "`restitution` (a lower restitution damps harder)"),
+            (
+                P::Restitution,
+                None,
+                "`restitution` (a lower restitution damps harder)",
+            ),
         ];
         for (parameter, adaptive, names) in cases {
             let e = step_error(parameter, adaptive).to_string();

@@ -444,7 +444,10 @@ fn step_limit_messages() {
     ] {
         assert!(lib.contains(part), "{part:?} not in {lib}");
     }
-    assert!(!lib.contains("--"), "an option of the app in the library's message: {lib}");
+    assert!(
+        !lib.contains("--"),
+        "an option of the app in the library's message: {lib}"
+    );
     assert!(longest_digit_run(&lib) <= 5, "{lib}");
     // From a real run at the paper's scene, fixed 1e-3 s: the CLI adds its options.
     let o = bin()

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 /// The messages speak to the caller of the layer that returns them: the plain API's errors name
 /// the API's parameters (`dt`, [`StepControl`](crate::rapier::stepper::StepControl)'s `max_dt`,
 /// a law's `stiffness`); the ECS layer and the scene layer put their own names in
-/// ([`Error::named`]: `Physics::world.integration_parameters.dt`, `run.dt_s`,
+/// ([`Error::named`]: `Physics::world.rapier.integration_parameters.dt`, `run.dt_s`,
 /// `hinges[NAME].clearance.contact.eta_s`). No message carries an application's command-line
 /// flags: the variants carry the numbers, so an application phrases its own advice.
 #[derive(Debug, thiserror::Error)]
@@ -44,7 +44,7 @@ pub enum Error {
     )]
     StepTooLarge {
         /// The parameter that sets the step, as the caller names it: `dt` from the plain API,
-        /// `Physics::world.integration_parameters.dt` from the ECS layer, `run.dt_s` from a scene.
+        /// `Physics::world.rapier.integration_parameters.dt` from the ECS layer, `run.dt_s` from a scene.
         field: String,
         /// The name of the joint whose contact limits the step.
         joint: String,

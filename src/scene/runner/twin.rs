@@ -5,18 +5,17 @@ use super::invariants::Invariants;
 use crate::error::Result;
 use crate::model::angle::{HingeAngle, UnwrappedAngle, twist_angle};
 use crate::model::laws::NormalForceLaw;
-use crate::rapier::drive::{DriveSet, TorsionSpring};
-use crate::rapier::joint::{ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet};
+use crate::rapier::drive::{DriveHandle, TorsionSpring};
+use crate::rapier::joint::{ClearanceJointBuilder, ClearanceJointHandle};
 use crate::rapier::metrics::{ContactObservation, ImpactRecorder};
-use crate::rapier::prescribed::{
-    PrescribedMotion, PrescribedPath, PrescribedSet, Table as MotionTable,
-};
+use crate::rapier::prescribed::{PrescribedMotion, PrescribedPath, Table as MotionTable};
 use crate::rapier::reaction::{
-    IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, KinematicState,
-    ReactionSolver, SoftMotor,
+    IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, ReactionSolver,
+    SoftMotor,
 };
 use crate::rapier::replay::{ReplayRecorder, in_plane_u};
 use crate::rapier::stepper::StepInfo;
+use crate::rapier::world::ClearanceWorld;
 use crate::scene::{JointKindSpec, MotionSpec, MotorSpec, Scene};
 use crate::table::Table;
 use rapier3d_f64::math::Vector;
@@ -53,7 +52,7 @@ pub(super) struct BodyTrack {
     pub(super) fixed: bool,
     /// Not a fixed body (driven bodies move).
     moves: bool,
-    /// The body's tabulated motion (index in the twin's prescribed set).
+    /// The body's tabulated motion (index in the world's prescribed set).
     table: Option<usize>,
     /// The centre of mass in the body's frame (not the origin for a spinning body), m.
     local_com: Vector,
@@ -131,12 +130,8 @@ pub struct Twin {
     pub kind: TwinKind,
     pub(super) bodies: Vec<BodyTrack>,
     pub(super) hinges: Vec<HingeTrack>,
-    /// The clearance joints of this twin.
-    pub clearance: ClearanceJointSet,
-    /// The drives of this twin.
-    pub drives: DriveSet,
-    /// The tabulated motions of this twin's driven bodies.
-    pub prescribed: PrescribedSet,
+    /// This twin's drives in the world's drive set.
+    drives: Vec<DriveHandle>,
     /// The ideal joints: the ideal hinges' revolutes (with the hinge index of each), then the
     /// scene's other joints.
     ideal_joints: Vec<IdealJoint>,
@@ -148,8 +143,6 @@ pub struct Twin {
     motors: Vec<Option<f64>>,
     body_motion: bool,
     reactions: ReactionSolver,
-    /// The drives' and clearance joints' wrenches at the current state (scratch).
-    source_wrenches: Vec<crate::rapier::ledger::Wrench>,
     /// Spring and contact elastic energy at the state before the current step, J.
     pub(super) source_energy_before: f64,
     /// The joint motors in Rapier, with the index of their scene joint: their impulses over each
@@ -171,9 +164,9 @@ pub struct Twin {
 }
 
 impl Twin {
-    pub(super) fn build(scene: &Scene, kind: TwinKind, world: &mut PhysicsWorld) -> Result<Twin> {
+    pub(super) fn build(scene: &Scene, kind: TwinKind, world: &mut ClearanceWorld) -> Result<Twin> {
         let mut bodies = Vec::new();
-        let mut prescribed = PrescribedSet::default();
+        let prescribed = &mut world.prescribed;
         for (i, b) in scene.bodies.iter().enumerate() {
             let com = Vector::from(b.center_of_mass_m);
             let origin = Vector::from(scene.body_origin(i));
@@ -260,7 +253,7 @@ impl Twin {
                         .build()
                 }
             };
-            let handle = world.bodies.insert(rb);
+            let handle = world.rapier.bodies.insert(rb);
             if let Some(k) = table {
                 prescribed.motions[k].body = handle;
             }
@@ -279,7 +272,6 @@ impl Twin {
                 rotation_before: rapier3d_f64::math::Rotation::IDENTITY,
             });
         }
-        let mut clearance = ClearanceJointSet::new();
         let mut hinges = Vec::new();
         for h in &scene.hinges {
             let (ib, ij) = (
@@ -310,7 +302,12 @@ impl Twin {
                         b = b.max_valid_penetration(depth);
                     }
                     let j = b.build()?;
-                    HingeJoint::Clearance(clearance.insert(b1, b2, j, &mut world.impulse_joints))
+                    HingeJoint::Clearance(world.clearance.insert(
+                        b1,
+                        b2,
+                        j,
+                        &mut world.rapier.impulse_joints,
+                    ))
                 }
                 _ => {
                     let j = RevoluteJointBuilder::new(axis)
@@ -318,7 +315,7 @@ impl Twin {
                         .local_anchor2(a2)
                         .contacts_enabled(false);
                     {
-                        world.impulse_joints.insert(b1, b2, j, true);
+                        world.rapier.impulse_joints.insert(b1, b2, j, true);
                         HingeJoint::Ideal
                     }
                 }
@@ -338,7 +335,7 @@ impl Twin {
                 recorder: ImpactRecorder::new(),
             });
         }
-        let mut drives = DriveSet::new();
+        let mut drives = Vec::new();
         for d in &scene.drives {
             let hi = scene.hinge_index(&d.hinge).unwrap();
             let h = &hinges[hi];
@@ -351,7 +348,7 @@ impl Twin {
                 d.torque_scale * per_rad,
             )
             .map_err(|e| e.within(&format!("drives[{}]", d.name)))?;
-            drives.insert(spring);
+            drives.push(world.drives.insert(spring));
         }
         let (mut ideal_joints, mut ideal_hinges) = (Vec::new(), Vec::new());
         for (i, h) in hinges.iter().enumerate() {
@@ -419,7 +416,7 @@ impl Twin {
                         }
                         None => IdealJoint::Prismatic(ideal),
                     };
-                    let h = world.impulse_joints.insert(b1, b2, rj, true);
+                    let h = world.rapier.impulse_joints.insert(b1, b2, rj, true);
                     if j.motor.is_some() {
                         motor_joints.push((h, JointAxis::LinX, k));
                     }
@@ -452,7 +449,7 @@ impl Twin {
                         }
                         None => IdealJoint::Revolute(ideal),
                     };
-                    let h = world.impulse_joints.insert(b1, b2, rj, true);
+                    let h = world.rapier.impulse_joints.insert(b1, b2, rj, true);
                     if j.motor.is_some() {
                         motor_joints.push((h, JointAxis::AngX, k));
                     }
@@ -463,7 +460,7 @@ impl Twin {
                         .local_anchor1(a1)
                         .local_anchor2(a2)
                         .contacts_enabled(false);
-                    world.impulse_joints.insert(b1, b2, rj, true);
+                    world.rapier.impulse_joints.insert(b1, b2, rj, true);
                     IdealJoint::Fixed(IdealFixed {
                         body1: b1,
                         body2: b2,
@@ -476,7 +473,7 @@ impl Twin {
                         .local_anchor1(a1)
                         .local_anchor2(a2)
                         .contacts_enabled(false);
-                    world.impulse_joints.insert(b1, b2, rj, true);
+                    world.rapier.impulse_joints.insert(b1, b2, rj, true);
                     IdealJoint::Spherical(IdealSpherical {
                         body1: b1,
                         body2: b2,
@@ -542,16 +539,13 @@ impl Twin {
             kind,
             bodies,
             hinges,
-            clearance,
             drives,
             ideal_joints,
             ideal_hinges,
             joints,
             motors,
             body_motion,
-            prescribed,
             reactions,
-            source_wrenches: Vec::new(),
             source_energy_before: 0.0,
             motor_joints,
             held_motors,
@@ -575,15 +569,9 @@ impl Twin {
 
     /// Reads the state before a step (from the sources' evaluation at it): invariants, the
     /// clearance samples and forces, the angles, and (with `rows`) the row values of the state.
-    /// `lag`: how long before the state the stored velocities are (half the last step), s.
-    pub(super) fn before_step(
-        &mut self,
-        bodies: &RigidBodySet,
-        gravity: Vector,
-        t: f64,
-        lag: f64,
-        rows: bool,
-    ) -> Result<()> {
+    pub(super) fn before_step(&mut self, world: &mut ClearanceWorld, rows: bool) -> Result<()> {
+        let t = world.time();
+        let bodies = &world.rapier.bodies;
         let axis_ref = self.reference_axis;
         for b in &mut self.bodies {
             let rb = &bodies[b.handle];
@@ -602,7 +590,7 @@ impl Twin {
             // Every state, so the unwrapped angle never aliases whatever the output interval.
             h.angle.update(r1.rotation(), r2.rotation(), h.local_axis1);
             if let HingeJoint::Clearance(c) = h.joint {
-                let j = self.clearance.get(c).expect("handle of this twin");
+                let j = world.clearance.get(c).expect("handle of this twin");
                 let r = j.report();
                 let f = &r.force;
                 let elastic = j.normal_law().elastic_force(r.state.penetration);
@@ -623,31 +611,21 @@ impl Twin {
                 };
             }
         }
-        self.solve_ideal_reactions(bodies, gravity, t, lag)?;
-        self.source_energy_before = self.drives.potential_energy()
-            + self
-                .clearance
-                .iter()
-                .map(|(_, j)| j.elastic_energy())
-                .sum::<f64>();
+        self.solve_ideal_reactions(world)?;
+        self.source_energy_before = self.source_energy(world);
         if rows {
             std::mem::swap(&mut self.row_prev, &mut self.row_cur);
-            self.fill_row(t, bodies);
+            self.fill_row(t, world);
         }
         Ok(())
     }
 
     /// Completes the step that started from the state [`before_step`](Self::before_step) read:
     /// ideal reactions (which only the step determines), metrics of that state over the step.
-    pub(super) fn after_step(
-        &mut self,
-        bodies: &RigidBodySet,
-        joints: &ImpulseJointSet,
-        info: &StepInfo,
-        gravity: Vector,
-    ) {
+    pub(super) fn after_step(&mut self, world: &ClearanceWorld, info: &StepInfo) {
+        let (bodies, joints) = (&world.rapier.bodies, &world.rapier.impulse_joints);
         self.update_force_metrics(info.t0, info.dt);
-        self.update_invariants(bodies, gravity, info);
+        self.update_invariants(bodies, world.rapier.gravity, info);
         // The motors' work over the step: the angular or linear impulse Rapier's motor row
         // applied to body 2 (minus its stored impulse) times the joint's speed at the state the
         // step started from (the solve's synchronous one), what a kick does to kinetic energy.
@@ -684,7 +662,11 @@ impl Twin {
         // penetration change, and the slip at the step's velocity.
         for h in &self.hinges {
             if let HingeJoint::Clearance(c) = h.joint {
-                let r = self.clearance.get(c).expect("handle of this twin").report();
+                let r = world
+                    .clearance
+                    .get(c)
+                    .expect("handle of this twin")
+                    .report();
                 let sample = &h.sample;
                 if sample.penetration > 0.0 {
                     self.invariants.dissipated_j += sample.damping_force
@@ -697,47 +679,14 @@ impl Twin {
 
     /// Ideal-joint reactions, motor torques and the bodies' velocities and accelerations at the
     /// current state, exact: the constrained rigid-body equations solved for the joint forces
-    /// ([`ReactionSolver`]), whatever the step control (the stored velocities, `lag` before the
-    /// state, advanced to it).
+    /// ([`ClearanceWorld::solve_reactions`]), whatever the step control.
     /// A solve that fails (a non-finite state) is an error: never reactions left at zero.
-    fn solve_ideal_reactions(
-        &mut self,
-        bodies: &RigidBodySet,
-        gravity: Vector,
-        t: f64,
-        lag: f64,
-    ) -> Result<()> {
+    fn solve_ideal_reactions(&mut self, world: &mut ClearanceWorld) -> Result<()> {
         if self.ideal_joints.is_empty() && !self.body_motion {
             return Ok(());
         }
-        self.reactions.velocity_lag = lag;
-        // Tabulated drives at this state: their velocities and accelerations.
-        self.reactions.kinematic.clear();
-        for b in &self.bodies {
-            if let Some(k) = b.table {
-                let m = &self.prescribed.motions[k];
-                let (v, a, w, alpha) = m.rates(t);
-                self.reactions.kinematic.push(KinematicState {
-                    body: b.handle,
-                    linvel: v,
-                    angvel: w,
-                    linacc: a,
-                    angacc: alpha,
-                });
-            }
-        }
-        // The sources' wrenches act during the steps only: the solver gets them explicitly.
-        self.source_wrenches.clear();
-        self.source_wrenches
-            .extend_from_slice(self.drives.wrenches());
-        self.source_wrenches
-            .extend_from_slice(self.clearance.wrenches());
-        let Some(forces) = self.reactions.solve_joints_with(
-            bodies,
-            &self.ideal_joints,
-            gravity,
-            &self.source_wrenches,
-        ) else {
+        let t = world.time();
+        let Some(forces) = world.solve_reactions(&mut self.reactions, &self.ideal_joints) else {
             return Err(crate::Error::Diverged {
                 t,
                 reason: format!(
@@ -764,6 +713,26 @@ impl Twin {
         Ok(())
     }
 
+    /// The elastic energy of this twin's drives and clearance contacts at the current state, J.
+    fn source_energy(&self, world: &ClearanceWorld) -> f64 {
+        let drives: f64 = self
+            .drives
+            .iter()
+            .filter_map(|&d| world.drives.get(d))
+            .map(|d| d.potential_energy(d.angle()))
+            .sum();
+        let contacts: f64 = self
+            .hinges
+            .iter()
+            .filter_map(|h| match h.joint {
+                HingeJoint::Clearance(c) => world.clearance.get(c),
+                HingeJoint::Ideal => None,
+            })
+            .map(|j| j.elastic_energy())
+            .sum();
+        drives + contacts
+    }
+
     /// Metrics of the state before the step (its sample and force), weighted by the step.
     fn update_force_metrics(&mut self, t: f64, dt: f64) {
         for h in &mut self.hinges {
@@ -773,7 +742,8 @@ impl Twin {
     }
 
     /// The row values of the current state into `row_cur`.
-    fn fill_row(&mut self, t: f64, bodies: &RigidBodySet) {
+    fn fill_row(&mut self, t: f64, world: &ClearanceWorld) {
+        let bodies = &world.rapier.bodies;
         let axis_ref = self.reference_axis;
         let v = &mut self.row_cur;
         v.clear();
@@ -794,7 +764,7 @@ impl Twin {
                 // origin, so its centre of mass moves with `w x r`).
                 let (vel, acc) = match (b.table, b.fixed) {
                     (Some(k), _) => {
-                        let (v0, a, w, alpha) = self.prescribed.motions[k].rates(t);
+                        let (v0, a, w, alpha) = world.prescribed.motions[k].rates(t);
                         (v0 + w.cross(r), a + alpha.cross(r) + w.cross(w.cross(r)))
                     }
                     (None, true) => {
@@ -821,7 +791,11 @@ impl Twin {
             v.push(h.force);
             match h.joint {
                 HingeJoint::Clearance(c) => {
-                    let r = self.clearance.get(c).expect("handle of this twin").report();
+                    let r = world
+                        .clearance
+                        .get(c)
+                        .expect("handle of this twin")
+                        .report();
                     let e = r.state.eccentricity;
                     v.push(e.dot(*r1.rotation() * h.local_u1) * 1e3);
                     v.push(e.dot(*r1.rotation() * h.local_v1) * 1e3);
@@ -944,24 +918,30 @@ fn motor_of(spec: Option<&MotorSpec>) -> Option<Motor> {
 
 impl Twin {
     /// Tracks this twin's bodies and hinges in `recorder` (group: the twin's name): clearance
-    /// hinges as journals of the clearance set passed `set_index`-th to
-    /// [`ReplayRecorder::record`], ideal hinges as pins at their scene point.
+    /// hinges as journals of the world's clearance set (passed first to
+    /// [`ReplayRecorder::record`]), ideal hinges as pins at their scene point.
     pub fn track_replay(
         &self,
         scene: &Scene,
-        world: &PhysicsWorld,
-        set_index: usize,
+        world: &ClearanceWorld,
         recorder: &mut ReplayRecorder,
     ) -> Result<()> {
         let group = self.kind.name();
+        let physics = &world.rapier;
         for b in &self.bodies {
-            recorder.track_body(&b.name, group, b.handle, &world.bodies, &world.colliders);
+            recorder.track_body(
+                &b.name,
+                group,
+                b.handle,
+                &physics.bodies,
+                &physics.colliders,
+            );
         }
         for (h, spec) in self.hinges.iter().zip(&scene.hinges) {
             let (b1, b2) = (self.bodies[h.bearing].handle, self.bodies[h.journal].handle);
             match h.joint {
                 HingeJoint::Clearance(c) => {
-                    recorder.track_journal(&h.name, group, set_index, c, &self.clearance)?
+                    recorder.track_journal(&h.name, group, 0, c, &world.clearance)?
                 }
                 HingeJoint::Ideal => {
                     let anchor =

@@ -92,6 +92,43 @@ fn a_fixed_step_too_large_names_the_api() {
     }
     assert!(e.suggested_step().is_some_and(|dt| dt < 1e-3), "{m}");
     assert_plain(&m);
+
+    // The same through a `ClearanceWorld`, the plain API's world.
+    let mut rapier = PhysicsWorld::new();
+    rapier.integration_parameters.num_solver_iterations = 1;
+    let mut world = ClearanceWorld::new(rapier, StepControl::fixed(1e-3));
+    let base = world.rapier.bodies.insert(RigidBodyBuilder::fixed());
+    let arm = world.rapier.bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(Vector::new(0.3, 0.0, 0.0))
+            .additional_mass_properties(MassProperties::new(
+                Vector::ZERO,
+                2.0,
+                Vector::splat(0.02),
+            )),
+    );
+    let pin = steel()
+        .name("pin")
+        .joint(
+            Vector::ZERO,
+            Vector::new(-0.3, 0.0, 0.0),
+            Vector::Z,
+            Vector::Z,
+        )
+        .unwrap();
+    world.insert_clearance(base, arm, pin);
+    let e = loop {
+        match world.step(1.0) {
+            Ok(_) => assert!(world.time() < 1.0, "never refused"),
+            Err(e) => break e,
+        }
+    };
+    let m2 = e.to_string();
+    assert!(
+        matches!(&e, Error::StepTooLarge { field, .. } if field == "StepControl::max_dt"),
+        "{m2}"
+    );
+    assert_plain(&m2);
 }
 
 #[test]

@@ -3,13 +3,21 @@
 use std::path::PathBuf;
 
 /// Everything that can go wrong in this crate. Nothing here panics on bad input.
+///
+/// The messages speak to the caller of the layer that returns them: the plain API's errors name
+/// the API's parameters (`dt`, [`StepControl`](crate::rapier::stepper::StepControl)'s `max_dt`,
+/// a law's `stiffness`); the ECS layer and the scene layer put their own names in
+/// ([`Error::named`]: `Physics::world.rapier.integration_parameters.dt`, `run.dt_s`,
+/// `hinges[NAME].clearance.contact.eta_s`). No message carries an application's command-line
+/// flags: the variants carry the numbers, so an application phrases its own advice.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum Error {
-    /// A parameter is out of its domain (`field` is the path of the parameter, e.g.
-    /// `hinges[hinge].clearance.clearance_mm`).
+    /// A parameter is out of its domain (`field` is the name or path of the parameter as the
+    /// caller knows it: `clearance`, or in a scene `hinges[hinge].clearance.clearance_mm`).
     #[error("invalid `{field}`: {reason}")]
     Invalid {
-        /// Path of the offending parameter.
+        /// Name or path of the offending parameter.
         field: String,
         /// What is wrong with it.
         reason: String,
@@ -24,37 +32,42 @@ pub enum Error {
     },
     /// The time step is too large for the stiffness (and damping) of a contact: the explicit
     /// integration would blow up. Raised before the state is destroyed, never silently. The
-    /// message names the contact parameter that makes the contact this stiff and gives advice
-    /// fitting the step mode (when the caller knows it, see [`Error::with_step_mode`]).
+    /// message names the contact parameter that makes the contact this stiff
+    /// ([`ContactParameter`]) and gives advice fitting the step mode (when the code that raised
+    /// it knows the mode, see [`Error::with_step_mode`]).
     #[error(
-        "`{field}` = {} s is too large for the contact of hinge `{hinge}`{at}: the explicit step is \
+        "`{field}` = {} s is too large for the contact of joint `{joint}`{at}: the explicit step is \
          stable only below {} s there (penetration {} um, natural frequency {} rad/s, damping ratio {}). {}",
         sig4(*dt), sig4(*dt_max), sig4(*penetration_um), sig4(*omega), sig4(*zeta),
-        step_advice(field, hinge, *law, *dt_max, *zeta, *adaptive),
+        step_advice(field, *dt_max, *parameter, *adaptive, names.as_deref()),
         at = t.map_or(String::new(), |t| format!(" at t = {} s", sig4(t)))
     )]
     StepTooLarge {
-        /// The parameter that sets the step (`run.dt_s`).
+        /// The parameter that sets the step, as the caller names it: `dt` from the plain API,
+        /// `Physics::world.rapier.integration_parameters.dt` from the ECS layer, `run.dt_s` from a scene.
         field: String,
-        /// The hinge whose contact limits the step.
-        hinge: String,
-        /// The step in use.
+        /// The name of the joint whose contact limits the step.
+        joint: String,
+        /// The step in use, s.
         dt: f64,
-        /// The largest stable step for this contact.
+        /// The largest stable step for this contact, s.
         dt_max: f64,
         /// Simulated time when detected, when the caller knows it.
         t: Option<f64>,
         /// Penetration at detection, micrometres.
         penetration_um: f64,
-        /// Linearised natural frequency of the contact.
+        /// Linearised natural frequency of the contact, rad/s.
         omega: f64,
         /// Linearised damping ratio of the contact.
         zeta: f64,
-        /// The contact law: it tells which parameter sets the stiffness and the damping.
-        law: crate::model::laws::LawKind,
+        /// The contact parameter that makes the contact this stiff (or this damped).
+        parameter: ContactParameter,
         /// Whether the step was adaptive (`Some(true)`), fixed (`Some(false)`) or unknown to the
         /// code that raised the error (`None`); see [`Error::with_step_mode`].
         adaptive: Option<bool>,
+        /// The caller's names of the parameters the advice mentions, when a layer above the
+        /// plain API put its own ([`Error::named`]); `None`: the plain API's names.
+        names: Option<Box<ParameterNames>>,
     },
     /// The simulation state became non-physical (non-finite, or energy/momentum destroyed).
     #[error("simulation diverged at t = {t:.6} s: {reason}")]
@@ -73,7 +86,9 @@ pub enum Error {
         /// What was seen, with the likely cause.
         reason: String,
     },
-    /// A run-time guard was violated and the step control is strict (`--strict`).
+    /// A run-time guard was violated and the step control is strict
+    /// ([`StepControl::strict`](crate::rapier::stepper::StepControl::strict), a scene's
+    /// `run.strict`).
     #[error("guard violated (strict) by t = {t:.6} s: {violations}")]
     Guard {
         /// Simulated time when detected.
@@ -92,6 +107,84 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
+}
+
+/// The contact parameter that makes a contact stiff (or, when it is over-damped, damped): what
+/// to change when no step resolves the contact. Chosen by the code that raises
+/// [`Error::StepTooLarge`] from the contact law and its damping ratio.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[non_exhaustive]
+pub enum ContactParameter {
+    /// The law's stiffness `K` (Hertz, Kelvin-Voigt, the hysteresis laws), or the materials'
+    /// Young's moduli where `K` is computed from the geometry.
+    Stiffness,
+    /// The materials' Young's moduli and the bearing's width: the stiffness of the Liu laws is
+    /// (pi/2) E* L.
+    ModulusAndWidth,
+    /// The Kelvin-Voigt law's damping `D` (an over-damped contact).
+    Damping,
+    /// The improved law's maximum damping, set by `eta` or `D_max` (an over-damped contact).
+    MaxDamping,
+    /// A hysteresis law's restitution (an over-damped contact: a lower restitution damps
+    /// harder).
+    Restitution,
+}
+
+impl ContactParameter {
+    /// The plain API's names of the parameter, in the order [`ParameterNames::contact`] gives
+    /// a caller's own: [`Stiffness`](Self::Stiffness): the law's `stiffness`, then the
+    /// materials' modulus; [`ModulusAndWidth`](Self::ModulusAndWidth): the moduli, then the
+    /// width; [`MaxDamping`](Self::MaxDamping): `eta`, then `D_max`.
+    pub fn api_names(self) -> &'static [&'static str] {
+        match self {
+            ContactParameter::Stiffness => &["stiffness", "Material::youngs_modulus_pa"],
+            ContactParameter::ModulusAndWidth => &["Material::youngs_modulus_pa", "length"],
+            ContactParameter::Damping => &["damping"],
+            ContactParameter::MaxDamping => &["MaxDamping::Eta", "MaxDamping::Explicit"],
+            ContactParameter::Restitution => &["restitution"],
+        }
+    }
+
+    /// The parameter in words, under `names` (the API's, or a caller's in the same order).
+    fn describe<S: AsRef<str>>(self, names: &[S]) -> String {
+        let quoted: Vec<String> = names.iter().map(|n| format!("`{}`", n.as_ref())).collect();
+        let (first, rest) = match quoted.split_first() {
+            Some((first, rest)) => (first.clone(), rest),
+            None => return "its contact law's parameters".into(),
+        };
+        let list = match quoted.len() {
+            1 => first.clone(),
+            n => format!("{} and {}", quoted[..n - 1].join(", "), quoted[n - 1]),
+        };
+        match self {
+            ContactParameter::Stiffness if !rest.is_empty() => format!(
+                "{first} (or the materials' {} when the stiffness is left to the geometry)",
+                rest.join(", ")
+            ),
+            ContactParameter::MaxDamping if !rest.is_empty() => {
+                format!("{first} (or {})", rest.join(", "))
+            }
+            ContactParameter::ModulusAndWidth => {
+                format!("{list} (the law's stiffness is (pi/2) E* L)")
+            }
+            ContactParameter::Restitution => {
+                format!("{list} (a lower restitution damps harder)")
+            }
+            _ => list,
+        }
+    }
+}
+
+/// A caller's own names for the parameters a step-limit error advises on, put in by the layer
+/// that knows them (the ECS layer, the scene layer) with [`Error::named`].
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct ParameterNames {
+    /// How the caller turns adaptive stepping on (e.g. `run.step = Adaptive`); empty: the plain
+    /// API's [`StepControl::adaptive`](crate::rapier::stepper::StepControl::adaptive).
+    pub adaptive: String,
+    /// The contact parameters, in the order of [`ContactParameter::api_names`] (e.g.
+    /// `hinges[pin].clearance.contact.eta_s`, `d_max_n_s_per_m`); empty: the plain API's names.
+    pub contact: Vec<String>,
 }
 
 /// Shorthand for results of this crate.
@@ -122,6 +215,34 @@ impl Error {
             *adaptive = Some(is_adaptive);
         }
         self
+    }
+
+    /// Puts a caller's names into an [`Error::StepTooLarge`]: `step` for the parameter that sets
+    /// the step, and the names of `names` for the rest (how the layer above the plain API calls
+    /// them); other variants pass through.
+    pub fn named(mut self, step: &str, names: ParameterNames) -> Self {
+        if let Error::StepTooLarge {
+            field, names: n, ..
+        } = &mut self
+        {
+            *field = step.into();
+            *n = Some(Box::new(names));
+        }
+        self
+    }
+
+    /// The fixed step an [`Error::StepTooLarge`] advises, s: 80 % of the contact's stability
+    /// limit, when the step was fixed and such a step can be taken (`None` otherwise, and for
+    /// other variants). An application phrases it in its own options.
+    pub fn suggested_step(&self) -> Option<f64> {
+        match self {
+            Error::StepTooLarge {
+                dt_max,
+                adaptive: Some(false),
+                ..
+            } if 0.8 * dt_max >= SMALLEST_STEP => Some(0.8 * dt_max),
+            _ => None,
+        }
     }
 
     /// Prefixes the field path of an [`Error::Invalid`] with `prefix` (`prefix.field`);
@@ -290,46 +411,30 @@ pub fn sig4(x: f64) -> String {
     }
 }
 
-/// The contact parameter that sets a contact's stiffness (or, when it is over-damped, its
-/// damping), as a scene path under `hinges[<hinge>].clearance`.
-fn stiff_field(hinge: &str, law: crate::model::laws::LawKind, zeta: f64) -> String {
-    use crate::model::laws::LawKind as L;
-    let p = format!("hinges[{hinge}].clearance");
-    let damped = zeta > 1.0;
-    match law {
-        L::ImprovedLiu if damped => format!("`{p}.contact.eta_s` (or `d_max_n_s_per_m`)"),
-        L::KelvinVoigt if damped => format!("`{p}.contact.damping`"),
-        L::HuntCrossley | L::LankaraniNikravesh | L::FloresEtAl | L::GonthierEtAl if damped => {
-            format!("`{p}.contact.restitution` (a lower restitution damps harder)")
-        }
-        L::ImprovedLiu | L::LiuEtAl => format!(
-            "`{p}.bearing_material.youngs_modulus_pa`, `{p}.journal_material.youngs_modulus_pa` and \
-             `{p}.width_mm` (the law's stiffness is (pi/2) E* L)"
-        ),
-        _ => format!(
-            "`{p}.contact.stiffness` (or the materials' `youngs_modulus_pa` when the stiffness is left to the geometry)"
-        ),
-    }
-}
-
 /// The smallest step a run takes, s: the adaptive steps' default floor (`min_dt` of
-/// [`StepControl`](crate::rapier::stepper::StepControl)); a scene's fixed step is at least
-/// 1e-9 s.
+/// [`StepControl`](crate::rapier::stepper::StepControl)).
 const SMALLEST_STEP: f64 = 1e-10;
 
-/// What to do about a step beyond a contact's stability limit, fitting the step mode.
+/// What to do about a step beyond a contact's stability limit, fitting the step mode, in the
+/// caller's names (`names`) or the plain API's.
 fn step_advice(
     field: &str,
-    hinge: &str,
-    law: crate::model::laws::LawKind,
     dt_max: f64,
-    zeta: f64,
+    parameter: ContactParameter,
     adaptive: Option<bool>,
+    names: Option<&ParameterNames>,
 ) -> String {
-    let soft = stiff_field(hinge, law, zeta);
+    let soft = match names.filter(|n| !n.contact.is_empty()) {
+        Some(n) => parameter.describe(&n.contact),
+        None => parameter.describe(parameter.api_names()),
+    };
+    let switch = match names.filter(|n| !n.adaptive.is_empty()) {
+        Some(n) => n.adaptive.as_str(),
+        None => "StepControl::adaptive",
+    };
     match adaptive {
         Some(true) => format!(
-            "Adaptive stepping is on and this is already its smallest step: no step the runner takes \
+            "Adaptive stepping is on and this is already its smallest step: no step it takes \
              resolves this contact. It is too stiff (or too damped) for the bodies' masses: check {soft}."
         ),
         // Below the smallest step any run takes: no step resolves it.
@@ -339,12 +444,99 @@ fn step_advice(
             sig4(SMALLEST_STEP)
         ),
         Some(false) => format!(
-            "Use `{field}` below {} s (`--dt`), or adaptive stepping (`--set run.step=Adaptive`), which \
-             shrinks the step inside contacts; or soften the contact: {soft}.",
+            "Use `{field}` below {} s, or adaptive stepping (`{switch}`), which shrinks the step \
+             inside contacts; or soften the contact: {soft}.",
             sig4(0.8 * dt_max)
         ),
-        None => {
-            format!("Use a smaller `{field}` or adaptive stepping, or soften the contact: {soft}.")
+        None => format!(
+            "Use a smaller `{field}` or adaptive stepping (`{switch}`), or soften the contact: {soft}."
+        ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A step-limit error as the plain API raises it (field `dt`, no caller names).
+    fn step_error(parameter: ContactParameter, adaptive: Option<bool>) -> Error {
+        Error::StepTooLarge {
+            field: "dt".into(),
+            joint: "pin".into(),
+            dt: 1e-3,
+            dt_max: 1.3122521820485098e-4,
+            t: Some(0.08800000000000001),
+            penetration_um: 11.333333333333334,
+            omega: 15241.234567890123,
+            zeta: 0.1234567890123,
+            parameter,
+            adaptive,
+            names: None,
         }
+    }
+
+    #[test]
+    fn step_limit_messages_speak_the_api() {
+        use ContactParameter as P;
+        let cases = [
+            (
+                P::ModulusAndWidth,
+                Some(false),
+                "`Material::youngs_modulus_pa` and `length`",
+            ),
+            (
+                P::MaxDamping,
+                Some(false),
+                "`MaxDamping::Eta` (or `MaxDamping::Explicit`)",
+            ),
+            (P::Stiffness, Some(true), "`stiffness` (or the materials'"),
+            (P::Damping, Some(true), "check `damping`"),
+            (
+                P::Restitution,
+                None,
+                "`restitution` (a lower restitution damps harder)",
+            ),
+        ];
+        for (parameter, adaptive, names) in cases {
+            let e = step_error(parameter, adaptive).to_string();
+            assert!(e.contains("1.312e-4 s") && e.contains("t = 0.088 s"), "{e}");
+            assert!(e.contains("joint `pin`") && e.contains(names), "{e}");
+            match adaptive {
+                Some(true) => assert!(e.contains("Adaptive stepping is on"), "{e}"),
+                Some(false) => assert!(
+                    e.contains("`dt` below 1.05e-4 s")
+                        && e.contains("adaptive stepping (`StepControl::adaptive`)"),
+                    "{e}"
+                ),
+                None => assert!(e.contains("smaller `dt`"), "{e}"),
+            }
+            for word in ["--", "run.", "hinges["] {
+                assert!(!e.contains(word), "{word:?} in {e}");
+            }
+        }
+        assert_eq!(
+            step_error(P::Stiffness, Some(false)).suggested_step(),
+            Some(0.8 * 1.3122521820485098e-4)
+        );
+        assert_eq!(step_error(P::Stiffness, Some(true)).suggested_step(), None);
+    }
+
+    #[test]
+    fn a_caller_puts_its_own_names() {
+        let names = ParameterNames {
+            adaptive: "my.adaptive".into(),
+            contact: vec!["my.eta".into(), "my.d_max".into()],
+        };
+        let e = step_error(ContactParameter::MaxDamping, Some(false))
+            .named("my.step", names)
+            .to_string();
+        assert!(
+            e.contains("`my.step` = 0.001 s")
+                && e.contains("`my.step` below")
+                && e.contains("(`my.adaptive`)")
+                && e.contains("`my.eta` (or `my.d_max`)")
+                && !e.contains("MaxDamping"),
+            "{e}"
+        );
     }
 }

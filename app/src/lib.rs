@@ -9,6 +9,7 @@
 //! - [`progress`]: progress of a long run on a terminal.
 //! - [`replay`]: the self-contained `replay.html` of a run (3D, journal insets, timeline).
 //! - [`resultset`]: a result set (data, figures, report, replay) written as one unit.
+//! - [`advice`]: the library's errors phrased for the command line (its options added).
 //!
 //! The binary (`src/main.rs`) parses arguments, calls these, prints and sets the exit code. The
 //! library crate `clearance_joint` knows nothing of this crate: depending on it builds none of
@@ -17,6 +18,7 @@
 #![warn(missing_docs)]
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod advice;
 pub mod cli;
 pub mod figures;
 pub mod progress;

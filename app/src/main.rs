@@ -477,7 +477,7 @@ fn main() -> ExitCode {
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            eprintln!("error: {}", clearance_joint_app::advice::describe(&e));
             ExitCode::FAILURE
         }
     }

@@ -145,5 +145,10 @@ fn the_console_shows_the_worst_violation_and_strict_fails() {
         stderr.contains("guard violated (strict)") && stderr.contains("joint `pivot`"),
         "{stderr}"
     );
+    // Issue 18: the app, not the library, names its option.
+    assert!(
+        stderr.contains("`--strict` made these guard violations an error"),
+        "{stderr}"
+    );
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -496,11 +496,14 @@ impl Physics {
         let result = self.world.step(until);
         // Rapier's `dt` as the user set it (the stepper sets it per step).
         self.world.rapier.integration_parameters.dt = dt;
-        result.map(|_| ()).map_err(|mut e| {
-            if let Error::StepTooLarge { field, .. } = &mut e {
-                *field = "Physics::world.rapier.integration_parameters.dt".into();
-            }
-            e
+        result.map(|_| ()).map_err(|e| {
+            e.named(
+                "Physics::world.rapier.integration_parameters.dt",
+                crate::error::ParameterNames {
+                    adaptive: "Physics::set_step_control(StepControl::adaptive(..))".into(),
+                    contact: Vec::new(),
+                },
+            )
         })
     }
 

@@ -282,6 +282,16 @@ fn errors_are_values_and_stop_the_systems() {
         Error::StepTooLarge { field, t, .. } => {
             assert_eq!(field, "Physics::world.rapier.integration_parameters.dt");
             assert!(t.is_some_and(|t| t.is_finite() && t > 0.0));
+            // Issue 18: the ECS's names, never the app's options or the scene's paths.
+            let msg = e.to_string();
+            assert!(
+                msg.contains("`Physics::world.rapier.integration_parameters.dt` =")
+                    && msg.contains("Physics::set_step_control(StepControl::adaptive(..))"),
+                "{msg}"
+            );
+            for word in ["--", "run.", "hinges["] {
+                assert!(!msg.contains(word), "{word:?} in {msg}");
+            }
         }
         other => panic!("expected StepTooLarge, got {other}"),
     }

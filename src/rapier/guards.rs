@@ -55,8 +55,9 @@ pub struct Violation {
     pub first_t_s: f64,
     /// States (accepted steps) that violated the guard.
     pub count: u64,
-    /// Extra words (the step in use, the floor, the motor...); for [`GuardKind::Other`] the
-    /// whole message.
+    /// Extra words (the step in use, the floor...); for [`GuardKind::MotorSpeed`] the advice,
+    /// in place of the default that names the plain API's parameters; for [`GuardKind::Other`]
+    /// the whole message.
     #[serde(skip)]
     pub note: String,
     /// The unit of `worst` and `limit` where they are absolute rather than the kind's usual
@@ -181,7 +182,7 @@ impl Violation {
                     ),
                 };
                 let advice = if self.note.is_empty() {
-                    "; raise its `factor` or shorten the steps (`run.max_dt_s`)"
+                    "; raise its damping `factor` or shorten the steps (`StepControl`'s `max_dt`)"
                 } else {
                     &self.note
                 };

@@ -889,8 +889,14 @@ impl ClearanceJointSet {
             return Err(Error::invalid(
                 "num_solver_iterations",
                 format!(
-                    "must be 1 with clearance joints (got {}): Rapier's substeps hold the hook's force \
-                     constant over the whole step and the scheme gains energy at every impact",
+                    "is {}, but the compliant clearance joints of a ClearanceJointSet need 1: their \
+                     contact force is evaluated once per step and held over it, and Rapier's \
+                     substeps would make every impact gain energy. Set Rapier's \
+                     `integration_parameters.num_solver_iterations = 1` (every body of the world \
+                     then gets one iteration: stacks of resting bodies soften), or build the \
+                     hinges with the large-step model, \
+                     `Clearance::model(ClearanceModel::LargeStep)` into a LargeStepJointSet, which \
+                     works with any number of iterations and steps as long as 1/60 s",
                     params.num_solver_iterations
                 ),
             ));
@@ -912,15 +918,16 @@ impl ClearanceJointSet {
             if dt > r.max_stable_dt {
                 return Err(Error::StepTooLarge {
                     field: "dt".into(),
-                    hinge: j.name.clone(),
+                    joint: j.name.clone(),
                     dt,
                     dt_max: r.max_stable_dt,
                     t: None,
                     penetration_um: r.state.penetration * 1e6,
                     omega: r.omega,
                     zeta: r.zeta,
-                    law: j.normal_law.kind(),
+                    parameter: j.normal_law.kind().stiff_parameter(r.zeta),
                     adaptive: None,
+                    names: None,
                 });
             }
         }

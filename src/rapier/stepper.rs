@@ -732,10 +732,12 @@ impl Stepper {
         Ok(())
     }
 
-    /// Adds the time and the step mode to a step-limit error (the joints know neither).
+    /// Adds the time, the step mode and the parameter that set the step to a step-limit error
+    /// (the joints know none of them).
     fn locate(&self, mut e: Error) -> Error {
-        if let Error::StepTooLarge { t, .. } = &mut e {
+        if let Error::StepTooLarge { t, field, .. } = &mut e {
             *t = Some(self.t);
+            *field = "StepControl::max_dt".into();
         }
         e.with_step_mode(self.control.mode == StepMode::Adaptive)
     }

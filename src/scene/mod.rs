@@ -11,6 +11,7 @@
 //! Built on [`crate::rapier`] and [`crate::model`]; the app's sweeps, studies and figures are
 //! built on this layer, never the other way.
 
+mod errors;
 mod format;
 pub mod output;
 pub mod report;

@@ -82,12 +82,16 @@ pub fn clean_stale_temps(dir: &Path) -> usize {
         .count()
 }
 
+/// The `field` of the [`Error::Invalid`] this module returns for a result folder that cannot be
+/// used (not a folder, claimed by another run): an application names its own option for it.
+pub const OUTPUT_FOLDER: &str = "output folder";
+
 /// Creates `dir` (and its parents) and checks that it is a writable folder, before any work is
 /// done for it; removes stale temporaries found there.
 pub fn prepare_dir(dir: &Path) -> Result<()> {
     if dir.exists() && !dir.is_dir() {
         return Err(Error::invalid(
-            "--out",
+            OUTPUT_FOLDER,
             format!("`{}` exists and is not a folder", dir.display()),
         ));
     }
@@ -154,10 +158,10 @@ impl DirLock {
                     let holder = std::fs::read_to_string(&path).unwrap_or_default();
                     let holder = holder.trim();
                     return Err(Error::invalid(
-                        "--out",
+                        OUTPUT_FOLDER,
                         format!(
                             "`{}` is being written by another run{}: wait for it to finish or choose another \
-                             --out (two runs into one folder would mix their files)",
+                             folder (two runs into one folder would mix their files)",
                             dir.display(),
                             if holder.is_empty() {
                                 String::new()
@@ -179,7 +183,7 @@ impl DirLock {
             return Ok(DirLock { path, _file: file });
         }
         Err(Error::invalid(
-            "--out",
+            OUTPUT_FOLDER,
             format!(
                 "the lock file of `{}` keeps changing: another process is claiming it",
                 dir.display()
@@ -376,34 +380,33 @@ impl MemoryEstimate {
     }
 
     /// Refuses the run when `concurrent` such runs would need more than `budget` bytes, with the
-    /// numbers and the option to change (a larger `--output-interval`, the largest that fits).
+    /// numbers and the fields to change (a larger `run.output_interval_s`, the smallest that
+    /// fits: [`fitting_interval`](Self::fitting_interval)).
     pub fn check(&self, scene: &crate::scene::Scene, concurrent: u64, budget: u64) -> Result<()> {
         let need = self.bytes.saturating_mul(concurrent.max(1));
         if need <= budget {
             return Ok(());
         }
-        let per_run = budget / concurrent.max(1);
-        let fit_rows = per_run.saturating_sub(BASE_BYTES) / (16 * self.values_per_row.max(1));
-        let advice = if fit_rows > 2 {
-            format!(
-                "use --output-interval {} or larger (or a shorter --end; --max-memory sets the budget)",
-                sig4(round_up_sig(scene.run.end_s / (fit_rows - 2) as f64))
-            )
-        } else {
-            format!(
-                "that is less than the {} a run needs beyond its rows: raise --max-memory{}",
+        let advice = match self.fitting_interval(scene, concurrent, budget) {
+            Some(interval) => format!(
+                "use `run.output_interval_s` = {} or larger (or a shorter `run.end_s`, or a larger \
+                 memory budget)",
+                sig4(interval)
+            ),
+            None => format!(
+                "that is less than the {} a run needs beyond its rows: raise the memory budget{}",
                 bytes_text(BASE_BYTES),
                 if concurrent > 1 {
-                    " or lower --jobs"
+                    " or run fewer in parallel"
                 } else {
                     ""
                 }
-            )
+            ),
         };
         Err(Error::invalid(
             "run.output_interval_s",
             format!(
-                "{} rows of {} values{} would need about {} of memory, more than the {} available{}: {advice}",
+                "{} rows of {} values{} would need about {} of memory, more than the {} available: {advice}",
                 sig4(self.rows as f64),
                 self.values_per_row,
                 if concurrent > 1 {
@@ -413,13 +416,22 @@ impl MemoryEstimate {
                 },
                 bytes_text(need),
                 bytes_text(budget),
-                if concurrent > 1 {
-                    " (--jobs runs them in parallel)"
-                } else {
-                    ""
-                },
             ),
         ))
+    }
+
+    /// The smallest output interval, s (2 significant digits, rounded up), at which
+    /// `concurrent` runs of `scene` fit `budget` bytes; `None` when no interval does (the budget
+    /// is below what a run needs beyond its rows).
+    pub fn fitting_interval(
+        &self,
+        scene: &crate::scene::Scene,
+        concurrent: u64,
+        budget: u64,
+    ) -> Option<f64> {
+        let per_run = budget / concurrent.max(1);
+        let fit_rows = per_run.saturating_sub(BASE_BYTES) / (16 * self.values_per_row.max(1));
+        (fit_rows > 2).then(|| round_up_sig(scene.run.end_s / (fit_rows - 2) as f64))
     }
 }
 
@@ -468,7 +480,7 @@ pub fn parse_bytes(text: &str) -> Result<u64> {
         Ok(v as u64)
     } else {
         Err(Error::invalid(
-            "--max-memory",
+            "size",
             format!(
                 "expected a size such as 4G, 512M or 2GiB (got `{}`)",
                 crate::error::excerpt(text, 40)

@@ -35,6 +35,7 @@ pub fn memory_budget(max_memory: Option<&str>) -> Result<Option<u64>> {
     max_memory
         .map(clearance_joint::scene::output::parse_bytes)
         .transpose()
+        .map_err(|e| crate::advice::from_option(e, "--max-memory"))
 }
 
 /// The thread count `--jobs N` as given (possibly negative), refused below 1.

@@ -25,7 +25,10 @@ impl SceneRun {
     /// the folder is ours alone until the set is in place, its staging folder writable.
     pub fn prepare(scene: Scene, out: PathBuf, max_memory: Option<u64>) -> Result<SceneRun> {
         if let Some(budget) = max_memory.or_else(available_memory) {
-            MemoryEstimate::of(&scene).check(&scene, 1, budget)?;
+            let estimate = MemoryEstimate::of(&scene);
+            estimate
+                .check(&scene, 1, budget)
+                .map_err(|e| crate::advice::memory_options(e, &estimate, &scene, 1, budget))?;
         }
         let set = ResultSet::begin(&out, &[])?;
         Ok(SceneRun { scene, out, set })

@@ -11,6 +11,7 @@
 
 use super::grid::{Axis, Grid, Point, Shard};
 use super::metrics::RunMetrics;
+use crate::advice::memory_options;
 use clearance_joint::error::{Error, Result};
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::output::{
@@ -517,8 +518,10 @@ fn execute_with(
     let progress = Reporter::new(count, options.progress);
     let run = |job: &Job| -> Result<PointOutcome> {
         if let Some(budget) = run_budget {
-            MemoryEstimate::of(&job.scene)
+            let estimate = MemoryEstimate::of(&job.scene);
+            estimate
                 .check(&job.scene, concurrent, budget)
+                .map_err(|e| memory_options(e, &estimate, &job.scene, concurrent, budget))
                 .map_err(|e| in_point(e, &job.point))?;
         }
         // A finished point is reused unless a replay is asked for and it has none.
@@ -579,6 +582,7 @@ pub fn check_memory(jobs: &[Job], threads: usize, budget: Option<u64>) -> Result
     let concurrent = threads.min(jobs.len()).max(1) as u64;
     estimate
         .check(&job.scene, concurrent, budget)
+        .map_err(|e| memory_options(e, &estimate, &job.scene, concurrent, budget))
         .map_err(|e| match e {
             Error::Invalid { field, reason } => Error::Invalid {
                 field,

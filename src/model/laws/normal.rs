@@ -1,7 +1,7 @@
 //! Normal contact-force laws (MODEL.md §2).
 
 use super::step::{step, step_slope};
-use crate::error::{Result, in_range, in_range_open_closed, positive};
+use crate::error::{ContactParameter, Result, in_range, in_range_open_closed, positive};
 use std::f64::consts::PI;
 
 /// The state a normal law is evaluated at.
@@ -621,6 +621,28 @@ impl LawKind {
             LawKind::GonthierEtAl => "GonthierEtAl",
             LawKind::LiuEtAl => "LiuEtAl",
             LawKind::ImprovedLiu => "ImprovedLiu",
+        }
+    }
+
+    /// The parameter that limits a contact's stable step under this law: its damping when the
+    /// contact is over-damped (damping ratio `zeta > 1`) and the law has a damping parameter,
+    /// else what sets its stiffness.
+    pub fn stiff_parameter(self, zeta: f64) -> ContactParameter {
+        use ContactParameter as P;
+        let damped = zeta > 1.0;
+        match self {
+            LawKind::ImprovedLiu if damped => P::MaxDamping,
+            LawKind::KelvinVoigt if damped => P::Damping,
+            LawKind::HuntCrossley
+            | LawKind::LankaraniNikravesh
+            | LawKind::FloresEtAl
+            | LawKind::GonthierEtAl
+                if damped =>
+            {
+                P::Restitution
+            }
+            LawKind::ImprovedLiu | LawKind::LiuEtAl => P::ModulusAndWidth,
+            _ => P::Stiffness,
         }
     }
 }

@@ -109,7 +109,7 @@ fn check_group(path: &str, slot: &serde_json::Value, new: &serde_json::Value) ->
     Err(Error::invalid(
         path,
         format!(
-            "is a group of settings ({}): set one of them, e.g. `--set {path}.{example}=VALUE`",
+            "is a group of settings ({}): set one of them, e.g. `{path}.{example}=VALUE`",
             names.join(", ")
         ),
     ))

@@ -324,7 +324,7 @@ impl Simulation {
                 };
                 let advice = match &inv.motor_start_mismatch {
                     Some(_) if *t == 0.0 => start_mismatch_note(inv),
-                    _ => String::new(),
+                    _ => "; raise its `factor` or shorten the steps (`run.max_dt_s`)".to_string(),
                 };
                 let mut v = Violation::new(GuardKind::MotorSpeed, worst, limit, *t)
                     .twin(twin.kind.name())
@@ -511,10 +511,7 @@ fn name_bodies(mut e: crate::Error, twins: &[Twin]) -> crate::Error {
     e
 }
 
-/// Names the scene's step field in a step-limit error (the stepper knows only `dt`).
-fn name_step_field(mut e: crate::Error, name: &str) -> crate::Error {
-    if let crate::Error::StepTooLarge { field, .. } = &mut e {
-        *field = name.into();
-    }
-    e
+/// Names the scene's fields in a step-limit error (the stepper knows only the API's names).
+fn name_step_field(e: crate::Error, name: &str) -> crate::Error {
+    crate::scene::errors::in_scene(e, name)
 }

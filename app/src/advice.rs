@@ -1,0 +1,75 @@
+//! The library's errors phrased for the command line. The library's messages name the scene's
+//! fields (`run.dt_s`, `hinges[NAME].clearance.contact.eta_s`), never this program's options: it
+//! carries the numbers, and this module adds what to type (`--dt`, `--set run.step=Adaptive`,
+//! `--strict`, `--out`, `--max-memory`), as ripgrep's binary phrases its libraries' errors.
+
+use clearance_joint::error::{Error, sig4};
+use clearance_joint::scene::Scene;
+use clearance_joint::scene::output::{MemoryEstimate, OUTPUT_FOLDER};
+
+/// `e` as the command line shows it: the library's message, then the options that act on it.
+pub fn describe(e: &Error) -> String {
+    let message = e.to_string();
+    match e {
+        Error::StepTooLarge { .. } => match e.suggested_step() {
+            Some(dt) => format!(
+                "{message} On the command line: `--dt {}` (or smaller), or `--set run.step=Adaptive`.",
+                sig4(dt)
+            ),
+            None => message,
+        },
+        // The library's result folder is this program's `--out`.
+        Error::Invalid { field, reason } if field == OUTPUT_FOLDER => {
+            format!("invalid `--out`: {reason}")
+        }
+        Error::Guard { .. } => format!(
+            "{message} (`--strict` made these guard violations an error; without it the run is \
+             written, its summary listing them)"
+        ),
+        _ => message,
+    }
+}
+
+/// A memory refusal of [`MemoryEstimate::check`] with the options that act on it: the output
+/// interval that fits (`--output-interval`), the budget (`--max-memory`) and the runs in
+/// parallel (`--jobs`). Other errors pass through.
+pub fn memory_options(
+    e: Error,
+    estimate: &MemoryEstimate,
+    scene: &Scene,
+    concurrent: u64,
+    budget: u64,
+) -> Error {
+    let Error::Invalid { field, reason } = e else {
+        return e;
+    };
+    let parallel = if concurrent > 1 {
+        " (`--jobs` runs them in parallel)"
+    } else {
+        ""
+    };
+    let options = match estimate.fitting_interval(scene, concurrent, budget) {
+        Some(interval) => format!(
+            "`--output-interval {}` or larger (or a shorter `--end`; `--max-memory` sets the \
+             budget){parallel}",
+            sig4(interval)
+        ),
+        None if concurrent > 1 => "raise `--max-memory` or lower `--jobs`".into(),
+        None => "raise `--max-memory`".into(),
+    };
+    Error::Invalid {
+        field,
+        reason: format!("{reason}. On the command line: {options}"),
+    }
+}
+
+/// An error about a value the command line gave in `option` (`--max-memory`), named by it.
+pub fn from_option(e: Error, option: &str) -> Error {
+    match e {
+        Error::Invalid { reason, .. } => Error::Invalid {
+            field: option.into(),
+            reason,
+        },
+        other => other,
+    }
+}

@@ -228,6 +228,13 @@ impl Clearance {
         self
     }
 
+    /// Sets the gap a free flight must open for the next contact to count as an impact, m
+    /// (checked when the joint is built: not negative).
+    pub fn min_separation(mut self, gap: f64) -> Self {
+        self.min_separation = gap;
+        self
+    }
+
     /// Sets the deepest penetration at which the contact law is trusted, m (checked when the
     /// joint is built: positive, at most the journal radius).
     pub fn max_valid_penetration(mut self, depth: f64) -> Self {

@@ -3,7 +3,7 @@
 mod build;
 
 use super::HingeMetrics;
-use super::invariants::Invariants;
+use super::invariants::{BodyBefore, Invariants};
 use crate::error::Result;
 use crate::model::angle::{HingeAngle, UnwrappedAngle, twist_angle};
 use crate::model::laws::NormalForceLaw;
@@ -45,9 +45,9 @@ impl TwinKind {
 pub(super) struct BodyTrack {
     pub(super) name: String,
     pub(super) handle: RigidBodyHandle,
-    pub(super) mass: f64,
+    mass: f64,
     /// Fixed or driven by a prescribed motion: outside the energy and momentum balances.
-    pub(super) fixed: bool,
+    fixed: bool,
     /// Not a fixed body (driven bodies move).
     moves: bool,
     /// The body's tabulated motion (index in the twin's prescribed set).
@@ -55,11 +55,11 @@ pub(super) struct BodyTrack {
     /// The centre of mass in the body's frame (not the origin for a spinning body), m.
     local_com: Vector,
     angle: UnwrappedAngle,
-    pub(super) linvel_before: Vector,
+    linvel_before: Vector,
     /// Angular velocity, centre of mass and rotation at the state before the current step.
-    pub(super) angvel_before: Vector,
-    pub(super) com_before: Vector,
-    pub(super) rotation_before: rapier3d_f64::math::Rotation,
+    angvel_before: Vector,
+    com_before: Vector,
+    rotation_before: rapier3d_f64::math::Rotation,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -148,7 +148,7 @@ pub struct Twin {
     /// The drives' and clearance joints' wrenches at the current state (scratch).
     source_wrenches: Vec<crate::rapier::ledger::Wrench>,
     /// Spring and contact elastic energy at the state before the current step, J.
-    pub(super) source_energy_before: f64,
+    source_energy_before: f64,
     /// The joint motors in Rapier, with the index of their scene joint: their impulses over each
     /// step give their work.
     motor_joints: Vec<(ImpulseJointHandle, JointAxis, usize)>,
@@ -357,6 +357,21 @@ impl Twin {
             }
         }
         Ok(())
+    }
+
+    /// The invariants at the state before the step just taken, from this twin's moving bodies
+    /// and its sources' elastic energy there.
+    fn update_invariants(&mut self, bodies: &RigidBodySet, gravity: Vector, info: &StepInfo) {
+        let moving = self.bodies.iter().filter(|b| !b.fixed).map(|b| BodyBefore {
+            mass: b.mass,
+            com: b.com_before,
+            rotation: b.rotation_before,
+            linvel: b.linvel_before,
+            angvel: b.angvel_before,
+            after: &bodies[b.handle],
+        });
+        self.invariants
+            .update(moving, self.source_energy_before, gravity, info);
     }
 
     /// Metrics of the state before the step (its sample and force), weighted by the step.

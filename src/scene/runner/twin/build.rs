@@ -619,3 +619,92 @@ fn motor_of(spec: Option<&MotorSpec>) -> Option<Motor> {
         )),
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::rapier::convert::ClearanceModel;
+    use crate::scene::Scene;
+    use crate::scene::runner::{RunOptions, Simulation, Twins};
+
+    fn error_of(scene: &Scene, twins: Twins) -> Option<String> {
+        let options = RunOptions {
+            twins,
+            ..RunOptions::default()
+        };
+        Simulation::new(scene, options).err().map(|e| e.to_string())
+    }
+
+    #[test]
+    fn a_large_step_hinge_is_refused_by_the_runner_naming_its_field() {
+        let base = Scene::solar_panel();
+        let name = base.hinges[0].name.clone();
+        // A valid scene: the format may choose the model.
+        let scene = base
+            .with_overrides(&[format!("{name}.model=LargeStep")])
+            .unwrap();
+        let spec = scene.hinges[0].clearance.as_ref().unwrap();
+        assert_eq!(spec.model, ClearanceModel::LargeStep);
+        let v = scene.validated().unwrap();
+        assert_eq!(v.clearance(0).unwrap().model, ClearanceModel::LargeStep);
+        // The runner does not step it yet: refused, naming the field.
+        let e = error_of(&scene, Twins::Both).expect("refused");
+        assert!(
+            e.contains(&format!("`hinges[{name}].clearance.model`")) && e.contains("not run"),
+            "{e}"
+        );
+        // The ideal twin alone has no clearance joint to build.
+        assert_eq!(error_of(&scene, Twins::IdealOnly), None);
+        assert!(error_of(&base, Twins::Both).is_none());
+    }
+
+    #[test]
+    fn the_models_settings_are_checked_at_the_scene() {
+        let base = Scene::solar_panel();
+        let name = base.hinges[0].name.clone();
+        // A restitution is the large-step model's only.
+        let e = base
+            .with_overrides(&[format!("{name}.clearance.restitution=0.5")])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("`hinges[{name}].clearance.restitution`"))
+                && e.contains("large-step"),
+            "{e}"
+        );
+        let e = base
+            .with_overrides(&[
+                format!("{name}.model=LargeStep"),
+                format!("{name}.clearance.restitution=1.5"),
+            ])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("`hinges[{name}].clearance.restitution`")),
+            "{e}"
+        );
+        let ok = base
+            .with_overrides(&[
+                format!("{name}.model=LargeStep"),
+                format!("{name}.clearance.restitution=0.5"),
+            ])
+            .unwrap();
+        assert_eq!(
+            ok.validated().unwrap().clearance(0).unwrap().restitution,
+            Some(0.5)
+        );
+        // Written back, the choice reads the same; the default is not written (old scenes
+        // and their files read as before).
+        assert_eq!(Scene::from_ron(&ok.to_ron(), "round trip").unwrap(), ok);
+        assert!(ok.to_ron().contains("LargeStep"));
+        assert!(!base.to_ron().contains("model"), "{}", base.to_ron());
+        // An unknown model is a parse error naming the variants.
+        let text = crate::scene::SOLAR_PANEL_RON.replacen(
+            "clearance: Some((",
+            "clearance: Some((model: Rigid, ",
+            1,
+        );
+        assert!(text.contains("model: Rigid"), "the asset's hinge moved");
+        let e = Scene::from_ron(&text, "test").unwrap_err().to_string();
+        assert!(e.contains("Rigid"), "{e}");
+    }
+}

@@ -104,7 +104,7 @@ impl Scene {
     }
 
     /// The scene, checked ([`validate`](Self::validate)), with its hinges' clearance settings
-    /// built: what [`Simulation`](crate::scene::Simulation) builds its twins from.
+    /// built: what [`Simulation`](crate::scene::runner::Simulation) builds its twins from.
     pub fn validated(&self) -> Result<ValidatedScene> {
         let clearances = self.check()?;
         Ok(ValidatedScene::new(self.clone(), clearances))

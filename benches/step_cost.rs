@@ -37,18 +37,19 @@ fn main() {
     // locked axes), so the lock joint is removed from the built world and the bodies locked here.
     let locked_axes = median_us_per_step(|| {
         let mut sim = Simulation::new(&scene, opts(Twins::ClearanceOnly)).unwrap();
-        let locks: Vec<_> = sim.twins[0]
+        let locks: Vec<_> = sim
+            .world
             .clearance
             .iter()
             .filter_map(|(_, j)| j.lock_handle())
             .collect();
         for h in locks {
-            sim.world.impulse_joints.remove(h, true);
+            sim.world.rapier.impulse_joints.remove(h, true);
         }
         let planar = LockedAxes::TRANSLATION_LOCKED_Y
             | LockedAxes::ROTATION_LOCKED_X
             | LockedAxes::ROTATION_LOCKED_Z;
-        for (_, rb) in sim.world.bodies.iter_mut() {
+        for (_, rb) in sim.world.rapier.bodies.iter_mut() {
             rb.set_locked_axes(planar, true);
         }
         sim

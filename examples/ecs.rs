@@ -54,7 +54,11 @@ fn link((mass, length): (f64, f64), center: Vector, rotation: Rotation) -> Body 
 fn spawn(world: &mut World, elbow_has_clearance: bool) -> Result<(Entity, Entity)> {
     let mut physics = Physics::new(DT, Vector::new(0.0, -9.81, 0.0));
     // The compliant clearance model needs one solver iteration; the setting is the whole world's.
-    physics.world.integration_parameters.num_solver_iterations = 1;
+    physics
+        .world
+        .rapier
+        .integration_parameters
+        .num_solver_iterations = 1;
     world.insert_resource(physics);
     let r = Rotation::from_rotation_z(START_DEG.to_radians());
     let down = r * Vector::NEG_Y;

@@ -14,47 +14,50 @@
 //!
 //! Keep your world and your loop. Two changes make a loop clearance-ready: one solver iteration
 //! (the hook's force is constant over a step; Rapier's substeps would make every impact gain
-//! energy), and [`Stepper::step`](rapier::stepper::Stepper::step) in place of `world.step()`: it
-//! evaluates the force sources, chooses the step (adaptive by default, or fixed with a stability
-//! check), takes it, judges it and retries it if a contact was entered blindly, and keeps the run's
-//! guards. Then one call turns a revolute joint you already have into a clearance joint:
+//! energy), and a [`ClearanceWorld`](rapier::world::ClearanceWorld) around your `PhysicsWorld`,
+//! whose [`step`](rapier::world::ClearanceWorld::step) takes the place of `world.step()`: it
+//! evaluates the joints' and drives' forces, chooses the step (adaptive by default, or fixed with
+//! a stability check), takes it with every joint set's hooks, judges it and retries it if a
+//! contact was entered blindly, and keeps the run's guards. Then one call turns a revolute joint
+//! you already have into a clearance joint:
 //!
 //! ```
 //! use clearance_joint::prelude::*;
 //! use rapier3d_f64::prelude::*;
 //!
-//! let mut world = PhysicsWorld::new(); // gravity -9.81 m/s^2 along y
-//! world.integration_parameters.num_solver_iterations = 1;
-//! let base = world.bodies.insert(RigidBodyBuilder::fixed());
-//! let arm = world.bodies.insert(
+//! let mut rapier = PhysicsWorld::new(); // gravity -9.81 m/s^2 along y
+//! rapier.integration_parameters.num_solver_iterations = 1;
+//! let base = rapier.bodies.insert(RigidBodyBuilder::fixed());
+//! let arm = rapier.bodies.insert(
 //!     RigidBodyBuilder::dynamic()
 //!         .translation(Vector::new(0.0, -0.3, 0.0))
 //!         .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02))),
 //! );
 //! let hinge = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0));
-//! let hinge = world.impulse_joints.insert(base, arm, hinge, true);
+//! let hinge = rapier.impulse_joints.insert(base, arm, hinge, true);
+//! // Adaptive steps of at most 1 ms, 0.75 % of a contact period inside contacts.
+//! let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.0075));
 //!
 //! // 0.2 mm of play in a 20 mm steel bearing, 16 mm wide; the base carries the bearing.
-//! let mut clearance = ClearanceJointSet::new();
 //! let play = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?;
-//! let hinge = clearance.convert_revolute(hinge, BearingSide::Body1, play, &mut world.impulse_joints)?;
+//! let hinge = world.clearance.convert_revolute(hinge, BearingSide::Body1, play, &mut world.rapier.impulse_joints)?;
 //!
-//! // Adaptive steps of at most 1 ms, 0.75 % of a contact period inside contacts.
-//! let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.0075));
-//! while stepper.time() < 0.1 {
-//!     stepper.step(&mut world, &mut [&mut clearance], 0.1)?;
-//! }
-//! let report = clearance.get(hinge).unwrap().report(); // force, eccentricity, penetration, ...
-//! assert!(report.state.penetration >= 0.0 && stepper.guards().is_clean());
+//! world.step_to(0.1)?;
+//! let report = world.clearance.get(hinge).unwrap().report(); // force, eccentricity, penetration, ...
+//! assert!(report.state.penetration >= 0.0 && world.guards().is_clean());
 //! # Ok::<(), clearance_joint::Error>(())
 //! ```
 //!
 //! The pieces: [`Clearance`](rapier::convert::Clearance) (geometry and laws, any law of
 //! [`model::laws`]), [`ClearanceJointSet`](rapier::joint::ClearanceJointSet) (the joints and their
-//! force hook), [`Stepper`](rapier::stepper::Stepper) with
+//! force hook), [`LargeStepJointSet`](rapier::large_step::LargeStepJointSet) (the play as a
+//! constraint, for game and robot rates), [`Stepper`](rapier::stepper::Stepper) with
 //! [`StepControl`](rapier::stepper::StepControl) (step choice, acceptance,
-//! [`GuardReport`](rapier::stepper::GuardReport)), and
+//! [`GuardReport`](rapier::stepper::GuardReport)), the step protocol every set implements
+//! ([`StepHooks`](rapier::step_hooks::StepHooks)), and
 //! [`ClearanceJointBuilder`](rapier::joint::ClearanceJointBuilder) for a joint built from scratch.
+//! [`ClearanceWorld`](rapier::world::ClearanceWorld) bundles them; the scene runner and the
+//! bevy_ecs layer are built on it.
 //!
 //! # 2. A driven mechanism, with its metrics
 //!
@@ -193,7 +196,7 @@ mod chapter_doctests {
 /// ```
 pub mod prelude {
     pub use crate::rapier::convert::{BearingSide, Clearance, ClearanceModel, ConvertRevolute};
-    pub use crate::rapier::drive::{DriveSet, TorsionSpring};
+    pub use crate::rapier::drive::{DriveHandle, DriveSet, TorsionSpring};
     pub use crate::rapier::guards::GuardReport;
     pub use crate::rapier::joint::{
         ClearanceJoint, ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet,
@@ -207,7 +210,8 @@ pub mod prelude {
         IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, KinematicState,
         ReactionSolver,
     };
-    pub use crate::rapier::stepper::{ForceSource, StepControl, StepInfo, Stepper};
+    pub use crate::rapier::stepper::{StepControl, StepHooks, StepInfo, Stepper};
+    pub use crate::rapier::world::ClearanceWorld;
     /// The same item as Rapier's (`rapier3d_f64::math::Vector`), so no clash with its prelude.
     pub use rapier3d_f64::math::Vector;
 }

@@ -43,7 +43,11 @@ fn the_papers_scene_through_the_ecs_is_the_runners() {
     let mut world = World::new();
     let mut physics = Physics::new(1e-4, Vector::ZERO);
     // The compliant model's need, as the runner's world has it.
-    physics.world.integration_parameters.num_solver_iterations = 1;
+    physics
+        .world
+        .rapier
+        .integration_parameters
+        .num_solver_iterations = 1;
     world.insert_resource(physics);
     let h = &scene.hinges[0];
     let spec = h.clearance.as_ref().unwrap();

@@ -59,6 +59,7 @@ fn run_with_impulses(
     .unwrap();
     let (handle, axis) = sim
         .world
+        .rapier
         .impulse_joints
         .iter()
         .find(|(_, j)| !j.data.motor_axes.is_empty())
@@ -75,8 +76,8 @@ fn run_with_impulses(
     while sim.time() < scene.run.end_s * (1.0 - 1e-12) {
         let t0 = sim.time();
         sim.step().unwrap();
-        let dt = sim.world.integration_parameters.dt;
-        let j = sim.world.impulse_joints.get(handle).unwrap();
+        let dt = sim.world.rapier.integration_parameters.dt;
+        let j = sim.world.rapier.impulse_joints.get(handle).unwrap();
         impulses.push((t0, -j.data.motors[axis as usize].impulse / dt));
     }
     (sim.run().unwrap(), impulses)

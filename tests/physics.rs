@@ -264,7 +264,7 @@ fn adaptive_steps_resolve_contact_onset() {
         let (mut onset, mut peak) = (None, 0.0f64);
         while sim.time() < 0.1 {
             sim.step().unwrap();
-            let (_, joint) = sim.twins[0].clearance.iter().next().unwrap();
+            let (_, joint) = sim.world.clearance.iter().next().unwrap();
             let r = joint.report();
             if r.onset && onset.is_none() {
                 onset = Some(r.state.penetration);

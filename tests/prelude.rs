@@ -10,7 +10,7 @@ use rapier3d_f64::prelude::*;
 /// Every name of the prelude, used once (types by name, traits as bounds).
 #[test]
 fn every_prelude_name_resolves_next_to_rapiers_prelude() {
-    fn force_source<T: ForceSource>() -> &'static str {
+    fn step_hooks<T: StepHooks>() -> &'static str {
         std::any::type_name::<T>()
     }
     fn converts<T: ConvertRevolute>() -> &'static str {
@@ -22,7 +22,9 @@ fn every_prelude_name_resolves_next_to_rapiers_prelude() {
         std::any::type_name::<ClearanceModel>(),
         converts::<ClearanceJointSet>(),
         converts::<LargeStepJointSet>(),
-        std::any::type_name::<DriveSet>(),
+        step_hooks::<DriveSet>(),
+        std::any::type_name::<DriveHandle>(),
+        std::any::type_name::<ClearanceWorld>(),
         std::any::type_name::<TorsionSpring>(),
         std::any::type_name::<GuardReport>(),
         std::any::type_name::<ClearanceJoint>(),
@@ -42,7 +44,7 @@ fn every_prelude_name_resolves_next_to_rapiers_prelude() {
         std::any::type_name::<IdealSpherical>(),
         std::any::type_name::<KinematicState>(),
         std::any::type_name::<ReactionSolver>(),
-        force_source::<DriveSet>(),
+        step_hooks::<LargeStepJointSet>(),
         std::any::type_name::<StepControl>(),
         std::any::type_name::<StepInfo>(),
         std::any::type_name::<Stepper>(),

@@ -107,7 +107,7 @@ fn measure(v: &Variant) -> String {
     )
     .unwrap();
     if let Some((f, z)) = v.softness {
-        for (_, j) in sim.world.impulse_joints.iter_mut() {
+        for (_, j) in sim.world.rapier.impulse_joints.iter_mut() {
             j.data.softness = SpringCoefficients::new(f, z);
         }
     }

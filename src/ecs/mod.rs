@@ -53,7 +53,7 @@
 //! let mut world = World::new();
 //! let mut physics = Physics::new(1e-5, Vector::new(0.0, -9.81, 0.0));
 //! // The compliant model's one need, for the whole world (see above).
-//! physics.world.integration_parameters.num_solver_iterations = 1;
+//! physics.world.rapier.integration_parameters.num_solver_iterations = 1;
 //! world.insert_resource(physics);
 //! let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
 //! let arm = world
@@ -120,7 +120,7 @@
 //! // The compliant model needs one solver iteration; the world is left as it is.
 //! let refused = run_step(&mut world, &mut schedule).unwrap_err().to_string();
 //! assert!(refused.contains("num_solver_iterations") && refused.contains("LargeStep"), "{refused}");
-//! assert_eq!(world.resource::<Physics>().world.integration_parameters.num_solver_iterations, 4);
+//! assert_eq!(world.resource::<Physics>().world.rapier.integration_parameters.num_solver_iterations, 4);
 //! // The large-step model steps the world as it is.
 //! world
 //!     .entity_mut(hinge)
@@ -152,7 +152,4 @@ pub use components::{
 };
 pub use physics::{HingeJoint, Physics};
 pub use schedule::{PhysicsSet, add_physics_systems, physics_schedule, run_step};
-pub use systems::{
-    apply_forces, finish_large_step, prepare_large_step, record, step_physics, sync_bodies,
-    sync_hinges,
-};
+pub use systems::{apply_forces, record, step_physics, sync_bodies, sync_hinges};

@@ -5,12 +5,12 @@
 use super::components::{Drive, Hinge};
 use crate::error::{Error, Result};
 use crate::rapier::convert::{BearingSide, Clearance, ClearanceModel, ConvertRevolute};
-use crate::rapier::drive::{DriveSet, TorsionSpring};
+use crate::rapier::drive::{DriveHandle, TorsionSpring};
 use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle, ClearanceJointSet};
 use crate::rapier::large_step::{LargeStepJoint, LargeStepJointHandle, LargeStepJointSet};
-use crate::rapier::ledger::Wrench;
-use crate::rapier::reaction::{IdealRevolute, ReactionSolver};
-use crate::rapier::stepper::{ForceSource, GuardReport, StepControl, StepMode, Stepper};
+use crate::rapier::reaction::{IdealJoint, IdealRevolute, ReactionSolver};
+use crate::rapier::stepper::{GuardReport, StepControl, StepMode};
+use crate::rapier::world::ClearanceWorld;
 use bevy_ecs::prelude::*;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{ImpulseJointHandle, PhysicsWorld, RigidBody, RigidBodyHandle};
@@ -40,27 +40,25 @@ struct RealizedHinge {
 
 #[derive(Clone, Debug)]
 struct RealizedDrive {
-    set: DriveSet,
+    handle: DriveHandle,
     drive: Drive,
     bodies: BodyPair,
     axis: Vector,
 }
 
-/// The physics of an ECS world: the Rapier world, the clearance joints and the drives, and the
-/// map from entities to what they are in Rapier.
+/// The physics of an ECS world: a [`ClearanceWorld`] (the Rapier world, the clearance joints,
+/// the drives and the step control: the pieces the scene runner and a plain-Rapier loop use),
+/// and the map from entities to what they are in it.
 #[derive(Resource)]
 pub struct Physics {
-    /// The Rapier world. Set gravity, the step (`integration_parameters.dt`) and colliders here;
-    /// bodies and joints are managed through the components.
-    pub world: PhysicsWorld,
-    clearance: ClearanceJointSet,
-    large_step: LargeStepJointSet,
+    /// The world. Set gravity, the step (`world.rapier.integration_parameters.dt`) and colliders
+    /// in `world.rapier`; bodies, joints and drives are managed through the components (read
+    /// the sets freely, do not insert into them by hand).
+    pub world: ClearanceWorld,
     bodies: BTreeMap<Entity, RigidBodyHandle>,
     hinges: BTreeMap<Entity, RealizedHinge>,
     drives: BTreeMap<Entity, RealizedDrive>,
     error: Option<Error>,
-    /// The step control: the same public piece the scene runner uses.
-    stepper: Stepper,
     /// Set when the sync systems changed joints, drives or bodies: the force sources are
     /// evaluated again before the next step.
     changed: bool,
@@ -71,15 +69,14 @@ pub struct Physics {
     #[cfg(test)]
     pub(super) hinge_passes: u64,
     reactions: ReactionSolver,
-    ideal_joints: Vec<IdealRevolute>,
-    source_wrenches: Vec<Wrench>,
+    ideal_joints: Vec<IdealJoint>,
 }
 
 impl Physics {
     /// An empty Rapier world stepping by `dt` (s) under `gravity` (m/s^2), with Rapier's
     /// defaults otherwise (4 solver iterations): ready for ideal and large-step hinges. The
     /// compliant clearance model needs one solver iteration; set
-    /// `world.integration_parameters.num_solver_iterations = 1` yourself before spawning such a
+    /// `world.rapier.integration_parameters.num_solver_iterations = 1` yourself before spawning such a
     /// hinge (see the [module docs](super) for why and what it costs the world's other bodies).
     pub fn new(dt: f64, gravity: Vector) -> Self {
         let mut world = PhysicsWorld::new();
@@ -95,68 +92,64 @@ impl Physics {
     pub fn from_world(world: PhysicsWorld) -> Self {
         let dt = world.integration_parameters.dt;
         Physics {
-            world,
-            clearance: ClearanceJointSet::new(),
-            large_step: LargeStepJointSet::new(),
+            world: ClearanceWorld::new(world, StepControl::fixed(dt)),
             bodies: BTreeMap::new(),
             hinges: BTreeMap::new(),
             drives: BTreeMap::new(),
             error: None,
-            stepper: Stepper::new(StepControl::fixed(dt)),
             changed: true,
             hinges_stale: true,
             #[cfg(test)]
             hinge_passes: 0,
             reactions: ReactionSolver::default(),
             ideal_joints: Vec::new(),
-            source_wrenches: Vec::new(),
         }
     }
 
-    /// The step control: fixed steps of `world.integration_parameters.dt` by default (changing
+    /// The step control: fixed steps of `world.rapier.integration_parameters.dt` by default (changing
     /// `dt` between steps is followed). With [`StepControl::adaptive`] each run of the schedule
     /// takes ONE accepted step of the stepper's choice, at most up to `time() + dt`: inside
     /// contacts that step is far shorter than a frame, so a game loop must run the schedule until
     /// `time()` reaches the frame's time (each run records its state and impacts).
     pub fn set_step_control(&mut self, control: StepControl) {
-        self.stepper.set_control(control);
+        self.world.set_step_control(control);
     }
 
     /// What the run-time guards recorded (rejected steps, penetrations beyond a law's validity,
     /// steps at the floor).
     pub fn guards(&self) -> &GuardReport {
-        self.stepper.guards()
+        self.world.guards()
     }
 
     /// The clearance joints (read-only: they follow the
     /// [`ClearanceHinge`](super::ClearanceHinge) components).
     pub fn clearance(&self) -> &ClearanceJointSet {
-        &self.clearance
+        &self.world.clearance
     }
 
     /// The large-step clearance joints (read-only: they follow the
     /// [`ClearanceHinge`](super::ClearanceHinge) components whose [`Clearance::model`] is
     /// [`ClearanceModel::LargeStep`]).
     pub fn large_step(&self) -> &LargeStepJointSet {
-        &self.large_step
+        &self.world.large_step
     }
 
     /// The large-step clearance joint of a [`ClearanceHinge`](super::ClearanceHinge) entity.
     pub fn large_step_joint(&self, entity: Entity) -> Option<&LargeStepJoint> {
         match self.joint(entity)? {
-            HingeJoint::LargeStep(h) => self.large_step.get(h),
+            HingeJoint::LargeStep(h) => self.world.large_step.get(h),
             _ => None,
         }
     }
 
     /// Simulated time, s.
     pub fn time(&self) -> f64 {
-        self.stepper.time()
+        self.world.time()
     }
 
     /// Steps taken.
     pub fn steps(&self) -> u64 {
-        self.stepper.steps()
+        self.world.steps()
     }
 
     /// The first error of the systems, if any. While it is set the systems do nothing: the
@@ -183,14 +176,14 @@ impl Physics {
     /// The clearance joint of a [`ClearanceHinge`](super::ClearanceHinge) entity.
     pub fn clearance_joint(&self, entity: Entity) -> Option<&ClearanceJoint> {
         match self.joint(entity)? {
-            HingeJoint::Clearance(h) => self.clearance.get(h),
+            HingeJoint::Clearance(h) => self.world.clearance.get(h),
             HingeJoint::Ideal(_) | HingeJoint::LargeStep(_) => None,
         }
     }
 
     /// The drive of a [`Drive`] entity.
     pub fn drive(&self, entity: Entity) -> Option<&TorsionSpring> {
-        self.drives.get(&entity)?.set.drives().first()
+        self.world.drives.get(self.drives.get(&entity)?.handle)
     }
 
     /// Records `error` unless one is already set (the first error is the cause).
@@ -219,7 +212,7 @@ impl Physics {
         self.remove_body(entity);
         self.changed = true;
         self.hinges_stale = true;
-        let h = self.world.bodies.insert(body);
+        let h = self.world.rapier.bodies.insert(body);
         self.bodies.insert(entity, h);
         h
     }
@@ -227,7 +220,7 @@ impl Physics {
     /// Makes the existing Rapier body `handle` the body of `entity` (its previous body goes, as
     /// on removal).
     pub(super) fn adopt_body(&mut self, entity: Entity, handle: RigidBodyHandle) -> Result<()> {
-        if !self.world.bodies.contains(handle) {
+        if !self.world.rapier.bodies.contains(handle) {
             return Err(Error::invalid(
                 format!("body {entity}"),
                 format!("no rigid body with handle {handle:?} in the Rapier world"),
@@ -272,7 +265,7 @@ impl Physics {
         for e in driven {
             self.unrealize_drive(e);
         }
-        let w = &mut self.world;
+        let w = &mut self.world.rapier;
         w.bodies.remove(
             handle,
             &mut w.islands,
@@ -300,31 +293,24 @@ impl Physics {
             self.changed = true;
             match h.joint {
                 HingeJoint::Ideal(j) => {
-                    self.world.impulse_joints.remove(j, true);
+                    self.world.rapier.impulse_joints.remove(j, true);
                 }
                 HingeJoint::Clearance(c) => {
-                    self.clearance.remove(
-                        c,
-                        &mut self.world.bodies,
-                        &mut self.world.impulse_joints,
-                    );
+                    self.world.remove_clearance(c);
                 }
                 HingeJoint::LargeStep(k) => {
-                    self.large_step.remove(
-                        k,
-                        &mut self.world.bodies,
-                        &mut self.world.impulse_joints,
-                    );
+                    self.world.remove_large_step(k);
                 }
             }
         }
     }
 
-    /// Takes back the last torques of drive `entity` and forgets it.
+    /// Removes the drive of `entity` (its torques act during the steps only: nothing to take
+    /// back from the bodies).
     fn unrealize_drive(&mut self, entity: Entity) {
-        if let Some(mut d) = self.drives.remove(&entity) {
+        if let Some(d) = self.drives.remove(&entity) {
             self.changed = true;
-            d.set.take_back(&mut self.world.bodies);
+            self.world.remove_drive(d.handle);
         }
     }
 
@@ -342,13 +328,13 @@ impl Physics {
         if let Some(Some(c)) = desired
             && c.model != ClearanceModel::LargeStep
         {
-            check_compliant(&self.world, entity)?;
+            check_compliant(&self.world.rapier, entity)?;
         }
         if let Some(r) = self.hinges.get(&entity) {
             let same_place = r.bodies == bodies && r.frame == *frame;
             let w = &mut self.world;
-            // The swaps, in place: the plain API's conversions. A large-step joint is no force
-            // source, so only the compliant swaps make the stepper evaluate its forces again.
+            // The swaps, in place: the plain API's conversions. The world sees the sets' sizes
+            // change; the compliant swaps also mark the forces for evaluation (`changed`).
             let swapped = match (r.joint, desired) {
                 (HingeJoint::Ideal(_), Some(None)) if same_place => return Ok(()),
                 (HingeJoint::Clearance(_) | HingeJoint::LargeStep(_), Some(Some(c)))
@@ -359,41 +345,41 @@ impl Physics {
                 (HingeJoint::Ideal(j), Some(Some(c)))
                     if same_place && c.model == ClearanceModel::LargeStep =>
                 {
-                    let h = self
+                    let h = w
                         .large_step
                         .convert_revolute(
                             j,
                             BearingSide::Body1,
                             named(c, entity),
-                            &mut w.impulse_joints,
+                            &mut w.rapier.impulse_joints,
                         )
                         .map_err(context)?;
                     Some((HingeJoint::LargeStep(h), Some(c)))
                 }
                 (HingeJoint::LargeStep(k), Some(None)) if same_place => {
-                    let j = self
+                    let j = w
                         .large_step
-                        .revert_to_revolute(k, &mut w.bodies, &mut w.impulse_joints)
+                        .revert_to_revolute(k, &mut w.rapier.bodies, &mut w.rapier.impulse_joints)
                         .map_err(context)?;
                     Some((HingeJoint::Ideal(j), None))
                 }
                 (HingeJoint::Ideal(j), Some(Some(c))) if same_place => {
-                    let h = self
+                    let h = w
                         .clearance
                         .convert_revolute(
                             j,
                             BearingSide::Body1,
                             named(c, entity),
-                            &mut w.impulse_joints,
+                            &mut w.rapier.impulse_joints,
                         )
                         .map_err(context)?;
                     self.changed = true;
                     Some((HingeJoint::Clearance(h), Some(c)))
                 }
                 (HingeJoint::Clearance(k), Some(None)) if same_place => {
-                    let j = self
+                    let j = w
                         .clearance
-                        .revert_to_revolute(k, &mut w.bodies, &mut w.impulse_joints)
+                        .revert_to_revolute(k, &mut w.rapier.bodies, &mut w.rapier.impulse_joints)
                         .map_err(context)?;
                     self.changed = true;
                     Some((HingeJoint::Ideal(j), None))
@@ -421,7 +407,7 @@ impl Physics {
         );
         let w = &mut self.world;
         let joint = match clearance {
-            None => HingeJoint::Ideal(w.impulse_joints.insert(
+            None => HingeJoint::Ideal(w.rapier.impulse_joints.insert(
                 bodies.0,
                 bodies.1,
                 frame.revolute(),
@@ -431,21 +417,11 @@ impl Physics {
                 let joint = named(c, entity)
                     .large_step_joint(a1, a2, x1, x2)
                     .map_err(context)?;
-                HingeJoint::LargeStep(self.large_step.insert(
-                    bodies.0,
-                    bodies.1,
-                    joint,
-                    &mut w.impulse_joints,
-                ))
+                HingeJoint::LargeStep(w.insert_large_step(bodies.0, bodies.1, joint))
             }
             Some(c) => {
                 let joint = named(c, entity).joint(a1, a2, x1, x2).map_err(context)?;
-                HingeJoint::Clearance(self.clearance.insert(
-                    bodies.0,
-                    bodies.1,
-                    joint,
-                    &mut w.impulse_joints,
-                ))
+                HingeJoint::Clearance(w.insert_clearance(bodies.0, bodies.1, joint))
             }
         };
         self.changed = true;
@@ -486,13 +462,12 @@ impl Physics {
             drive.stiffness,
         )
         .map_err(|e| e.within(&format!("drive {entity}")))?;
-        let mut set = DriveSet::new();
-        set.insert(spring);
+        let handle = self.world.insert_drive(spring);
         self.changed = true;
         self.drives.insert(
             entity,
             RealizedDrive {
-                set,
+                handle,
                 drive: *drive,
                 bodies,
                 axis: frame.local_axis1,
@@ -503,99 +478,53 @@ impl Physics {
 
     // ----- The step -----
 
-    /// Evaluates the force sources at the current state when the stepper needs it (see
+    /// Evaluates the joints and drives at the current state when the stepper needs it (see
     /// [`apply_forces`](super::apply_forces)).
     pub(super) fn prepare_forces(&mut self) -> Result<()> {
-        let Physics {
-            world,
-            clearance,
-            drives,
-            stepper,
-            changed,
-            ..
-        } = self;
-        if std::mem::take(changed) {
-            stepper.invalidate(false);
+        if std::mem::take(&mut self.changed) {
+            self.world.invalidate(false);
         }
-        follow_dt(stepper, world);
-        stepper.prepare(world, &mut sources(clearance, drives))
+        follow_dt(&mut self.world);
+        self.world.prepare()
     }
 
-    /// One accepted step of the stepper, at most `integration_parameters.dt` long.
+    /// One accepted step of the world's step control, at most `integration_parameters.dt` long.
     pub(super) fn step(&mut self) -> Result<()> {
-        let Physics {
-            world,
-            clearance,
-            drives,
-            stepper,
-            ..
-        } = self;
-        let dt = world.integration_parameters.dt;
-        follow_dt(stepper, world);
-        let until = stepper.time() + dt;
-        let result = stepper.step(world, &mut sources(clearance, drives), until);
+        let dt = self.world.rapier.integration_parameters.dt;
+        follow_dt(&mut self.world);
+        let until = self.world.time() + dt;
+        let result = self.world.step(until);
         // Rapier's `dt` as the user set it (the stepper sets it per step).
-        world.integration_parameters.dt = dt;
+        self.world.rapier.integration_parameters.dt = dt;
         result.map(|_| ()).map_err(|mut e| {
             if let Error::StepTooLarge { field, .. } = &mut e {
-                *field = "Physics::world.integration_parameters.dt".into();
+                *field = "Physics::world.rapier.integration_parameters.dt".into();
             }
             e
         })
     }
 
-    /// [`LargeStepJointSet::before_step`]: substeps, friction motors.
-    pub(super) fn prepare_large_step(&mut self) {
-        let w = &mut self.world;
-        self.large_step.before_step(
-            &mut w.bodies,
-            &mut w.impulse_joints,
-            &w.integration_parameters,
-        );
-    }
-
-    /// [`LargeStepJointSet::after_step`]: readout and the impacts' bounce.
-    pub(super) fn finish_large_step(&mut self) {
-        let w = &mut self.world;
-        self.large_step.after_step(&mut w.bodies, &w.impulse_joints);
-    }
-
-    /// The exact reaction force magnitude of each ideal hinge at the current state (the runner's
-    /// piece, [`ReactionSolver`]), N; empty when the solver fails.
-    /// The ideal hinges' reaction magnitudes, N, by entity. A solve that fails (a non-finite
-    /// state or mass) is an error, never a zero force.
+    /// The ideal hinges' reaction magnitudes, N, by entity, at the current state
+    /// ([`ClearanceWorld::solve_reactions`], the runner's piece). A solve that fails (a
+    /// non-finite state or mass) is an error, never a zero force.
     pub(super) fn ideal_forces(&mut self) -> Result<BTreeMap<Entity, f64>> {
         self.ideal_joints.clear();
         let mut ideal_entities = Vec::new();
         for (e, r) in &self.hinges {
             if let HingeJoint::Ideal(_) = r.joint {
-                self.ideal_joints.push(IdealRevolute {
+                self.ideal_joints.push(IdealJoint::Revolute(IdealRevolute {
                     body1: r.bodies.0,
                     body2: r.bodies.1,
                     local_anchor1: r.frame.local_anchor1,
                     local_anchor2: r.frame.local_anchor2,
                     local_axis1: r.frame.unit_axis1(),
-                });
+                }));
                 ideal_entities.push(*e);
             }
         }
-        // The sources' wrenches act during the steps only: the solver gets them explicitly.
-        self.source_wrenches.clear();
-        for d in self.drives.values() {
-            self.source_wrenches.extend_from_slice(d.set.wrenches());
-        }
-        self.source_wrenches
-            .extend_from_slice(self.clearance.wrenches());
-        // Rapier's stored velocities are half the last step behind the positions (the runner's
-        // correction, the same solver).
-        self.reactions.velocity_lag = 0.5 * self.stepper.last_dt();
-        self.reactions
-            .solve_with(
-                &self.world.bodies,
-                &self.ideal_joints,
-                self.world.gravity,
-                &self.source_wrenches,
-            )
+        let t = self.world.time();
+        self.world
+            .solve_reactions(&mut self.reactions, &self.ideal_joints)
             .map(|f| {
                 ideal_entities
                     .iter()
@@ -604,7 +533,7 @@ impl Physics {
                     .collect()
             })
             .ok_or_else(|| Error::Diverged {
-                t: self.stepper.time(),
+                t,
                 reason: "the ideal hinges' reactions cannot be solved: the state or a body's \
                          mass is not finite"
                     .into(),
@@ -620,7 +549,7 @@ fn check_compliant(world: &PhysicsWorld, entity: Entity) -> Result<()> {
         return Ok(());
     }
     Err(Error::invalid(
-        "Physics::world.integration_parameters.num_solver_iterations",
+        "Physics::world.rapier.integration_parameters.num_solver_iterations",
         format!(
             "the compliant clearance model of hinge {entity} needs 1 (the world has {n}): its \
              contact force is evaluated once per step and held over it, and Rapier's substeps \
@@ -653,24 +582,10 @@ fn absent<'a>(
 }
 
 /// Fixed steps follow `integration_parameters.dt` as the user sets it, between any two steps.
-fn follow_dt(stepper: &mut Stepper, world: &PhysicsWorld) {
-    let mut control = *stepper.control();
+fn follow_dt(world: &mut ClearanceWorld) {
+    let mut control = *world.step_control();
     if control.mode == StepMode::Fixed {
-        control.max_dt = world.integration_parameters.dt;
-        stepper.set_control(control);
+        control.max_dt = world.rapier.integration_parameters.dt;
+        world.set_step_control(control);
     }
-}
-
-/// The force sources of the ECS world, in a fixed order (drives by entity, then the clearance
-/// joints: the runner's order, so both add forces to a body in the same order, to the bit).
-fn sources<'a>(
-    clearance: &'a mut ClearanceJointSet,
-    drives: &'a mut BTreeMap<Entity, RealizedDrive>,
-) -> Vec<&'a mut dyn ForceSource> {
-    let mut v: Vec<&mut dyn ForceSource> = Vec::with_capacity(1 + drives.len());
-    for d in drives.values_mut() {
-        v.push(&mut d.set);
-    }
-    v.push(clearance);
-    v
 }

@@ -1,10 +1,7 @@
 //! The order of a physics step ([`PhysicsSet`]) and the schedule that runs it.
 
 use super::physics::Physics;
-use super::systems::{
-    apply_forces, finish_large_step, prepare_large_step, record, step_physics, sync_bodies,
-    sync_hinges,
-};
+use super::systems::{apply_forces, record, step_physics, sync_bodies, sync_hinges};
 use crate::error::{Error, Result};
 use bevy_ecs::prelude::*;
 
@@ -38,12 +35,6 @@ pub fn add_physics_systems(schedule: &mut Schedule) {
         apply_forces.in_set(PhysicsSet::Forces),
         step_physics.in_set(PhysicsSet::Step),
         record.in_set(PhysicsSet::Record),
-    ));
-    schedule.add_systems((
-        prepare_large_step
-            .in_set(PhysicsSet::Forces)
-            .after(apply_forces),
-        finish_large_step.in_set(PhysicsSet::Record).before(record),
     ));
 }
 

@@ -1,7 +1,8 @@
 //! The systems of a physics step, in [`PhysicsSet`](super::PhysicsSet) order: components to
 //! Rapier ([`sync_bodies`], [`sync_hinges`]), the forces and the step ([`apply_forces`],
-//! [`prepare_large_step`], [`step_physics`], [`finish_large_step`]), and Rapier back to the
-//! components ([`record`]). Each does nothing while [`Physics::error`] is set. Entities are
+//! [`step_physics`]: the [`ClearanceWorld`](crate::rapier::world::ClearanceWorld)'s, which runs
+//! every joint set's hooks, the large-step joints' included), and Rapier back to the components
+//! ([`record`]). Each does nothing while [`Physics::error`] is set. Entities are
 //! visited in order, so that Rapier sees the same calls in the same order on every run.
 
 use super::components::{
@@ -125,7 +126,7 @@ pub fn sync_hinges(
             Some(HingeJoint::LargeStep(_)) => HingeMode::LargeStep,
         };
         if !state.angle_tracker.has_reference() {
-            let w = &physics.world.bodies;
+            let w = &physics.world.rapier.bodies;
             if let (Some(r1), Some(r2)) = (w.get(bodies.0), w.get(bodies.1)) {
                 state
                     .angle_tracker
@@ -148,8 +149,8 @@ pub fn apply_forces(mut physics: ResMut<Physics>) {
     }
 }
 
-/// One accepted step of the [`Stepper`](crate::rapier::stepper::Stepper) (fixed steps of
-/// `world.integration_parameters.dt` unless [`Physics::set_step_control`] chose otherwise):
+/// One accepted step of the [`ClearanceWorld`](crate::rapier::world::ClearanceWorld) (fixed steps
+/// of `world.rapier.integration_parameters.dt` unless [`Physics::set_step_control`] chose otherwise):
 /// variable-step consistent kicks, step acceptance, guards. An error stops the systems where the
 /// state was last valid.
 pub fn step_physics(mut physics: ResMut<Physics>) {
@@ -159,26 +160,6 @@ pub fn step_physics(mut physics: ResMut<Physics>) {
     if let Err(e) = physics.step() {
         physics.fail(e);
     }
-}
-
-/// Prepares the large-step clearance joints for the step
-/// ([`LargeStepJointSet::before_step`](crate::rapier::large_step::LargeStepJointSet::before_step):
-/// substeps, friction motors).
-pub fn prepare_large_step(mut physics: ResMut<Physics>) {
-    if physics.error().is_some() {
-        return;
-    }
-    physics.prepare_large_step();
-}
-
-/// Finishes the step for the large-step clearance joints
-/// ([`LargeStepJointSet::after_step`](crate::rapier::large_step::LargeStepJointSet::after_step):
-/// readout and the impacts' bounce), before [`record`].
-pub fn finish_large_step(mut physics: ResMut<Physics>) {
-    if physics.error().is_some() {
-        return;
-    }
-    physics.finish_large_step();
 }
 
 /// Copies the state of the step into [`HingeState`] and [`BodyState`].
@@ -198,7 +179,7 @@ pub fn record(
         }
     };
     let physics = &*physics;
-    let w = &physics.world;
+    let w = &physics.world.rapier;
     for (body, mut state) in bodies.iter_mut() {
         if let Some(rb) = body.handle.and_then(|h| w.bodies.get(h)) {
             *state = BodyState {

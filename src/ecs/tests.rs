@@ -31,7 +31,11 @@ fn arm_at(x: f64) -> Body {
 fn pendulum(dt: f64) -> (World, Schedule, Entity, Entity) {
     let mut world = World::new();
     let mut physics = Physics::new(dt, Vector::new(0.0, -9.81, 0.0));
-    physics.world.integration_parameters.num_solver_iterations = 1;
+    physics
+        .world
+        .rapier
+        .integration_parameters
+        .num_solver_iterations = 1;
     world.insert_resource(physics);
     let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
     let arm = world.spawn(arm_at(0.0)).id();
@@ -57,7 +61,7 @@ fn swapping_the_mode_converts_the_rapier_joint_both_ways() {
     steps(&mut world, &mut schedule, 10).unwrap();
     let p = world.resource::<Physics>();
     assert!(matches!(p.joint(hinge), Some(HingeJoint::Ideal(_))));
-    assert_eq!(p.world.impulse_joints.len(), 1);
+    assert_eq!(p.world.rapier.impulse_joints.len(), 1);
     assert_eq!(
         world.get::<HingeState>(hinge).unwrap().mode,
         HingeMode::Ideal
@@ -73,7 +77,7 @@ fn swapping_the_mode_converts_the_rapier_joint_both_ways() {
     let j = p.clearance_joint(hinge).expect("converted");
     assert_eq!(j.local_anchor2(), Vector::new(0.0, 0.3, 0.0));
     assert_eq!(p.clearance().len(), 1);
-    assert_eq!(p.world.impulse_joints.len(), 1, "only the lock");
+    assert_eq!(p.world.rapier.impulse_joints.len(), 1, "only the lock");
     let s = world.get::<HingeState>(hinge).unwrap();
     assert_eq!(s.mode, HingeMode::Clearance);
     assert!(s.impacts > 0);
@@ -89,7 +93,7 @@ fn swapping_the_mode_converts_the_rapier_joint_both_ways() {
     let p = world.resource::<Physics>();
     assert!(p.clearance().is_empty());
     assert!(matches!(p.joint(hinge), Some(HingeJoint::Ideal(_))));
-    let rb = &p.world.bodies[p.body(arm).unwrap()];
+    let rb = &p.world.rapier.bodies[p.body(arm).unwrap()];
     assert_eq!(rb.user_force(), Vector::ZERO);
     assert_eq!(rb.user_torque(), Vector::ZERO);
 
@@ -98,7 +102,7 @@ fn swapping_the_mode_converts_the_rapier_joint_both_ways() {
     steps(&mut world, &mut schedule, 100).unwrap();
     let p = world.resource::<Physics>();
     assert_eq!(p.joint(hinge), None);
-    assert_eq!(p.world.impulse_joints.len(), 0);
+    assert_eq!(p.world.rapier.impulse_joints.len(), 0);
     assert_eq!(
         world.get::<HingeState>(hinge).unwrap().mode,
         HingeMode::None
@@ -172,7 +176,7 @@ fn bodies_of_an_existing_rapier_world_by_handle() {
     steps(&mut world, &mut schedule, 20_000).unwrap();
     let p = world.resource::<Physics>();
     assert_eq!(p.body(a), Some(arm));
-    assert_eq!(p.world.bodies.len(), 2);
+    assert_eq!(p.world.rapier.bodies.len(), 2);
     // PhysicsWorld::new() has Rapier's default gravity, -9.81 along y.
     let s = world.get::<HingeState>(hinge).unwrap();
     assert!((s.force - 19.62).abs() < 0.02, "{}", s.force);
@@ -199,8 +203,8 @@ fn despawning_a_hinge_with_its_body_removes_them_from_rapier() {
     world.despawn(arm);
     steps(&mut world, &mut schedule, 10).unwrap();
     let p = world.resource::<Physics>();
-    assert_eq!(p.world.bodies.len(), 1, "the base is left");
-    assert_eq!(p.world.impulse_joints.len(), 0);
+    assert_eq!(p.world.rapier.bodies.len(), 1, "the base is left");
+    assert_eq!(p.world.rapier.impulse_joints.len(), 0);
     assert!(p.clearance().is_empty());
     assert!(p.drive(hinge).is_none());
 }
@@ -241,7 +245,7 @@ fn removing_a_drive_takes_back_its_torque_exactly() {
     steps(&mut world, &mut schedule, 1).unwrap();
     let p = world.resource::<Physics>();
     for e in [a, b] {
-        let rb = &p.world.bodies[p.body(e).unwrap()];
+        let rb = &p.world.rapier.bodies[p.body(e).unwrap()];
         assert_eq!(rb.user_torque(), Vector::ZERO, "torque left on {e}");
     }
 }
@@ -276,7 +280,7 @@ fn errors_are_values_and_stop_the_systems() {
     let e = steps(&mut world, &mut schedule, 2_000).unwrap_err();
     match &e {
         Error::StepTooLarge { field, t, .. } => {
-            assert_eq!(field, "Physics::world.integration_parameters.dt");
+            assert_eq!(field, "Physics::world.rapier.integration_parameters.dt");
             assert!(t.is_some_and(|t| t.is_finite() && t > 0.0));
         }
         other => panic!("expected StepTooLarge, got {other}"),
@@ -341,6 +345,7 @@ fn large_step_hinge_at_game_rate_with_rapiers_defaults() {
     world
         .resource_mut::<Physics>()
         .world
+        .rapier
         .integration_parameters
         .num_solver_iterations = 4;
     let large = clearance()
@@ -355,7 +360,7 @@ fn large_step_hinge_at_game_rate_with_rapiers_defaults() {
     assert!(p.clearance().is_empty());
     assert_eq!(p.large_step().len(), 1);
     assert_eq!(
-        p.world.impulse_joints.len(),
+        p.world.rapier.impulse_joints.len(),
         1,
         "the revolute became the play joint"
     );
@@ -377,7 +382,7 @@ fn large_step_hinge_at_game_rate_with_rapiers_defaults() {
     let p = world.resource::<Physics>();
     assert!(p.large_step().is_empty());
     assert!(matches!(p.joint(hinge), Some(HingeJoint::Ideal(_))));
-    let rb = &p.world.bodies[p.body(arm).unwrap()];
+    let rb = &p.world.rapier.bodies[p.body(arm).unwrap()];
     assert_eq!(rb.additional_solver_iterations(), 0, "substeps handed back");
     world.entity_mut(hinge).insert(ClearanceHinge(large));
     steps(&mut world, &mut schedule, 2).unwrap();
@@ -387,8 +392,16 @@ fn large_step_hinge_at_game_rate_with_rapiers_defaults() {
     );
     // Compliant <-> large step: the model change rebuilds the joint.
     world.entity_mut(hinge).insert(ClearanceHinge(clearance()));
-    world.resource_mut::<Physics>().world.integration_parameters = {
-        let mut p = world.resource::<Physics>().world.integration_parameters;
+    world
+        .resource_mut::<Physics>()
+        .world
+        .rapier
+        .integration_parameters = {
+        let mut p = world
+            .resource::<Physics>()
+            .world
+            .rapier
+            .integration_parameters;
         p.num_solver_iterations = 1;
         p.dt = 1e-5;
         p
@@ -410,8 +423,11 @@ fn the_worlds_settings_stay_the_users() {
     let defaults = PhysicsWorld::new().integration_parameters;
     let mut expected = defaults;
     expected.dt = 1e-3;
-    assert_eq!(p.world.integration_parameters, expected);
-    assert_eq!(p.world.integration_parameters.num_solver_iterations, 4);
+    assert_eq!(p.world.rapier.integration_parameters, expected);
+    assert_eq!(
+        p.world.rapier.integration_parameters.num_solver_iterations,
+        4
+    );
 
     // A compliant hinge in a world with 4 iterations is refused, naming the setting, why and
     // the way out; the world and the hinge stay as they were.
@@ -420,12 +436,13 @@ fn the_worlds_settings_stay_the_users() {
     world
         .resource_mut::<Physics>()
         .world
+        .rapier
         .integration_parameters
         .num_solver_iterations = 4;
     world.entity_mut(hinge).insert(ClearanceHinge(clearance()));
     let msg = run_step(&mut world, &mut schedule).unwrap_err().to_string();
     for needle in [
-        "Physics::world.integration_parameters.num_solver_iterations",
+        "Physics::world.rapier.integration_parameters.num_solver_iterations",
         &format!("hinge {hinge} needs 1 (the world has 4)"),
         "gain energy",
         "ClearanceModel::LargeStep",
@@ -433,13 +450,17 @@ fn the_worlds_settings_stay_the_users() {
         assert!(msg.contains(needle), "{needle:?} not in: {msg}");
     }
     let p = world.resource::<Physics>();
-    assert_eq!(p.world.integration_parameters.num_solver_iterations, 4);
+    assert_eq!(
+        p.world.rapier.integration_parameters.num_solver_iterations,
+        4
+    );
     assert!(matches!(p.joint(hinge), Some(HingeJoint::Ideal(_))));
     assert!(p.clearance().is_empty());
     // Set up by the user, the same hinge is realised.
     world
         .resource_mut::<Physics>()
         .world
+        .rapier
         .integration_parameters
         .num_solver_iterations = 1;
     steps(&mut world, &mut schedule, 2).unwrap();
@@ -620,10 +641,10 @@ fn stack_beside_a_sign(iterations: usize) -> Vector {
     );
     let p = world.resource::<Physics>();
     assert_eq!(
-        p.world.integration_parameters.num_solver_iterations, iterations,
+        p.world.rapier.integration_parameters.num_solver_iterations, iterations,
         "the layer left the setting as it was"
     );
-    p.world.bodies[top].translation()
+    p.world.rapier.bodies[top].translation()
 }
 
 #[test]

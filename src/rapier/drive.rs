@@ -2,7 +2,10 @@
 
 use crate::error::{Result, finite, non_negative, unit_vector};
 use crate::model::angle::HingeAngle;
+use crate::rapier::arena::OrderedArena;
 use crate::rapier::ledger::{ForceLedger, Wrench};
+use crate::rapier::step_hooks::StepHooks;
+use rapier3d_f64::data::Index;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
 
@@ -87,10 +90,19 @@ impl TorsionSpring {
     }
 }
 
-/// All drives of a world; [`DriveSet::apply`] is called before every step.
+/// Handle of a drive in a [`DriveSet`], returned by its [`insert`](DriveSet::insert):
+/// generational, as the joint sets' handles (removing a drive never changes another's handle;
+/// the handle of a removed drive finds nothing ever after).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct DriveHandle(Index);
+
+/// All drives of a world, visited in insertion order. Under the
+/// [`Stepper`](crate::rapier::stepper::Stepper) (or a
+/// [`ClearanceWorld`](crate::rapier::world::ClearanceWorld)) their torques act during the steps
+/// only; a loop that calls `world.step()` itself calls [`DriveSet::apply`] before every step.
 #[derive(Clone, Debug, Default)]
 pub struct DriveSet {
-    drives: Vec<TorsionSpring>,
+    drives: OrderedArena<TorsionSpring>,
     ledger: ForceLedger,
     wrenches: Vec<Wrench>,
     saved: Vec<(HingeAngle, f64)>,
@@ -102,14 +114,34 @@ impl DriveSet {
     pub fn new() -> Self {
         Self::default()
     }
-    /// Adds a drive; returns its index.
-    pub fn insert(&mut self, drive: TorsionSpring) -> usize {
-        self.drives.push(drive);
-        self.drives.len() - 1
+    /// Adds a drive; returns its handle.
+    pub fn insert(&mut self, drive: TorsionSpring) -> DriveHandle {
+        DriveHandle(self.drives.insert(drive))
     }
-    /// The drives.
-    pub fn drives(&self) -> &[TorsionSpring] {
-        &self.drives
+    /// Removes the drive and returns it (`None` for a handle of no drive of this set); the others
+    /// keep their handles and order. Its torque leaves the next evaluation (a loop that applies
+    /// the torques itself calls [`apply`](Self::apply) or [`take_back`](Self::take_back)).
+    pub fn remove(&mut self, handle: DriveHandle) -> Option<TorsionSpring> {
+        let d = self.drives.remove(handle.0)?;
+        // A saved state is by position: it no longer matches the drives.
+        self.saved.clear();
+        Some(d)
+    }
+    /// The drive behind `handle` (`None` once it was removed).
+    pub fn get(&self, handle: DriveHandle) -> Option<&TorsionSpring> {
+        self.drives.get(handle.0)
+    }
+    /// The drives with their handles, in insertion order.
+    pub fn iter(&self) -> impl Iterator<Item = (DriveHandle, &TorsionSpring)> {
+        self.drives.iter().map(|(i, d)| (DriveHandle(i), d))
+    }
+    /// Number of drives.
+    pub fn len(&self) -> usize {
+        self.drives.len()
+    }
+    /// Whether the set is empty.
+    pub fn is_empty(&self) -> bool {
+        self.drives.is_empty()
     }
     /// Replaces the torques applied at the previous call by the current ones (for a loop that
     /// calls `world.step()` itself; the [`Stepper`](crate::rapier::stepper::Stepper) uses
@@ -123,7 +155,7 @@ impl DriveSet {
     /// touching the bodies' forces.
     pub fn evaluate(&mut self, bodies: &RigidBodySet) {
         self.wrenches.clear();
-        for d in &mut self.drives {
+        for d in self.drives.values_mut() {
             if let Some((w1, w2)) = d.evaluate(bodies) {
                 self.wrenches.push(w1);
                 self.wrenches.push(w2);
@@ -143,16 +175,16 @@ impl DriveSet {
     }
 
     /// Saves the angle trackers and applied torques (before a step that may be rejected).
-    pub fn save_state(&mut self) {
+    pub(crate) fn save_state(&mut self) {
         self.saved.clear();
         self.saved
-            .extend(self.drives.iter().map(|d| (d.angle, d.last_torque)));
+            .extend(self.drives.values().map(|d| (d.angle, d.last_torque)));
         self.saved_wrenches.clone_from(&self.wrenches);
     }
 
     /// Restores what [`save_state`](Self::save_state) saved.
-    pub fn restore_state(&mut self) {
-        for (d, &(angle, torque)) in self.drives.iter_mut().zip(&self.saved) {
+    pub(crate) fn restore_state(&mut self) {
+        for (d, &(angle, torque)) in self.drives.values_mut().zip(&self.saved) {
             d.angle = angle;
             d.last_torque = torque;
         }
@@ -162,8 +194,25 @@ impl DriveSet {
     /// Total potential energy of the springs at their last measured angles, J.
     pub fn potential_energy(&self) -> f64 {
         self.drives
-            .iter()
+            .values()
             .map(|d| d.potential_energy(d.angle()))
             .sum()
+    }
+}
+
+/// The drives take part in the stepper's steps: their torques, saved and restored with a rejected
+/// step ([`crate::rapier::step_hooks`]).
+impl StepHooks for DriveSet {
+    fn evaluate(&mut self, bodies: &mut RigidBodySet) {
+        DriveSet::evaluate(self, bodies);
+    }
+    fn wrenches(&self) -> &[Wrench] {
+        DriveSet::wrenches(self)
+    }
+    fn save_state(&mut self) {
+        DriveSet::save_state(self);
+    }
+    fn restore_state(&mut self) {
+        DriveSet::restore_state(self);
     }
 }

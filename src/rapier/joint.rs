@@ -10,9 +10,11 @@ use crate::model::laws::{
     crossing_fraction, loaded_impact_rate, speed_at_crossing,
 };
 use crate::rapier::arena::OrderedArena;
+use crate::rapier::guards::{GuardKind, GuardReport, Violation};
 use crate::rapier::ledger::{
     ForceLedger, Wrench, ensure_mass_properties, inverse_mass_along, world_center_of_mass,
 };
+use crate::rapier::stall::StalledContact;
 use rapier3d_f64::data::Index;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
@@ -932,7 +934,7 @@ impl ClearanceJointSet {
 
     /// Saves every joint's contact history and report and its last wrenches (before a step that
     /// may be rejected; no allocation after the first call).
-    pub fn save_state(&mut self) {
+    pub(crate) fn save_state(&mut self) {
         self.saved.clear();
         self.saved
             .extend(self.joints.values().map(|j| j.dynamics()));
@@ -940,7 +942,7 @@ impl ClearanceJointSet {
     }
 
     /// Restores what [`save_state`](Self::save_state) saved.
-    pub fn restore_state(&mut self) {
+    pub(crate) fn restore_state(&mut self) {
         for (j, d) in self.joints.values_mut().zip(&self.saved) {
             j.set_dynamics(*d);
         }
@@ -949,7 +951,7 @@ impl ClearanceJointSet {
 
     /// [`ClearanceJoint::judge_step`] over all joints, with their contact state saved by the last
     /// [`save_state`](Self::save_state): the shortest retry step asked for, if any.
-    pub fn judge_step(&self, dt: f64, tolerance: f64) -> Option<f64> {
+    pub(crate) fn judge_step(&self, dt: f64, tolerance: f64) -> Option<f64> {
         self.joints
             .values()
             .enumerate()
@@ -975,6 +977,72 @@ impl ClearanceJointSet {
             .values()
             .map(|j| j.report.max_stable_dt)
             .fold(f64::INFINITY, f64::min)
+    }
+}
+
+/// The clearance joints take part in the stepper's steps: their contact forces, step limits,
+/// acceptance and guards ([`crate::rapier::step_hooks`]).
+impl crate::rapier::step_hooks::StepHooks for ClearanceJointSet {
+    fn evaluate(&mut self, bodies: &mut RigidBodySet) {
+        ClearanceJointSet::evaluate(self, bodies);
+    }
+    fn wrenches(&self) -> &[Wrench] {
+        ClearanceJointSet::wrenches(self)
+    }
+    fn save_state(&mut self) {
+        ClearanceJointSet::save_state(self);
+    }
+    fn restore_state(&mut self) {
+        ClearanceJointSet::restore_state(self);
+    }
+    fn check_world(&self, params: &IntegrationParameters) -> Result<()> {
+        self.check_substeps(params)
+    }
+    fn step_limit(&self, tolerance: f64, last_dt: f64) -> f64 {
+        self.adaptive_step(tolerance, last_dt)
+    }
+    fn check_step(&self, dt: f64) -> Result<()> {
+        ClearanceJointSet::check_step(self, dt)
+    }
+    fn judge_step(&self, dt: f64, tolerance: f64) -> Option<f64> {
+        ClearanceJointSet::judge_step(self, dt, tolerance)
+    }
+    fn record_guards(&self, guards: &mut GuardReport, t: f64, dt: f64, fixed: bool) {
+        for (handle, j) in self.iter() {
+            let limit = j.report().friction_stable_dt;
+            if fixed && dt > limit {
+                guards.record(
+                    Violation::new(GuardKind::Friction, dt / limit, 1.0, t)
+                        .joint(j.name(), Some(handle))
+                        .note(format!(
+                            "step {} s, friction's limit {} s",
+                            crate::error::sig4(dt),
+                            crate::error::sig4(limit)
+                        )),
+                );
+            }
+            let (depth, valid) = (j.report().state.penetration, j.max_valid_penetration());
+            let ratio = depth / valid;
+            if ratio > guards.worst_penetration_ratio {
+                guards.worst_penetration_ratio = ratio;
+            }
+            if ratio > 1.0 {
+                guards.record(
+                    Violation::new(GuardKind::Penetration, depth, valid, t)
+                        .joint(j.name(), Some(handle)),
+                );
+            }
+        }
+    }
+    fn stalled_contact(&self, bodies: &RigidBodySet) -> Option<StalledContact> {
+        crate::rapier::stall::stalled_contact([self], bodies)
+    }
+    fn joints_of(&self, body: RigidBodyHandle, names: &mut Vec<String>) {
+        for (_, j) in self.iter() {
+            if j.body1() == body || j.body2() == body {
+                names.push(format!("clearance joint `{}`", j.name()));
+            }
+        }
     }
 }
 

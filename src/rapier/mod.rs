@@ -31,4 +31,6 @@ pub mod prescribed;
 pub mod reaction;
 pub mod replay;
 pub mod stall;
+pub mod step_hooks;
 pub mod stepper;
+pub mod world;

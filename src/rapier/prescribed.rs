@@ -2,16 +2,16 @@
 //! through a point, or moved by a tabulated position along a direction, interpolated smoothly
 //! (cubic Hermite, continuous slope: [`Table`]).
 //!
-//! A [`PrescribedSet`] is a [`ForceSource`] that applies no force:
+//! A [`PrescribedSet`] takes part in the stepper's steps ([`StepHooks`]) but applies no force:
 //! before each Rapier step the [`Stepper`](crate::rapier::stepper::Stepper) hands it the step's start and
 //! length, and it sets each body's next pose at the step's end (Rapier's position-based kinematic
 //! bodies then move there, their velocity being the step's mean). Poses are exact at every
 //! state, whatever the step.
 
 use crate::error::{Error, Result};
-use crate::rapier::stepper::ForceSource;
+use crate::rapier::step_hooks::StepHooks;
 use rapier3d_f64::math::{Pose, Rotation, Vector};
-use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
+use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle};
 
 /// A value against time, interpolated by cubic Hermite segments with slopes from the neighbours
 /// (`(v[i+1] - v[i-1]) / (t[i+1] - t[i-1])`, one-sided at the ends): the value and its rate are
@@ -191,7 +191,7 @@ impl PrescribedMotion {
     }
 }
 
-/// The tabulated motions of a world, as a force source for the stepper (it sets poses, not
+/// The tabulated motions of a world, a participant in the stepper's steps (it sets poses, not
 /// forces).
 #[derive(Clone, Debug, Default)]
 pub struct PrescribedSet {
@@ -199,16 +199,12 @@ pub struct PrescribedSet {
     pub motions: Vec<PrescribedMotion>,
 }
 
-impl ForceSource for PrescribedSet {
-    fn evaluate(&mut self, _bodies: &mut RigidBodySet) {}
-    fn wrenches(&self) -> &[crate::rapier::ledger::Wrench] {
-        &[]
-    }
-    fn save_state(&mut self) {}
-    fn restore_state(&mut self) {}
-    fn before_rapier_step(&mut self, bodies: &mut RigidBodySet, t0: f64, dt: f64) {
+/// The tabulated motions take part in the stepper's steps: each Rapier step (a retried one
+/// included) gets the bodies' poses at its end time ([`crate::rapier::step_hooks`]).
+impl StepHooks for PrescribedSet {
+    fn before_rapier_step(&mut self, world: &mut PhysicsWorld, t0: f64, dt: f64) {
         for m in &self.motions {
-            if let Some(rb) = bodies.get_mut(m.body) {
+            if let Some(rb) = world.bodies.get_mut(m.body) {
                 rb.set_next_kinematic_position(m.pose(t0 + dt));
             }
         }

@@ -1,6 +1,9 @@
 //! The step control, public: one [`Stepper`] chooses, takes, judges and (when needed) retries
-//! every Rapier step of a world that holds clearance joints. The scene runner and the bevy_ecs
-//! layer use it; a plain-Rapier user calls it in their own loop in place of `world.step()`.
+//! every Rapier step of a world that holds clearance joints. It steps whatever takes part in the
+//! step through the step protocol ([`StepHooks`]: the joint sets, the drives, the prescribed
+//! motions; called the sources here). [`ClearanceWorld`](crate::rapier::world::ClearanceWorld)
+//! bundles it with the sets (the scene runner and the bevy_ecs layer are built on it); a loop that
+//! keeps its sets apart calls [`Stepper::step`] with them in place of `world.step()`.
 //!
 //! What it adds to `PhysicsWorld::step`:
 //! - **Consistent variable steps.** With one solver iteration a Rapier step is symplectic Euler
@@ -72,78 +75,14 @@
 //! ```
 
 use crate::error::{Error, Result};
-use crate::rapier::drive::DriveSet;
-use crate::rapier::joint::ClearanceJointSet;
 use crate::rapier::joint_correction::JointCorrection;
-use crate::rapier::ledger::Wrench;
 use crate::rapier::motion_step::motion_step;
 use rapier3d_f64::math::{Pose, Vector};
 use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle, RigidBodyType};
 use serde::{Deserialize, Serialize};
 
 pub use crate::rapier::guards::{GuardKind, GuardReport, Violation};
-
-/// Something that exerts forces on the bodies of a world, computed from their state:
-/// [`ClearanceJointSet`] and [`DriveSet`] are ones. The [`Stepper`] evaluates it at the state
-/// before each step and adds its wrenches to the bodies for the duration of that step only, so
-/// between steps the bodies carry nothing but your own forces (reset or replace them as you like).
-pub trait ForceSource {
-    /// Evaluates at the bodies' current state (without touching their forces).
-    fn evaluate(&mut self, bodies: &mut rapier3d_f64::prelude::RigidBodySet);
-    /// The wrenches of the last evaluation.
-    fn wrenches(&self) -> &[Wrench];
-    /// Saves the internal state (before a step that may be rejected).
-    fn save_state(&mut self);
-    /// Restores the state saved last (the stepper restores the bodies).
-    fn restore_state(&mut self);
-    /// The clearance joints of this source, for the step choice and acceptance.
-    fn clearance_joints(&self) -> Option<&ClearanceJointSet> {
-        None
-    }
-    /// Called right before each Rapier step (a retried step included) with its start `t0` and
-    /// length `dt`, s: a source that prescribes kinematic motion sets the bodies' next poses here
-    /// ([`PrescribedSet`](crate::rapier::prescribed::PrescribedSet)). Default: nothing.
-    fn before_rapier_step(
-        &mut self,
-        _bodies: &mut rapier3d_f64::prelude::RigidBodySet,
-        _t0: f64,
-        _dt: f64,
-    ) {
-    }
-}
-
-impl ForceSource for ClearanceJointSet {
-    fn evaluate(&mut self, bodies: &mut rapier3d_f64::prelude::RigidBodySet) {
-        ClearanceJointSet::evaluate(self, bodies);
-    }
-    fn wrenches(&self) -> &[Wrench] {
-        ClearanceJointSet::wrenches(self)
-    }
-    fn save_state(&mut self) {
-        ClearanceJointSet::save_state(self);
-    }
-    fn restore_state(&mut self) {
-        ClearanceJointSet::restore_state(self);
-    }
-    fn clearance_joints(&self) -> Option<&ClearanceJointSet> {
-        Some(self)
-    }
-}
-
-impl ForceSource for DriveSet {
-    fn evaluate(&mut self, bodies: &mut rapier3d_f64::prelude::RigidBodySet) {
-        DriveSet::evaluate(self, bodies);
-    }
-    fn wrenches(&self) -> &[Wrench] {
-        DriveSet::wrenches(self)
-    }
-    fn save_state(&mut self) {
-        DriveSet::save_state(self);
-    }
-    fn restore_state(&mut self) {
-        DriveSet::restore_state(self);
-    }
-}
+pub use crate::rapier::step_hooks::StepHooks;
 
 /// How the step is chosen (`run.step` in scene files).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -416,7 +355,7 @@ impl Stepper {
     pub fn prepare(
         &mut self,
         world: &mut PhysicsWorld,
-        sources: &mut [&mut dyn ForceSource],
+        sources: &mut [&mut dyn StepHooks],
     ) -> Result<()> {
         if self.prepared {
             return Ok(());
@@ -424,25 +363,21 @@ impl Stepper {
         self.control.validate()?;
         for s in sources.iter_mut() {
             s.evaluate(&mut world.bodies);
-            if let Some(j) = s.clearance_joints() {
-                j.check_substeps(&world.integration_parameters)?;
-            }
+            s.check_world(&world.integration_parameters)?;
         }
         self.prepared = true;
         Ok(())
     }
 
     /// The step the control would take now, before landing on `until`.
-    fn choose(&self, world: &PhysicsWorld, sources: &[&mut dyn ForceSource]) -> f64 {
+    fn choose(&self, world: &PhysicsWorld, sources: &[&mut dyn StepHooks]) -> f64 {
         let c = &self.control;
         match c.mode {
             StepMode::Fixed => c.max_dt,
             StepMode::Adaptive => {
                 let mut dt = c.max_dt.min(motion_step(world, c.tolerance));
                 for s in sources {
-                    if let Some(j) = s.clearance_joints() {
-                        dt = dt.min(j.adaptive_step(c.tolerance, self.last_dt));
-                    }
+                    dt = dt.min(s.step_limit(c.tolerance, self.last_dt));
                 }
                 if self.last_dt > 0.0 {
                     dt = dt.min(c.max_growth * self.last_dt);
@@ -471,7 +406,7 @@ impl Stepper {
     pub fn step(
         &mut self,
         world: &mut PhysicsWorld,
-        sources: &mut [&mut dyn ForceSource],
+        sources: &mut [&mut dyn StepHooks],
         until: f64,
     ) -> Result<StepInfo> {
         // Cheap, and `set_control` may have changed it since the last step.
@@ -504,9 +439,7 @@ impl Stepper {
                 dt = left;
             }
             for s in sources.iter() {
-                if let Some(j) = s.clearance_joints() {
-                    j.check_step(dt).map_err(|e| self.locate(e))?;
-                }
+                s.check_step(dt).map_err(|e| self.locate(e))?;
             }
         }
         // Save the state: bodies (always: their forces are restored after the scaled step) and,
@@ -517,55 +450,13 @@ impl Stepper {
                 s.save_state();
             }
         }
-        let gravity = world.gravity;
         let mut rejected = 0u32;
         loop {
-            let kick = 0.5 * (self.last_dt + dt);
-            let scale = kick / dt;
-            // For this step only: your forces and the sources' wrenches, scaled to the kick.
-            for b in &self.saved {
-                if let Some(rb) = world.bodies.get_mut(b.handle)
-                    && rb.is_dynamic()
-                    && scale != 1.0
-                {
-                    rb.reset_forces(false);
-                    rb.reset_torques(false);
-                    rb.add_force(b.force * scale, false);
-                    rb.add_torque(b.torque * scale, false);
-                }
-            }
-            for s in sources.iter() {
-                for w in s.wrenches() {
-                    if let Some(rb) = world.bodies.get_mut(w.body)
-                        && rb.is_dynamic()
-                    {
-                        let wake = w.force != Vector::ZERO || w.torque != Vector::ZERO;
-                        rb.add_force(w.force * scale, wake);
-                        rb.add_torque(w.torque * scale, wake);
-                    }
-                }
-            }
-            world.gravity = gravity * scale;
-            world.integration_parameters.dt = dt;
-            for s in sources.iter_mut() {
-                s.before_rapier_step(&mut world.bodies, self.t, dt);
-            }
-            if self.control.joint_correction {
-                self.correction.apply(&mut world.impulse_joints, dt);
-            }
-            world.step();
-            self.correction.restore(&mut world.impulse_joints);
-            world.gravity = gravity;
-            exact_kinematic_poses(world, &self.saved, dt);
-            self.restore_forces(world);
-            for s in sources.iter_mut() {
-                s.evaluate(&mut world.bodies);
-            }
+            let kick = self.take_rapier_step(world, sources, dt);
             let retry = if adaptive {
                 sources
                     .iter()
-                    .filter_map(|s| s.clearance_joints())
-                    .filter_map(|j| j.judge_step(dt, self.control.tolerance))
+                    .filter_map(|s| s.judge_step(dt, self.control.tolerance))
                     .reduce(f64::min)
             } else {
                 None
@@ -592,9 +483,7 @@ impl Stepper {
                     if !adaptive {
                         // The last step is checked too: the contact it ended in.
                         for s in sources.iter() {
-                            if let Some(j) = s.clearance_joints() {
-                                j.check_step(dt).map_err(|e| self.locate(e))?;
-                            }
+                            s.check_step(dt).map_err(|e| self.locate(e))?;
                         }
                     }
                     self.check_health(world, sources, dt)?;
@@ -627,13 +516,71 @@ impl Stepper {
         }
     }
 
+    /// One Rapier step of `dt` from the saved state, with the kick `(h_prev + h)/2`: your forces,
+    /// the sources' wrenches and gravity scaled to the kick for this step only, the sources'
+    /// hooks around it, the joint correction, exact kinematic poses; then the sources evaluated
+    /// at the new state. Returns the kick, s.
+    fn take_rapier_step(
+        &mut self,
+        world: &mut PhysicsWorld,
+        sources: &mut [&mut dyn StepHooks],
+        dt: f64,
+    ) -> f64 {
+        let gravity = world.gravity;
+        let kick = 0.5 * (self.last_dt + dt);
+        let scale = kick / dt;
+        // For this step only: your forces and the sources' wrenches, scaled to the kick.
+        for b in &self.saved {
+            if let Some(rb) = world.bodies.get_mut(b.handle)
+                && rb.is_dynamic()
+                && scale != 1.0
+            {
+                rb.reset_forces(false);
+                rb.reset_torques(false);
+                rb.add_force(b.force * scale, false);
+                rb.add_torque(b.torque * scale, false);
+            }
+        }
+        for s in sources.iter() {
+            for w in s.wrenches() {
+                if let Some(rb) = world.bodies.get_mut(w.body)
+                    && rb.is_dynamic()
+                {
+                    let wake = w.force != Vector::ZERO || w.torque != Vector::ZERO;
+                    rb.add_force(w.force * scale, wake);
+                    rb.add_torque(w.torque * scale, wake);
+                }
+            }
+        }
+        world.gravity = gravity * scale;
+        world.integration_parameters.dt = dt;
+        for s in sources.iter_mut() {
+            s.before_rapier_step(world, self.t, dt);
+        }
+        if self.control.joint_correction {
+            self.correction.apply(&mut world.impulse_joints, dt);
+        }
+        world.step();
+        self.correction.restore(&mut world.impulse_joints);
+        world.gravity = gravity;
+        exact_kinematic_poses(world, &self.saved, dt);
+        self.restore_forces(world);
+        for s in sources.iter_mut() {
+            s.after_rapier_step(world);
+        }
+        for s in sources.iter_mut() {
+            s.evaluate(&mut world.bodies);
+        }
+        kick
+    }
+
     /// Takes a step of the last step's size (or `dt` if none), lets `read` look at the world and
     /// the step, then restores the state before it exactly: e.g. an ideal joint's reaction at
     /// the final time, which only the step after it determines.
     pub fn peek<R>(
         &mut self,
         world: &mut PhysicsWorld,
-        sources: &mut [&mut dyn ForceSource],
+        sources: &mut [&mut dyn StepHooks],
         dt: f64,
         read: impl FnOnce(&PhysicsWorld, &StepInfo) -> R,
     ) -> Result<R> {
@@ -684,7 +631,7 @@ impl Stepper {
     }
 
     /// Puts the bodies and the sources back as they were before the step.
-    fn restore(&self, world: &mut PhysicsWorld, sources: &mut [&mut dyn ForceSource]) {
+    fn restore(&self, world: &mut PhysicsWorld, sources: &mut [&mut dyn StepHooks]) {
         for b in &self.saved {
             if let Some(rb) = world.bodies.get_mut(b.handle) {
                 rb.set_position(b.position, false);
@@ -706,20 +653,22 @@ impl Stepper {
     fn stall_reason(
         &self,
         world: &PhysicsWorld,
-        sources: &[&mut dyn ForceSource],
+        sources: &[&mut dyn StepHooks],
         seen: &str,
     ) -> String {
-        let contact = crate::rapier::stall::stalled_contact(
-            sources.iter().filter_map(|s| s.clearance_joints()),
-            &world.bodies,
-        );
+        // The contact whose step limit is the shortest stops the step control.
+        let limit = |c: &crate::rapier::stall::StalledContact| c.stable_dt.min(c.friction_dt);
+        let contact = sources
+            .iter()
+            .filter_map(|s| s.stalled_contact(&world.bodies))
+            .min_by(|a, b| limit(a).total_cmp(&limit(b)));
         crate::rapier::stall::explain(seen, contact.as_ref(), self.control.min_dt)
     }
 
     fn count_floor(
         &mut self,
         world: &PhysicsWorld,
-        sources: &[&mut dyn ForceSource],
+        sources: &[&mut dyn StepHooks],
         dt: f64,
     ) -> Result<()> {
         if self.control.mode == StepMode::Adaptive && dt <= self.control.min_dt * (1.0 + 1e-9) {
@@ -751,7 +700,7 @@ impl Stepper {
     fn check_health(
         &mut self,
         world: &PhysicsWorld,
-        sources: &[&mut dyn ForceSource],
+        sources: &[&mut dyn StepHooks],
         dt: f64,
     ) -> Result<()> {
         for b in &self.saved {
@@ -770,37 +719,9 @@ impl Stepper {
                 });
             }
         }
-        let t = self.t;
         let fixed = self.control.mode == StepMode::Fixed;
         for s in sources {
-            let Some(set) = s.clearance_joints() else {
-                continue;
-            };
-            for (handle, j) in set.iter() {
-                let limit = j.report().friction_stable_dt;
-                if fixed && dt > limit {
-                    self.guards.record(
-                        Violation::new(GuardKind::Friction, dt / limit, 1.0, t)
-                            .joint(j.name(), Some(handle))
-                            .note(format!(
-                                "step {} s, friction's limit {} s",
-                                crate::error::sig4(dt),
-                                crate::error::sig4(limit)
-                            )),
-                    );
-                }
-                let (depth, valid) = (j.report().state.penetration, j.max_valid_penetration());
-                let ratio = depth / valid;
-                if ratio > self.guards.worst_penetration_ratio {
-                    self.guards.worst_penetration_ratio = ratio;
-                }
-                if ratio > 1.0 {
-                    self.guards.record(
-                        Violation::new(GuardKind::Penetration, depth, valid, t)
-                            .joint(j.name(), Some(handle)),
-                    );
-                }
-            }
+            s.record_guards(&mut self.guards, self.t, dt, fixed);
         }
         if self.control.strict && !self.guards.is_clean() {
             return Err(Error::Guard {
@@ -854,7 +775,7 @@ fn check_gravity(world: &PhysicsWorld) -> Result<()> {
 /// sources' clearance joints), its speed and the likely cause.
 fn diverged_body(
     world: &PhysicsWorld,
-    sources: &[&mut dyn ForceSource],
+    sources: &[&mut dyn StepHooks],
     body: rapier3d_f64::prelude::RigidBodyHandle,
     speed: f64,
     joint_correction: bool,
@@ -866,12 +787,8 @@ fn diverged_body(
         .collect();
     // Rapier's joints: the ones whose drift correction can make it diverge.
     let jointed = !joined.is_empty();
-    for set in sources.iter().filter_map(|s| s.clearance_joints()) {
-        for (_, j) in set.iter() {
-            if j.body1() == body || j.body2() == body {
-                joined.push(format!("clearance joint `{}`", j.name()));
-            }
-        }
+    for s in sources {
+        s.joints_of(body, &mut joined);
     }
     let joined = if joined.is_empty() {
         String::new()

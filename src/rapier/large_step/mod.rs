@@ -77,12 +77,15 @@ pub mod resolution;
 use crate::error::{Error, Result, non_negative, positive, unit_vector};
 use crate::model::laws::{BearingGeometry, NormalModel, impact_restitution};
 use crate::rapier::arena::OrderedArena;
-use crate::rapier::ledger::{ensure_mass_properties, inverse_mass_along, world_center_of_mass};
+use crate::rapier::ledger::{
+    Wrench, ensure_mass_properties, inverse_mass_along, world_center_of_mass,
+};
 use rapier3d_f64::data::Index;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     GenericJoint, GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, IntegrationParameters,
-    JointAxesMask, JointAxis, RigidBody, RigidBodyHandle, RigidBodySet, RigidBodyType,
+    JointAxesMask, JointAxis, PhysicsWorld, RigidBody, RigidBodyHandle, RigidBodySet,
+    RigidBodyType,
 };
 use resolution::{quantized_substeps, rocking_frequency, substeps_needed};
 use std::collections::BTreeMap;
@@ -644,6 +647,8 @@ pub struct LargeStepJointSet {
     /// Per-step scratch: what each joint needs, and each group's largest count.
     needs: Vec<Need>,
     group_max: Vec<usize>,
+    /// The joints' states before a step the stepper may reject.
+    saved: Vec<(JointState, LargeStepReport)>,
 }
 
 /// What one joint asks of the coming step.
@@ -691,6 +696,8 @@ impl LargeStepJointSet {
     ) -> Option<LargeStepJoint> {
         let mut joint = self.joints.remove(handle.0)?;
         self.groups_valid = false;
+        // A saved state is by position: it no longer matches the joints.
+        self.saved.clear();
         if let Some(h) = joint.handle.take() {
             impulse_joints.remove(h, true);
         }
@@ -866,6 +873,36 @@ impl LargeStepJointSet {
         }
     }
 
+    /// Appends to `out` the forces the joints' constraints exerted over the last step, as
+    /// wrenches on both bodies (the normal force at the journal centre and the friction moment,
+    /// from the [`report`](LargeStepJoint::report)s): what an exact reaction solve
+    /// ([`ReactionSolver`](crate::rapier::reaction::ReactionSolver)) must be given to know the
+    /// joints, which are no ideal joints. Not the step protocol's
+    /// [`wrenches`](crate::rapier::step_hooks::StepHooks::wrenches): Rapier's solver applies these
+    /// forces itself.
+    pub fn constraint_wrenches(&self, bodies: &RigidBodySet, out: &mut Vec<Wrench>) {
+        for j in self.joints.values() {
+            let (Some(rb1), Some(rb2)) = (bodies.get(j.body1), bodies.get(j.body2)) else {
+                continue;
+            };
+            let r = &j.report;
+            let axis = *rb1.rotation() * j.local_axis1;
+            let p2 = *rb2.position() * j.local_anchor2;
+            let f = r.force_on_journal;
+            let moment = r.friction_torque * axis;
+            out.push(Wrench {
+                body: j.body1,
+                force: -f,
+                torque: (p2 - world_center_of_mass(rb1)).cross(-f) - moment,
+            });
+            out.push(Wrench {
+                body: j.body2,
+                force: f,
+                torque: (p2 - world_center_of_mass(rb2)).cross(f) + moment,
+            });
+        }
+    }
+
     /// Group index of each joint, in the joints' order: joints sharing a dynamic body are in the
     /// same group.
     fn groups(&self, bodies: &RigidBodySet) -> Vec<usize> {
@@ -896,5 +933,41 @@ impl LargeStepJointSet {
             }
         }
         (0..n).map(|i| find(&mut parent, i)).collect()
+    }
+}
+
+/// The large-step joints take part in the stepper's steps: their substeps and friction motors
+/// before each Rapier step, their readout and bounces after it, saved and restored with a
+/// rejected step ([`crate::rapier::step_hooks`]). Under a
+/// [`Stepper`](crate::rapier::stepper::Stepper) or a
+/// [`ClearanceWorld`](crate::rapier::world::ClearanceWorld) no hook can be forgotten.
+impl crate::rapier::step_hooks::StepHooks for LargeStepJointSet {
+    fn save_state(&mut self) {
+        self.saved.clear();
+        self.saved
+            .extend(self.joints.values().map(|j| (j.state, j.report)));
+    }
+    fn restore_state(&mut self) {
+        for (j, (state, report)) in self.joints.values_mut().zip(&self.saved) {
+            j.state = *state;
+            j.report = *report;
+        }
+    }
+    fn before_rapier_step(&mut self, world: &mut PhysicsWorld, _t0: f64, _dt: f64) {
+        self.before_step(
+            &mut world.bodies,
+            &mut world.impulse_joints,
+            &world.integration_parameters,
+        );
+    }
+    fn after_rapier_step(&mut self, world: &mut PhysicsWorld) {
+        self.after_step(&mut world.bodies, &world.impulse_joints);
+    }
+    fn joints_of(&self, body: RigidBodyHandle, names: &mut Vec<String>) {
+        for (_, j) in self.iter() {
+            if j.body1() == body || j.body2() == body {
+                names.push(format!("large-step clearance joint `{}`", j.name()));
+            }
+        }
     }
 }

@@ -12,7 +12,8 @@ pub use twin::{Twin, TwinKind};
 
 use crate::error::Result;
 use crate::rapier::replay::ReplayRecorder;
-use crate::rapier::stepper::{ForceSource, GuardKind, GuardReport, Stepper, Violation};
+use crate::rapier::stepper::{GuardKind, GuardReport, Violation};
+use crate::rapier::world::ClearanceWorld;
 use crate::scene::{Scene, ValidatedScene};
 use comparison::ComparisonSums;
 use rapier3d_f64::math::Vector;
@@ -44,12 +45,11 @@ pub use crate::rapier::metrics::HingeMetrics;
 
 /// A scene built in a Rapier world, ready to step.
 pub struct Simulation {
-    /// The Rapier world holding both twins.
-    pub world: PhysicsWorld,
+    /// The world holding both twins, with its step control (the same public piece a
+    /// plain-Rapier loop uses).
+    pub world: ClearanceWorld,
     /// The twins, ideal first.
     pub twins: Vec<Twin>,
-    /// The step control (the same public piece a plain-Rapier loop uses).
-    pub stepper: Stepper,
     scene: Scene,
     /// Index of the next output row (row `k` is at `k * output_interval_s`, the last at `end_s`).
     next_row: u64,
@@ -118,11 +118,12 @@ impl Simulation {
     pub fn from_validated(scene: &ValidatedScene, options: RunOptions) -> Result<Simulation> {
         let control = scene.run.step_control();
         control.validate().map_err(|e| e.within("run"))?;
-        let mut world = PhysicsWorld::new();
-        world.gravity = Vector::from(scene.gravity);
-        world.integration_parameters.dt = scene.run.dt_s;
+        let mut physics = PhysicsWorld::new();
+        physics.gravity = Vector::from(scene.gravity);
+        physics.integration_parameters.dt = scene.run.dt_s;
         // One substep: the hook's force is constant over the step (substeps gain energy).
-        world.integration_parameters.num_solver_iterations = 1;
+        physics.integration_parameters.num_solver_iterations = 1;
+        let mut world = ClearanceWorld::new(physics, control);
         let kinds: &[TwinKind] = match options.twins {
             Twins::Both => &[TwinKind::Ideal, TwinKind::Clearance],
             Twins::IdealOnly => &[TwinKind::Ideal],
@@ -134,11 +135,10 @@ impl Simulation {
         }
         // Mass properties before the first step (Rapier computes them in it; the reactions and
         // the hooks need them at the initial state).
-        crate::rapier::reaction::prepare_mass_properties(&mut world.bodies);
+        crate::rapier::reaction::prepare_mass_properties(&mut world.rapier.bodies);
         Ok(Simulation {
             world,
             twins,
-            stepper: Stepper::new(control),
             scene: scene.scene().clone(),
             next_row: 0,
             t_prev: 0.0,
@@ -151,7 +151,7 @@ impl Simulation {
 
     /// Simulated time, s.
     pub fn time(&self) -> f64 {
-        self.stepper.time()
+        self.world.time()
     }
 
     fn done(&self) -> bool {
@@ -228,17 +228,19 @@ impl Simulation {
     /// e.g. from [`run_observed`](Self::run_observed).
     pub fn replay_recorder(&self, interval: f64, contact_interval: f64) -> Result<ReplayRecorder> {
         let mut recorder = ReplayRecorder::new(interval, contact_interval)?;
-        for (i, twin) in self.twins.iter().enumerate() {
-            twin.track_replay(&self.scene, &self.world, i, &mut recorder)?;
+        for twin in &self.twins {
+            twin.track_replay(&self.scene, &self.world, &mut recorder)?;
         }
         Ok(recorder)
     }
 
     /// Records the current state into a recorder from [`replay_recorder`](Self::replay_recorder).
     pub fn record_replay(&self, recorder: &mut ReplayRecorder) {
-        let sets: Vec<&crate::rapier::joint::ClearanceJointSet> =
-            self.twins.iter().map(|t| &t.clearance).collect();
-        recorder.record(self.time(), &self.world.bodies, &sets);
+        recorder.record(
+            self.time(),
+            &self.world.rapier.bodies,
+            &[&self.world.clearance],
+        );
     }
 
     /// As [`run_keeping_partial`](Self::run_keeping_partial) (a stalled run returns what it
@@ -252,10 +254,7 @@ impl Simulation {
     ) -> Result<RunResult> {
         let start = Instant::now();
         let mut stopped = None;
-        {
-            let mut sources = sources(&mut self.twins);
-            self.stepper.prepare(&mut self.world, &mut sources)?;
-        }
+        self.world.prepare()?;
         observe(&self);
         while !self.done() {
             match self.step() {
@@ -269,7 +268,7 @@ impl Simulation {
             progress(&Progress {
                 t: self.time(),
                 end: self.scene.run.end_s,
-                steps: self.stepper.steps(),
+                steps: self.world.steps(),
             });
             observe(&self);
         }
@@ -294,7 +293,7 @@ impl Simulation {
             comparison,
             scene: self.scene,
             twins: self.twins,
-            steps: self.stepper.steps(),
+            steps: self.world.steps(),
             wall_s: start.elapsed().as_secs_f64(),
             guards,
             stopped,
@@ -305,7 +304,7 @@ impl Simulation {
     /// What the guards saw so far: the stepper's, plus the twins' energy balance and velocity
     /// motors (judged over the states recorded so far).
     pub fn guards(&self) -> GuardReport {
-        let mut guards = self.stepper.guards().clone();
+        let mut guards = self.world.guards().clone();
         for twin in &self.twins {
             let inv = &twin.invariants;
             let g = inv.energy_growth.unwrap_or(0.0);
@@ -350,40 +349,28 @@ impl Simulation {
     /// due, the contact samples), lets the stepper take it, then completes what only the step
     /// determines (ideal reactions, metrics).
     pub fn step(&mut self) -> Result<()> {
-        {
-            // The sources' forces at the first state, before it is read.
-            let mut sources = sources(&mut self.twins);
-            self.stepper.prepare(&mut self.world, &mut sources)?;
-        }
+        // The sources' forces at the first state, before it is read.
+        self.world.prepare()?;
         let t = self.time();
-        let gravity = self.world.gravity;
         let rows = !self.skip_rows;
-        let lag = 0.5 * self.stepper.last_dt();
         for twin in &mut self.twins {
-            twin.before_step(&self.world.bodies, gravity, t, lag, rows)?;
+            twin.before_step(&mut self.world, rows)?;
         }
         self.last_read = t;
         let target = self.target();
-        let stepped = {
-            let mut sources = sources(&mut self.twins);
-            self.stepper
-                .step(&mut self.world, &mut sources, target)
-                .map_err(|e| name_bodies(name_step_field(e, "run.dt_s"), &self.twins))
-        };
+        let stepped = self
+            .world
+            .step(target)
+            .map_err(|e| name_bodies(name_step_field(e, "run.dt_s"), &self.twins));
         let info = stepped.map_err(|e| self.name_diverged_body(e))?;
         for twin in &mut self.twins {
-            twin.after_step(
-                &self.world.bodies,
-                &self.world.impulse_joints,
-                &info,
-                gravity,
-            );
+            twin.after_step(&self.world, &info);
         }
         self.write_rows(t);
         self.t_prev = t;
         if let [ideal, clear] = self.twins.as_slice() {
             self.comparison
-                .record(ideal, clear, &self.world.bodies, info.t0, info.dt);
+                .record(ideal, clear, &self.world.rapier.bodies, info.t0, info.dt);
         }
         Ok(())
     }
@@ -411,10 +398,10 @@ impl Simulation {
         let crate::Error::Diverged { t, .. } = e else {
             return e;
         };
-        let params = &self.world.integration_parameters;
+        let params = &self.world.rapier.integration_parameters;
         let found = self.twins.iter().find_map(|twin| {
             twin.bodies.iter().find_map(|b| {
-                let rb = self.world.bodies.get(b.handle)?;
+                let rb = self.world.rapier.bodies.get(b.handle)?;
                 left_physical_range(rb, params).map(|speed| (twin.kind, b, speed))
             })
         });
@@ -477,16 +464,11 @@ impl Simulation {
     /// Records the final state: invariants, a last row at `end_s` (its reactions, velocities and
     /// accelerations solved at that state like every other), final metrics.
     fn finish(&mut self) -> Result<()> {
-        {
-            let mut sources = sources(&mut self.twins);
-            self.stepper.prepare(&mut self.world, &mut sources)?;
-        }
+        self.world.prepare()?;
         let t = self.time();
-        let gravity = self.world.gravity;
         let rows = !self.skip_rows;
-        let lag = 0.5 * self.stepper.last_dt();
         for twin in &mut self.twins {
-            twin.before_step(&self.world.bodies, gravity, t, lag, rows)?;
+            twin.before_step(&mut self.world, rows)?;
         }
         self.write_rows(t);
         let duration = self.time();
@@ -515,19 +497,6 @@ fn start_mismatch_note(inv: &Invariants) -> String {
         ),
         None => String::new(),
     }
-}
-
-/// The force sources of all twins, for the stepper.
-fn sources(twins: &mut [Twin]) -> Vec<&mut dyn ForceSource> {
-    let mut v: Vec<&mut dyn ForceSource> = Vec::with_capacity(3 * twins.len());
-    for t in twins.iter_mut() {
-        v.push(&mut t.drives);
-        v.push(&mut t.clearance);
-        if !t.prescribed.motions.is_empty() {
-            v.push(&mut t.prescribed);
-        }
-    }
-    v
 }
 
 /// Names the scene's bodies in a stall's message (the stepper knows only Rapier handles).

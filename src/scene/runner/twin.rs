@@ -7,13 +7,13 @@ use super::invariants::{BodyBefore, Invariants};
 use crate::error::Result;
 use crate::model::angle::{HingeAngle, UnwrappedAngle, twist_angle};
 use crate::model::laws::NormalForceLaw;
-use crate::rapier::drive::DriveSet;
-use crate::rapier::joint::{ClearanceJointHandle, ClearanceJointSet};
+use crate::rapier::drive::DriveHandle;
+use crate::rapier::joint::ClearanceJointHandle;
 use crate::rapier::metrics::{ContactObservation, ImpactRecorder};
-use crate::rapier::prescribed::PrescribedSet;
-use crate::rapier::reaction::{IdealJoint, KinematicState, ReactionSolver};
+use crate::rapier::reaction::{IdealJoint, ReactionSolver};
 use crate::rapier::replay::ReplayRecorder;
 use crate::rapier::stepper::StepInfo;
+use crate::rapier::world::ClearanceWorld;
 use crate::scene::Scene;
 use crate::table::Table;
 use rapier3d_f64::math::Vector;
@@ -50,7 +50,7 @@ pub(super) struct BodyTrack {
     fixed: bool,
     /// Not a fixed body (driven bodies move).
     moves: bool,
-    /// The body's tabulated motion (index in the twin's prescribed set).
+    /// The body's tabulated motion (index in the world's prescribed set).
     table: Option<usize>,
     /// The centre of mass in the body's frame (not the origin for a spinning body), m.
     local_com: Vector,
@@ -128,12 +128,8 @@ pub struct Twin {
     pub kind: TwinKind,
     pub(super) bodies: Vec<BodyTrack>,
     pub(super) hinges: Vec<HingeTrack>,
-    /// The clearance joints of this twin.
-    pub clearance: ClearanceJointSet,
-    /// The drives of this twin.
-    pub drives: DriveSet,
-    /// The tabulated motions of this twin's driven bodies.
-    pub prescribed: PrescribedSet,
+    /// This twin's drives in the world's drive set.
+    drives: Vec<DriveHandle>,
     /// The ideal joints: the ideal hinges' revolutes (with the hinge index of each), then the
     /// scene's other joints.
     ideal_joints: Vec<IdealJoint>,
@@ -145,8 +141,6 @@ pub struct Twin {
     motors: Vec<Option<f64>>,
     body_motion: bool,
     reactions: ReactionSolver,
-    /// The drives' and clearance joints' wrenches at the current state (scratch).
-    source_wrenches: Vec<crate::rapier::ledger::Wrench>,
     /// Spring and contact elastic energy at the state before the current step, J.
     source_energy_before: f64,
     /// The joint motors in Rapier, with the index of their scene joint: their impulses over each
@@ -170,15 +164,9 @@ pub struct Twin {
 impl Twin {
     /// Reads the state before a step (from the sources' evaluation at it): invariants, the
     /// clearance samples and forces, the angles, and (with `rows`) the row values of the state.
-    /// `lag`: how long before the state the stored velocities are (half the last step), s.
-    pub(super) fn before_step(
-        &mut self,
-        bodies: &RigidBodySet,
-        gravity: Vector,
-        t: f64,
-        lag: f64,
-        rows: bool,
-    ) -> Result<()> {
+    pub(super) fn before_step(&mut self, world: &mut ClearanceWorld, rows: bool) -> Result<()> {
+        let t = world.time();
+        let bodies = &world.rapier.bodies;
         let axis_ref = self.reference_axis;
         for b in &mut self.bodies {
             let rb = &bodies[b.handle];
@@ -197,7 +185,7 @@ impl Twin {
             // Every state, so the unwrapped angle never aliases whatever the output interval.
             h.angle.update(r1.rotation(), r2.rotation(), h.local_axis1);
             if let HingeJoint::Clearance(c) = h.joint {
-                let j = self.clearance.get(c).expect("handle of this twin");
+                let j = world.clearance.get(c).expect("handle of this twin");
                 let r = j.report();
                 let f = &r.force;
                 let elastic = j.normal_law().elastic_force(r.state.penetration);
@@ -218,31 +206,21 @@ impl Twin {
                 };
             }
         }
-        self.solve_ideal_reactions(bodies, gravity, t, lag)?;
-        self.source_energy_before = self.drives.potential_energy()
-            + self
-                .clearance
-                .iter()
-                .map(|(_, j)| j.elastic_energy())
-                .sum::<f64>();
+        self.solve_ideal_reactions(world)?;
+        self.source_energy_before = self.source_energy(world);
         if rows {
             std::mem::swap(&mut self.row_prev, &mut self.row_cur);
-            self.fill_row(t, bodies);
+            self.fill_row(t, world);
         }
         Ok(())
     }
 
     /// Completes the step that started from the state [`before_step`](Self::before_step) read:
     /// ideal reactions (which only the step determines), metrics of that state over the step.
-    pub(super) fn after_step(
-        &mut self,
-        bodies: &RigidBodySet,
-        joints: &ImpulseJointSet,
-        info: &StepInfo,
-        gravity: Vector,
-    ) {
+    pub(super) fn after_step(&mut self, world: &ClearanceWorld, info: &StepInfo) {
+        let (bodies, joints) = (&world.rapier.bodies, &world.rapier.impulse_joints);
         self.update_force_metrics(info.t0, info.dt);
-        self.update_invariants(bodies, gravity, info);
+        self.update_invariants(bodies, world.rapier.gravity, info);
         // The motors' work over the step: the angular or linear impulse Rapier's motor row
         // applied to body 2 (minus its stored impulse) times the joint's speed at the state the
         // step started from (the solve's synchronous one), what a kick does to kinetic energy.
@@ -279,7 +257,11 @@ impl Twin {
         // penetration change, and the slip at the step's velocity.
         for h in &self.hinges {
             if let HingeJoint::Clearance(c) = h.joint {
-                let r = self.clearance.get(c).expect("handle of this twin").report();
+                let r = world
+                    .clearance
+                    .get(c)
+                    .expect("handle of this twin")
+                    .report();
                 let sample = &h.sample;
                 if sample.penetration > 0.0 {
                     self.invariants.dissipated_j += sample.damping_force
@@ -292,47 +274,14 @@ impl Twin {
 
     /// Ideal-joint reactions, motor torques and the bodies' velocities and accelerations at the
     /// current state, exact: the constrained rigid-body equations solved for the joint forces
-    /// ([`ReactionSolver`]), whatever the step control (the stored velocities, `lag` before the
-    /// state, advanced to it).
+    /// ([`ClearanceWorld::solve_reactions`]), whatever the step control.
     /// A solve that fails (a non-finite state) is an error: never reactions left at zero.
-    fn solve_ideal_reactions(
-        &mut self,
-        bodies: &RigidBodySet,
-        gravity: Vector,
-        t: f64,
-        lag: f64,
-    ) -> Result<()> {
+    fn solve_ideal_reactions(&mut self, world: &mut ClearanceWorld) -> Result<()> {
         if self.ideal_joints.is_empty() && !self.body_motion {
             return Ok(());
         }
-        self.reactions.velocity_lag = lag;
-        // Tabulated drives at this state: their velocities and accelerations.
-        self.reactions.kinematic.clear();
-        for b in &self.bodies {
-            if let Some(k) = b.table {
-                let m = &self.prescribed.motions[k];
-                let (v, a, w, alpha) = m.rates(t);
-                self.reactions.kinematic.push(KinematicState {
-                    body: b.handle,
-                    linvel: v,
-                    angvel: w,
-                    linacc: a,
-                    angacc: alpha,
-                });
-            }
-        }
-        // The sources' wrenches act during the steps only: the solver gets them explicitly.
-        self.source_wrenches.clear();
-        self.source_wrenches
-            .extend_from_slice(self.drives.wrenches());
-        self.source_wrenches
-            .extend_from_slice(self.clearance.wrenches());
-        let Some(forces) = self.reactions.solve_joints_with(
-            bodies,
-            &self.ideal_joints,
-            gravity,
-            &self.source_wrenches,
-        ) else {
+        let t = world.time();
+        let Some(forces) = world.solve_reactions(&mut self.reactions, &self.ideal_joints) else {
             return Err(crate::Error::Diverged {
                 t,
                 reason: format!(
@@ -359,6 +308,26 @@ impl Twin {
         Ok(())
     }
 
+    /// The elastic energy of this twin's drives and clearance contacts at the current state, J.
+    fn source_energy(&self, world: &ClearanceWorld) -> f64 {
+        let drives: f64 = self
+            .drives
+            .iter()
+            .filter_map(|&d| world.drives.get(d))
+            .map(|d| d.potential_energy(d.angle()))
+            .sum();
+        let contacts: f64 = self
+            .hinges
+            .iter()
+            .filter_map(|h| match h.joint {
+                HingeJoint::Clearance(c) => world.clearance.get(c),
+                HingeJoint::Ideal => None,
+            })
+            .map(|j| j.elastic_energy())
+            .sum();
+        drives + contacts
+    }
+
     /// The invariants at the state before the step just taken, from this twin's moving bodies
     /// and its sources' elastic energy there.
     fn update_invariants(&mut self, bodies: &RigidBodySet, gravity: Vector, info: &StepInfo) {
@@ -383,7 +352,8 @@ impl Twin {
     }
 
     /// The row values of the current state into `row_cur`.
-    fn fill_row(&mut self, t: f64, bodies: &RigidBodySet) {
+    fn fill_row(&mut self, t: f64, world: &ClearanceWorld) {
+        let bodies = &world.rapier.bodies;
         let axis_ref = self.reference_axis;
         let v = &mut self.row_cur;
         v.clear();
@@ -404,7 +374,7 @@ impl Twin {
                 // origin, so its centre of mass moves with `w x r`).
                 let (vel, acc) = match (b.table, b.fixed) {
                     (Some(k), _) => {
-                        let (v0, a, w, alpha) = self.prescribed.motions[k].rates(t);
+                        let (v0, a, w, alpha) = world.prescribed.motions[k].rates(t);
                         (v0 + w.cross(r), a + alpha.cross(r) + w.cross(w.cross(r)))
                     }
                     (None, true) => {
@@ -431,7 +401,11 @@ impl Twin {
             v.push(h.force);
             match h.joint {
                 HingeJoint::Clearance(c) => {
-                    let r = self.clearance.get(c).expect("handle of this twin").report();
+                    let r = world
+                        .clearance
+                        .get(c)
+                        .expect("handle of this twin")
+                        .report();
                     let e = r.state.eccentricity;
                     v.push(e.dot(*r1.rotation() * h.local_u1) * 1e3);
                     v.push(e.dot(*r1.rotation() * h.local_v1) * 1e3);
@@ -508,24 +482,30 @@ impl Twin {
 
 impl Twin {
     /// Tracks this twin's bodies and hinges in `recorder` (group: the twin's name): clearance
-    /// hinges as journals of the clearance set passed `set_index`-th to
-    /// [`ReplayRecorder::record`], ideal hinges as pins at their scene point.
+    /// hinges as journals of the world's clearance set (passed first to
+    /// [`ReplayRecorder::record`]), ideal hinges as pins at their scene point.
     pub fn track_replay(
         &self,
         scene: &Scene,
-        world: &PhysicsWorld,
-        set_index: usize,
+        world: &ClearanceWorld,
         recorder: &mut ReplayRecorder,
     ) -> Result<()> {
         let group = self.kind.name();
+        let physics = &world.rapier;
         for b in &self.bodies {
-            recorder.track_body(&b.name, group, b.handle, &world.bodies, &world.colliders);
+            recorder.track_body(
+                &b.name,
+                group,
+                b.handle,
+                &physics.bodies,
+                &physics.colliders,
+            );
         }
         for (h, spec) in self.hinges.iter().zip(&scene.hinges) {
             let (b1, b2) = (self.bodies[h.bearing].handle, self.bodies[h.journal].handle);
             match h.joint {
                 HingeJoint::Clearance(c) => {
-                    recorder.track_journal(&h.name, group, set_index, c, &self.clearance)?
+                    recorder.track_journal(&h.name, group, 0, c, &world.clearance)?
                 }
                 HingeJoint::Ideal => {
                     let anchor =

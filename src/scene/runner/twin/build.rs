@@ -5,17 +5,15 @@ use super::{BodyTrack, ContactSample, HingeJoint, HingeTrack, Twin, TwinKind};
 use crate::error::{Error, Result};
 use crate::model::angle::{HingeAngle, UnwrappedAngle};
 use crate::rapier::convert::{Clearance, ClearanceModel};
-use crate::rapier::drive::{DriveSet, TorsionSpring};
-use crate::rapier::joint::ClearanceJointSet;
+use crate::rapier::drive::{DriveHandle, TorsionSpring};
 use crate::rapier::metrics::ImpactRecorder;
-use crate::rapier::prescribed::{
-    PrescribedMotion, PrescribedPath, PrescribedSet, Table as MotionTable,
-};
+use crate::rapier::prescribed::{PrescribedMotion, PrescribedPath, Table as MotionTable};
 use crate::rapier::reaction::{
     IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, ReactionSolver,
     SoftMotor,
 };
 use crate::rapier::replay::in_plane_u;
+use crate::rapier::world::ClearanceWorld;
 use crate::scene::runner::invariants::Invariants;
 use crate::scene::{BodySpec, JointKindSpec, JointSpec, MotionSpec, MotorSpec, ValidatedScene};
 use crate::table::Table;
@@ -29,11 +27,11 @@ impl Twin {
     pub(in crate::scene::runner) fn build(
         scene: &ValidatedScene,
         kind: TwinKind,
-        world: &mut PhysicsWorld,
+        world: &mut ClearanceWorld,
     ) -> Result<Twin> {
-        let (bodies, prescribed) = build_bodies(scene, world)?;
-        let (hinges, clearance) = build_hinges(scene, kind, &bodies, world)?;
-        let drives = build_drives(scene, &bodies, &hinges)?;
+        let bodies = build_bodies(scene, world)?;
+        let hinges = build_hinges(scene, kind, &bodies, world)?;
+        let drives = build_drives(scene, &bodies, &hinges, world)?;
         let (mut ideal_joints, ideal_hinges) = ideal_hinge_joints(scene, &bodies, &hinges);
         let other = build_joints(scene, &bodies, world);
         ideal_joints.extend(other.ideal);
@@ -41,16 +39,13 @@ impl Twin {
         let reactions = reaction_solver(&bodies);
         Ok(Twin {
             kind,
-            clearance,
             drives,
-            prescribed,
             ideal_joints,
             ideal_hinges,
             motors: other.motors,
             joints: other.joints,
             body_motion: scene.run.body_motion,
             reactions,
-            source_wrenches: Vec::new(),
             source_energy_before: 0.0,
             motor_joints: other.motor_joints,
             held_motors: other.held_motors,
@@ -75,13 +70,11 @@ impl Twin {
     }
 }
 
-/// The scene's bodies in `world`, tracked, and the tabulated motions of the driven ones.
-fn build_bodies(
-    scene: &ValidatedScene,
-    world: &mut PhysicsWorld,
-) -> Result<(Vec<BodyTrack>, PrescribedSet)> {
+/// The scene's bodies in `world`, tracked, with the tabulated motions of the driven ones in
+/// the world's prescribed set.
+fn build_bodies(scene: &ValidatedScene, world: &mut ClearanceWorld) -> Result<Vec<BodyTrack>> {
     let mut bodies = Vec::with_capacity(scene.bodies.len());
-    let mut prescribed = PrescribedSet::default();
+    let prescribed = &mut world.prescribed;
     for (i, b) in scene.bodies.iter().enumerate() {
         let com = Vector::from(b.center_of_mass_m);
         let origin = Vector::from(scene.body_origin(i));
@@ -94,7 +87,7 @@ fn build_bodies(
             Some(m) => (driven_body(m, origin), None),
             None => (free_or_fixed_body(b, com), None),
         };
-        let handle = world.bodies.insert(rb);
+        let handle = world.rapier.bodies.insert(rb);
         if let Some(k) = table {
             prescribed.motions[k].body = handle;
         }
@@ -113,7 +106,7 @@ fn build_bodies(
             rotation_before: rapier3d_f64::math::Rotation::IDENTITY,
         });
     }
-    Ok((bodies, prescribed))
+    Ok(bodies)
 }
 
 /// A tabulated drive: a position-based kinematic body whose next pose the prescribed set gives
@@ -201,15 +194,14 @@ fn free_or_fixed_body(b: &BodySpec, com: Vector) -> RigidBody {
 }
 
 /// The scene's hinges in `world`: in a clearance twin, a hinge with clearance is a clearance
-/// joint built by its [`Clearance`](crate::rapier::convert::Clearance) (the validated scene's,
+/// joint (in the world's clearance set) built by its [`Clearance`](crate::rapier::convert::Clearance) (the validated scene's,
 /// the one route from settings to joint); every other hinge is Rapier's revolute joint.
 fn build_hinges(
     scene: &ValidatedScene,
     kind: TwinKind,
     bodies: &[BodyTrack],
-    world: &mut PhysicsWorld,
-) -> Result<(Vec<HingeTrack>, ClearanceJointSet)> {
-    let mut clearance = ClearanceJointSet::new();
+    world: &mut ClearanceWorld,
+) -> Result<Vec<HingeTrack>> {
     let mut hinges = Vec::with_capacity(scene.hinges.len());
     for (i, h) in scene.hinges.iter().enumerate() {
         let (ib, ij) = (
@@ -225,14 +217,15 @@ fn build_hinges(
             (Some(settings), TwinKind::Clearance) => {
                 refuse_unrun_model(settings, &h.name)?;
                 let j = settings.joint(a1, a2, axis, axis)?;
-                HingeJoint::Clearance(clearance.insert(b1, b2, j, &mut world.impulse_joints))
+                let rapier = &mut world.rapier.impulse_joints;
+                HingeJoint::Clearance(world.clearance.insert(b1, b2, j, rapier))
             }
             _ => {
                 let j = RevoluteJointBuilder::new(axis)
                     .local_anchor1(a1)
                     .local_anchor2(a2)
                     .contacts_enabled(false);
-                world.impulse_joints.insert(b1, b2, j, true);
+                world.rapier.impulse_joints.insert(b1, b2, j, true);
                 HingeJoint::Ideal
             }
         };
@@ -251,7 +244,7 @@ fn build_hinges(
             recorder: ImpactRecorder::new(),
         });
     }
-    Ok((hinges, clearance))
+    Ok(hinges)
 }
 
 /// The scene runner steps compliant clearance joints only, for now: a hinge that chose the
@@ -276,13 +269,14 @@ fn anchors(scene: &ValidatedScene, point: [f64; 3], i1: usize, i2: usize) -> (Ve
     )
 }
 
-/// The scene's torsion-spring drives on their hinges.
+/// The scene's torsion-spring drives on their hinges, in the world's drive set.
 fn build_drives(
     scene: &ValidatedScene,
     bodies: &[BodyTrack],
     hinges: &[HingeTrack],
-) -> Result<DriveSet> {
-    let mut drives = DriveSet::new();
+    world: &mut ClearanceWorld,
+) -> Result<Vec<DriveHandle>> {
+    let mut drives = Vec::with_capacity(scene.drives.len());
     for d in &scene.drives {
         let h = &hinges[scene.hinge_index(&d.hinge).expect("validated")];
         let per_rad = d.stiffness_nm_per_deg.to_degrees();
@@ -294,7 +288,7 @@ fn build_drives(
             d.torque_scale * per_rad,
         )
         .map_err(|e| e.within(&format!("drives[{}]", d.name)))?;
-        drives.insert(spring);
+        drives.push(world.drives.insert(spring));
     }
     Ok(drives)
 }
@@ -343,7 +337,7 @@ struct SceneJoints {
 fn build_joints(
     scene: &ValidatedScene,
     bodies: &[BodyTrack],
-    world: &mut PhysicsWorld,
+    world: &mut ClearanceWorld,
 ) -> SceneJoints {
     let mut out = SceneJoints::default();
     for (k, j) in scene.joints.iter().enumerate() {
@@ -389,7 +383,7 @@ fn build_joint(
     j: &JointSpec,
     motor: Option<Motor>,
     bodies: &[BodyTrack],
-    world: &mut PhysicsWorld,
+    world: &mut ClearanceWorld,
 ) -> (IdealJoint, ImpulseJointHandle) {
     let (i1, i2) = (
         scene.body_index(&j.body1).expect("validated"),
@@ -437,7 +431,7 @@ fn build_joint(
             }),
         ),
     };
-    let handle = world.impulse_joints.insert(b1, b2, rapier, true);
+    let handle = world.rapier.impulse_joints.insert(b1, b2, rapier, true);
     (ideal, handle)
 }
 

@@ -1,0 +1,105 @@
+//! The step protocol: what the [`Stepper`](crate::rapier::stepper::Stepper) asks of everything
+//! that takes part in a step, as a hook trait with default methods (as Rapier's
+//! `PhysicsHooks`). Every joint set of this crate implements it
+//! ([`ClearanceJointSet`](crate::rapier::joint::ClearanceJointSet),
+//! [`LargeStepJointSet`](crate::rapier::large_step::LargeStepJointSet)), as do the drives
+//! ([`DriveSet`](crate::rapier::drive::DriveSet)) and the prescribed motions
+//! ([`PrescribedSet`](crate::rapier::prescribed::PrescribedSet)). A new joint model plugs in
+//! here: it overrides what it needs, the rest does nothing.
+//!
+//! One step of the stepper, in the order the hooks are called:
+//! 1. [`check_world`](StepHooks::check_world) once before the first step (the solver settings a
+//!    participant needs), then [`evaluate`](StepHooks::evaluate) at the state before the step.
+//! 2. The step's length: the smallest [`step_limit`](StepHooks::step_limit) (adaptive), or a
+//!    fixed step checked by [`check_step`](StepHooks::check_step).
+//! 3. [`save_state`](StepHooks::save_state) (adaptive: the step may be rejected); the
+//!    [`wrenches`](StepHooks::wrenches) are added to the bodies for this step only;
+//!    [`before_rapier_step`](StepHooks::before_rapier_step), Rapier's step,
+//!    [`after_rapier_step`](StepHooks::after_rapier_step); then
+//!    [`evaluate`](StepHooks::evaluate) at the new state.
+//! 4. [`judge_step`](StepHooks::judge_step) (adaptive): a participant that asks for a shorter
+//!    step has the step undone ([`restore_state`](StepHooks::restore_state), the bodies restored
+//!    by the stepper) and retried from 3.
+//! 5. On acceptance: [`check_step`](StepHooks::check_step) again (fixed steps: the contact the step
+//!    ended in) and [`record_guards`](StepHooks::record_guards).
+//!
+//! Users rarely call these methods themselves: [`ClearanceWorld`](crate::rapier::world::ClearanceWorld)
+//! and the stepper do. A loop that calls `world.step()` itself uses each set's own
+//! `apply`/`before_step`/`after_step` instead.
+
+use crate::error::Result;
+use crate::rapier::guards::GuardReport;
+use crate::rapier::ledger::Wrench;
+use crate::rapier::stall::StalledContact;
+use rapier3d_f64::prelude::{IntegrationParameters, PhysicsWorld, RigidBodyHandle, RigidBodySet};
+
+/// What the stepper asks of a participant in a step; every method has a default that does
+/// nothing (see the [module](self) docs for the order of the calls).
+pub trait StepHooks {
+    /// Evaluates at the bodies' current state, without touching their forces: the wrenches of
+    /// the next step. Default: nothing.
+    fn evaluate(&mut self, _bodies: &mut RigidBodySet) {}
+
+    /// The wrenches of the last evaluation, added to the bodies for the next step only.
+    /// Default: none.
+    fn wrenches(&self) -> &[Wrench] {
+        &[]
+    }
+
+    /// Saves the internal state (before a step that may be rejected). Default: nothing.
+    fn save_state(&mut self) {}
+
+    /// Restores the state saved last (the stepper restores the bodies). Default: nothing.
+    fn restore_state(&mut self) {}
+
+    /// Whether the world's settings can step this participant (checked before the first step
+    /// and after [`Stepper::invalidate`](crate::rapier::stepper::Stepper::invalidate)). Default:
+    /// any settings.
+    fn check_world(&self, _params: &IntegrationParameters) -> Result<()> {
+        Ok(())
+    }
+
+    /// The longest adaptive step this participant allows from the current state, s, for the
+    /// step control's `tolerance` and the last accepted step `last_dt` (0 before the first).
+    /// Default: no limit.
+    fn step_limit(&self, _tolerance: f64, _last_dt: f64) -> f64 {
+        f64::INFINITY
+    }
+
+    /// Whether a fixed step `dt` is within the stability limit of this participant's state (before
+    /// the step, and again at the state the step ended in): an
+    /// [`Error::StepTooLarge`](crate::Error::StepTooLarge) if not. Default: any step.
+    fn check_step(&self, _dt: f64) -> Result<()> {
+        Ok(())
+    }
+
+    /// Judges an adaptive step `dt` just taken (evaluated at its end): `Some(shorter)` rejects
+    /// it, to be retried at most `shorter` long. Default: accepted.
+    fn judge_step(&self, _dt: f64, _tolerance: f64) -> Option<f64> {
+        None
+    }
+
+    /// Right before each Rapier step (a retried one included), with the step's start `t0` and
+    /// length `dt`, s (`world.integration_parameters.dt` is set to it): e.g. the next poses of
+    /// prescribed kinematic bodies, or the substeps of large-step joints. Default: nothing.
+    fn before_rapier_step(&mut self, _world: &mut PhysicsWorld, _t0: f64, _dt: f64) {}
+
+    /// Right after each Rapier step, before [`evaluate`](Self::evaluate): e.g. reading the
+    /// constraint forces of large-step joints and bouncing their impacts. Default: nothing.
+    fn after_rapier_step(&mut self, _world: &mut PhysicsWorld) {}
+
+    /// Records, after an accepted step of `dt` (s) ending at `t`, what the run-time guards must
+    /// know of this participant's state (penetrations beyond a law's validity, a fixed step
+    /// beyond friction's limit, when `fixed`). Default: nothing.
+    fn record_guards(&self, _guards: &mut GuardReport, _t: f64, _dt: f64, _fixed: bool) {}
+
+    /// The contact of this participant whose step limit is the shortest, with its numbers, for a
+    /// stall's diagnosis; `None` when none is in contact. Default: none.
+    fn stalled_contact(&self, _bodies: &RigidBodySet) -> Option<StalledContact> {
+        None
+    }
+
+    /// Names (in words) this participant's joints that join `body`, for a divergence's message.
+    /// Default: none.
+    fn joints_of(&self, _body: RigidBodyHandle, _names: &mut Vec<String>) {}
+}

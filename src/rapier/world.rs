@@ -1,0 +1,312 @@
+//! [`ClearanceWorld`]: a Rapier world with everything a clearance joint needs around its step,
+//! in one type (as Rapier's `PhysicsWorld` bundles its sets): the compliant and large-step
+//! clearance joints, the drives, the prescribed motions, and the one step control that takes
+//! every step ([`Stepper`]). The scene runner and the bevy_ecs layer are built on it; a
+//! plain-Rapier user calls [`ClearanceWorld::step`] in place of `world.step()`, and no hook can
+//! be forgotten.
+//!
+//! ```
+//! use clearance_joint::prelude::*;
+//! use rapier3d_f64::prelude::*;
+//!
+//! // A 2 kg arm on a steel pin with 0.2 mm of play, released horizontal under gravity.
+//! let mut rapier = PhysicsWorld::new();
+//! rapier.gravity = Vector::new(0.0, -9.81, 0.0);
+//! rapier.integration_parameters.num_solver_iterations = 1; // the compliant model needs 1
+//! let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.02));
+//! let base = world.rapier.bodies.insert(RigidBodyBuilder::fixed());
+//! let arm = world.rapier.bodies.insert(
+//!     RigidBodyBuilder::dynamic()
+//!         .translation(Vector::new(0.3, 0.0, 0.0))
+//!         .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02)))
+//!         .can_sleep(false),
+//! );
+//! let pin = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?.joint(
+//!     Vector::ZERO,
+//!     Vector::new(-0.3, 0.0, 0.0),
+//!     Vector::Z,
+//!     Vector::Z,
+//! )?;
+//! let pin = world.insert_clearance(base, arm, pin);
+//! let mut peak: f64 = 0.0;
+//! while world.time() < 0.2 {
+//!     world.step(0.2)?; // one accepted step, landing on 0.2 s at the end
+//!     peak = peak.max(world.clearance.get(pin).unwrap().report().force.normal_force);
+//! }
+//! assert!(world.guards().is_clean(), "{:?}", world.guards());
+//! assert!(peak > 19.62, "the first impact exceeds the static load: {peak} N");
+//! # Ok::<(), clearance_joint::Error>(())
+//! ```
+
+use crate::error::Result;
+use crate::rapier::drive::{DriveHandle, DriveSet, TorsionSpring};
+use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle, ClearanceJointSet};
+use crate::rapier::large_step::{LargeStepJoint, LargeStepJointHandle, LargeStepJointSet};
+use crate::rapier::ledger::Wrench;
+use crate::rapier::prescribed::{PrescribedMotion, PrescribedSet};
+use crate::rapier::reaction::{IdealJoint, KinematicState, ReactionSolver};
+use crate::rapier::step_hooks::StepHooks;
+use crate::rapier::stepper::{GuardReport, StepControl, StepInfo, Stepper};
+use rapier3d_f64::math::Vector;
+use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle};
+
+/// A Rapier world with clearance joints, drives and prescribed motions, stepped by one
+/// [`Stepper`]. The sets are public fields, as in Rapier's `PhysicsWorld`: read them freely;
+/// add and remove joints, drives and motions with the `insert_*`/`remove_*` methods (which also
+/// add their Rapier parts and tell the step control when forces must be evaluated again). A
+/// compliant joint or a drive added or removed through the fields is noticed at the next step;
+/// after moving bodies or setting velocities by hand between steps, call
+/// [`invalidate`](Self::invalidate).
+pub struct ClearanceWorld {
+    /// The Rapier world: bodies, colliders, Rapier's own joints, gravity, integration parameters.
+    pub rapier: PhysicsWorld,
+    /// The compliant clearance joints (contact and friction laws as forces).
+    pub clearance: ClearanceJointSet,
+    /// The large-step clearance joints (the play as a constraint of Rapier's solver).
+    pub large_step: LargeStepJointSet,
+    /// The torsion springs and torques.
+    pub drives: DriveSet,
+    /// The tabulated (prescribed) motions of kinematic bodies.
+    pub prescribed: PrescribedSet,
+    stepper: Stepper,
+    /// The sizes of the compliant joint set and the drive set at the last step: a change means
+    /// their forces must be evaluated again before the next step.
+    counts: [usize; 2],
+    /// Scratch: the sources' wrenches for a reaction solve.
+    wrenches: Vec<Wrench>,
+}
+
+impl ClearanceWorld {
+    /// Wraps `rapier` (its settings, bodies and joints stay as they are) with empty sets and a
+    /// stepper of `control`.
+    pub fn new(rapier: PhysicsWorld, control: StepControl) -> Self {
+        ClearanceWorld {
+            rapier,
+            clearance: ClearanceJointSet::new(),
+            large_step: LargeStepJointSet::new(),
+            drives: DriveSet::new(),
+            prescribed: PrescribedSet::default(),
+            stepper: Stepper::new(control),
+            counts: [usize::MAX; 2],
+            wrenches: Vec::new(),
+        }
+    }
+
+    // ----- Joints, drives, motions -----
+
+    /// Adds a compliant clearance joint between `body1` (bearing) and `body2` (journal), with its
+    /// Rapier lock.
+    pub fn insert_clearance(
+        &mut self,
+        body1: RigidBodyHandle,
+        body2: RigidBodyHandle,
+        joint: ClearanceJoint,
+    ) -> ClearanceJointHandle {
+        self.stepper.invalidate(false);
+        self.clearance
+            .insert(body1, body2, joint, &mut self.rapier.impulse_joints)
+    }
+
+    /// Removes a compliant clearance joint (and its Rapier lock); `None` for a handle of no joint.
+    pub fn remove_clearance(&mut self, handle: ClearanceJointHandle) -> Option<ClearanceJoint> {
+        self.stepper.invalidate(false);
+        let w = &mut self.rapier;
+        self.clearance
+            .remove(handle, &mut w.bodies, &mut w.impulse_joints)
+    }
+
+    /// Adds a large-step clearance joint between `body1` (bearing) and `body2` (journal), with
+    /// its Rapier joint.
+    pub fn insert_large_step(
+        &mut self,
+        body1: RigidBodyHandle,
+        body2: RigidBodyHandle,
+        joint: LargeStepJoint,
+    ) -> LargeStepJointHandle {
+        // No force to evaluate: its hooks run inside each step.
+        self.large_step
+            .insert(body1, body2, joint, &mut self.rapier.impulse_joints)
+    }
+
+    /// Removes a large-step clearance joint (and its Rapier joint); `None` for a handle of no
+    /// joint.
+    pub fn remove_large_step(&mut self, handle: LargeStepJointHandle) -> Option<LargeStepJoint> {
+        let w = &mut self.rapier;
+        self.large_step
+            .remove(handle, &mut w.bodies, &mut w.impulse_joints)
+    }
+
+    /// Adds a drive.
+    pub fn insert_drive(&mut self, drive: TorsionSpring) -> DriveHandle {
+        self.stepper.invalidate(false);
+        self.drives.insert(drive)
+    }
+
+    /// Removes a drive; `None` for a handle of no drive.
+    pub fn remove_drive(&mut self, handle: DriveHandle) -> Option<TorsionSpring> {
+        self.stepper.invalidate(false);
+        self.drives.remove(handle)
+    }
+
+    /// Adds a prescribed motion (its body must be a position-based kinematic body); returns its
+    /// index in [`PrescribedSet::motions`].
+    pub fn insert_prescribed(&mut self, motion: PrescribedMotion) -> usize {
+        self.prescribed.motions.push(motion);
+        self.prescribed.motions.len() - 1
+    }
+
+    // ----- The step -----
+
+    /// Takes one accepted step towards `until` (s), landing on it exactly
+    /// ([`Stepper::step`]: the step control, acceptance, guards; the joints', drives' and
+    /// motions' hooks in their order). Call it in place of Rapier's `PhysicsWorld::step`.
+    pub fn step(&mut self, until: f64) -> Result<StepInfo> {
+        self.follow_changes();
+        let (stepper, physics, mut hooks) = self.parts();
+        stepper.step(physics, &mut hooks, until)
+    }
+
+    /// Steps until the clock reaches `until` (s); returns the number of accepted steps taken.
+    pub fn step_to(&mut self, until: f64) -> Result<u64> {
+        let start = self.stepper.steps();
+        while self.time() < until {
+            self.step(until)?;
+        }
+        Ok(self.stepper.steps() - start)
+    }
+
+    /// Evaluates the joints and drives at the current state if the next step has not yet
+    /// (done by [`step`](Self::step) on its own; call it to read the joints' forces at the
+    /// initial state before the first step). Also checks the world's settings.
+    pub fn prepare(&mut self) -> Result<()> {
+        self.follow_changes();
+        let (stepper, physics, mut hooks) = self.parts();
+        stepper.prepare(physics, &mut hooks)
+    }
+
+    /// [`Stepper::peek`]: a step of the last step's size (or `dt`), read by `read`, then undone
+    /// exactly.
+    pub fn peek<R>(
+        &mut self,
+        dt: f64,
+        read: impl FnOnce(&PhysicsWorld, &StepInfo) -> R,
+    ) -> Result<R> {
+        self.follow_changes();
+        let (stepper, physics, mut hooks) = self.parts();
+        stepper.peek(physics, &mut hooks, dt, read)
+    }
+
+    /// Forgets the evaluation of the joints and drives, after you changed the world between
+    /// steps by hand (bodies moved, sets edited through their fields); with `restart_kick`, also
+    /// after setting velocities by hand ([`Stepper::invalidate`]).
+    pub fn invalidate(&mut self, restart_kick: bool) {
+        self.stepper.invalidate(restart_kick);
+    }
+
+    /// The simulated time, s.
+    pub fn time(&self) -> f64 {
+        self.stepper.time()
+    }
+
+    /// Accepted steps so far.
+    pub fn steps(&self) -> u64 {
+        self.stepper.steps()
+    }
+
+    /// The last accepted step, s (0 before the first).
+    pub fn last_dt(&self) -> f64 {
+        self.stepper.last_dt()
+    }
+
+    /// What the run-time guards recorded.
+    pub fn guards(&self) -> &GuardReport {
+        self.stepper.guards()
+    }
+
+    /// The step control.
+    pub fn step_control(&self) -> &StepControl {
+        self.stepper.control()
+    }
+
+    /// Replaces the step control (between steps).
+    pub fn set_step_control(&mut self, control: StepControl) {
+        self.stepper.set_control(control);
+    }
+
+    /// The stepper itself.
+    pub fn stepper(&self) -> &Stepper {
+        &self.stepper
+    }
+
+    // ----- Reactions -----
+
+    /// The force on each ideal joint's body 2 at the current state (N, world frame, in the order
+    /// of `joints`; [`ReactionSolver::solve_joints_with`]), with what the step loop knows and a
+    /// bare solve would not: the joints' and drives' wrenches (they act during the steps only;
+    /// a large-step joint's, its constraint's force over the last step),
+    /// the prescribed motions' rates at this time, and the stored velocities' lag of half the
+    /// last step. `None` when the solve fails ([`ReactionSolver::failure`] says why).
+    pub fn solve_reactions<'s>(
+        &mut self,
+        solver: &'s mut ReactionSolver,
+        joints: &[IdealJoint],
+    ) -> Option<&'s [Vector]> {
+        let t = self.time();
+        solver.velocity_lag = 0.5 * self.stepper.last_dt();
+        solver.kinematic.clear();
+        for m in &self.prescribed.motions {
+            let (linvel, linacc, angvel, angacc) = m.rates(t);
+            solver.kinematic.push(KinematicState {
+                body: m.body,
+                linvel,
+                angvel,
+                linacc,
+                angacc,
+            });
+        }
+        self.wrenches.clear();
+        self.wrenches.extend_from_slice(self.drives.wrenches());
+        self.wrenches.extend_from_slice(self.clearance.wrenches());
+        // The large-step joints' constraint forces of the last step (no ideal joints to solve).
+        self.large_step
+            .constraint_wrenches(&self.rapier.bodies, &mut self.wrenches);
+        solver.solve_joints_with(
+            &self.rapier.bodies,
+            joints,
+            self.rapier.gravity,
+            &self.wrenches,
+        )
+    }
+
+    // ----- Internals -----
+
+    /// The stepper, the Rapier world and the hooks in their order: drives, compliant joints,
+    /// large-step joints, prescribed motions (the drives' and joints' forces are added to a body
+    /// in that order).
+    fn parts(&mut self) -> (&mut Stepper, &mut PhysicsWorld, [&mut dyn StepHooks; 4]) {
+        (
+            &mut self.stepper,
+            &mut self.rapier,
+            [
+                &mut self.drives,
+                &mut self.clearance,
+                &mut self.large_step,
+                &mut self.prescribed,
+            ],
+        )
+    }
+
+    /// A force source edited through its public field since the last step (a compliant joint or
+    /// a drive added or removed): its forces are evaluated again before the next step. Only
+    /// these: an evaluation at the same state again is not free (the joints' reports would lose
+    /// the onset they flagged), and the other sets carry no forces to evaluate.
+    fn follow_changes(&mut self) {
+        let counts = [self.clearance.len(), self.drives.len()];
+        if counts != self.counts {
+            if self.counts[0] != usize::MAX {
+                self.stepper.invalidate(false);
+            }
+            self.counts = counts;
+        }
+    }
+}

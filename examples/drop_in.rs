@@ -1,8 +1,8 @@
 //! Drop-in, plain Rapier: a two-link arm hangs from a fixed base on two ideal revolute joints and
 //! swings down from 30 degrees under gravity. The same Rapier code runs twice; the second time,
 //! one call turns the elbow's revolute joint into a clearance joint (0.1 mm of radial play in a
-//! 10 mm steel bearing, dry friction). Everything else, including the step loop (the library's
-//! stepper in place of `world.step()`), is identical.
+//! 10 mm steel bearing, dry friction). Everything else, including the step loop (a
+//! `ClearanceWorld`, whose `step` takes the place of `world.step()`), is identical.
 //!
 //! `cargo run --release --example drop_in`
 
@@ -10,8 +10,8 @@ use clearance_joint::Result;
 use clearance_joint::model::angle::{UnwrappedAngle, twist_angle};
 use clearance_joint::model::laws::{Bai, FrictionModel};
 use clearance_joint::rapier::convert::{BearingSide, Clearance, ConvertRevolute};
-use clearance_joint::rapier::joint::ClearanceJointSet;
-use clearance_joint::rapier::stepper::{StepControl, Stepper};
+use clearance_joint::rapier::stepper::StepControl;
+use clearance_joint::rapier::world::ClearanceWorld;
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::{
     ImpulseJointHandle, MassProperties, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder,
@@ -61,8 +61,9 @@ fn link(
     )
 }
 
-/// A Rapier world with the arm on two ideal revolute joints about z, gravity along -y.
-pub fn build() -> (PhysicsWorld, Arm) {
+/// The arm on two ideal revolute joints about z, gravity along -y, in a `ClearanceWorld` at
+/// fixed steps of [`DT`].
+pub fn build() -> (ClearanceWorld, Arm) {
     let mut world = PhysicsWorld::new();
     world.gravity = Vector::new(0.0, -GRAVITY, 0.0);
     world.integration_parameters.dt = DT;
@@ -90,7 +91,7 @@ pub fn build() -> (PhysicsWorld, Arm) {
         true,
     );
     (
-        world,
+        ClearanceWorld::new(world, StepControl::fixed(DT)),
         Arm {
             upper,
             lower,
@@ -120,34 +121,35 @@ pub struct Run {
     pub max_penetration_um: f64,
 }
 
-/// Steps `world` to [`END`] with the library's stepper in place of `world.step()`: it applies the
-/// clearance forces, keeps the kicks consistent and refuses an unstable step. The same loop for
-/// both runs.
-fn simulate(mut world: PhysicsWorld, arm: &Arm, mut clearance: ClearanceJointSet) -> Result<Run> {
-    let mut stepper = Stepper::new(StepControl::fixed(DT));
-    stepper.prepare(&mut world, &mut [&mut clearance])?; // the hook's forces at the start
+/// Steps `world` to [`END`] with `ClearanceWorld::step` in place of `world.step()`: it applies
+/// the clearance forces, keeps the kicks consistent and refuses an unstable step. The same loop
+/// for both runs.
+fn simulate(mut world: ClearanceWorld, arm: &Arm) -> Result<Run> {
+    world.prepare()?; // the joints' forces at the start
     let mut run = Run::default();
     let (mut shoulder, mut elbow) = (UnwrappedAngle::default(), UnwrappedAngle::default());
-    let start = *world.bodies[arm.upper].rotation();
+    let start = *world.rapier.bodies[arm.upper].rotation();
     let (mut sum_sq, mut steps) = (0.0, 0u64);
-    while stepper.time() < END {
-        let v_before = world.bodies[arm.lower].linvel();
-        // The hook's contact over the coming step (evaluated at its start).
-        for (_, j) in clearance.iter() {
+    while world.time() < END {
+        let v_before = world.rapier.bodies[arm.lower].linvel();
+        // The joint's contact over the coming step (evaluated at its start).
+        for (_, j) in world.clearance.iter() {
             let r = j.report();
             run.impacts += u64::from(r.onset);
             run.peak_contact_force_n = run.peak_contact_force_n.max(r.force.on_journal.length());
             run.max_penetration_um = run.max_penetration_um.max(r.state.penetration * 1e6);
         }
-        let step = stepper.step(&mut world, &mut [&mut clearance], END)?; // was: world.step()
+        let step = world.step(END)?; // was: world.step()
         // The lower link's momentum balance: applied forces act for the step's kick.
-        let lower = &world.bodies[arm.lower];
+        let bodies = &world.rapier.bodies;
+        let lower = &bodies[arm.lower];
+        let gravity = world.rapier.gravity;
         let force =
-            (LOWER.0 * (lower.linvel() - v_before) / step.kick - LOWER.0 * world.gravity).length();
+            (LOWER.0 * (lower.linvel() - v_before) / step.kick - LOWER.0 * gravity).length();
         run.peak_elbow_force_n = run.peak_elbow_force_n.max(force);
         sum_sq += force * force;
         steps += 1;
-        let (q1, q2) = (*world.bodies[arm.upper].rotation(), *lower.rotation());
+        let (q1, q2) = (*bodies[arm.upper].rotation(), *lower.rotation());
         shoulder.update(twist_angle(&(q1 * start.inverse()), Vector::Z));
         elbow.update(twist_angle(&(q1.inverse() * q2), Vector::Z));
     }
@@ -167,21 +169,20 @@ pub fn elbow_clearance() -> Result<Clearance> {
 /// The arm with ideal hinges.
 pub fn ideal_run() -> Result<Run> {
     let (world, arm) = build();
-    simulate(world, &arm, ClearanceJointSet::new())
+    simulate(world, &arm)
 }
 
 /// The same arm with the elbow converted into a clearance joint.
 pub fn clearance_run() -> Result<Run> {
     let (mut world, arm) = build();
-    let mut clearance = ClearanceJointSet::new();
     // The whole change: the elbow's revolute joint becomes a clearance joint.
-    clearance.convert_revolute(
+    world.clearance.convert_revolute(
         arm.elbow,
         BearingSide::Body1,
         elbow_clearance()?,
-        &mut world.impulse_joints,
+        &mut world.rapier.impulse_joints,
     )?;
-    simulate(world, &arm, clearance)
+    simulate(world, &arm)
 }
 
 /// Both runs: ideal, then with the elbow converted.

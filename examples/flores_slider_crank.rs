@@ -4,7 +4,8 @@
 //! guide, gravity along -y, and a clearance joint at the rod-slider pin (bearing on the slider,
 //! R = 10 mm, c = 0.5 mm, steel, Lankarani-Nikravesh cr = 0.9 with the geometric stiffness,
 //! Ambrósio friction mu = 0.01, v0 = 0.1 mm/s, v1 = 10 mm/s). Started with the crank at 0 deg,
-//! the journal centred, rod and slider at the velocities of the ideal mechanism.
+//! the journal centred, rod and slider at the velocities of the ideal mechanism. One
+//! `ClearanceWorld` holds it all and takes every step (adaptive by default).
 //!
 //! `cargo run --release --example flores_slider_crank -- [adaptive[:TOL[:MAX_DT]]|FIXED_DT] [CLEARANCE_MM] [TURNS]`
 //!
@@ -17,9 +18,10 @@ use clearance_joint::model::laws::{
     Ambrosio, BearingGeometry, FrictionModel, LankaraniNikravesh, Material, NormalModel,
 };
 use clearance_joint::rapier::convert::{BearingSide, Clearance, ConvertRevolute};
-use clearance_joint::rapier::joint::{ClearanceJointHandle, ClearanceJointSet};
+use clearance_joint::rapier::joint::ClearanceJointHandle;
 use clearance_joint::rapier::metrics::{ContactObservation, ImpactRecorder};
-use clearance_joint::rapier::stepper::{StepControl, Stepper};
+use clearance_joint::rapier::stepper::StepControl;
+use clearance_joint::rapier::world::ClearanceWorld;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::*;
 use std::f64::consts::TAU;
@@ -65,12 +67,10 @@ pub fn closed_form_acceleration(theta: f64) -> f64 {
     OMEGA * OMEGA * x2
 }
 
-/// The world, the clearance set, the pin (if any) and the crank, rod and slider.
+/// The world, the pin (if any) and the crank, rod and slider.
 pub struct Mechanism {
-    /// The Rapier world.
-    pub world: PhysicsWorld,
-    /// The clearance joints (empty for the ideal twin).
-    pub clearance: ClearanceJointSet,
+    /// The clearance-ready world: Rapier's, and the clearance joints (none for the ideal twin).
+    pub world: ClearanceWorld,
     /// The clearance pin.
     pub pin: Option<ClearanceJointHandle>,
     /// Crank, rod, slider.
@@ -78,8 +78,8 @@ pub struct Mechanism {
 }
 
 /// Builds the mechanism with the crank along +x, the rod-slider pin a clearance joint when
-/// `clearance` is given.
-pub fn build(clearance: Option<Clearance>) -> Result<Mechanism> {
+/// `clearance` is given, stepped with `control`.
+pub fn build(clearance: Option<Clearance>, control: StepControl) -> Result<Mechanism> {
     let (r, l) = (CRANK, ROD);
     let mut world = PhysicsWorld::new();
     world.gravity = Vector::new(0.0, -9.81, 0.0);
@@ -138,19 +138,18 @@ pub fn build(clearance: Option<Clearance>) -> Result<Mechanism> {
             .contacts_enabled(false),
         true,
     );
-    let mut set = ClearanceJointSet::new();
+    let mut world = ClearanceWorld::new(world, control);
     let pin = match clearance {
-        Some(c) => Some(set.convert_revolute(
+        Some(c) => Some(world.clearance.convert_revolute(
             pin_joint,
             BearingSide::Body1,
             c,
-            &mut world.impulse_joints,
+            &mut world.rapier.impulse_joints,
         )?),
         None => None,
     };
     Ok(Mechanism {
         world,
-        clearance: set,
         pin,
         bodies: [crank, rod, slider],
     })
@@ -185,31 +184,35 @@ pub struct Run {
 
 /// Runs to `end` (s) with `control`.
 pub fn simulate(clearance: Option<Clearance>, control: StepControl, end: f64) -> Result<Run> {
-    let mut m = build(clearance)?;
-    let [crank, _, slider] = m.bodies;
-    let mut stepper = Stepper::new(control);
-    stepper.prepare(&mut m.world, &mut [&mut m.clearance])?;
+    let Mechanism {
+        mut world,
+        pin,
+        bodies: [crank, _, slider],
+    } = build(clearance, control)?;
+    world.prepare()?;
     let mut run = Run::default();
     let mut theta = UnwrappedAngle::default();
     // Position differences: the mean velocity of each step.
-    let mut last_x = m.world.bodies[slider].translation().x;
+    let mut last_x = world.rapier.bodies[slider].translation().x;
     let mut last_mean: Option<(f64, f64)> = None;
-    let observe = |m: &Mechanism| {
-        m.pin
-            .map(|p| ContactObservation::of(m.clearance.get(p).expect("pin")))
+    let observe = |w: &ClearanceWorld| {
+        pin.map(|p| ContactObservation::of(w.clearance.get(p).expect("pin")))
             .unwrap_or_default()
     };
-    while stepper.time() < end {
-        let obs = observe(&m);
-        theta.update(twist_angle(m.world.bodies[crank].rotation(), Vector::Z));
+    while world.time() < end {
+        let obs = observe(&world);
+        theta.update(twist_angle(
+            world.rapier.bodies[crank].rotation(),
+            Vector::Z,
+        ));
         let th = theta.value();
-        let info = stepper.step(&mut m.world, &mut [&mut m.clearance], end)?;
+        let info = world.step(end)?;
         run.recorder.record(info.t0, info.dt, &obs);
         if info.t0 >= TURN {
             run.late_peak_n = run.late_peak_n.max(obs.force);
             run.late_penetration_um = run.late_penetration_um.max(obs.penetration * 1e6);
         }
-        let x = m.world.bodies[slider].translation().x;
+        let x = world.rapier.bodies[slider].translation().x;
         let mean = (x - last_x) / info.dt;
         if info.t0 >= 0.5 * TURN {
             let a = last_mean.map_or(0.0, |(mv, _)| (mean - mv) / info.kick);
@@ -219,13 +222,16 @@ pub fn simulate(clearance: Option<Clearance>, control: StepControl, end: f64) ->
         last_mean = Some((mean, info.dt));
         last_x = x;
     }
-    run.recorder.finish(stepper.time(), &observe(&m));
-    theta.update(twist_angle(m.world.bodies[crank].rotation(), Vector::Z));
-    run.crank_error_rad = theta.value() - OMEGA * stepper.time();
-    run.steps = stepper.steps();
-    run.rejected = stepper.guards().rejected_steps;
-    run.clean = stepper.guards().is_clean();
-    run.violations = stepper.guards().messages();
+    run.recorder.finish(world.time(), &observe(&world));
+    theta.update(twist_angle(
+        world.rapier.bodies[crank].rotation(),
+        Vector::Z,
+    ));
+    run.crank_error_rad = theta.value() - OMEGA * world.time();
+    run.steps = world.steps();
+    run.rejected = world.guards().rejected_steps;
+    run.clean = world.guards().is_clean();
+    run.violations = world.guards().messages();
     Ok(run)
 }
 

@@ -8,14 +8,18 @@
 //! cart has stopped. The same sign on Rapier's ideal revolute joint runs beside it. One minute of
 //! game time.
 //!
+//! The world is a `ClearanceWorld` stepped at fixed 1/60 s steps (`StepControl::fixed`): its
+//! `step` takes the place of `world.step()` and runs the large-step joint's hooks around Rapier's
+//! step, so none can be forgotten.
+//!
 //! `cargo run --release --example game_rate`
 
 use clearance_joint::Result;
 use clearance_joint::model::angle::HingeAngle;
 use clearance_joint::model::laws::BearingGeometry;
-use clearance_joint::rapier::large_step::{
-    DEFAULT_MAX_SUBSTEPS, LargeStepJointBuilder, LargeStepJointSet,
-};
+use clearance_joint::rapier::large_step::{DEFAULT_MAX_SUBSTEPS, LargeStepJointBuilder};
+use clearance_joint::rapier::stepper::StepControl;
+use clearance_joint::rapier::world::ClearanceWorld;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     IntegrationParameters, MassProperties, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder,
@@ -127,20 +131,20 @@ fn energy(world: &PhysicsWorld, body: RigidBodyHandle) -> f64 {
 /// One minute of the sign: with play (`true`, at most `max_substeps` substeps per step) or on
 /// Rapier's ideal revolute joint.
 pub fn simulate(with_play: bool, max_substeps: usize) -> Result<Run> {
-    let mut world = PhysicsWorld::new();
-    world.gravity = Vector::new(0.0, -9.81, 0.0);
-    world.integration_parameters = IntegrationParameters::default(); // 1/60 s, 4 iterations
-    let dt = world.integration_parameters.dt;
-    let cart = world
+    let mut rapier = PhysicsWorld::new();
+    rapier.gravity = Vector::new(0.0, -9.81, 0.0);
+    rapier.integration_parameters = IntegrationParameters::default(); // 1/60 s, 4 iterations
+    let dt = rapier.integration_parameters.dt;
+    let cart = rapier
         .bodies
         .insert(RigidBodyBuilder::kinematic_position_based());
-    let body = world.bodies.insert(
+    let body = rapier.bodies.insert(
         RigidBodyBuilder::dynamic()
             .translation(Vector::new(0.0, -PIN, 0.0))
             .additional_mass_properties(MassProperties::new(Vector::ZERO, MASS, inertia()))
             .can_sleep(false),
     );
-    let mut play = LargeStepJointSet::new();
+    let mut world = ClearanceWorld::new(rapier, StepControl::fixed(dt));
     let pin = if with_play {
         // The one difference from the ideal sign: the pin's joint.
         let joint = LargeStepJointBuilder::new(
@@ -153,9 +157,9 @@ pub fn simulate(with_play: bool, max_substeps: usize) -> Result<Run> {
         .max_substeps(max_substeps)
         .name("sign pin")
         .build()?;
-        Some(play.insert(cart, body, joint, &mut world.impulse_joints))
+        Some(world.insert_large_step(cart, body, joint))
     } else {
-        world.impulse_joints.insert(
+        world.rapier.impulse_joints.insert(
             cart,
             body,
             RevoluteJointBuilder::new(Vector::Z)
@@ -168,7 +172,7 @@ pub fn simulate(with_play: bool, max_substeps: usize) -> Result<Run> {
     let steps = (END / dt).round() as u64;
     let mut run = Run {
         dt,
-        iterations: world.integration_parameters.num_solver_iterations,
+        iterations: world.rapier.integration_parameters.num_solver_iterations,
         steps,
         ..Run::default()
     };
@@ -178,22 +182,14 @@ pub fn simulate(with_play: bool, max_substeps: usize) -> Result<Run> {
     for step in 0..steps {
         let t = (step + 1) as f64 * dt;
         let x = travel(t);
-        world.bodies[cart].set_next_kinematic_translation(Vector::new(x, cobbles(x), 0.0));
-        play.before_step(
-            &mut world.bodies,
-            &mut world.impulse_joints,
-            &world.integration_parameters,
-        );
-        world.step();
-        play.after_step(&mut world.bodies, &world.impulse_joints);
+        let bodies = &mut world.rapier.bodies;
+        bodies[cart].set_next_kinematic_translation(Vector::new(x, cobbles(x), 0.0));
+        world.step(t)?; // was: world.step(), with the joints' hooks around it
 
         // The swing from hanging, in (-180, 180] deg.
+        let bodies = &world.rapier.bodies;
         let a = swing
-            .update(
-                world.bodies[cart].rotation(),
-                world.bodies[body].rotation(),
-                Vector::Z,
-            )
+            .update(bodies[cart].rotation(), bodies[body].rotation(), Vector::Z)
             .to_degrees();
         let a = (a + 180.0).rem_euclid(360.0) - 180.0;
         run.max_swing_deg = run.max_swing_deg.max(a.abs());
@@ -201,7 +197,7 @@ pub fn simulate(with_play: bool, max_substeps: usize) -> Result<Run> {
             run.final_swing_deg = run.final_swing_deg.max(a.abs());
         }
         if t >= STOP {
-            let e = energy(&world, body);
+            let e = energy(&world.rapier, body);
             if !stopped {
                 run.energy_at_stop_j = e;
                 stopped = true;
@@ -209,7 +205,7 @@ pub fn simulate(with_play: bool, max_substeps: usize) -> Result<Run> {
             run.max_energy_rise_j = run.max_energy_rise_j.max(e - run.energy_at_stop_j);
         }
         if let Some(pin) = pin {
-            let r = play.get(pin).expect("inserted").report();
+            let r = world.large_step.get(pin).expect("inserted").report();
             run.max_eccentricity_ratio = run.max_eccentricity_ratio.max(r.eccentricity_ratio);
             run.max_impact_impulse = run.max_impact_impulse.max(r.impact_impulse);
             if r.impact {
@@ -226,7 +222,7 @@ pub fn simulate(with_play: bool, max_substeps: usize) -> Result<Run> {
         }
     }
     run.us_per_step = start.elapsed().as_secs_f64() / steps as f64 * 1e6;
-    run.final_energy_j = energy(&world, body);
+    run.final_energy_j = energy(&world.rapier, body);
     if pin.is_some() {
         run.mean_substeps = substeps as f64 / steps as f64;
     } else {

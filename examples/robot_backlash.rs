@@ -10,14 +10,18 @@
 //! controller on Rapier's ideal revolute joints runs in lockstep beside it: the distance between
 //! the two hands is the tracking error the play causes.
 //!
+//! Each arm is a `ClearanceWorld` stepped at fixed 1 ms steps (`StepControl::fixed`): its `step`
+//! takes the place of `world.step()` and runs the large-step joints' hooks around Rapier's step,
+//! so none can be forgotten. The controller's torques are ordinary Rapier user torques.
+//!
 //! `cargo run --release --example robot_backlash`
 
 use clearance_joint::Result;
 use clearance_joint::model::angle::HingeAngle;
 use clearance_joint::model::laws::BearingGeometry;
-use clearance_joint::rapier::large_step::{
-    LargeStepJointBuilder, LargeStepJointHandle, LargeStepJointSet,
-};
+use clearance_joint::rapier::large_step::{LargeStepJointBuilder, LargeStepJointHandle};
+use clearance_joint::rapier::stepper::StepControl;
+use clearance_joint::rapier::world::ClearanceWorld;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     IntegrationParameters, MassProperties, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder,
@@ -40,7 +44,8 @@ const TUNED_INERTIA: [f64; 2] = [0.45, 0.035];
 
 /// PD gains per joint (stiffness N m/rad, damping N m s/rad) for a controller ticking every `dt`:
 /// closed-loop bandwidth 5 Hz, damping ratio 0.7, slowed to `0.3/dt` rad/s when the tick is too
-/// slow for it (the explicit PD torque is then still stable).
+/// slow for it. Stable at 1 kHz; not at 60 Hz, where the ideal arm diverges within 0.27 s and
+/// `ClearanceWorld::step` stops the run with that error.
 fn gains(dt: f64) -> [(f64, f64); 2] {
     let w = (2.0 * PI * 5.0).min(0.3 / dt);
     TUNED_INERTIA.map(|i| (i * w * w, 2.0 * 0.7 * i * w))
@@ -76,12 +81,12 @@ pub fn hand(q: [f64; 2]) -> Vector {
     UPPER.1 * along(q[0]) + LOWER.1 * along(q[0] + q[1])
 }
 
-/// One arm in its own Rapier world, with its controller.
+/// One arm in its own world, with its controller.
 struct Arm {
-    world: PhysicsWorld,
+    world: ClearanceWorld,
+    dt: f64,
     pairs: [(RigidBodyHandle, RigidBodyHandle); 2],
     lower: RigidBodyHandle,
-    play: LargeStepJointSet,
     pins: Vec<LargeStepJointHandle>,
     angles: [HingeAngle; 2],
 }
@@ -121,7 +126,7 @@ impl Arm {
                 Vector::new(-0.5 * LOWER.1, 0.0, 0.0),
             ),
         ];
-        let mut play = LargeStepJointSet::new();
+        let mut world = ClearanceWorld::new(world, StepControl::fixed(dt));
         let mut pins = Vec::new();
         for (i, ((b1, b2), (a1, a2))) in pairs.into_iter().zip(anchors).enumerate() {
             if with_play {
@@ -136,9 +141,9 @@ impl Arm {
                 .friction(0.1)
                 .name(["shoulder", "elbow"][i])
                 .build()?;
-                pins.push(play.insert(b1, b2, joint, &mut world.impulse_joints));
+                pins.push(world.insert_large_step(b1, b2, joint));
             } else {
-                world.impulse_joints.insert(
+                world.rapier.impulse_joints.insert(
                     b1,
                     b2,
                     RevoluteJointBuilder::new(Vector::Z)
@@ -151,9 +156,9 @@ impl Arm {
         }
         Ok(Arm {
             world,
+            dt,
             pairs,
             lower,
-            play,
             pins,
             angles: Default::default(),
         })
@@ -163,7 +168,8 @@ impl Arm {
     fn joints(&mut self) -> ([f64; 2], [f64; 2]) {
         let (mut q, mut rate) = ([0.0; 2], [0.0; 2]);
         for (k, (b1, b2)) in self.pairs.iter().enumerate() {
-            let (r1, r2) = (&self.world.bodies[*b1], &self.world.bodies[*b2]);
+            let bodies = &self.world.rapier.bodies;
+            let (r1, r2) = (&bodies[*b1], &bodies[*b2]);
             q[k] = self.angles[k].update(r1.rotation(), r2.rotation(), Vector::Z);
             rate[k] = (r2.angvel() - r1.angvel()).z;
         }
@@ -172,36 +178,29 @@ impl Arm {
 
     /// The hand: the tip of the lower link, from the bodies (the play moves the links).
     fn hand(&self) -> Vector {
-        *self.world.bodies[self.lower].position() * Vector::new(0.5 * LOWER.1, 0.0, 0.0)
+        *self.world.rapier.bodies[self.lower].position() * Vector::new(0.5 * LOWER.1, 0.0, 0.0)
     }
 
     /// One controller tick and physics step at `t`; returns the encoder angles.
-    fn step(&mut self, t: f64) -> [f64; 2] {
+    fn step(&mut self, t: f64) -> Result<[f64; 2]> {
         let (q, rate) = self.joints();
         let (qt, rt) = target(t);
-        let gains = gains(self.world.integration_parameters.dt);
+        let gains = gains(self.dt);
         for (k, (b1, b2)) in self.pairs.iter().enumerate() {
             let (kp, kd) = gains[k];
             let tau = Vector::new(0.0, 0.0, kp * (qt[k] - q[k]) + kd * (rt[k] - rate[k]));
             // The motor's torque on the driven link and its reaction on the driving one (the
             // shoulder's goes to the fixed base). User torques persist in Rapier: reset first.
             for (body, sign) in [(*b2, 1.0), (*b1, -1.0)] {
-                let rb = &mut self.world.bodies[body];
+                let rb = &mut self.world.rapier.bodies[body];
                 if k == 0 || sign > 0.0 {
                     rb.reset_torques(false);
                 }
                 rb.add_torque(sign * tau, true);
             }
         }
-        self.play.before_step(
-            &mut self.world.bodies,
-            &mut self.world.impulse_joints,
-            &self.world.integration_parameters,
-        );
-        self.world.step();
-        self.play
-            .after_step(&mut self.world.bodies, &self.world.impulse_joints);
-        q
+        self.world.step(t + self.dt)?; // was: world.step(), with the joints' hooks around it
+        Ok(q)
     }
 }
 
@@ -250,10 +249,10 @@ pub fn run_at(dt: f64, end: f64) -> Result<Outcome> {
     for step in 0..steps {
         let t = step as f64 * dt;
         let clock = Instant::now();
-        let qi = ideal.step(t);
+        let qi = ideal.step(t)?;
         wall[0] += clock.elapsed().as_secs_f64();
         let clock = Instant::now();
-        let qp = play.step(t);
+        let qp = play.step(t)?;
         wall[1] += clock.elapsed().as_secs_f64();
         let path = hand(target(t + dt).0);
         let (hi, hp) = (ideal.hand(), play.hand());
@@ -268,7 +267,7 @@ pub fn run_at(dt: f64, end: f64) -> Result<Outcome> {
             angle_sq[k] += (qp[k] - qi[k]).powi(2);
         }
         for (k, pin) in play.pins.iter().enumerate() {
-            let r = play.play.get(*pin).expect("inserted").report();
+            let r = play.world.large_step.get(*pin).expect("inserted").report();
             o.max_eccentricity_ratio[k] = o.max_eccentricity_ratio[k].max(r.eccentricity_ratio);
             o.max_pin_force_n[k] = o.max_pin_force_n[k].max(r.normal_force);
             o.max_substeps = o.max_substeps.max(r.substeps);
@@ -282,7 +281,7 @@ pub fn run_at(dt: f64, end: f64) -> Result<Outcome> {
     o.play_effect_mm.0 = rms(sq[2]);
     for (k, pin) in play.pins.iter().enumerate() {
         o.angle_effect_deg[k] = (angle_sq[k] / n).sqrt().to_degrees();
-        o.impacts[k] = play.play.get(*pin).expect("inserted").impacts();
+        o.impacts[k] = play.world.large_step.get(*pin).expect("inserted").impacts();
     }
     o.us_per_step = (wall[0] / n * 1e6, wall[1] / n * 1e6);
     Ok(o)

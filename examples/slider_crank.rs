@@ -1,8 +1,8 @@
 //! The literature's standard clearance benchmark built with the plain API: a slider-crank whose
 //! crank turns at a prescribed 5000 rpm (a kinematic, velocity-based Rapier body), an ideal
 //! revolute crank pin, a prismatic slider guide (Rapier's `PrismaticJointBuilder`), gravity, and
-//! one clearance joint at the rod-slider pin (the slider carries the bearing), stepped by the
-//! crate's `Stepper` at fixed steps. The ideal and clearance twins are compared on the slider's
+//! one clearance joint at the rod-slider pin (the slider carries the bearing), in a
+//! `ClearanceWorld` stepped at fixed steps. The ideal and clearance twins are compared on the slider's
 //! acceleration and the pin force; the ideal slider's acceleration is checked against the closed
 //! form, and the first impact is computed at halving steps.
 //!
@@ -13,19 +13,21 @@
 //! `x[n+1] = x[n] + h v[n+1/2]`, so this is exactly `(v[n+1/2] - v[n-1/2]) / h`, the acceleration
 //! the step applied at state `n` (the stored velocities live at half steps, so a velocity read
 //! at a state is not the state's velocity). The ideal pin force is the exact reaction of the
-//! constrained equations at each state (`ReactionSolver` with the crank pin, the slider pin and
-//! the prismatic guide, told that the stored velocities lag the state by half the last step);
-//! the clearance pin force is the contact and friction force.
+//! constrained equations at each state (`ClearanceWorld::solve_reactions` with the crank pin, the
+//! slider pin and the prismatic guide: it tells the `ReactionSolver` that the stored velocities
+//! lag the state by half the last step); the clearance pin force is the contact and friction
+//! force.
 
 use clearance_joint::Result;
 use clearance_joint::model::angle::twist_angle;
 use clearance_joint::rapier::convert::{BearingSide, Clearance, ConvertRevolute};
-use clearance_joint::rapier::joint::{ClearanceJointHandle, ClearanceJointSet};
+use clearance_joint::rapier::joint::ClearanceJointHandle;
 use clearance_joint::rapier::metrics::{ContactObservation, HingeMetrics, ImpactRecorder};
 use clearance_joint::rapier::reaction::{
     IdealJoint, IdealPrismatic, IdealRevolute, ReactionSolver, prepare_mass_properties,
 };
-use clearance_joint::rapier::stepper::{StepControl, Stepper};
+use clearance_joint::rapier::stepper::StepControl;
+use clearance_joint::rapier::world::ClearanceWorld;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::*;
 use std::f64::consts::TAU;
@@ -66,10 +68,9 @@ pub fn closed_form_acceleration(theta: f64) -> f64 {
 
 /// The world and its handles.
 pub struct Mechanism {
-    /// The Rapier world (one solver iteration, gravity -9.81 m/s^2 along y).
-    pub world: PhysicsWorld,
-    /// The clearance joint set (empty for the ideal twin).
-    pub clearance: ClearanceJointSet,
+    /// The clearance-ready world: the Rapier world (one solver iteration, gravity -9.81 m/s^2
+    /// along y) and the clearance joints (none for the ideal twin).
+    pub world: ClearanceWorld,
     /// The clearance pin, if any.
     pub pin: Option<ClearanceJointHandle>,
     /// Ground, crank, rod and slider.
@@ -80,8 +81,9 @@ pub struct Mechanism {
 }
 
 /// Builds the mechanism at top dead centre (crank along +x, slider at rest, the rod turning
-/// about its slider end), with the rod-slider pin a clearance joint when `clearance` is given.
-pub fn build(clearance: Option<Clearance>) -> Result<Mechanism> {
+/// about its slider end), with the rod-slider pin a clearance joint when `clearance` is given,
+/// stepped with `control`.
+pub fn build(clearance: Option<Clearance>, control: StepControl) -> Result<Mechanism> {
     let (r, l) = (CRANK, ROD);
     let mut world = PhysicsWorld::new();
     world.gravity = Vector::new(0.0, -9.81, 0.0);
@@ -148,13 +150,13 @@ pub fn build(clearance: Option<Clearance>) -> Result<Mechanism> {
         local_anchor2: crank_pin.1,
         local_axis1: Vector::Z,
     })];
-    let mut set = ClearanceJointSet::new();
+    let mut world = ClearanceWorld::new(world, control);
     let pin = match clearance {
-        Some(c) => Some(set.convert_revolute(
+        Some(c) => Some(world.clearance.convert_revolute(
             pin_joint,
             BearingSide::Body1,
             c,
-            &mut world.impulse_joints,
+            &mut world.rapier.impulse_joints,
         )?),
         None => {
             ideal.push(IdealJoint::Revolute(IdealRevolute {
@@ -167,7 +169,7 @@ pub fn build(clearance: Option<Clearance>) -> Result<Mechanism> {
             None
         }
     };
-    world.impulse_joints.insert(
+    world.rapier.impulse_joints.insert(
         ground,
         slider,
         PrismaticJointBuilder::new(Vector::X)
@@ -182,10 +184,9 @@ pub fn build(clearance: Option<Clearance>) -> Result<Mechanism> {
         local_anchor2: Vector::ZERO,
         local_axis1: Vector::X,
     }));
-    prepare_mass_properties(&mut world.bodies);
+    prepare_mass_properties(&mut world.rapier.bodies);
     Ok(Mechanism {
         world,
-        clearance: set,
         pin,
         bodies: [ground, crank, rod, slider],
         ideal,
@@ -229,10 +230,13 @@ impl Run {
 
 /// Runs the mechanism with fixed steps `dt` to `end` (s); the ideal twin without `clearance`.
 pub fn simulate(clearance: Option<Clearance>, dt: f64, end: f64) -> Result<Run> {
-    let mut m = build(clearance)?;
-    let [_, crank, _, slider] = m.bodies;
-    let mut stepper = Stepper::new(StepControl::fixed(dt));
-    stepper.prepare(&mut m.world, &mut [&mut m.clearance])?;
+    let Mechanism {
+        mut world,
+        pin,
+        bodies: [_, crank, _, slider],
+        ideal,
+    } = build(clearance, StepControl::fixed(dt))?;
+    world.prepare()?;
     let mut reactions = ReactionSolver::default();
     let mut run = Run {
         dt,
@@ -245,28 +249,27 @@ pub fn simulate(clearance: Option<Clearance>, dt: f64, end: f64) -> Result<Run> 
     let mut theta = clearance_joint::model::angle::UnwrappedAngle::default();
     loop {
         // The state before the step: its pin force and contact, its positions.
-        let obs = match m.pin {
-            Some(pin) => ContactObservation::of(m.clearance.get(pin).expect("pin")),
+        let obs = match pin {
+            Some(pin) => ContactObservation::of(world.clearance.get(pin).expect("pin")),
             None => {
-                let g = m.world.gravity;
-                // Rapier's velocities lag the state by half the last step.
-                reactions.velocity_lag = 0.5 * stepper.last_dt();
-                let f = reactions
-                    .solve_joints(&m.world.bodies, &m.ideal, g)
+                // The exact reactions at this state (the slider pin is `ideal[1]`).
+                let f = world
+                    .solve_reactions(&mut reactions, &ideal)
                     .map_or(f64::NAN, |f| f[1].length());
                 ContactObservation::ideal(f)
             }
         };
-        theta.update(twist_angle(m.world.bodies[crank].rotation(), Vector::Z));
-        run.t.push(stepper.time());
+        let bodies = &world.rapier.bodies;
+        theta.update(twist_angle(bodies[crank].rotation(), Vector::Z));
+        run.t.push(world.time());
         run.theta.push(theta.value());
-        run.x.push(m.world.bodies[slider].translation().x);
+        run.x.push(bodies[slider].translation().x);
         run.force.push(obs.force);
-        if stepper.time() >= end {
-            run.recorder.finish(stepper.time(), &obs);
+        if world.time() >= end {
+            run.recorder.finish(world.time(), &obs);
             return Ok(run);
         }
-        let info = stepper.step(&mut m.world, &mut [&mut m.clearance], end)?;
+        let info = world.step(end)?;
         run.recorder.record(info.t0, info.dt, &obs);
     }
 }

@@ -1,8 +1,8 @@
 //! The paper's scene in code, no scene file (MODEL.md §4): a 768 kg satellite and a 7.68 kg solar
 //! panel, free-floating, deployed by a torsion spring `T = T0 - k theta` about a hinge with 0.5 mm
 //! radial clearance (steel, the paper's improved contact law, dry friction). An ideal twin (Rapier
-//! revolute joint) and a clearance twin run side by side in one Rapier world, with the paper's
-//! fixed step of 1e-4 s for 5 s.
+//! revolute joint) and a clearance twin run side by side in one `ClearanceWorld` (the Rapier
+//! world with the joints and the springs), with the paper's fixed step of 1e-4 s for 5 s.
 //!
 //! `cargo run --release --example solar_panel`
 
@@ -12,12 +12,13 @@ use clearance_joint::model::laws::{
     Bai, BearingGeometry, FrictionModel, ImprovedLiu, Material, MaxDamping, NormalModel,
     effective_modulus,
 };
-use clearance_joint::rapier::drive::{DriveSet, TorsionSpring};
-use clearance_joint::rapier::joint::{
-    ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet,
+use clearance_joint::rapier::drive::TorsionSpring;
+use clearance_joint::rapier::joint::{ClearanceJointBuilder, ClearanceJointHandle};
+use clearance_joint::rapier::reaction::{
+    IdealJoint, IdealRevolute, ReactionSolver, prepare_mass_properties,
 };
-use clearance_joint::rapier::reaction::{IdealRevolute, ReactionSolver, prepare_mass_properties};
-use clearance_joint::rapier::stepper::{StepControl, Stepper};
+use clearance_joint::rapier::stepper::StepControl;
+use clearance_joint::rapier::world::ClearanceWorld;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     MassProperties, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder, RigidBodyHandle,
@@ -36,11 +37,10 @@ const AXIS: Vector = Vector::NEG_Y;
 const T0: f64 = 0.135; // N m
 const K_PER_DEG: f64 = 0.0015; // N m/deg
 
-/// One twin: its bodies, drive and (for the clearance twin) joint.
+/// One twin: its bodies and (for the clearance twin) joint.
 struct Twin {
     satellite: RigidBodyHandle,
     panel: RigidBodyHandle,
-    drives: DriveSet,
     clearance: Option<ClearanceJointHandle>,
 }
 
@@ -71,10 +71,10 @@ pub struct Outcome {
 }
 
 fn body(
-    world: &mut PhysicsWorld,
+    world: &mut ClearanceWorld,
     (mass, inertia, com): (f64, [f64; 3], [f64; 3]),
 ) -> RigidBodyHandle {
-    world.bodies.insert(
+    world.rapier.bodies.insert(
         RigidBodyBuilder::dynamic()
             .translation(Vector::from(com))
             .additional_mass_properties(MassProperties::new(
@@ -86,11 +86,7 @@ fn body(
     )
 }
 
-fn add_twin(
-    world: &mut PhysicsWorld,
-    set: &mut ClearanceJointSet,
-    with_clearance: bool,
-) -> Result<Twin> {
+fn add_twin(world: &mut ClearanceWorld, with_clearance: bool) -> Result<Twin> {
     let satellite = body(world, SATELLITE);
     let panel = body(world, PANEL);
     let h = Vector::from(HINGE_POINT);
@@ -110,19 +106,19 @@ fn add_twin(
         .friction(FrictionModel::Bai(Bai::DRY))
         .name("hinge")
         .build()?;
-        Some(set.insert(satellite, panel, joint, &mut world.impulse_joints))
+        Some(world.insert_clearance(satellite, panel, joint))
     } else {
         let revolute = RevoluteJointBuilder::new(AXIS)
             .local_anchor1(a1)
             .local_anchor2(a2)
             .contacts_enabled(false);
         world
+            .rapier
             .impulse_joints
             .insert(satellite, panel, revolute, true);
         None
     };
-    let mut drives = DriveSet::new();
-    drives.insert(TorsionSpring::new(
+    world.insert_drive(TorsionSpring::new(
         satellite,
         panel,
         AXIS,
@@ -132,7 +128,6 @@ fn add_twin(
     Ok(Twin {
         satellite,
         panel,
-        drives,
         clearance,
     })
 }
@@ -157,61 +152,48 @@ fn momentum(bodies: &RigidBodySet, twin: &Twin) -> (Vector, Vector, f64, f64) {
     (p, l, max_p, max_l)
 }
 
-/// Runs both twins in one world, stepped by the library's stepper (fixed steps of [`DT`]).
+/// Runs both twins in one world, stepped by `ClearanceWorld::step` (fixed steps of [`DT`]).
 pub fn run() -> Result<(Outcome, Outcome)> {
-    let mut world = PhysicsWorld::new();
-    world.gravity = Vector::ZERO;
-    world.integration_parameters.dt = DT;
-    world.integration_parameters.num_solver_iterations = 1; // the hook's force is constant over a step
-    let mut set = ClearanceJointSet::new();
-    let [mut ideal, mut clear] = [
-        add_twin(&mut world, &mut set, false)?,
-        add_twin(&mut world, &mut set, true)?,
-    ];
+    let mut rapier = PhysicsWorld::new();
+    rapier.gravity = Vector::ZERO;
+    rapier.integration_parameters.dt = DT;
+    rapier.integration_parameters.num_solver_iterations = 1; // the hook's force is constant over a step
+    let mut world = ClearanceWorld::new(rapier, StepControl::fixed(DT));
+    let [ideal, clear] = [add_twin(&mut world, false)?, add_twin(&mut world, true)?];
     // The ideal hinge's exact reaction at each state (not a momentum difference over a step).
-    prepare_mass_properties(&mut world.bodies);
+    prepare_mass_properties(&mut world.rapier.bodies);
     let h = Vector::from(HINGE_POINT);
-    let ideal_hinge = [IdealRevolute {
+    let ideal_hinge = [IdealJoint::Revolute(IdealRevolute {
         body1: ideal.satellite,
         body2: ideal.panel,
         local_anchor1: h - Vector::from(SATELLITE.2),
         local_anchor2: h - Vector::from(PANEL.2),
         local_axis1: AXIS,
-    }];
+    })];
     let mut reactions = ReactionSolver::default();
-    let mut stepper = Stepper::new(StepControl::fixed(DT));
-    stepper.prepare(
-        &mut world,
-        &mut [&mut ideal.drives, &mut clear.drives, &mut set],
-    )?;
+    world.prepare()?;
     let mut out = [Outcome::default(), Outcome::default()];
     let mut angles = [[UnwrappedAngle::default(); 3]; 2];
     let mut p0 = [None; 2];
     let (mut dp, mut dl, mut sp, mut sl) = ([0.0f64; 2], [0.0f64; 2], [0.0f64; 2], [0.0f64; 2]);
     loop {
-        // The state at the stepper's time, with the forces the next step applies.
-        let t = stepper.time();
+        // The state at the world's time, with the forces the next step applies.
+        let t = world.time();
         for (k, twin) in [&ideal, &clear].into_iter().enumerate() {
-            let (p, l, mp, ml) = momentum(&world.bodies, twin);
+            let (p, l, mp, ml) = momentum(&world.rapier.bodies, twin);
             let (p_start, l_start) = *p0[k].get_or_insert((p, l));
             dp[k] = dp[k].max((p - p_start).length());
             dl[k] = dl[k].max((l - l_start).length());
             sp[k] = sp[k].max(mp);
             sl[k] = sl[k].max(ml);
             let o = &mut out[k];
-            // Rapier's velocities lag the state by half the last step.
-            reactions.velocity_lag = 0.5 * stepper.last_dt();
             let force = match twin.clearance {
-                None => reactions
-                    .solve_with(
-                        &world.bodies,
-                        &ideal_hinge,
-                        world.gravity,
-                        ideal.drives.wrenches(),
-                    )
+                // With the spring's torque, at this state (the velocities' lag taken care of).
+                None => world
+                    .solve_reactions(&mut reactions, &ideal_hinge)
                     .map_or(0.0, |f| f[0].length()),
                 Some(c) => {
-                    let r = set.get(c).expect("inserted").report();
+                    let r = world.clearance.get(c).expect("inserted").report();
                     if r.onset {
                         o.impacts += 1;
                         o.first_impact_s.get_or_insert(t);
@@ -221,9 +203,10 @@ pub fn run() -> Result<(Outcome, Outcome)> {
                 }
             };
             o.peak_force_n = o.peak_force_n.max(force);
+            let bodies = &world.rapier.bodies;
             let (qs, qp) = (
-                *world.bodies[twin.satellite].rotation(),
-                *world.bodies[twin.panel].rotation(),
+                *bodies[twin.satellite].rotation(),
+                *bodies[twin.panel].rotation(),
             );
             let a = &mut angles[k];
             o.satellite_deg = a[0].update(twist_angle(&qs, AXIS)).to_degrees();
@@ -231,16 +214,12 @@ pub fn run() -> Result<(Outcome, Outcome)> {
             o.deployment_deg = a[2]
                 .update(twist_angle(&(qs.inverse() * qp), AXIS))
                 .to_degrees();
-            o.panel_rate_deg_s = world.bodies[twin.panel].angvel().dot(AXIS).to_degrees();
+            o.panel_rate_deg_s = bodies[twin.panel].angvel().dot(AXIS).to_degrees();
         }
         if t >= END {
             break;
         }
-        stepper.step(
-            &mut world,
-            &mut [&mut ideal.drives, &mut clear.drives, &mut set],
-            END,
-        )?;
+        world.step(END)?;
     }
     for k in 0..2 {
         out[k].linear_momentum_drift = dp[k] / sp[k].max(f64::MIN_POSITIVE);

@@ -2,8 +2,8 @@
 //! `study`), prints what it returns, and sets the exit code.
 
 use clap::{Args, Parser, Subcommand};
-use clearance_joint::scene::Scene;
 use clearance_joint::scene::report::comparison_table;
+use clearance_joint::scene::{Scene, ValidatedScene};
 use clearance_joint_app::cli::{self, merge::Merged, run::SceneRun, sweep::SweepJob};
 use clearance_joint_app::figures::run::{can_draw, draw_run_figures};
 use clearance_joint_app::progress::RunProgress;
@@ -240,10 +240,10 @@ struct RunArgs {
 }
 
 impl RunArgs {
-    fn scene(&self) -> clearance_joint::Result<Scene> {
+    fn scene(&self) -> clearance_joint::Result<ValidatedScene> {
         let mut overrides = self.overrides.clone();
         overrides.extend(self.time.overrides());
-        cli::load_scene(self.scene.as_deref())?.with_overrides(&overrides)
+        cli::load_validated(self.scene.as_deref())?.with_overrides(&overrides)
     }
 }
 

@@ -56,7 +56,7 @@ fn static_penetration(scene: &Scene, hinge: &str, load: f64) -> f64 {
         .clearance
         .as_ref()
         .unwrap();
-    let p = spec.build().unwrap();
+    let p = spec.clearance().unwrap();
     let (mut lo, mut hi) = (0.0, p.geometry.clearance());
     assert!(p.normal.elastic_force(hi) > load);
     for _ in 0..200 {

@@ -228,6 +228,13 @@ impl Clearance {
         self
     }
 
+    /// Sets the gap a free flight must open for the next contact to count as an impact, m
+    /// (checked when the joint is built: not negative).
+    pub fn min_separation(mut self, gap: f64) -> Self {
+        self.min_separation = gap;
+        self
+    }
+
     /// Sets the deepest penetration at which the contact law is trusted, m (checked when the
     /// joint is built: positive, at most the journal radius).
     pub fn max_valid_penetration(mut self, depth: f64) -> Self {
@@ -306,6 +313,9 @@ impl Clearance {
         local_axis1: Vector,
         local_axis2: Vector,
     ) -> Result<LargeStepJoint> {
+        // The law's restitution is evaluated at the law's clearance: it must be the bearing's.
+        self.normal
+            .check_clearance("normal", self.geometry.clearance())?;
         let mut b = LargeStepJointBuilder::new(local_axis1, self.geometry)
             .local_axis2(local_axis2)
             .local_anchor1(local_anchor1)
@@ -1094,5 +1104,35 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(msg.contains("limits"), "{msg}");
+    }
+
+    #[test]
+    fn a_law_built_for_another_clearance_is_refused_naming_the_field() {
+        // The geometry says 0.5 mm, the improved law was built for 0.2 mm.
+        let geometry = BearingGeometry::from_clearance(0.010, 0.5e-3, 0.016).unwrap();
+        let law = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
+            .unwrap()
+            .normal;
+        let c = Clearance::new(geometry, law);
+        let msg = c
+            .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.contains("`normal_law`") && msg.contains("clearance"),
+            "{msg}"
+        );
+        let msg = c
+            .large_step_joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            msg.contains("`normal`") && msg.contains("clearance"),
+            "{msg}"
+        );
+        // The same law with its own geometry builds.
+        let ok = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016).unwrap();
+        ok.joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
+            .unwrap();
     }
 }

@@ -136,7 +136,9 @@ impl ClearanceJointBuilder {
         self.joint.name = name.into();
         self
     }
-    /// Validates and returns the joint.
+    /// Validates and returns the joint: unit axes, finite anchors, a normal law that holds a
+    /// clearance (Liu's family) built for the geometry's
+    /// ([`NormalModel::check_clearance`]), the floors and the validity limit.
     pub fn build(mut self) -> Result<ClearanceJoint> {
         let j = &mut self.joint;
         j.local_axis1 = crate::error::unit_vector("local_axis1", j.local_axis1)?;
@@ -149,6 +151,9 @@ impl ClearanceJointBuilder {
                 return Err(Error::invalid(field, format!("must be finite (got {v:?})")));
             }
         }
+        // The clearance is held twice, by the geometry and by a law of Liu's family: they agree.
+        j.normal_law
+            .check_clearance("normal_law", j.geometry.clearance())?;
         crate::error::positive("min_impact_speed", j.min_impact_speed)?;
         crate::error::non_negative("min_separation", j.min_separation)?;
         if let Some(d) = j.max_valid_penetration {

@@ -13,14 +13,19 @@ pub mod sweep;
 
 use crate::study::sweep::{ExecOptions, Progress, thread_count};
 use clearance_joint::error::{Error, Result};
-use clearance_joint::scene::Scene;
+use clearance_joint::scene::{SOLAR_PANEL_RON, Scene, ValidatedScene};
 use std::path::Path;
 
 /// The scene file at `path`, or without one the paper's solar-panel scene.
 pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
+    load_validated(path).map(ValidatedScene::into_scene)
+}
+
+/// As [`load_scene`], keeping what the scene's check built (the run needs no second check).
+pub fn load_validated(path: Option<&Path>) -> Result<ValidatedScene> {
     match path {
-        Some(p) => Scene::load(p),
-        None => Ok(Scene::solar_panel()),
+        Some(p) => ValidatedScene::load(p),
+        None => ValidatedScene::from_ron(SOLAR_PANEL_RON, "assets/solar_panel.ron"),
     }
 }
 

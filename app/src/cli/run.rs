@@ -5,14 +5,14 @@ use crate::resultset::ResultSet;
 use clearance_joint::error::Result;
 use clearance_joint::scene::output::{MemoryEstimate, available_memory};
 use clearance_joint::scene::runner::{Progress, RunOptions, RunResult, Simulation};
-use clearance_joint::scene::{Scene, StepMode};
+use clearance_joint::scene::{StepMode, ValidatedScene};
 use std::path::PathBuf;
 
 /// A run ready to go: its memory checked and its output folder claimed (until dropped).
 #[derive(Debug)]
 pub struct SceneRun {
-    /// The scene, overrides applied.
-    pub scene: Scene,
+    /// The scene, overrides applied, checked.
+    pub scene: ValidatedScene,
     /// The output folder.
     pub out: PathBuf,
     /// The result set: every file of the run goes into [`ResultSet::dir`], and
@@ -23,7 +23,11 @@ pub struct SceneRun {
 impl SceneRun {
     /// Before any work: the run fits `max_memory` (default: what the system has available), and
     /// the folder is ours alone until the set is in place, its staging folder writable.
-    pub fn prepare(scene: Scene, out: PathBuf, max_memory: Option<u64>) -> Result<SceneRun> {
+    pub fn prepare(
+        scene: ValidatedScene,
+        out: PathBuf,
+        max_memory: Option<u64>,
+    ) -> Result<SceneRun> {
         if let Some(budget) = max_memory.or_else(available_memory) {
             let estimate = MemoryEstimate::of(&scene);
             estimate
@@ -43,7 +47,7 @@ impl SceneRun {
     /// scene's step mode. A run the step control stalls returns what it computed up to the
     /// stall ([`RunResult::stopped`] holds the error): write it, then fail.
     pub fn execute(&self, progress: impl FnMut(&Progress)) -> Result<RunResult> {
-        Simulation::new(&self.scene, RunOptions::default())?
+        Simulation::from_validated(&self.scene, RunOptions::default())?
             .run_keeping_partial(progress)
             .map_err(|e| e.with_step_mode(self.scene.run.step == StepMode::Adaptive))
     }

@@ -19,9 +19,9 @@
 
 use clearance_joint::error::{Error, Result};
 use clearance_joint::rapier::replay::Recording;
-use clearance_joint::scene::Scene;
 use clearance_joint::scene::output::write_atomic;
 use clearance_joint::scene::runner::{Progress, RunOptions, RunResult, Simulation, TwinKind};
+use clearance_joint::scene::{Scene, ValidatedScene};
 use clearance_joint::table::Table;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
@@ -40,11 +40,11 @@ const TEMPLATE: &str = include_str!("../../assets/replay/replay.html");
 /// Runs `scene` (both twins) like [`Simulation::run_with_progress`], recording a replay when
 /// `replay` (see the module docs for the frame rule).
 pub fn run_recorded(
-    scene: &Scene,
+    scene: &ValidatedScene,
     progress: impl FnMut(&Progress),
     replay: bool,
 ) -> Result<(RunResult, Option<Recording>)> {
-    let sim = Simulation::new(scene, RunOptions::default())?;
+    let sim = Simulation::from_validated(scene, RunOptions::default())?;
     if !replay {
         return Ok((sim.run_keeping_partial(progress)?, None));
     }

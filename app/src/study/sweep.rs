@@ -429,8 +429,9 @@ impl Job {
         let _lock = DirLock::acquire(&self.dir)?;
         remove_if_present(&self.dir.join(MANIFEST))?;
         let adaptive = self.scene.run.step == clearance_joint::scene::StepMode::Adaptive;
-        let (mut result, recording) = crate::replay::run_recorded(&self.scene, |_| {}, replay)
-            .map_err(|e| e.with_step_mode(adaptive))?;
+        let (mut result, recording) =
+            crate::replay::run_recorded(&self.scene.validated()?, |_| {}, replay)
+                .map_err(|e| e.with_step_mode(adaptive))?;
         // A point the step control stalled is an error of the sweep, not a result.
         if let Some(e) = result.stopped.take() {
             return Err(e.with_step_mode(adaptive));

@@ -1,7 +1,9 @@
 //! Normal contact-force laws (MODEL.md §2).
 
 use super::step::{step, step_slope};
-use crate::error::{ContactParameter, Result, in_range, in_range_open_closed, positive};
+use crate::error::{
+    ContactParameter, Error, Result, in_range, in_range_open_closed, positive, sig4,
+};
 use std::f64::consts::PI;
 
 /// The state a normal law is evaluated at.
@@ -397,6 +399,13 @@ impl LiuEtAl {
     }
 }
 
+impl LiuEtAl {
+    /// The radial clearance `c` of the law, m.
+    pub fn clearance(&self) -> f64 {
+        self.0.clearance()
+    }
+}
+
 impl NormalForceLaw for LiuEtAl {
     fn elastic_force(&self, delta: f64) -> f64 {
         self.0.elastic_force(delta)
@@ -474,6 +483,11 @@ impl ImprovedLiu {
             }
         };
         Ok(law)
+    }
+
+    /// The radial clearance `c` of eq. 14, m.
+    pub fn clearance(&self) -> f64 {
+        self.clearance
     }
 
     /// The maximum damping coefficient `D_max`, N s/m.
@@ -568,6 +582,35 @@ impl NormalForceLaw for NormalModel {
 }
 
 impl NormalModel {
+    /// The radial clearance the law was built with, m, for the laws that hold one (Liu's and
+    /// the improved law, eq. 14); `None` for the others.
+    pub fn clearance(&self) -> Option<f64> {
+        match self {
+            NormalModel::LiuEtAl(l) => Some(l.clearance()),
+            NormalModel::ImprovedLiu(l) => Some(l.clearance()),
+            _ => None,
+        }
+    }
+
+    /// Checks that the law's clearance, if it holds one, is the bearing's `clearance` (m) within
+    /// a relative 1e-9 (the geometry's `R_b - R_j` may differ in the last bits from the `c` the
+    /// law was given); the error names `field`.
+    pub fn check_clearance(&self, field: &str, clearance: f64) -> Result<()> {
+        match self.clearance() {
+            Some(c) if (c - clearance).abs() > 1e-9 * clearance.abs() => Err(Error::invalid(
+                field,
+                format!(
+                    "the {} law was built for a clearance of {} m, but the bearing's is {} m: \
+                     build the law with the bearing's clearance",
+                    self.name(),
+                    sig4(c),
+                    sig4(clearance)
+                ),
+            )),
+            _ => Ok(()),
+        }
+    }
+
     /// The law's name as written in scene files.
     pub fn name(&self) -> &'static str {
         self.kind().name()
@@ -650,6 +693,31 @@ impl LawKind {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_laws_clearance_must_be_the_bearings() {
+        let law = NormalModel::ImprovedLiu(
+            ImprovedLiu::new(1.137e11, 0.016, 0.5e-3, 1.0, 1e-4, MaxDamping::Eta(0.01)).unwrap(),
+        );
+        assert_eq!(law.clearance(), Some(0.5e-3));
+        // The geometry's R_b - (R_b - c) differs from c in the last bits: accepted.
+        let c = 0.010 - (0.010 - 0.5e-3);
+        law.check_clearance("normal", c).unwrap();
+        let e = law
+            .check_clearance("normal", 0.2e-3)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("`normal`") && e.contains("5e-4") && e.contains("2e-4"),
+            "{e}"
+        );
+        let liu = NormalModel::LiuEtAl(LiuEtAl::new(1.137e11, 0.016, 0.3e-3).unwrap());
+        assert!(liu.check_clearance("normal", 0.5e-3).is_err());
+        // A law without a clearance agrees with any bearing.
+        let hertz = NormalModel::Hertz(Hertz::new(1e10, 1.5).unwrap());
+        assert_eq!(hertz.clearance(), None);
+        hertz.check_clearance("normal", 0.5e-3).unwrap();
+    }
 
     fn contact(delta: f64, rate: f64, rate0: f64) -> NormalContact {
         NormalContact {

@@ -94,143 +94,163 @@ impl Scene {
             if !names.insert(b.name.as_str()) {
                 return Err(Error::invalid(p, "duplicate name"));
             }
-            if b.fixed || b.motion.is_some() {
-                // A ground or driven body: its mass and inertia are ignored (0 is fine).
-                non_negative(&format!("{p}.mass_kg"), b.mass_kg)?;
-                for (i, j) in b.inertia_kg_m2.iter().enumerate() {
-                    non_negative(&format!("{p}.inertia_kg_m2[{i}]"), *j)?;
-                }
-            } else {
-                let (lo, hi) = MASS_RANGE;
-                in_range(&format!("{p}.mass_kg"), b.mass_kg, lo, hi, "kg")?;
-                let (lo, hi) = INERTIA_RANGE;
-                for (i, j) in b.inertia_kg_m2.iter().enumerate() {
-                    in_range(&format!("{p}.inertia_kg_m2[{i}]"), *j, lo, hi, "kg m^2")?;
-                }
-                let [a, bb, c] = b.inertia_kg_m2;
-                if a + bb < c || bb + c < a || a + c < bb {
-                    return Err(Error::invalid(
-                        format!("{p}.inertia_kg_m2"),
-                        "violates the triangle inequality of principal moments",
-                    ));
-                }
-            }
-            for (i, x) in b.center_of_mass_m.iter().enumerate() {
-                position(&format!("{p}.center_of_mass_m[{i}]"), *x)?;
-            }
-            speed(&format!("{p}.velocity_m_s"), &b.velocity_m_s)?;
-            for (i, w) in b.angular_velocity_rad_s.iter().enumerate() {
-                in_range(
-                    &format!("{p}.angular_velocity_rad_s[{i}]"),
-                    *w,
-                    -RATE_MAX,
-                    RATE_MAX,
-                    "rad/s",
-                )?;
-            }
-            // A fixed or driven body's velocity is not its own: one given would be ignored.
-            if b.fixed || b.motion.is_some() {
-                let what = if b.fixed {
-                    "a fixed body does not move"
-                } else {
-                    "a body with a prescribed motion moves as its `motion` says"
-                };
-                for (field, v) in [
-                    ("velocity_m_s", b.velocity_m_s),
-                    ("angular_velocity_rad_s", b.angular_velocity_rad_s),
-                ] {
-                    if v != [0.0; 3] {
-                        return Err(Error::invalid(
-                            format!("{p}.{field}"),
-                            format!("{what}: an initial velocity would be ignored; remove it"),
-                        ));
-                    }
-                }
-            }
-            match &b.motion {
-                Some(_) if b.fixed => {
-                    return Err(Error::invalid(
-                        format!("{p}.motion"),
-                        "a fixed body cannot also have a prescribed motion: remove `fixed: true` or the motion",
-                    ));
-                }
-                Some(MotionSpec::Spin {
-                    axis,
-                    point_m,
-                    rate_rad_s,
-                }) => {
-                    unit(axis, &format!("{p}.motion.axis"))?;
-                    for (i, x) in point_m.iter().enumerate() {
-                        position(&format!("{p}.motion.point_m[{i}]"), *x)?;
-                    }
-                    in_range(
-                        &format!("{p}.motion.rate_rad_s"),
-                        *rate_rad_s,
-                        -RATE_MAX,
-                        RATE_MAX,
-                        "rad/s",
-                    )?;
-                    turning_speed(
-                        &format!("{p}.motion.rate_rad_s"),
-                        rate_rad_s.abs(),
-                        point_m,
-                        &b.center_of_mass_m,
-                    )?;
-                }
-                Some(MotionSpec::TableAngle {
-                    axis,
-                    point_m,
-                    t_s,
-                    angle_rad,
-                }) => {
-                    unit(axis, &format!("{p}.motion.axis"))?;
-                    for (i, x) in point_m.iter().enumerate() {
-                        position(&format!("{p}.motion.point_m[{i}]"), *x)?;
-                    }
-                    let table = crate::rapier::prescribed::Table::new(t_s, angle_rad)
-                        .map_err(|e| table_error(e, &p, "angle_rad"))?;
-                    let field = format!("{p}.motion.angle_rad");
-                    let rate = table.max_rate();
-                    if rate > RATE_MAX {
-                        return Err(Error::invalid(
-                            field,
-                            format!(
-                                "turns at up to {} rad/s between its points, more than {} rad/s",
-                                sig4(rate),
-                                sig4(RATE_MAX)
-                            ),
-                        ));
-                    }
-                    turning_speed(&field, rate, point_m, &b.center_of_mass_m)?;
-                }
-                Some(MotionSpec::TablePosition {
-                    direction,
-                    t_s,
-                    position_m,
-                }) => {
-                    unit(direction, &format!("{p}.motion.direction"))?;
-                    let table = crate::rapier::prescribed::Table::new(t_s, position_m)
-                        .map_err(|e| table_error(e, &p, "position_m"))?;
-                    let rate = table.max_rate();
-                    if rate > SPEED_MAX {
-                        return Err(Error::invalid(
-                            format!("{p}.motion.position_m"),
-                            format!(
-                                "moves at up to {} m/s between its points, more than {} m/s",
-                                sig4(rate),
-                                sig4(SPEED_MAX)
-                            ),
-                        ));
-                    }
-                }
-                Some(MotionSpec::Translate { velocity_m_s }) => {
-                    speed(&format!("{p}.motion.velocity_m_s"), velocity_m_s)?;
-                }
-                None => {}
-            }
+            validate_mass(b, &p)?;
+            validate_initial_state(b, &p)?;
+            validate_motion(b, &p)?;
         }
         Ok(())
     }
+}
+
+/// A body's mass and inertia: ignored (0 is fine) for a ground or driven body, in range and
+/// physical (the triangle inequality) otherwise.
+fn validate_mass(b: &BodySpec, p: &str) -> Result<()> {
+    if b.fixed || b.motion.is_some() {
+        // A ground or driven body: its mass and inertia are ignored (0 is fine).
+        non_negative(&format!("{p}.mass_kg"), b.mass_kg)?;
+        for (i, j) in b.inertia_kg_m2.iter().enumerate() {
+            non_negative(&format!("{p}.inertia_kg_m2[{i}]"), *j)?;
+        }
+    } else {
+        let (lo, hi) = MASS_RANGE;
+        in_range(&format!("{p}.mass_kg"), b.mass_kg, lo, hi, "kg")?;
+        let (lo, hi) = INERTIA_RANGE;
+        for (i, j) in b.inertia_kg_m2.iter().enumerate() {
+            in_range(&format!("{p}.inertia_kg_m2[{i}]"), *j, lo, hi, "kg m^2")?;
+        }
+        let [a, bb, c] = b.inertia_kg_m2;
+        if a + bb < c || bb + c < a || a + c < bb {
+            return Err(Error::invalid(
+                format!("{p}.inertia_kg_m2"),
+                "violates the triangle inequality of principal moments",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A body's position and initial velocities (none for a fixed or driven body: it would be
+/// ignored).
+fn validate_initial_state(b: &BodySpec, p: &str) -> Result<()> {
+    for (i, x) in b.center_of_mass_m.iter().enumerate() {
+        position(&format!("{p}.center_of_mass_m[{i}]"), *x)?;
+    }
+    speed(&format!("{p}.velocity_m_s"), &b.velocity_m_s)?;
+    for (i, w) in b.angular_velocity_rad_s.iter().enumerate() {
+        in_range(
+            &format!("{p}.angular_velocity_rad_s[{i}]"),
+            *w,
+            -RATE_MAX,
+            RATE_MAX,
+            "rad/s",
+        )?;
+    }
+    // A fixed or driven body's velocity is not its own: one given would be ignored.
+    if b.fixed || b.motion.is_some() {
+        let what = if b.fixed {
+            "a fixed body does not move"
+        } else {
+            "a body with a prescribed motion moves as its `motion` says"
+        };
+        for (field, v) in [
+            ("velocity_m_s", b.velocity_m_s),
+            ("angular_velocity_rad_s", b.angular_velocity_rad_s),
+        ] {
+            if v != [0.0; 3] {
+                return Err(Error::invalid(
+                    format!("{p}.{field}"),
+                    format!("{what}: an initial velocity would be ignored; remove it"),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A body's prescribed motion.
+fn validate_motion(b: &BodySpec, p: &str) -> Result<()> {
+    match &b.motion {
+        Some(_) if b.fixed => {
+            return Err(Error::invalid(
+                format!("{p}.motion"),
+                "a fixed body cannot also have a prescribed motion: remove `fixed: true` or the motion",
+            ));
+        }
+        Some(MotionSpec::Spin {
+            axis,
+            point_m,
+            rate_rad_s,
+        }) => {
+            unit(axis, &format!("{p}.motion.axis"))?;
+            for (i, x) in point_m.iter().enumerate() {
+                position(&format!("{p}.motion.point_m[{i}]"), *x)?;
+            }
+            in_range(
+                &format!("{p}.motion.rate_rad_s"),
+                *rate_rad_s,
+                -RATE_MAX,
+                RATE_MAX,
+                "rad/s",
+            )?;
+            turning_speed(
+                &format!("{p}.motion.rate_rad_s"),
+                rate_rad_s.abs(),
+                point_m,
+                &b.center_of_mass_m,
+            )?;
+        }
+        Some(MotionSpec::TableAngle {
+            axis,
+            point_m,
+            t_s,
+            angle_rad,
+        }) => {
+            unit(axis, &format!("{p}.motion.axis"))?;
+            for (i, x) in point_m.iter().enumerate() {
+                position(&format!("{p}.motion.point_m[{i}]"), *x)?;
+            }
+            let table = crate::rapier::prescribed::Table::new(t_s, angle_rad)
+                .map_err(|e| table_error(e, p, "angle_rad"))?;
+            let field = format!("{p}.motion.angle_rad");
+            let rate = table.max_rate();
+            if rate > RATE_MAX {
+                return Err(Error::invalid(
+                    field,
+                    format!(
+                        "turns at up to {} rad/s between its points, more than {} rad/s",
+                        sig4(rate),
+                        sig4(RATE_MAX)
+                    ),
+                ));
+            }
+            turning_speed(&field, rate, point_m, &b.center_of_mass_m)?;
+        }
+        Some(MotionSpec::TablePosition {
+            direction,
+            t_s,
+            position_m,
+        }) => {
+            unit(direction, &format!("{p}.motion.direction"))?;
+            let table = crate::rapier::prescribed::Table::new(t_s, position_m)
+                .map_err(|e| table_error(e, p, "position_m"))?;
+            let rate = table.max_rate();
+            if rate > SPEED_MAX {
+                return Err(Error::invalid(
+                    format!("{p}.motion.position_m"),
+                    format!(
+                        "moves at up to {} m/s between its points, more than {} m/s",
+                        sig4(rate),
+                        sig4(SPEED_MAX)
+                    ),
+                ));
+            }
+        }
+        Some(MotionSpec::Translate { velocity_m_s }) => {
+            speed(&format!("{p}.motion.velocity_m_s"), velocity_m_s)?;
+        }
+        None => {}
+    }
+    Ok(())
 }
 
 /// A velocity: finite components and a speed of at most [`SPEED_MAX`].

@@ -7,7 +7,7 @@ use crate::model::laws::{
     FrictionModel, GonthierEtAl, Hertz, HuntCrossley, ImprovedLiu, KelvinVoigt, LankaraniNikravesh,
     LiuEtAl, Material, MaxDamping, NormalModel, Threlfall, effective_modulus,
 };
-use crate::rapier::convert::Clearance;
+use crate::rapier::convert::{Clearance, ClearanceModel};
 use crate::rapier::joint::OutOfPlaneLock;
 use serde::{Deserialize, Serialize};
 
@@ -44,6 +44,20 @@ pub struct ClearanceSpec {
     /// What holds the out-of-plane degrees of freedom.
     #[serde(default)]
     pub lock: OutOfPlaneLock,
+    /// Which model solves the hinge: `Compliant` (the default: the contact law as a force, the
+    /// paper's model) or `LargeStep` (the radial limit inside Rapier's solver, for 1/60 s and
+    /// 1 kHz worlds). See docs/scene-format.md.
+    #[serde(default, skip_serializing_if = "is_compliant")]
+    pub model: ClearanceModel,
+    /// The large-step model's coefficient of restitution, in [0, 1] (default `None`: the contact
+    /// law's own restitution at each impact). Only the large-step model takes it: the compliant
+    /// model's restitution is its contact law's.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub restitution: Option<f64>,
+}
+
+fn is_compliant(model: &ClearanceModel) -> bool {
+    *model == ClearanceModel::Compliant
 }
 
 fn default_min_impact_speed() -> f64 {
@@ -194,40 +208,44 @@ pub enum FrictionSpec {
     Lubricated,
 }
 
-/// The laws and geometry of a validated clearance spec.
-#[derive(Clone, Copy, Debug)]
-pub struct ClearanceParams {
-    /// Radial geometry (SI).
-    pub geometry: BearingGeometry,
-    /// Normal law.
-    pub normal: NormalModel,
-    /// Friction law.
-    pub friction: FrictionModel,
-    /// Floor on the impact speed, m/s.
-    pub min_impact_speed: f64,
-    /// Gap that separates two impacts, m.
-    pub min_separation: f64,
-    /// The validity limit of the penetration, m (`None`: the joint's default).
-    pub max_valid_penetration: Option<f64>,
-}
-
 impl ClearanceSpec {
-    /// The [`Clearance`] this spec describes (validated; errors name the field relative to
-    /// this spec).
+    /// The [`Clearance`] this spec describes, in SI units, validated (errors name the field
+    /// relative to this spec, e.g. `contact.eta_s`): geometry, laws, impact-speed floor, impact
+    /// separation, validity limit, lock, model and restitution. The hinge's name is the
+    /// caller's to set ([`Clearance::name`]).
     pub fn clearance(&self) -> Result<Clearance> {
-        let p = self.build()?;
-        Ok(Clearance {
-            min_impact_speed: p.min_impact_speed,
-            min_separation: p.min_separation,
-            max_valid_penetration: p.max_valid_penetration,
-            ..Clearance::new(p.geometry, p.normal)
-                .friction(p.friction)
-                .lock(self.lock)
-        })
+        let geometry = self.geometry()?;
+        let normal = self.normal_law(&geometry)?;
+        let friction = self.friction_law()?;
+        let mm = 1e-3;
+        let min_impact_speed =
+            speed_mm_s("min_impact_speed_mm_s", self.min_impact_speed_mm_s)? * mm;
+        let min_separation =
+            in_range("min_separation_um", self.min_separation_um, 0.0, 1e4, "um")? * 1e-6;
+        let mut clearance = Clearance::new(geometry, normal)
+            .friction(friction)
+            .min_impact_speed(min_impact_speed)
+            .min_separation(min_separation)
+            .lock(self.lock)
+            .model(self.model);
+        if let Some(depth) = self.max_valid_penetration(&geometry)? {
+            clearance = clearance.max_valid_penetration(depth);
+        }
+        if let Some(e) = self.restitution {
+            if self.model != ClearanceModel::LargeStep {
+                return Err(Error::invalid(
+                    "restitution",
+                    "only the large-step model takes a restitution (`model: LargeStep`): the \
+                     compliant model's restitution is its contact law's",
+                ));
+            }
+            clearance = clearance.restitution(in_range("restitution", e, 0.0, 1.0, "")?);
+        }
+        Ok(clearance)
     }
 
-    /// Validates and converts to SI laws; errors name the field relative to this spec.
-    pub fn build(&self) -> Result<ClearanceParams> {
+    /// The radial geometry (SI), validated.
+    fn geometry(&self) -> Result<BearingGeometry> {
         let (lo, hi) = LENGTH_MM_RANGE;
         let c = positive("clearance_mm", self.clearance_mm)? * 1e-3;
         in_range(
@@ -255,7 +273,14 @@ impl ClearanceSpec {
                 ),
             ));
         }
-        let geometry = BearingGeometry::from_clearance(rb, c, len)?;
+        BearingGeometry::from_clearance(rb, c, len)
+    }
+
+    /// The normal law (SI) and the materials, validated; errors name `contact.<field>`.
+    fn normal_law(&self, geometry: &BearingGeometry) -> Result<NormalModel> {
+        // The law's clearance as the spec gives it (the geometry's `R_b - (R_b - c)` may differ
+        // in the last bit; the joint checks that the two agree).
+        let (c, len) = (self.clearance_mm * 1e-3, geometry.length());
         self.bearing_material
             .validate()
             .map_err(|e| e.within("bearing_material"))?;
@@ -264,7 +289,7 @@ impl ClearanceSpec {
             .map_err(|e| e.within("journal_material"))?;
         let e_star = effective_modulus(&self.bearing_material, &self.journal_material);
         let geometric = LankaraniNikravesh::stiffness_from_geometry(
-            &geometry,
+            geometry,
             &self.bearing_material,
             &self.journal_material,
         );
@@ -285,7 +310,7 @@ impl ClearanceSpec {
                 )),
             }
         };
-        let normal = (|| -> Result<NormalModel> {
+        (|| -> Result<NormalModel> {
             Ok(match &self.contact {
                 ContactSpec::Hertz {
                     stiffness,
@@ -357,9 +382,13 @@ impl ClearanceSpec {
                 }
             })
         })()
-        .map_err_within("contact")?;
+        .map_err_within("contact")
+    }
+
+    /// The friction law (SI), validated; errors name `friction.<field>`.
+    fn friction_law(&self) -> Result<FrictionModel> {
         let mm = 1e-3;
-        let friction = (|| -> Result<FrictionModel> {
+        (|| -> Result<FrictionModel> {
             Ok(match &self.friction {
                 FrictionSpec::None => FrictionModel::None,
                 FrictionSpec::Coulomb { mu_d, v_eps_mm_s } => {
@@ -395,18 +424,18 @@ impl ClearanceSpec {
                 FrictionSpec::Lubricated => FrictionModel::Bai(Bai::LUBRICATED),
             })
         })()
-        .map_err_within("friction")?;
-        let min_impact_speed =
-            speed_mm_s("min_impact_speed_mm_s", self.min_impact_speed_mm_s)? * mm;
-        let min_separation =
-            in_range("min_separation_um", self.min_separation_um, 0.0, 1e4, "um")? * 1e-6;
-        let max_valid_penetration = self
-            .max_valid_penetration_um
+        .map_err_within("friction")
+    }
+
+    /// The validity limit of the penetration, m (`None`: the joint's default), validated
+    /// against the journal radius; the error speaks the scene's unit.
+    fn max_valid_penetration(&self, geometry: &BearingGeometry) -> Result<Option<f64>> {
+        self.max_valid_penetration_um
             .map(|um| {
                 crate::rapier::joint::validate_max_valid_penetration(
                     "max_valid_penetration_um",
                     um * 1e-6,
-                    &geometry,
+                    geometry,
                 )
             })
             .transpose()
@@ -419,19 +448,11 @@ impl ClearanceSpec {
                          default {} um, 1 % of the journal radius",
                         sig4(geometry.journal_radius() * 1e6),
                         sig4(self.max_valid_penetration_um.unwrap_or(f64::NAN)),
-                        sig4(crate::rapier::joint::default_max_valid_penetration(&geometry) * 1e6)
+                        sig4(crate::rapier::joint::default_max_valid_penetration(geometry) * 1e6)
                     ),
                 ),
                 other => other,
-            })?;
-        Ok(ClearanceParams {
-            geometry,
-            normal,
-            friction,
-            min_impact_speed,
-            min_separation,
-            max_valid_penetration,
-        })
+            })
     }
 }
 

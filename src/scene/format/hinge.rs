@@ -3,6 +3,7 @@
 use super::limits::*;
 use super::{ClearanceSpec, FrictionSpec, Scene};
 use crate::error::{Error, Result, sig4};
+use crate::rapier::convert::Clearance;
 use crate::rapier::joint::OutOfPlaneLock;
 use rapier3d_f64::math::Vector;
 use serde::{Deserialize, Serialize};
@@ -27,11 +28,13 @@ pub struct HingeSpec {
 }
 
 impl Scene {
-    /// The hinges' fields and clearance specs (names into `names`).
+    /// The hinges' fields and clearance specs (names into `names`): each hinge's [`Clearance`]
+    /// (named after the hinge), `None` for an ideal hinge.
     pub(super) fn validate_hinges<'a>(
         &'a self,
         names: &mut std::collections::HashSet<&'a str>,
-    ) -> Result<()> {
+    ) -> Result<Vec<Option<Clearance>>> {
+        let mut clearances = Vec::with_capacity(self.hinges.len());
         for h in &self.hinges {
             let p = format!("hinges[{}]", h.name);
             if !is_plain_name(&h.name) {
@@ -64,18 +67,28 @@ impl Scene {
                 position(&format!("{p}.point_m[{i}]"), *x)?;
             }
             unit(&h.axis, &format!("{p}.axis"))?;
-            if let Some(c) = &h.clearance {
-                c.build().map_err(|e| e.within(&format!("{p}.clearance")))?;
-                if c.lock == OutOfPlaneLock::None {
-                    return Err(Error::invalid(
-                        format!("{p}.clearance.lock"),
-                        "`None` leaves the axial translation and the tilts free, and a scene has no locked axes to \
-                         hold them: use `Joint` (plain-API users may lock the bodies' axes themselves)",
-                    ));
-                }
-            }
+            let clearance = match &h.clearance {
+                Some(c) => Some(Self::hinge_clearance(c, &p)?.name(h.name.clone())),
+                None => None,
+            };
+            clearances.push(clearance);
         }
-        Ok(())
+        Ok(clearances)
+    }
+
+    /// The [`Clearance`] of the hinge at path `p`, its errors under `p.clearance`.
+    fn hinge_clearance(c: &ClearanceSpec, p: &str) -> Result<Clearance> {
+        let clearance = c
+            .clearance()
+            .map_err(|e| e.within(&format!("{p}.clearance")))?;
+        if c.lock == OutOfPlaneLock::None {
+            return Err(Error::invalid(
+                format!("{p}.clearance.lock"),
+                "`None` leaves the axial translation and the tilts free, and a scene has no locked axes to \
+                 hold them: use `Joint` (plain-API users may lock the bodies' axes themselves)",
+            ));
+        }
+        Ok(clearance)
     }
 }
 

@@ -1,6 +1,6 @@
 //! Loading a scene: from RON text or a file, the embedded paper's scene, and hints for RON errors.
 
-use super::Scene;
+use super::{Scene, ValidatedScene};
 use crate::error::{Error, Result, excerpt};
 use std::path::Path;
 
@@ -8,27 +8,35 @@ use std::path::Path;
 pub const SOLAR_PANEL_RON: &str = include_str!("../../../assets/solar_panel.ron");
 
 impl Scene {
-    /// Parses a scene from RON text; `origin` names the source in errors.
+    /// Parses and checks a scene from RON text; `origin` names the source in errors.
+    /// [`ValidatedScene::from_ron`] keeps what the check built.
     pub fn from_ron(text: &str, origin: &str) -> Result<Scene> {
-        // Editors on some systems start UTF-8 files with a byte-order mark: not RON, but harmless.
-        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
-        let scene: Scene = ron::from_str(text).map_err(|e| {
-            let hint = variant_hint(text, &e.span.end).map_or(String::new(), |h| format!(" ({h})"));
-            Error::parse(origin, format!("{}{hint}", excerpt(&e.to_string(), 300)))
-        })?;
-        scene.validate()?;
-        scene.validate_studies()?;
-        Ok(scene)
+        ValidatedScene::from_ron(text, origin).map(ValidatedScene::into_scene)
     }
 
-    /// Reads and parses a scene file.
+    /// Reads, parses and checks a scene file ([`ValidatedScene::load`] keeps what the check
+    /// built).
     pub fn load(path: &Path) -> Result<Scene> {
-        let text = std::fs::read_to_string(path).map_err(|source| Error::Io {
+        ValidatedScene::load(path).map(ValidatedScene::into_scene)
+    }
+
+    /// Parses a scene from RON text, unchecked; `origin` names the source in errors.
+    pub(super) fn parse_ron(text: &str, origin: &str) -> Result<Scene> {
+        // Editors on some systems start UTF-8 files with a byte-order mark: not RON, but harmless.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        ron::from_str(text).map_err(|e| {
+            let hint = variant_hint(text, &e.span.end).map_or(String::new(), |h| format!(" ({h})"));
+            Error::parse(origin, format!("{}{hint}", excerpt(&e.to_string(), 300)))
+        })
+    }
+
+    /// A scene file's text.
+    pub(super) fn read(path: &Path) -> Result<String> {
+        std::fs::read_to_string(path).map_err(|source| Error::Io {
             action: "cannot read scene",
             path: path.into(),
             source,
-        })?;
-        Self::from_ron(&text, &path.display().to_string())
+        })
     }
 
     /// The paper's scene (MODEL.md §4).

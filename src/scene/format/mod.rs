@@ -10,15 +10,17 @@ mod limits;
 mod load;
 mod overrides;
 mod run;
+mod validated;
 
 pub use body::{BodySpec, MotionSpec};
-pub use clearance::{ClearanceParams, ClearanceSpec, ContactSpec, FrictionSpec};
+pub use clearance::{ClearanceSpec, ContactSpec, FrictionSpec};
 pub use drive::DriveSpec;
 pub use hinge::HingeSpec;
 pub use joint::{JointKindSpec, JointSpec, MotorSpec};
 pub use limits::*;
 pub use load::SOLAR_PANEL_RON;
 pub use run::{RunSettings, StepMode};
+pub use validated::ValidatedScene;
 
 use crate::error::{Error, Result, in_range, sig4};
 pub(super) use limits::is_plain_name;
@@ -95,8 +97,22 @@ impl Scene {
         self.hinges.iter().position(|h| h.name == name)
     }
 
-    /// Checks every field; the error names the first invalid one.
+    /// Checks every field; the error names the first invalid one. [`validated`](Self::validated)
+    /// does the same and keeps what the check built.
     pub fn validate(&self) -> Result<()> {
+        self.check().map(drop)
+    }
+
+    /// The scene, checked ([`validate`](Self::validate)), with its hinges' clearance settings
+    /// built: what [`Simulation`](crate::scene::runner::Simulation) builds its twins from.
+    pub fn validated(&self) -> Result<ValidatedScene> {
+        let clearances = self.check()?;
+        Ok(ValidatedScene::new(self.clone(), clearances))
+    }
+
+    /// The one check of a scene: every field, the error naming the first invalid one; returns
+    /// each hinge's [`Clearance`](crate::rapier::convert::Clearance) (`None` for an ideal hinge).
+    fn check(&self) -> Result<Vec<Option<crate::rapier::convert::Clearance>>> {
         if !is_plain_name(&self.name) {
             return Err(Error::invalid(
                 "name",
@@ -118,13 +134,14 @@ impl Scene {
         }
         let mut names = std::collections::HashSet::new();
         self.validate_bodies(&mut names)?;
-        self.validate_hinges(&mut names)?;
+        let clearances = self.validate_hinges(&mut names)?;
         self.validate_joints(&mut names)?;
         self.validate_planar()?;
         self.validate_drives(&mut names)?;
         self.run.validate()?;
         self.validate_drive_steps()?;
-        self.validate_periods()
+        self.validate_periods()?;
+        Ok(clearances)
     }
 
     /// The per-turn statistics of a driven scene must fit: at most

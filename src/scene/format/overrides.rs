@@ -9,12 +9,22 @@ impl Scene {
     /// found at any depth below when unique (`hinge.clearance_mm` is
     /// `hinges[hinge].clearance.clearance_mm`). The value is JSON (`0.25`, `[0,0,-9.81]`,
     /// `{"HuntCrossley":{"restitution":0.9}}`) or else a bare word (`Lubricated`).
+    /// The result is checked ([`ValidatedScene::with_overrides`](super::ValidatedScene::with_overrides)
+    /// keeps what the check built).
     pub fn with_overrides<S: AsRef<str>>(&self, overrides: &[S]) -> Result<Scene> {
         if overrides.is_empty() {
             return Ok(self.clone());
         }
+        let scene = self.overridden(overrides)?;
+        scene.validate()?;
+        Ok(scene)
+    }
+
+    /// The scene with `overrides` applied ([`with_overrides`](Self::with_overrides)), unchecked.
+    pub(super) fn overridden<S: AsRef<str>>(&self, overrides: &[S]) -> Result<Scene> {
         let mut value =
             serde_json::to_value(self).map_err(|e| Error::invalid("scene", e.to_string()))?;
+        with_skipped_defaults(&mut value);
         for o in overrides {
             let o = o.as_ref();
             let (path, raw) = o
@@ -31,7 +41,6 @@ impl Scene {
             Ok(scene) => scene,
             Err(e) => return Err(self.first_unreadable(overrides, e)),
         };
-        scene.validate()?;
         Ok(scene)
     }
 
@@ -41,6 +50,7 @@ impl Scene {
         let Ok(mut value) = serde_json::to_value(self) else {
             return Error::parse("overrides", all.to_string());
         };
+        with_skipped_defaults(&mut value);
         for o in overrides {
             let o = o.as_ref();
             let Some((path, raw)) = o.split_once('=') else {
@@ -62,8 +72,9 @@ impl Scene {
     /// `hinges[hinge].clearance.clearance_mm`): two paths naming one field give the same text.
     /// Refused as [`Scene::with_overrides`] refuses the path.
     pub fn override_field(&self, path: &str) -> Result<String> {
-        let value =
+        let mut value =
             serde_json::to_value(self).map_err(|e| Error::invalid("scene", e.to_string()))?;
+        with_skipped_defaults(&mut value);
         let steps = locate_steps(&value, path.trim())?;
         let mut text = String::new();
         let mut cur = &value;
@@ -120,6 +131,22 @@ fn check_group(path: &str, slot: &serde_json::Value, new: &serde_json::Value) ->
 enum Step {
     Key(String),
     Index(usize),
+}
+
+/// Writes out the clearance fields a scene leaves unwritten at their defaults (`model`,
+/// `restitution`: skipped so that a scene written back reads as before), so that overrides can
+/// name them.
+fn with_skipped_defaults(root: &mut serde_json::Value) {
+    let Some(hinges) = root.get_mut("hinges").and_then(|h| h.as_array_mut()) else {
+        return;
+    };
+    let clearances = hinges
+        .iter_mut()
+        .filter_map(|h| h.get_mut("clearance").and_then(|c| c.as_object_mut()));
+    for c in clearances {
+        c.entry("model").or_insert_with(|| "Compliant".into());
+        c.entry("restitution").or_insert(serde_json::Value::Null);
+    }
 }
 
 /// Finds the JSON slot an override path names (see [`Scene::with_overrides`]). The first

@@ -1,9 +1,8 @@
 //! Conservation checks over every step: momentum drift and the energy balance.
 
-use super::twin::Twin;
 use crate::rapier::stepper::StepInfo;
-use rapier3d_f64::math::Vector;
-use rapier3d_f64::prelude::*;
+use rapier3d_f64::math::{Rotation, Vector};
+use rapier3d_f64::prelude::RigidBody;
 use serde::Serialize;
 
 /// Conservation checks over every step.
@@ -109,32 +108,46 @@ pub const MOTOR_SPEED_ERROR_LIMIT: f64 = 1e-2;
 /// Energy growth above this fraction of the energy scale is a guard violation.
 pub const ENERGY_GROWTH_LIMIT: f64 = 1e-2;
 
-impl Twin {
-    /// Momentum and energy at the state before the step just taken, with its synchronous
-    /// velocities: the half-step velocities around it weighted by the steps,
+/// A moving body at the state before a step, as the balances need it: the twin passes these
+/// in (the invariants know no twin).
+pub(super) struct BodyBefore<'a> {
+    /// Mass, kg.
+    pub(super) mass: f64,
+    /// Centre of mass (world), m.
+    pub(super) com: Vector,
+    /// Rotation.
+    pub(super) rotation: Rotation,
+    /// Stored (half-step) linear and angular velocities.
+    pub(super) linvel: Vector,
+    pub(super) angvel: Vector,
+    /// The body after the step: its velocities are the next half-step's.
+    pub(super) after: &'a RigidBody,
+}
+
+impl Invariants {
+    /// Momentum and energy at the state before the step just taken, from its moving bodies
+    /// and the sources' elastic energy there (J), with its synchronous velocities: the
+    /// half-step velocities around it weighted by the steps,
     /// `(h v_before + h_prev v_after)/(h_prev + h)` (second order, where the stored half-step
     /// velocities alone would make the energy balance first order).
-    pub(super) fn update_invariants(
+    pub(super) fn update<'a>(
         &mut self,
-        bodies: &RigidBodySet,
+        bodies: impl IntoIterator<Item = BodyBefore<'a>>,
+        source_energy: f64,
         gravity: Vector,
         info: &StepInfo,
     ) {
         let (h, h_prev) = (info.dt, (2.0 * info.kick - info.dt).max(0.0));
         let sync = |before: Vector, after: Vector| (h * before + h_prev * after) / (h_prev + h);
         let (mut p, mut l, mut ke, mut pe) = (Vector::ZERO, Vector::ZERO, 0.0, 0.0);
-        let inv = &mut self.invariants;
-        for b in &self.bodies {
-            if b.fixed {
-                continue;
-            }
-            let rb = &bodies[b.handle];
-            let com = b.com_before;
-            let v = sync(b.linvel_before, rb.linvel());
-            let w = sync(b.angvel_before, rb.angvel());
+        for b in bodies {
+            let rb = b.after;
+            let com = b.com;
+            let v = sync(b.linvel, rb.linvel());
+            let w = sync(b.angvel, rb.angvel());
             let mp = &rb.mass_properties().local_mprops;
             // I w in world: R I_principal R^T w.
-            let rot = b.rotation_before * mp.principal_inertia_local_frame;
+            let rot = b.rotation * mp.principal_inertia_local_frame;
             let iw = rot * (mp.principal_inertia() * (rot.inverse() * w));
             let pb = b.mass * v;
             let lb = com.cross(pb) + iw;
@@ -142,17 +155,23 @@ impl Twin {
             l += lb;
             ke += 0.5 * b.mass * v.length_squared() + 0.5 * w.dot(iw);
             pe -= b.mass * gravity.dot(com);
-            inv.max_p = inv.max_p.max(pb.length());
-            inv.max_l = inv.max_l.max(lb.length());
+            self.max_p = self.max_p.max(pb.length());
+            self.max_l = self.max_l.max(lb.length());
         }
-        pe += self.source_energy_before;
+        pe += source_energy;
+        self.record(p, l, ke, pe, info.t0);
+    }
+
+    /// Folds the momenta and energies of one state into the drifts and the balance.
+    fn record(&mut self, p: Vector, l: Vector, ke: f64, pe: f64, t: f64) {
+        let inv = self;
         let e = ke + pe + inv.dissipated_j - inv.motor_work_j;
         let (p0, l0, e0, pe0) = *inv.p0.get_or_insert((p, l, e, pe));
         inv.max_dp = inv.max_dp.max((p - p0).length());
         inv.max_dl = inv.max_dl.max((l - l0).length());
         if e - e0 > inv.max_de {
             inv.max_de = e - e0;
-            inv.energy_growth_at = info.t0;
+            inv.energy_growth_at = t;
         }
         inv.max_abs_de = inv.max_abs_de.max((e - e0).abs());
         inv.max_dpe = inv.max_dpe.max((pe - pe0).abs());

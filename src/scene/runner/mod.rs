@@ -14,7 +14,7 @@ use crate::error::Result;
 use crate::rapier::replay::ReplayRecorder;
 use crate::rapier::stepper::{GuardKind, GuardReport, Violation};
 use crate::rapier::world::ClearanceWorld;
-use crate::scene::Scene;
+use crate::scene::{Scene, ValidatedScene};
 use comparison::ComparisonSums;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::*;
@@ -107,9 +107,15 @@ impl RunResult {
 }
 
 impl Simulation {
-    /// Builds the world for `scene`.
+    /// Builds the world for `scene`, checking it ([`from_validated`](Self::from_validated)
+    /// takes a scene checked already).
     pub fn new(scene: &Scene, options: RunOptions) -> Result<Simulation> {
-        scene.validate()?;
+        Self::from_validated(&scene.validated()?, options)
+    }
+
+    /// Builds the world for a checked scene: its hinges' joints from the
+    /// [`Clearance`](crate::rapier::convert::Clearance)s its check built.
+    pub fn from_validated(scene: &ValidatedScene, options: RunOptions) -> Result<Simulation> {
         let control = scene.run.step_control();
         control.validate().map_err(|e| e.within("run"))?;
         let mut physics = PhysicsWorld::new();
@@ -133,7 +139,7 @@ impl Simulation {
         Ok(Simulation {
             world,
             twins,
-            scene: scene.clone(),
+            scene: scene.scene().clone(),
             next_row: 0,
             t_prev: 0.0,
             rows_done: false,

@@ -1,22 +1,20 @@
 //! A twin: its bodies, hinges, joints and drives built from the scene, tracked, and its rows.
 
+mod build;
+
 use super::HingeMetrics;
-use super::invariants::Invariants;
+use super::invariants::{BodyBefore, Invariants};
 use crate::error::Result;
 use crate::model::angle::{HingeAngle, UnwrappedAngle, twist_angle};
 use crate::model::laws::NormalForceLaw;
-use crate::rapier::drive::{DriveHandle, TorsionSpring};
-use crate::rapier::joint::{ClearanceJointBuilder, ClearanceJointHandle};
+use crate::rapier::drive::DriveHandle;
+use crate::rapier::joint::ClearanceJointHandle;
 use crate::rapier::metrics::{ContactObservation, ImpactRecorder};
-use crate::rapier::prescribed::{PrescribedMotion, PrescribedPath, Table as MotionTable};
-use crate::rapier::reaction::{
-    IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, ReactionSolver,
-    SoftMotor,
-};
-use crate::rapier::replay::{ReplayRecorder, in_plane_u};
+use crate::rapier::reaction::{IdealJoint, ReactionSolver};
+use crate::rapier::replay::ReplayRecorder;
 use crate::rapier::stepper::StepInfo;
 use crate::rapier::world::ClearanceWorld;
-use crate::scene::{JointKindSpec, MotionSpec, MotorSpec, Scene};
+use crate::scene::Scene;
 use crate::table::Table;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::*;
@@ -47,9 +45,9 @@ impl TwinKind {
 pub(super) struct BodyTrack {
     pub(super) name: String,
     pub(super) handle: RigidBodyHandle,
-    pub(super) mass: f64,
+    mass: f64,
     /// Fixed or driven by a prescribed motion: outside the energy and momentum balances.
-    pub(super) fixed: bool,
+    fixed: bool,
     /// Not a fixed body (driven bodies move).
     moves: bool,
     /// The body's tabulated motion (index in the world's prescribed set).
@@ -57,11 +55,11 @@ pub(super) struct BodyTrack {
     /// The centre of mass in the body's frame (not the origin for a spinning body), m.
     local_com: Vector,
     angle: UnwrappedAngle,
-    pub(super) linvel_before: Vector,
+    linvel_before: Vector,
     /// Angular velocity, centre of mass and rotation at the state before the current step.
-    pub(super) angvel_before: Vector,
-    pub(super) com_before: Vector,
-    pub(super) rotation_before: rapier3d_f64::math::Rotation,
+    angvel_before: Vector,
+    com_before: Vector,
+    rotation_before: rapier3d_f64::math::Rotation,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -144,7 +142,7 @@ pub struct Twin {
     body_motion: bool,
     reactions: ReactionSolver,
     /// Spring and contact elastic energy at the state before the current step, J.
-    pub(super) source_energy_before: f64,
+    source_energy_before: f64,
     /// The joint motors in Rapier, with the index of their scene joint: their impulses over each
     /// step give their work.
     motor_joints: Vec<(ImpulseJointHandle, JointAxis, usize)>,
@@ -164,409 +162,6 @@ pub struct Twin {
 }
 
 impl Twin {
-    pub(super) fn build(scene: &Scene, kind: TwinKind, world: &mut ClearanceWorld) -> Result<Twin> {
-        let mut bodies = Vec::new();
-        let prescribed = &mut world.prescribed;
-        for (i, b) in scene.bodies.iter().enumerate() {
-            let com = Vector::from(b.center_of_mass_m);
-            let origin = Vector::from(scene.body_origin(i));
-            let mut table = None;
-            let rb = match &b.motion {
-                // A tabulated drive: a position-based kinematic body whose next pose the
-                // prescribed set gives before each step.
-                Some(m @ (MotionSpec::TableAngle { .. } | MotionSpec::TablePosition { .. })) => {
-                    let (path, t, v) = match m {
-                        MotionSpec::TableAngle {
-                            axis,
-                            t_s,
-                            angle_rad,
-                            ..
-                        } => (
-                            PrescribedPath::Angle {
-                                axis: Vector::from(*axis).normalize(),
-                            },
-                            t_s,
-                            angle_rad,
-                        ),
-                        MotionSpec::TablePosition {
-                            direction,
-                            t_s,
-                            position_m,
-                        } => (
-                            PrescribedPath::Position {
-                                direction: Vector::from(*direction).normalize(),
-                            },
-                            t_s,
-                            position_m,
-                        ),
-                        _ => unreachable!("matched above"),
-                    };
-                    let rb = RigidBodyBuilder::kinematic_position_based()
-                        .translation(origin)
-                        .can_sleep(false)
-                        .build();
-                    let start = *rb.position();
-                    table = Some(prescribed.motions.len());
-                    prescribed.motions.push(PrescribedMotion {
-                        body: RigidBodyHandle::invalid(),
-                        start,
-                        path,
-                        table: MotionTable::new(t, v)
-                            .map_err(|e| e.within(&format!("bodies[{}].motion", b.name)))?,
-                    });
-                    rb
-                }
-                // A driven body: no mass properties, so Rapier turns it about its frame origin.
-                Some(m) => {
-                    let (v, w) = match m {
-                        MotionSpec::Spin {
-                            axis, rate_rad_s, ..
-                        } => (Vector::ZERO, Vector::from(*axis).normalize() * *rate_rad_s),
-                        MotionSpec::Translate { velocity_m_s } => {
-                            (Vector::from(*velocity_m_s), Vector::ZERO)
-                        }
-                        _ => unreachable!("tables are matched above"),
-                    };
-                    RigidBodyBuilder::kinematic_velocity_based()
-                        .translation(origin)
-                        .linvel(v)
-                        .angvel(w)
-                        .can_sleep(false)
-                        .build()
-                }
-                None => {
-                    let builder = if b.fixed {
-                        RigidBodyBuilder::fixed()
-                    } else {
-                        RigidBodyBuilder::dynamic()
-                            .linvel(Vector::from(b.velocity_m_s))
-                            .angvel(Vector::from(b.angular_velocity_rad_s))
-                    };
-                    builder
-                        .translation(com)
-                        .additional_mass_properties(MassProperties::new(
-                            Vector::ZERO,
-                            b.mass_kg,
-                            Vector::from(b.inertia_kg_m2),
-                        ))
-                        .can_sleep(false)
-                        .build()
-                }
-            };
-            let handle = world.rapier.bodies.insert(rb);
-            if let Some(k) = table {
-                prescribed.motions[k].body = handle;
-            }
-            bodies.push(BodyTrack {
-                table,
-                name: b.name.clone(),
-                handle,
-                mass: b.mass_kg,
-                fixed: b.fixed || b.motion.is_some(),
-                moves: !b.fixed,
-                local_com: com - origin,
-                angle: UnwrappedAngle::default(),
-                linvel_before: Vector::ZERO,
-                angvel_before: Vector::ZERO,
-                com_before: com,
-                rotation_before: rapier3d_f64::math::Rotation::IDENTITY,
-            });
-        }
-        let mut hinges = Vec::new();
-        for h in &scene.hinges {
-            let (ib, ij) = (
-                scene.body_index(&h.bearing).unwrap(),
-                scene.body_index(&h.journal).unwrap(),
-            );
-            let point = Vector::from(h.point_m);
-            let axis = Vector::from(h.axis).normalize();
-            // Bodies start unrotated with their frame at their origin (the centre of mass, or
-            // a spinning body's axis point).
-            let a1 = point - Vector::from(scene.body_origin(ib));
-            let a2 = point - Vector::from(scene.body_origin(ij));
-            let (b1, b2) = (bodies[ib].handle, bodies[ij].handle);
-            let joint = match (&h.clearance, kind) {
-                (Some(spec), TwinKind::Clearance) => {
-                    let p = spec
-                        .build()
-                        .map_err(|e| e.within(&format!("hinges[{}].clearance", h.name)))?;
-                    let mut b = ClearanceJointBuilder::new(axis, p.geometry, p.normal)
-                        .local_anchor1(a1)
-                        .local_anchor2(a2)
-                        .friction(p.friction)
-                        .min_impact_speed(p.min_impact_speed)
-                        .min_separation(p.min_separation)
-                        .lock(spec.lock)
-                        .name(h.name.clone());
-                    if let Some(depth) = p.max_valid_penetration {
-                        b = b.max_valid_penetration(depth);
-                    }
-                    let j = b.build()?;
-                    HingeJoint::Clearance(world.clearance.insert(
-                        b1,
-                        b2,
-                        j,
-                        &mut world.rapier.impulse_joints,
-                    ))
-                }
-                _ => {
-                    let j = RevoluteJointBuilder::new(axis)
-                        .local_anchor1(a1)
-                        .local_anchor2(a2)
-                        .contacts_enabled(false);
-                    {
-                        world.rapier.impulse_joints.insert(b1, b2, j, true);
-                        HingeJoint::Ideal
-                    }
-                }
-            };
-            let u = in_plane_u(axis);
-            hinges.push(HingeTrack {
-                name: h.name.clone(),
-                joint,
-                bearing: ib,
-                journal: ij,
-                local_axis1: axis,
-                local_u1: u,
-                local_v1: axis.cross(u),
-                angle: HingeAngle::default(),
-                force: 0.0,
-                sample: ContactSample::default(),
-                recorder: ImpactRecorder::new(),
-            });
-        }
-        let mut drives = Vec::new();
-        for d in &scene.drives {
-            let hi = scene.hinge_index(&d.hinge).unwrap();
-            let h = &hinges[hi];
-            let per_rad = d.stiffness_nm_per_deg.to_degrees();
-            let spring = TorsionSpring::new(
-                bodies[h.bearing].handle,
-                bodies[h.journal].handle,
-                h.local_axis1,
-                d.torque_scale * d.torque0_nm,
-                d.torque_scale * per_rad,
-            )
-            .map_err(|e| e.within(&format!("drives[{}]", d.name)))?;
-            drives.push(world.drives.insert(spring));
-        }
-        let (mut ideal_joints, mut ideal_hinges) = (Vec::new(), Vec::new());
-        for (i, h) in hinges.iter().enumerate() {
-            if let HingeJoint::Ideal = h.joint {
-                let hs = &scene.hinges[i];
-                let point = Vector::from(hs.point_m);
-                let com = |k: usize| Vector::from(scene.body_origin(k));
-                ideal_joints.push(IdealJoint::Revolute(IdealRevolute {
-                    body1: bodies[h.bearing].handle,
-                    body2: bodies[h.journal].handle,
-                    local_anchor1: point - com(h.bearing),
-                    local_anchor2: point - com(h.journal),
-                    local_axis1: h.local_axis1,
-                }));
-                ideal_hinges.push(i);
-            }
-        }
-        let (mut joints, mut motors, mut motor_columns) = (Vec::new(), Vec::new(), Vec::new());
-        let mut motor_joints = Vec::new();
-        let mut held_motors = Vec::new();
-        for (k, j) in scene.joints.iter().enumerate() {
-            if let Some(Motor::Held { target, .. }) = motor_of(j.motor.as_ref()) {
-                let unit = match j.motor {
-                    Some(MotorSpec::LinearVelocity { .. }) => "m/s",
-                    _ => "rad/s",
-                };
-                held_motors.push((k, target, j.name.clone(), unit));
-            }
-            let (i1, i2) = (
-                scene.body_index(&j.body1).unwrap(),
-                scene.body_index(&j.body2).unwrap(),
-            );
-            let point = Vector::from(j.point_m);
-            let a1 = point - Vector::from(scene.body_origin(i1));
-            let a2 = point - Vector::from(scene.body_origin(i2));
-            let (b1, b2) = (bodies[i1].handle, bodies[i2].handle);
-            let ideal = match &j.kind {
-                JointKindSpec::Prismatic { axis, limits_m } => {
-                    let axis = Vector::from(*axis).normalize();
-                    let mut rj = PrismaticJointBuilder::new(axis)
-                        .local_anchor1(a1)
-                        .local_anchor2(a2)
-                        .contacts_enabled(false);
-                    if let Some(l) = limits_m {
-                        rj = rj.limits(*l);
-                    }
-                    let ideal = IdealPrismatic {
-                        body1: b1,
-                        body2: b2,
-                        local_anchor1: a1,
-                        local_anchor2: a2,
-                        local_axis1: axis,
-                    };
-                    // Validated: only linear motors on a prismatic joint.
-                    let ideal = match motor_of(j.motor.as_ref()) {
-                        Some(Motor::Held { target, factor }) => {
-                            rj = rj.motor_velocity(target, factor);
-                            IdealJoint::MotorPrismatic(ideal)
-                        }
-                        Some(Motor::Soft(m)) => {
-                            rj = rj
-                                .set_motor(m.target_pos, m.target_vel, m.stiffness, m.damping)
-                                .motor_model(MotorModel::ForceBased);
-                            IdealJoint::SoftMotorPrismatic(ideal, m)
-                        }
-                        None => IdealJoint::Prismatic(ideal),
-                    };
-                    let h = world.rapier.impulse_joints.insert(b1, b2, rj, true);
-                    if j.motor.is_some() {
-                        motor_joints.push((h, JointAxis::LinX, k));
-                    }
-                    ideal
-                }
-                JointKindSpec::Revolute { axis } => {
-                    let axis = Vector::from(*axis).normalize();
-                    let mut rj = RevoluteJointBuilder::new(axis)
-                        .local_anchor1(a1)
-                        .local_anchor2(a2)
-                        .contacts_enabled(false);
-                    let ideal = IdealRevolute {
-                        body1: b1,
-                        body2: b2,
-                        local_anchor1: a1,
-                        local_anchor2: a2,
-                        local_axis1: axis,
-                    };
-                    // Validated: only angular motors on a revolute joint.
-                    let ideal = match motor_of(j.motor.as_ref()) {
-                        Some(Motor::Held { target, factor }) => {
-                            rj = rj.motor_velocity(target, factor);
-                            IdealJoint::MotorRevolute(ideal)
-                        }
-                        Some(Motor::Soft(m)) => {
-                            rj = rj
-                                .motor(m.target_pos, m.target_vel, m.stiffness, m.damping)
-                                .motor_model(MotorModel::ForceBased);
-                            IdealJoint::SoftMotorRevolute(ideal, m)
-                        }
-                        None => IdealJoint::Revolute(ideal),
-                    };
-                    let h = world.rapier.impulse_joints.insert(b1, b2, rj, true);
-                    if j.motor.is_some() {
-                        motor_joints.push((h, JointAxis::AngX, k));
-                    }
-                    ideal
-                }
-                JointKindSpec::Fixed => {
-                    let rj = FixedJointBuilder::new()
-                        .local_anchor1(a1)
-                        .local_anchor2(a2)
-                        .contacts_enabled(false);
-                    world.rapier.impulse_joints.insert(b1, b2, rj, true);
-                    IdealJoint::Fixed(IdealFixed {
-                        body1: b1,
-                        body2: b2,
-                        local_anchor1: a1,
-                        local_anchor2: a2,
-                    })
-                }
-                JointKindSpec::Spherical => {
-                    let rj = SphericalJointBuilder::new()
-                        .local_anchor1(a1)
-                        .local_anchor2(a2)
-                        .contacts_enabled(false);
-                    world.rapier.impulse_joints.insert(b1, b2, rj, true);
-                    IdealJoint::Spherical(IdealSpherical {
-                        body1: b1,
-                        body2: b2,
-                        local_anchor1: a1,
-                        local_anchor2: a2,
-                    })
-                }
-            };
-            ideal_joints.push(ideal);
-            joints.push((j.name.clone(), 0.0));
-            motors.push(j.motor.as_ref().map(|_| 0.0));
-            if j.motor.is_some() {
-                let unit = match j.kind {
-                    JointKindSpec::Prismatic { .. } => "n",
-                    _ => "nm",
-                };
-                motor_columns.push(format!("{}_motor_{unit}", j.name));
-            }
-        }
-        let mut columns = vec!["t_s".to_string()];
-        for b in &bodies {
-            columns.push(format!("{}_angle_deg", b.name));
-            columns.push(format!("{}_rate_deg_s", b.name));
-        }
-        let body_motion = scene.run.body_motion;
-        if body_motion {
-            for b in bodies.iter().filter(|b| b.moves) {
-                for c in [
-                    "x_m", "y_m", "z_m", "vx_m_s", "vy_m_s", "vz_m_s", "ax_m_s2", "ay_m_s2",
-                    "az_m_s2",
-                ] {
-                    columns.push(format!("{}_{c}", b.name));
-                }
-            }
-        }
-
-        for h in &hinges {
-            for c in [
-                "angle_deg",
-                "rate_deg_s",
-                "force_n",
-                "ecc_u_mm",
-                "ecc_v_mm",
-                "penetration_um",
-                "contact",
-            ] {
-                columns.push(format!("{}_{c}", h.name));
-            }
-        }
-        for (name, _) in &joints {
-            columns.push(format!("{name}_force_n"));
-        }
-        columns.extend(motor_columns);
-        // The rows' velocities and accelerations of every dynamic body come from the solve,
-        // held by an ideal joint or not.
-        let mut reactions = ReactionSolver::default();
-        reactions.track = bodies
-            .iter()
-            .filter(|b| !b.fixed)
-            .map(|b| b.handle)
-            .collect();
-        Ok(Twin {
-            kind,
-            bodies,
-            hinges,
-            drives,
-            ideal_joints,
-            ideal_hinges,
-            joints,
-            motors,
-            body_motion,
-            reactions,
-            source_energy_before: 0.0,
-            motor_joints,
-            held_motors,
-            reference_axis: Vector::from(scene.reference_axis).normalize(),
-            contact_columns: columns
-                .iter()
-                .enumerate()
-                .filter(|(_, c)| c.ends_with("_contact"))
-                .map(|(i, _)| i)
-                .collect(),
-            table: Table::new(columns),
-            row_prev: Vec::new(),
-            row_cur: Vec::new(),
-            invariants: Invariants::new(
-                scene.gravity == [0.0; 3]
-                    && scene.bodies.iter().all(|b| !b.fixed && b.motion.is_none()),
-                scene.bodies.iter().any(|b| b.motion.is_some()),
-            ),
-        })
-    }
-
     /// Reads the state before a step (from the sources' evaluation at it): invariants, the
     /// clearance samples and forces, the angles, and (with `rows`) the row values of the state.
     pub(super) fn before_step(&mut self, world: &mut ClearanceWorld, rows: bool) -> Result<()> {
@@ -733,6 +328,21 @@ impl Twin {
         drives + contacts
     }
 
+    /// The invariants at the state before the step just taken, from this twin's moving bodies
+    /// and its sources' elastic energy there.
+    fn update_invariants(&mut self, bodies: &RigidBodySet, gravity: Vector, info: &StepInfo) {
+        let moving = self.bodies.iter().filter(|b| !b.fixed).map(|b| BodyBefore {
+            mass: b.mass,
+            com: b.com_before,
+            rotation: b.rotation_before,
+            linvel: b.linvel_before,
+            angvel: b.angvel_before,
+            after: &bodies[b.handle],
+        });
+        self.invariants
+            .update(moving, self.source_energy_before, gravity, info);
+    }
+
     /// Metrics of the state before the step (its sample and force), weighted by the step.
     fn update_force_metrics(&mut self, t: f64, dt: f64) {
         for h in &mut self.hinges {
@@ -868,52 +478,6 @@ impl Twin {
         }
         m
     }
-}
-
-/// A scene motor in Rapier's terms.
-enum Motor {
-    /// A velocity motor that holds its speed: target (rad/s or m/s) and damping factor (1/s).
-    Held { target: f64, factor: f64 },
-    /// A force-based spring-damper.
-    Soft(SoftMotor),
-}
-
-fn motor_of(spec: Option<&MotorSpec>) -> Option<Motor> {
-    Some(match spec? {
-        MotorSpec::Velocity {
-            target_rad_s,
-            factor,
-        } => Motor::Held {
-            target: *target_rad_s,
-            factor: *factor,
-        },
-        MotorSpec::LinearVelocity { target_m_s, factor } => Motor::Held {
-            target: *target_m_s,
-            factor: *factor,
-        },
-        MotorSpec::Position {
-            target_rad,
-            stiffness_nm_per_rad,
-            damping_nm_s_per_rad,
-            target_rad_s,
-        } => Motor::Soft(SoftMotor::force_based(
-            *target_rad,
-            *target_rad_s,
-            *stiffness_nm_per_rad,
-            *damping_nm_s_per_rad,
-        )),
-        MotorSpec::LinearPosition {
-            target_m,
-            stiffness_n_per_m,
-            damping_n_s_per_m,
-            target_m_s,
-        } => Motor::Soft(SoftMotor::force_based(
-            *target_m,
-            *target_m_s,
-            *stiffness_n_per_m,
-            *damping_n_s_per_m,
-        )),
-    })
 }
 
 impl Twin {

@@ -1,0 +1,704 @@
+//! Building a twin from a validated scene, step by step: bodies, hinges, drives, the ideal
+//! joints the reactions are solved for, the scene's other joints and their motors, columns.
+
+use super::{BodyTrack, ContactSample, HingeJoint, HingeTrack, Twin, TwinKind};
+use crate::error::{Error, Result};
+use crate::model::angle::{HingeAngle, UnwrappedAngle};
+use crate::rapier::convert::{Clearance, ClearanceModel};
+use crate::rapier::drive::{DriveHandle, TorsionSpring};
+use crate::rapier::metrics::ImpactRecorder;
+use crate::rapier::prescribed::{PrescribedMotion, PrescribedPath, Table as MotionTable};
+use crate::rapier::reaction::{
+    IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, ReactionSolver,
+    SoftMotor,
+};
+use crate::rapier::replay::in_plane_u;
+use crate::rapier::world::ClearanceWorld;
+use crate::scene::runner::invariants::Invariants;
+use crate::scene::{BodySpec, JointKindSpec, JointSpec, MotionSpec, MotorSpec, ValidatedScene};
+use crate::table::Table;
+use rapier3d_f64::math::Vector;
+use rapier3d_f64::prelude::*;
+
+impl Twin {
+    /// Builds the twin `kind` of `scene` into `world`: its bodies, hinges (clearance joints
+    /// from the scene's [`Clearance`](crate::rapier::convert::Clearance)s in a clearance twin),
+    /// drives, the scene's other joints, and its table's columns.
+    pub(in crate::scene::runner) fn build(
+        scene: &ValidatedScene,
+        kind: TwinKind,
+        world: &mut ClearanceWorld,
+    ) -> Result<Twin> {
+        let bodies = build_bodies(scene, world)?;
+        let hinges = build_hinges(scene, kind, &bodies, world)?;
+        let drives = build_drives(scene, &bodies, &hinges, world)?;
+        let (mut ideal_joints, ideal_hinges) = ideal_hinge_joints(scene, &bodies, &hinges);
+        let other = build_joints(scene, &bodies, world);
+        ideal_joints.extend(other.ideal);
+        let columns = columns(scene, &bodies, &hinges, &other.joints, other.motor_columns);
+        let reactions = reaction_solver(&bodies);
+        Ok(Twin {
+            kind,
+            drives,
+            ideal_joints,
+            ideal_hinges,
+            motors: other.motors,
+            joints: other.joints,
+            body_motion: scene.run.body_motion,
+            reactions,
+            source_energy_before: 0.0,
+            motor_joints: other.motor_joints,
+            held_motors: other.held_motors,
+            reference_axis: Vector::from(scene.reference_axis).normalize(),
+            contact_columns: columns
+                .iter()
+                .enumerate()
+                .filter(|(_, c)| c.ends_with("_contact"))
+                .map(|(i, _)| i)
+                .collect(),
+            table: Table::new(columns),
+            row_prev: Vec::new(),
+            row_cur: Vec::new(),
+            invariants: Invariants::new(
+                scene.gravity == [0.0; 3]
+                    && scene.bodies.iter().all(|b| !b.fixed && b.motion.is_none()),
+                scene.bodies.iter().any(|b| b.motion.is_some()),
+            ),
+            bodies,
+            hinges,
+        })
+    }
+}
+
+/// The scene's bodies in `world`, tracked, with the tabulated motions of the driven ones in
+/// the world's prescribed set.
+fn build_bodies(scene: &ValidatedScene, world: &mut ClearanceWorld) -> Result<Vec<BodyTrack>> {
+    let mut bodies = Vec::with_capacity(scene.bodies.len());
+    let prescribed = &mut world.prescribed;
+    for (i, b) in scene.bodies.iter().enumerate() {
+        let com = Vector::from(b.center_of_mass_m);
+        let origin = Vector::from(scene.body_origin(i));
+        let (rb, table) = match &b.motion {
+            Some(m @ (MotionSpec::TableAngle { .. } | MotionSpec::TablePosition { .. })) => {
+                let (rb, motion) = tabulated_body(b, m, origin)?;
+                prescribed.motions.push(motion);
+                (rb, Some(prescribed.motions.len() - 1))
+            }
+            Some(m) => (driven_body(m, origin), None),
+            None => (free_or_fixed_body(b, com), None),
+        };
+        let handle = world.rapier.bodies.insert(rb);
+        if let Some(k) = table {
+            prescribed.motions[k].body = handle;
+        }
+        bodies.push(BodyTrack {
+            table,
+            name: b.name.clone(),
+            handle,
+            mass: b.mass_kg,
+            fixed: b.fixed || b.motion.is_some(),
+            moves: !b.fixed,
+            local_com: com - origin,
+            angle: UnwrappedAngle::default(),
+            linvel_before: Vector::ZERO,
+            angvel_before: Vector::ZERO,
+            com_before: com,
+            rotation_before: rapier3d_f64::math::Rotation::IDENTITY,
+        });
+    }
+    Ok(bodies)
+}
+
+/// A tabulated drive: a position-based kinematic body whose next pose the prescribed set gives
+/// before each step, and that motion (its body handle set once the body is inserted).
+fn tabulated_body(
+    b: &BodySpec,
+    m: &MotionSpec,
+    origin: Vector,
+) -> Result<(RigidBody, PrescribedMotion)> {
+    let (path, t, v) = match m {
+        MotionSpec::TableAngle {
+            axis,
+            t_s,
+            angle_rad,
+            ..
+        } => (
+            PrescribedPath::Angle {
+                axis: Vector::from(*axis).normalize(),
+            },
+            t_s,
+            angle_rad,
+        ),
+        MotionSpec::TablePosition {
+            direction,
+            t_s,
+            position_m,
+        } => (
+            PrescribedPath::Position {
+                direction: Vector::from(*direction).normalize(),
+            },
+            t_s,
+            position_m,
+        ),
+        _ => unreachable!("only tables are passed here"),
+    };
+    let rb = RigidBodyBuilder::kinematic_position_based()
+        .translation(origin)
+        .can_sleep(false)
+        .build();
+    let motion = PrescribedMotion {
+        body: RigidBodyHandle::invalid(),
+        start: *rb.position(),
+        path,
+        table: MotionTable::new(t, v)
+            .map_err(|e| e.within(&format!("bodies[{}].motion", b.name)))?,
+    };
+    Ok((rb, motion))
+}
+
+/// A steadily driven body: no mass properties, so Rapier turns it about its frame origin.
+fn driven_body(m: &MotionSpec, origin: Vector) -> RigidBody {
+    let (v, w) = match m {
+        MotionSpec::Spin {
+            axis, rate_rad_s, ..
+        } => (Vector::ZERO, Vector::from(*axis).normalize() * *rate_rad_s),
+        MotionSpec::Translate { velocity_m_s } => (Vector::from(*velocity_m_s), Vector::ZERO),
+        _ => unreachable!("tables are built by `tabulated_body`"),
+    };
+    RigidBodyBuilder::kinematic_velocity_based()
+        .translation(origin)
+        .linvel(v)
+        .angvel(w)
+        .can_sleep(false)
+        .build()
+}
+
+/// A dynamic body with its initial velocities, or a fixed one, at its centre of mass.
+fn free_or_fixed_body(b: &BodySpec, com: Vector) -> RigidBody {
+    let builder = if b.fixed {
+        RigidBodyBuilder::fixed()
+    } else {
+        RigidBodyBuilder::dynamic()
+            .linvel(Vector::from(b.velocity_m_s))
+            .angvel(Vector::from(b.angular_velocity_rad_s))
+    };
+    builder
+        .translation(com)
+        .additional_mass_properties(MassProperties::new(
+            Vector::ZERO,
+            b.mass_kg,
+            Vector::from(b.inertia_kg_m2),
+        ))
+        .can_sleep(false)
+        .build()
+}
+
+/// The scene's hinges in `world`: in a clearance twin, a hinge with clearance is a clearance
+/// joint (in the world's clearance set) built by its [`Clearance`](crate::rapier::convert::Clearance) (the validated scene's,
+/// the one route from settings to joint); every other hinge is Rapier's revolute joint.
+fn build_hinges(
+    scene: &ValidatedScene,
+    kind: TwinKind,
+    bodies: &[BodyTrack],
+    world: &mut ClearanceWorld,
+) -> Result<Vec<HingeTrack>> {
+    let mut hinges = Vec::with_capacity(scene.hinges.len());
+    for (i, h) in scene.hinges.iter().enumerate() {
+        let (ib, ij) = (
+            scene.body_index(&h.bearing).expect("validated"),
+            scene.body_index(&h.journal).expect("validated"),
+        );
+        let axis = Vector::from(h.axis).normalize();
+        // Bodies start unrotated with their frame at their origin (the centre of mass, or a
+        // spinning body's axis point).
+        let (a1, a2) = anchors(scene, h.point_m, ib, ij);
+        let (b1, b2) = (bodies[ib].handle, bodies[ij].handle);
+        let joint = match (scene.clearance(i), kind) {
+            (Some(settings), TwinKind::Clearance) => {
+                refuse_unrun_model(settings, &h.name)?;
+                let j = settings.joint(a1, a2, axis, axis)?;
+                let rapier = &mut world.rapier.impulse_joints;
+                HingeJoint::Clearance(world.clearance.insert(b1, b2, j, rapier))
+            }
+            _ => {
+                let j = RevoluteJointBuilder::new(axis)
+                    .local_anchor1(a1)
+                    .local_anchor2(a2)
+                    .contacts_enabled(false);
+                world.rapier.impulse_joints.insert(b1, b2, j, true);
+                HingeJoint::Ideal
+            }
+        };
+        let u = in_plane_u(axis);
+        hinges.push(HingeTrack {
+            name: h.name.clone(),
+            joint,
+            bearing: ib,
+            journal: ij,
+            local_axis1: axis,
+            local_u1: u,
+            local_v1: axis.cross(u),
+            angle: HingeAngle::default(),
+            force: 0.0,
+            sample: ContactSample::default(),
+            recorder: ImpactRecorder::new(),
+        });
+    }
+    Ok(hinges)
+}
+
+/// The scene runner steps compliant clearance joints only, for now: a hinge that chose the
+/// large-step model is refused, naming its field.
+fn refuse_unrun_model(settings: &Clearance, hinge: &str) -> Result<()> {
+    match settings.model {
+        ClearanceModel::Compliant => Ok(()),
+        ClearanceModel::LargeStep => Err(Error::invalid(
+            format!("hinges[{hinge}].clearance.model"),
+            "is LargeStep, which the scene runner does not run yet (a plain-Rapier loop can: \
+             `Clearance::large_step_joint` and `LargeStepJointSet`); use `Compliant`",
+        )),
+    }
+}
+
+/// The anchors of a joint at world point `point` (t = 0) in bodies `i1` and `i2`'s frames.
+fn anchors(scene: &ValidatedScene, point: [f64; 3], i1: usize, i2: usize) -> (Vector, Vector) {
+    let point = Vector::from(point);
+    (
+        point - Vector::from(scene.body_origin(i1)),
+        point - Vector::from(scene.body_origin(i2)),
+    )
+}
+
+/// The scene's torsion-spring drives on their hinges, in the world's drive set.
+fn build_drives(
+    scene: &ValidatedScene,
+    bodies: &[BodyTrack],
+    hinges: &[HingeTrack],
+    world: &mut ClearanceWorld,
+) -> Result<Vec<DriveHandle>> {
+    let mut drives = Vec::with_capacity(scene.drives.len());
+    for d in &scene.drives {
+        let h = &hinges[scene.hinge_index(&d.hinge).expect("validated")];
+        let per_rad = d.stiffness_nm_per_deg.to_degrees();
+        let spring = TorsionSpring::new(
+            bodies[h.bearing].handle,
+            bodies[h.journal].handle,
+            h.local_axis1,
+            d.torque_scale * d.torque0_nm,
+            d.torque_scale * per_rad,
+        )
+        .map_err(|e| e.within(&format!("drives[{}]", d.name)))?;
+        drives.push(world.drives.insert(spring));
+    }
+    Ok(drives)
+}
+
+/// The ideal hinges' revolutes for the reaction solve, with the hinge index of each.
+fn ideal_hinge_joints(
+    scene: &ValidatedScene,
+    bodies: &[BodyTrack],
+    hinges: &[HingeTrack],
+) -> (Vec<IdealJoint>, Vec<usize>) {
+    let (mut ideal_joints, mut ideal_hinges) = (Vec::new(), Vec::new());
+    for (i, h) in hinges.iter().enumerate() {
+        if let HingeJoint::Ideal = h.joint {
+            let (a1, a2) = anchors(scene, scene.hinges[i].point_m, h.bearing, h.journal);
+            ideal_joints.push(IdealJoint::Revolute(IdealRevolute {
+                body1: bodies[h.bearing].handle,
+                body2: bodies[h.journal].handle,
+                local_anchor1: a1,
+                local_anchor2: a2,
+                local_axis1: h.local_axis1,
+            }));
+            ideal_hinges.push(i);
+        }
+    }
+    (ideal_joints, ideal_hinges)
+}
+
+/// The scene's other joints, built: what the twin keeps of them.
+#[derive(Default)]
+struct SceneJoints {
+    /// Each joint for the reaction solve, in scene order.
+    ideal: Vec<IdealJoint>,
+    /// Each joint's name and force (zero until solved).
+    joints: Vec<(String, f64)>,
+    /// Each joint's motor torque or force (zero until solved), `None` without a motor.
+    motors: Vec<Option<f64>>,
+    /// The motor columns' names.
+    motor_columns: Vec<String>,
+    /// The motors in Rapier, with their axis and scene joint index.
+    motor_joints: Vec<(ImpulseJointHandle, JointAxis, usize)>,
+    /// The velocity motors: scene joint index, target, name, unit of the target.
+    held_motors: Vec<(usize, f64, String, &'static str)>,
+}
+
+/// The scene's joints of Rapier's other kinds in `world`, with their motors.
+fn build_joints(
+    scene: &ValidatedScene,
+    bodies: &[BodyTrack],
+    world: &mut ClearanceWorld,
+) -> SceneJoints {
+    let mut out = SceneJoints::default();
+    for (k, j) in scene.joints.iter().enumerate() {
+        let motor = motor_of(j.motor.as_ref());
+        if let Some(Motor::Held { target, .. }) = motor {
+            let unit = match j.motor {
+                Some(MotorSpec::LinearVelocity { .. }) => "m/s",
+                _ => "rad/s",
+            };
+            out.held_motors.push((k, target, j.name.clone(), unit));
+        }
+        let (ideal, handle) = build_joint(scene, j, motor, bodies, world);
+        if let (Some(_), Some(axis)) = (&j.motor, motor_axis(&j.kind)) {
+            out.motor_joints.push((handle, axis, k));
+        }
+        out.ideal.push(ideal);
+        out.joints.push((j.name.clone(), 0.0));
+        out.motors.push(j.motor.as_ref().map(|_| 0.0));
+        if j.motor.is_some() {
+            let unit = match j.kind {
+                JointKindSpec::Prismatic { .. } => "n",
+                _ => "nm",
+            };
+            out.motor_columns.push(format!("{}_motor_{unit}", j.name));
+        }
+    }
+    out
+}
+
+/// The axis a joint kind's motor drives (`None`: the kind takes no motor).
+fn motor_axis(kind: &JointKindSpec) -> Option<JointAxis> {
+    match kind {
+        JointKindSpec::Prismatic { .. } => Some(JointAxis::LinX),
+        JointKindSpec::Revolute { .. } => Some(JointAxis::AngX),
+        JointKindSpec::Fixed | JointKindSpec::Spherical => None,
+    }
+}
+
+/// One scene joint in `world` (with its motor, `motor`), and the same joint for the reaction
+/// solve.
+fn build_joint(
+    scene: &ValidatedScene,
+    j: &JointSpec,
+    motor: Option<Motor>,
+    bodies: &[BodyTrack],
+    world: &mut ClearanceWorld,
+) -> (IdealJoint, ImpulseJointHandle) {
+    let (i1, i2) = (
+        scene.body_index(&j.body1).expect("validated"),
+        scene.body_index(&j.body2).expect("validated"),
+    );
+    let (a1, a2) = anchors(scene, j.point_m, i1, i2);
+    let (b1, b2) = (bodies[i1].handle, bodies[i2].handle);
+    let (rapier, ideal): (GenericJoint, IdealJoint) = match &j.kind {
+        JointKindSpec::Prismatic { axis, limits_m } => prismatic(
+            b1,
+            b2,
+            a1,
+            a2,
+            Vector::from(*axis).normalize(),
+            *limits_m,
+            motor,
+        ),
+        JointKindSpec::Revolute { axis } => {
+            revolute(b1, b2, a1, a2, Vector::from(*axis).normalize(), motor)
+        }
+        JointKindSpec::Fixed => (
+            FixedJointBuilder::new()
+                .local_anchor1(a1)
+                .local_anchor2(a2)
+                .contacts_enabled(false)
+                .into(),
+            IdealJoint::Fixed(IdealFixed {
+                body1: b1,
+                body2: b2,
+                local_anchor1: a1,
+                local_anchor2: a2,
+            }),
+        ),
+        JointKindSpec::Spherical => (
+            SphericalJointBuilder::new()
+                .local_anchor1(a1)
+                .local_anchor2(a2)
+                .contacts_enabled(false)
+                .into(),
+            IdealJoint::Spherical(IdealSpherical {
+                body1: b1,
+                body2: b2,
+                local_anchor1: a1,
+                local_anchor2: a2,
+            }),
+        ),
+    };
+    let handle = world.rapier.impulse_joints.insert(b1, b2, rapier, true);
+    (ideal, handle)
+}
+
+/// A prismatic joint along `axis`, with its limits and motor (validated: only linear motors).
+fn prismatic(
+    b1: RigidBodyHandle,
+    b2: RigidBodyHandle,
+    a1: Vector,
+    a2: Vector,
+    axis: Vector,
+    limits: Option<[f64; 2]>,
+    motor: Option<Motor>,
+) -> (GenericJoint, IdealJoint) {
+    let mut rj = PrismaticJointBuilder::new(axis)
+        .local_anchor1(a1)
+        .local_anchor2(a2)
+        .contacts_enabled(false);
+    if let Some(l) = limits {
+        rj = rj.limits(l);
+    }
+    let ideal = IdealPrismatic {
+        body1: b1,
+        body2: b2,
+        local_anchor1: a1,
+        local_anchor2: a2,
+        local_axis1: axis,
+    };
+    let ideal = match motor {
+        Some(Motor::Held { target, factor }) => {
+            rj = rj.motor_velocity(target, factor);
+            IdealJoint::MotorPrismatic(ideal)
+        }
+        Some(Motor::Soft(m)) => {
+            rj = rj
+                .set_motor(m.target_pos, m.target_vel, m.stiffness, m.damping)
+                .motor_model(MotorModel::ForceBased);
+            IdealJoint::SoftMotorPrismatic(ideal, m)
+        }
+        None => IdealJoint::Prismatic(ideal),
+    };
+    (rj.into(), ideal)
+}
+
+/// A revolute joint about `axis`, with its motor (validated: only angular motors).
+fn revolute(
+    b1: RigidBodyHandle,
+    b2: RigidBodyHandle,
+    a1: Vector,
+    a2: Vector,
+    axis: Vector,
+    motor: Option<Motor>,
+) -> (GenericJoint, IdealJoint) {
+    let mut rj = RevoluteJointBuilder::new(axis)
+        .local_anchor1(a1)
+        .local_anchor2(a2)
+        .contacts_enabled(false);
+    let ideal = IdealRevolute {
+        body1: b1,
+        body2: b2,
+        local_anchor1: a1,
+        local_anchor2: a2,
+        local_axis1: axis,
+    };
+    let ideal = match motor {
+        Some(Motor::Held { target, factor }) => {
+            rj = rj.motor_velocity(target, factor);
+            IdealJoint::MotorRevolute(ideal)
+        }
+        Some(Motor::Soft(m)) => {
+            rj = rj
+                .motor(m.target_pos, m.target_vel, m.stiffness, m.damping)
+                .motor_model(MotorModel::ForceBased);
+            IdealJoint::SoftMotorRevolute(ideal, m)
+        }
+        None => IdealJoint::Revolute(ideal),
+    };
+    (rj.into(), ideal)
+}
+
+/// The table's columns: time, each body's angle and rate (and, with `run.body_motion`, each
+/// moving body's position, velocity and acceleration), each hinge's, each joint's force, then
+/// the motors'.
+fn columns(
+    scene: &ValidatedScene,
+    bodies: &[BodyTrack],
+    hinges: &[HingeTrack],
+    joints: &[(String, f64)],
+    motor_columns: Vec<String>,
+) -> Vec<String> {
+    let mut columns = vec!["t_s".to_string()];
+    for b in bodies {
+        columns.push(format!("{}_angle_deg", b.name));
+        columns.push(format!("{}_rate_deg_s", b.name));
+    }
+    if scene.run.body_motion {
+        for b in bodies.iter().filter(|b| b.moves) {
+            for c in [
+                "x_m", "y_m", "z_m", "vx_m_s", "vy_m_s", "vz_m_s", "ax_m_s2", "ay_m_s2", "az_m_s2",
+            ] {
+                columns.push(format!("{}_{c}", b.name));
+            }
+        }
+    }
+    for h in hinges {
+        for c in [
+            "angle_deg",
+            "rate_deg_s",
+            "force_n",
+            "ecc_u_mm",
+            "ecc_v_mm",
+            "penetration_um",
+            "contact",
+        ] {
+            columns.push(format!("{}_{c}", h.name));
+        }
+    }
+    for (name, _) in joints {
+        columns.push(format!("{name}_force_n"));
+    }
+    columns.extend(motor_columns);
+    columns
+}
+
+/// The reaction solver, tracking every dynamic body: the rows' velocities and accelerations of
+/// every dynamic body come from the solve, held by an ideal joint or not.
+fn reaction_solver(bodies: &[BodyTrack]) -> ReactionSolver {
+    let mut reactions = ReactionSolver::default();
+    reactions.track = bodies
+        .iter()
+        .filter(|b| !b.fixed)
+        .map(|b| b.handle)
+        .collect();
+    reactions
+}
+
+/// A scene motor in Rapier's terms.
+#[derive(Clone, Copy)]
+enum Motor {
+    /// A velocity motor that holds its speed: target (rad/s or m/s) and damping factor (1/s).
+    Held { target: f64, factor: f64 },
+    /// A force-based spring-damper.
+    Soft(SoftMotor),
+}
+
+fn motor_of(spec: Option<&MotorSpec>) -> Option<Motor> {
+    Some(match spec? {
+        MotorSpec::Velocity {
+            target_rad_s,
+            factor,
+        } => Motor::Held {
+            target: *target_rad_s,
+            factor: *factor,
+        },
+        MotorSpec::LinearVelocity { target_m_s, factor } => Motor::Held {
+            target: *target_m_s,
+            factor: *factor,
+        },
+        MotorSpec::Position {
+            target_rad,
+            stiffness_nm_per_rad,
+            damping_nm_s_per_rad,
+            target_rad_s,
+        } => Motor::Soft(SoftMotor::force_based(
+            *target_rad,
+            *target_rad_s,
+            *stiffness_nm_per_rad,
+            *damping_nm_s_per_rad,
+        )),
+        MotorSpec::LinearPosition {
+            target_m,
+            stiffness_n_per_m,
+            damping_n_s_per_m,
+            target_m_s,
+        } => Motor::Soft(SoftMotor::force_based(
+            *target_m,
+            *target_m_s,
+            *stiffness_n_per_m,
+            *damping_n_s_per_m,
+        )),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::rapier::convert::ClearanceModel;
+    use crate::scene::Scene;
+    use crate::scene::runner::{RunOptions, Simulation, Twins};
+
+    fn error_of(scene: &Scene, twins: Twins) -> Option<String> {
+        let options = RunOptions {
+            twins,
+            ..RunOptions::default()
+        };
+        Simulation::new(scene, options).err().map(|e| e.to_string())
+    }
+
+    #[test]
+    fn a_large_step_hinge_is_refused_by_the_runner_naming_its_field() {
+        let base = Scene::solar_panel();
+        let name = base.hinges[0].name.clone();
+        // A valid scene: the format may choose the model.
+        let scene = base
+            .with_overrides(&[format!("{name}.model=LargeStep")])
+            .unwrap();
+        let spec = scene.hinges[0].clearance.as_ref().unwrap();
+        assert_eq!(spec.model, ClearanceModel::LargeStep);
+        let v = scene.validated().unwrap();
+        assert_eq!(v.clearance(0).unwrap().model, ClearanceModel::LargeStep);
+        // The runner does not step it yet: refused, naming the field.
+        let e = error_of(&scene, Twins::Both).expect("refused");
+        assert!(
+            e.contains(&format!("`hinges[{name}].clearance.model`")) && e.contains("not run"),
+            "{e}"
+        );
+        // The ideal twin alone has no clearance joint to build.
+        assert_eq!(error_of(&scene, Twins::IdealOnly), None);
+        assert!(error_of(&base, Twins::Both).is_none());
+    }
+
+    #[test]
+    fn the_models_settings_are_checked_at_the_scene() {
+        let base = Scene::solar_panel();
+        let name = base.hinges[0].name.clone();
+        // A restitution is the large-step model's only.
+        let e = base
+            .with_overrides(&[format!("{name}.clearance.restitution=0.5")])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("`hinges[{name}].clearance.restitution`"))
+                && e.contains("large-step"),
+            "{e}"
+        );
+        let e = base
+            .with_overrides(&[
+                format!("{name}.model=LargeStep"),
+                format!("{name}.clearance.restitution=1.5"),
+            ])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("`hinges[{name}].clearance.restitution`")),
+            "{e}"
+        );
+        let ok = base
+            .with_overrides(&[
+                format!("{name}.model=LargeStep"),
+                format!("{name}.clearance.restitution=0.5"),
+            ])
+            .unwrap();
+        assert_eq!(
+            ok.validated().unwrap().clearance(0).unwrap().restitution,
+            Some(0.5)
+        );
+        // Written back, the choice reads the same; the default is not written (old scenes
+        // and their files read as before).
+        assert_eq!(Scene::from_ron(&ok.to_ron(), "round trip").unwrap(), ok);
+        assert!(ok.to_ron().contains("LargeStep"));
+        assert!(!base.to_ron().contains("model"), "{}", base.to_ron());
+        // An unknown model is a parse error naming the variants.
+        let text = crate::scene::SOLAR_PANEL_RON.replacen(
+            "clearance: Some((",
+            "clearance: Some((model: Rigid, ",
+            1,
+        );
+        assert!(text.contains("model: Rigid"), "the asset's hinge moved");
+        let e = Scene::from_ron(&text, "test").unwrap_err().to_string();
+        assert!(e.contains("Rigid"), "{e}");
+    }
+}

@@ -9,6 +9,7 @@ use crate::model::angle::{HingeAngle, UnwrappedAngle, twist_angle};
 use crate::model::laws::NormalForceLaw;
 use crate::rapier::drive::DriveHandle;
 use crate::rapier::joint::ClearanceJointHandle;
+use crate::rapier::large_step::{LargeStepJointHandle, LargeStepReport};
 use crate::rapier::metrics::{ContactObservation, ImpactRecorder};
 use crate::rapier::reaction::{IdealJoint, ReactionSolver};
 use crate::rapier::replay::ReplayRecorder;
@@ -66,6 +67,8 @@ pub(super) struct BodyTrack {
 enum HingeJoint {
     Ideal,
     Clearance(ClearanceJointHandle),
+    /// A clearance hinge of the large-step model (`clearance.model: LargeStep`).
+    LargeStep(LargeStepJointHandle),
 }
 
 #[derive(Clone, Debug)]
@@ -91,7 +94,7 @@ impl HingeTrack {
     pub(super) fn observation(&self) -> ContactObservation {
         match self.joint {
             HingeJoint::Ideal => ContactObservation::ideal(self.force),
-            HingeJoint::Clearance(_) => ContactObservation {
+            HingeJoint::Clearance(_) | HingeJoint::LargeStep(_) => ContactObservation {
                 force: self.force,
                 onset: self.sample.onset,
                 impact: self.sample.impact,
@@ -101,6 +104,28 @@ impl HingeTrack {
                 onset_fraction: self.sample.onset_fraction,
             },
         }
+    }
+}
+
+/// A large-step hinge's last step as a contact sample: the constraint model has no
+/// penetration, so the sample's is the journal's excursion beyond the clearance circle,
+/// `|e| - c` (negative: the gap; at least the smallest positive number while the constraint
+/// is in contact, so that the recorder counts the contact).
+fn large_step_sample(r: &LargeStepReport, c: f64) -> ContactSample {
+    let excursion = r.eccentricity.length() - c;
+    ContactSample {
+        onset: r.onset,
+        impact: r.impact,
+        penetration: if r.contact {
+            excursion.max(f64::MIN_POSITIVE)
+        } else {
+            excursion.min(0.0)
+        },
+        rate: if r.onset { r.approach_speed } else { 0.0 },
+        approach_speed: r.approach_speed,
+        onset_fraction: 1.0,
+        damping_force: 0.0,
+        friction_force: 0.0,
     }
 }
 
@@ -204,6 +229,15 @@ impl Twin {
                     },
                     friction_force: f.friction_force,
                 };
+            }
+            if let HingeJoint::LargeStep(k) = h.joint {
+                let r = world
+                    .large_step
+                    .get(k)
+                    .expect("handle of this twin")
+                    .report();
+                h.force = r.normal_force;
+                h.sample = large_step_sample(r, world.large_step.get(k).expect("same").clearance());
             }
         }
         self.solve_ideal_reactions(world)?;
@@ -321,7 +355,8 @@ impl Twin {
             .iter()
             .filter_map(|h| match h.joint {
                 HingeJoint::Clearance(c) => world.clearance.get(c),
-                HingeJoint::Ideal => None,
+                // The constraint model stores no elastic energy.
+                HingeJoint::Ideal | HingeJoint::LargeStep(_) => None,
             })
             .map(|j| j.elastic_energy())
             .sum();
@@ -412,6 +447,18 @@ impl Twin {
                     v.push(r.state.penetration.max(0.0) * 1e6);
                     v.push(if r.state.penetration > 0.0 { 1.0 } else { 0.0 });
                 }
+                HingeJoint::LargeStep(k) => {
+                    let r = world
+                        .large_step
+                        .get(k)
+                        .expect("handle of this twin")
+                        .report();
+                    let e = r.eccentricity;
+                    v.push(e.dot(*r1.rotation() * h.local_u1) * 1e3);
+                    v.push(e.dot(*r1.rotation() * h.local_v1) * 1e3);
+                    v.push(h.sample.penetration.max(0.0) * 1e6);
+                    v.push(if r.contact { 1.0 } else { 0.0 });
+                }
                 HingeJoint::Ideal => v.extend_from_slice(&[0.0, 0.0, 0.0, 0.0]),
             }
         }
@@ -462,7 +509,7 @@ impl Twin {
     pub fn clearance_hinges(&self) -> Vec<&str> {
         self.hinges
             .iter()
-            .filter(|h| matches!(h.joint, HingeJoint::Clearance(_)))
+            .filter(|h| matches!(h.joint, HingeJoint::Clearance(_) | HingeJoint::LargeStep(_)))
             .map(|h| h.name.as_str())
             .collect()
     }
@@ -507,7 +554,9 @@ impl Twin {
                 HingeJoint::Clearance(c) => {
                     recorder.track_journal(&h.name, group, 0, c, &world.clearance)?
                 }
-                HingeJoint::Ideal => {
+                // The replay draws journals of the compliant set only: a large-step hinge is
+                // drawn as a pin at its scene point (its orbit is in the rows).
+                HingeJoint::Ideal | HingeJoint::LargeStep(_) => {
                     let anchor =
                         Vector::from(spec.point_m) - Vector::from(scene.body_origin(h.bearing));
                     recorder.track_pin(&h.name, group, b1, b2, anchor, h.local_axis1)?

@@ -2,9 +2,9 @@
 //! joints the reactions are solved for, the scene's other joints and their motors, columns.
 
 use super::{BodyTrack, ContactSample, HingeJoint, HingeTrack, Twin, TwinKind};
-use crate::error::{Error, Result};
+use crate::error::Result;
 use crate::model::angle::{HingeAngle, UnwrappedAngle};
-use crate::rapier::convert::{Clearance, ClearanceModel};
+use crate::rapier::convert::ClearanceModel;
 use crate::rapier::drive::{DriveHandle, TorsionSpring};
 use crate::rapier::metrics::ImpactRecorder;
 use crate::rapier::prescribed::{PrescribedMotion, PrescribedPath, Table as MotionTable};
@@ -215,10 +215,17 @@ fn build_hinges(
         let (b1, b2) = (bodies[ib].handle, bodies[ij].handle);
         let joint = match (scene.clearance(i), kind) {
             (Some(settings), TwinKind::Clearance) => {
-                refuse_unrun_model(settings, &h.name)?;
-                let j = settings.joint(a1, a2, axis, axis)?;
                 let rapier = &mut world.rapier.impulse_joints;
-                HingeJoint::Clearance(world.clearance.insert(b1, b2, j, rapier))
+                match settings.model {
+                    ClearanceModel::Compliant => {
+                        let j = settings.joint(a1, a2, axis, axis)?;
+                        HingeJoint::Clearance(world.clearance.insert(b1, b2, j, rapier))
+                    }
+                    ClearanceModel::LargeStep => {
+                        let j = settings.large_step_joint(a1, a2, axis, axis)?;
+                        HingeJoint::LargeStep(world.large_step.insert(b1, b2, j, rapier))
+                    }
+                }
             }
             _ => {
                 let j = RevoluteJointBuilder::new(axis)
@@ -245,19 +252,6 @@ fn build_hinges(
         });
     }
     Ok(hinges)
-}
-
-/// The scene runner steps compliant clearance joints only, for now: a hinge that chose the
-/// large-step model is refused, naming its field.
-fn refuse_unrun_model(settings: &Clearance, hinge: &str) -> Result<()> {
-    match settings.model {
-        ClearanceModel::Compliant => Ok(()),
-        ClearanceModel::LargeStep => Err(Error::invalid(
-            format!("hinges[{hinge}].clearance.model"),
-            "is LargeStep, which the scene runner does not run yet (a plain-Rapier loop can: \
-             `Clearance::large_step_joint` and `LargeStepJointSet`); use `Compliant`",
-        )),
-    }
 }
 
 /// The anchors of a joint at world point `point` (t = 0) in bodies `i1` and `i2`'s frames.
@@ -629,26 +623,44 @@ mod tests {
     }
 
     #[test]
-    fn a_large_step_hinge_is_refused_by_the_runner_naming_its_field() {
+    fn a_large_step_hinge_runs_in_the_runner() {
         let base = Scene::solar_panel();
         let name = base.hinges[0].name.clone();
-        // A valid scene: the format may choose the model.
-        let scene = base
-            .with_overrides(&[format!("{name}.model=LargeStep")])
+        // The format may choose the model, and the runner steps it.
+        let mut scene = base
+            .with_overrides(&[format!("{name}.model=LargeStep"), "run.end_s=0.5".into()])
             .unwrap();
+        scene.run.output_interval_s = 1e-3;
         let spec = scene.hinges[0].clearance.as_ref().unwrap();
         assert_eq!(spec.model, ClearanceModel::LargeStep);
         let v = scene.validated().unwrap();
         assert_eq!(v.clearance(0).unwrap().model, ClearanceModel::LargeStep);
-        // The runner does not step it yet: refused, naming the field.
-        let e = error_of(&scene, Twins::Both).expect("refused");
-        assert!(
-            e.contains(&format!("`hinges[{name}].clearance.model`")) && e.contains("not run"),
-            "{e}"
-        );
-        // The ideal twin alone has no clearance joint to build.
         assert_eq!(error_of(&scene, Twins::IdealOnly), None);
-        assert!(error_of(&base, Twins::Both).is_none());
+        let sim = Simulation::new(&scene, RunOptions::default()).unwrap();
+        assert_eq!(sim.world.large_step.len(), 1);
+        assert!(sim.world.clearance.is_empty());
+        let run = sim.run().unwrap();
+        let clear = &run.twins[1];
+        assert_eq!(clear.clearance_hinges(), vec![name.as_str()]);
+        // The panel's first swing closes the play: contacts recorded, the journal kept within
+        // its bearing (the eccentricity columns, mm, against c = 0.5 mm), the guards clean.
+        let m = &clear.hinge_metrics()[&name];
+        assert!(m.impacts > 0, "{m:?}");
+        let t = &clear.table;
+        let (u, w) = (
+            t.column(&format!("{name}_ecc_u_mm")).unwrap(),
+            t.column(&format!("{name}_ecc_v_mm")).unwrap(),
+        );
+        let worst = u
+            .iter()
+            .zip(&w)
+            .map(|(a, b)| a.hypot(*b))
+            .fold(0.0, f64::max);
+        assert!(
+            worst > 0.4 && worst < 0.55,
+            "largest |e| {worst} mm, c = 0.5 mm"
+        );
+        assert!(run.guards.is_clean(), "{:?}", run.guards);
     }
 
     #[test]

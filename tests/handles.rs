@@ -128,3 +128,32 @@ fn large_step_handles_survive_removals_and_stale_ones_find_nothing() {
     set.after_step(&mut w.bodies, &w.impulse_joints);
     assert_eq!(set.len(), 3);
 }
+
+/// The drives' handles too: removing one leaves the others' handles and order, a removed drive's
+/// handle finds nothing, also after a new drive is inserted, and only the drives left act.
+#[test]
+fn drive_handles_survive_removals_and_stale_ones_find_nothing() {
+    use clearance_joint::rapier::drive::{DriveSet, TorsionSpring};
+    let (mut w, base, arms) = world(3);
+    let mut drives = DriveSet::new();
+    let handles: Vec<_> = (0..3)
+        .map(|i| {
+            let torque = (i + 1) as f64;
+            drives.insert(TorsionSpring::new(base, arms[i], Vector::Z, torque, 0.0).unwrap())
+        })
+        .collect();
+    let removed = drives.remove(handles[1]).expect("a drive of this set");
+    assert_eq!(removed.torque_at(0.0), 2.0);
+    assert!(drives.get(handles[1]).is_none() && drives.remove(handles[1]).is_none());
+    let fresh = drives.insert(TorsionSpring::new(base, arms[1], Vector::Z, 9.0, 0.0).unwrap());
+    assert_ne!(fresh, handles[1]);
+    assert!(drives.get(handles[1]).is_none());
+    assert_eq!(drives.get(handles[0]).unwrap().torque_at(0.0), 1.0);
+    assert_eq!(drives.get(handles[2]).unwrap().torque_at(0.0), 3.0);
+    // Insertion order: the first, the third, then the fresh one.
+    let order: Vec<f64> = drives.iter().map(|(_, d)| d.torque_at(0.0)).collect();
+    assert_eq!(order, vec![1.0, 3.0, 9.0]);
+    drives.apply(&mut w.bodies);
+    let torques: Vec<f64> = arms.iter().map(|&a| w.bodies[a].user_torque().z).collect();
+    assert_eq!(torques, vec![1.0, 9.0, 3.0]);
+}

@@ -163,3 +163,16 @@ fn reactions_see_the_large_step_joints() {
         "elbow reaction {f:?}, the lower link weighs {weight} N"
     );
 }
+
+/// `step_to` refuses a time it could never reach (no endless loop), naming the argument.
+#[test]
+fn step_to_refuses_an_unreachable_time() {
+    let (rapier, _, _) = arm_world(1);
+    let mut world = ClearanceWorld::new(rapier, StepControl::fixed(1e-3));
+    for until in [f64::INFINITY, f64::NAN] {
+        let e = world.step_to(until).unwrap_err().to_string();
+        assert!(e.contains("`until`") && e.contains("finite"), "{e}");
+    }
+    assert_eq!(world.step_to(0.01).unwrap(), 10);
+    assert_eq!(world.step_to(0.005).unwrap(), 0);
+}

@@ -166,8 +166,15 @@ impl ClearanceWorld {
         stepper.step(physics, &mut hooks, until)
     }
 
-    /// Steps until the clock reaches `until` (s); returns the number of accepted steps taken.
+    /// Steps until the clock reaches `until` (s, finite; at or before the current time nothing is
+    /// done); returns the number of accepted steps taken.
     pub fn step_to(&mut self, until: f64) -> Result<u64> {
+        if !until.is_finite() {
+            return Err(crate::Error::invalid(
+                "until",
+                format!("must be a finite time in seconds (got {until})"),
+            ));
+        }
         let start = self.stepper.steps();
         while self.time() < until {
             self.step(until)?;

@@ -101,7 +101,7 @@ pub fn run_studies(
                             .cloned()
                             .unwrap_or_else(|| job.point.dir.clone()),
                         value: job.point.assignments[0].1.clone(),
-                        scene: job.scene.clone(),
+                        scene: job.scene.scene().clone(),
                         metrics: o.manifest.metrics,
                         dir: job.dir.clone(),
                         reused: o.reused,

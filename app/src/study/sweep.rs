@@ -13,10 +13,10 @@ use super::grid::{Axis, Grid, Point, Shard};
 use super::metrics::RunMetrics;
 use crate::advice::memory_options;
 use clearance_joint::error::{Error, Result};
-use clearance_joint::scene::Scene;
 use clearance_joint::scene::output::{
     DirLock, MemoryEstimate, bytes_text, write_all_atomic, write_atomic,
 };
+use clearance_joint::scene::{Scene, ValidatedScene};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -48,8 +48,9 @@ pub struct Sweep {
 pub struct Job {
     /// The grid point.
     pub point: Point,
-    /// The scene with the base and point overrides applied (validated).
-    pub scene: Scene,
+    /// The scene with the base and point overrides applied, checked once (it carries the
+    /// hinges' built `Clearance`s the run uses).
+    pub scene: ValidatedScene,
     /// The point's folder.
     pub dir: PathBuf,
     /// The sweep's fixed overrides (recorded in the manifest).
@@ -180,7 +181,7 @@ impl Sweep {
     }
 
     /// The job of `point`, from the base scene with the fixed overrides applied.
-    fn job(&self, base: &Scene, out: &Path, point: Point) -> Result<Job> {
+    fn job(&self, base: &ValidatedScene, out: &Path, point: Point) -> Result<Job> {
         let scene = base
             .with_overrides(&point.overrides())
             .map_err(|e| in_point(e, &point))?;
@@ -196,8 +197,11 @@ impl Sweep {
     /// overrides applied: two axes naming one field by different paths are refused (the later
     /// would silently win), and every value of every axis is applied once, the other axes at
     /// their first value, so a bad value fails naming its point without building the whole grid.
-    pub fn check(&self) -> Result<Scene> {
-        let base = self.base.with_overrides(&self.base_overrides)?;
+    pub fn check(&self) -> Result<ValidatedScene> {
+        let base = self
+            .base
+            .with_overrides(&self.base_overrides)?
+            .validated()?;
         let first = self.grid.point(0);
         let reference = base
             .with_overrides(&first.overrides())
@@ -242,7 +246,7 @@ impl Sweep {
     /// budget left for the runs.
     fn check_memory(
         &self,
-        base: &Scene,
+        base: &ValidatedScene,
         points: usize,
         threads: usize,
         budget: Option<u64>,
@@ -429,9 +433,8 @@ impl Job {
         let _lock = DirLock::acquire(&self.dir)?;
         remove_if_present(&self.dir.join(MANIFEST))?;
         let adaptive = self.scene.run.step == clearance_joint::scene::StepMode::Adaptive;
-        let (mut result, recording) =
-            crate::replay::run_recorded(&self.scene.validated()?, |_| {}, replay)
-                .map_err(|e| e.with_step_mode(adaptive))?;
+        let (mut result, recording) = crate::replay::run_recorded(&self.scene, |_| {}, replay)
+            .map_err(|e| e.with_step_mode(adaptive))?;
         // A point the step control stalled is an error of the sweep, not a result.
         if let Some(e) = result.stopped.take() {
             return Err(e.with_step_mode(adaptive));

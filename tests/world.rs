@@ -22,6 +22,19 @@ fn arm_world(iterations: usize) -> (PhysicsWorld, RigidBodyHandle, RigidBodyHand
     (rapier, base, arm)
 }
 
+/// The arm's compliant pin: steel, bearing radius 10 mm, clearance 0.2 mm, width 16 mm.
+fn compliant_pin() -> ClearanceJoint {
+    Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
+        .unwrap()
+        .joint(
+            Vector::ZERO,
+            Vector::new(-0.3, 0.0, 0.0),
+            Vector::Z,
+            Vector::Z,
+        )
+        .unwrap()
+}
+
 fn large_step_pin() -> LargeStepJoint {
     let geometry = BearingGeometry::from_clearance(0.010, 1e-3, 0.016).unwrap();
     LargeStepJointBuilder::new(Vector::Z, geometry)
@@ -62,26 +75,15 @@ fn large_step_hooks_run_inside_the_world_step() {
 /// The world's step is the `Stepper`'s with the same sets, to the bit.
 #[test]
 fn the_world_steps_like_the_stepper_with_the_same_sets() {
-    let pin = || {
-        Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
-            .unwrap()
-            .joint(
-                Vector::ZERO,
-                Vector::new(-0.3, 0.0, 0.0),
-                Vector::Z,
-                Vector::Z,
-            )
-            .unwrap()
-    };
     let control = StepControl::adaptive(1e-3, 0.0075);
     let (rapier, base, arm) = arm_world(1);
     let mut world = ClearanceWorld::new(rapier, control);
-    world.insert_clearance(base, arm, pin());
+    world.insert_clearance(base, arm, compliant_pin());
     world.step_to(0.05).unwrap();
 
     let (mut rapier, base2, arm2) = arm_world(1);
     let mut joints = ClearanceJointSet::new();
-    joints.insert(base2, arm2, pin(), &mut rapier.impulse_joints);
+    joints.insert(base2, arm2, compliant_pin(), &mut rapier.impulse_joints);
     let mut stepper = Stepper::new(control);
     while stepper.time() < 0.05 {
         stepper.step(&mut rapier, &mut [&mut joints], 0.05).unwrap();
@@ -98,21 +100,12 @@ fn the_world_steps_like_the_stepper_with_the_same_sets() {
 /// cannot step (4 solver iterations) it is refused at that step, naming the setting.
 #[test]
 fn a_joint_added_through_the_field_is_noticed() {
-    let pin = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
-        .unwrap()
-        .joint(
-            Vector::ZERO,
-            Vector::new(-0.3, 0.0, 0.0),
-            Vector::Z,
-            Vector::Z,
-        )
-        .unwrap();
     let (rapier, base, arm) = arm_world(4);
     let mut world = ClearanceWorld::new(rapier, StepControl::fixed(1e-4));
     world.step(1e-4).unwrap();
     let w = &mut world;
     w.clearance
-        .insert(base, arm, pin, &mut w.rapier.impulse_joints);
+        .insert(base, arm, compliant_pin(), &mut w.rapier.impulse_joints);
     let e = world.step(2e-4).unwrap_err().to_string();
     assert!(e.contains("num_solver_iterations"), "{e}");
 }

@@ -8,8 +8,8 @@ use crate::error::Result;
 use crate::model::angle::{HingeAngle, UnwrappedAngle, twist_angle};
 use crate::model::laws::NormalForceLaw;
 use crate::rapier::drive::DriveHandle;
-use crate::rapier::joint::ClearanceJointHandle;
-use crate::rapier::large_step::{LargeStepJointHandle, LargeStepReport};
+use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle};
+use crate::rapier::large_step::{LargeStepJoint, LargeStepJointHandle};
 use crate::rapier::metrics::{ContactObservation, ImpactRecorder};
 use crate::rapier::reaction::{IdealJoint, ReactionSolver};
 use crate::rapier::replay::ReplayRecorder;
@@ -107,12 +107,34 @@ impl HingeTrack {
     }
 }
 
+/// A compliant hinge's contact at its last evaluation (the state before the step).
+fn compliant_sample(j: &ClearanceJoint) -> ContactSample {
+    let r = j.report();
+    let f = &r.force;
+    let elastic = j.normal_law().elastic_force(r.state.penetration);
+    ContactSample {
+        onset: r.onset,
+        impact: r.impact,
+        penetration: r.state.penetration,
+        rate: r.state.penetration_rate,
+        approach_speed: r.approach_speed,
+        onset_fraction: r.onset_fraction,
+        damping_force: if f.normal_force > 0.0 {
+            f.normal_force - elastic
+        } else {
+            0.0
+        },
+        friction_force: f.friction_force,
+    }
+}
+
 /// A large-step hinge's last step as a contact sample: the constraint model has no
 /// penetration, so the sample's is the journal's excursion beyond the clearance circle,
 /// `|e| - c` (negative: the gap; at least the smallest positive number while the constraint
 /// is in contact, so that the recorder counts the contact).
-fn large_step_sample(r: &LargeStepReport, c: f64) -> ContactSample {
-    let excursion = r.eccentricity.length() - c;
+fn large_step_sample(j: &LargeStepJoint) -> ContactSample {
+    let r = j.report();
+    let excursion = r.eccentricity.length() - j.clearance();
     ContactSample {
         onset: r.onset,
         impact: r.impact,
@@ -209,35 +231,18 @@ impl Twin {
             );
             // Every state, so the unwrapped angle never aliases whatever the output interval.
             h.angle.update(r1.rotation(), r2.rotation(), h.local_axis1);
-            if let HingeJoint::Clearance(c) = h.joint {
-                let j = world.clearance.get(c).expect("handle of this twin");
-                let r = j.report();
-                let f = &r.force;
-                let elastic = j.normal_law().elastic_force(r.state.penetration);
-                h.force = f.on_journal.length();
-                h.sample = ContactSample {
-                    onset: r.onset,
-                    impact: r.impact,
-                    penetration: r.state.penetration,
-                    rate: r.state.penetration_rate,
-                    approach_speed: r.approach_speed,
-                    onset_fraction: r.onset_fraction,
-                    damping_force: if f.normal_force > 0.0 {
-                        f.normal_force - elastic
-                    } else {
-                        0.0
-                    },
-                    friction_force: f.friction_force,
-                };
-            }
-            if let HingeJoint::LargeStep(k) = h.joint {
-                let r = world
-                    .large_step
-                    .get(k)
-                    .expect("handle of this twin")
-                    .report();
-                h.force = r.normal_force;
-                h.sample = large_step_sample(r, world.large_step.get(k).expect("same").clearance());
+            match h.joint {
+                HingeJoint::Clearance(c) => {
+                    let j = world.clearance.get(c).expect("handle of this twin");
+                    h.force = j.report().force.on_journal.length();
+                    h.sample = compliant_sample(j);
+                }
+                HingeJoint::LargeStep(k) => {
+                    let j = world.large_step.get(k).expect("handle of this twin");
+                    h.force = j.report().normal_force;
+                    h.sample = large_step_sample(j);
+                }
+                HingeJoint::Ideal => {}
             }
         }
         self.solve_ideal_reactions(world)?;

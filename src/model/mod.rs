@@ -10,3 +10,4 @@
 pub mod angle;
 pub mod kinematics;
 pub mod laws;
+pub mod spatial;

@@ -95,7 +95,8 @@ use rapier3d_f64::prelude::{
 /// |---|---|---|---|
 /// | [`Compliant`](Self::Compliant) | contact law, force hook outside Rapier's solver | about 1e-5..1e-4 s for steel, `num_solver_iterations = 1` | force histories, peak forces, penetrations |
 /// | [`LargeStep`](Self::LargeStep) | radial limit inside Rapier's solver, Newton restitution, friction moment | any step (1/60 s, 1e-3 s), any iterations | play, rattle, orbit, sustained forces, impulses |
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+/// | [`Spatial`](Self::Spatial) | contact laws along the width and on the faces, nothing locked | as `Compliant` | tilt, edge loading, axial knocks, moments across the hinge |
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum ClearanceModel {
     /// The compliant contact-law joint ([`ClearanceJoint`] in a [`ClearanceJointSet`]).
     #[default]
@@ -104,6 +105,11 @@ pub enum ClearanceModel {
     /// [`Clearance::restitution`] (or, when unset, the normal law's own restitution at each
     /// impact) and Coulomb friction with the friction law's sliding coefficient.
     LargeStep,
+    /// The compliant joint in space ([`crate::model::spatial`]): the journal tilts and slides
+    /// axially, nothing is locked; the bore's law acts along the width in slices, the shoulders
+    /// meet the bearing's faces with the face law. A [`ClearanceJoint`] in a
+    /// [`ClearanceJointSet`], like `Compliant`, which is its aligned limit.
+    Spatial(crate::model::spatial::SpatialModel),
 }
 
 /// Which body of a revolute joint carries the bearing (the hole); the other carries the journal
@@ -275,7 +281,7 @@ impl Clearance {
         local_axis1: Vector,
         local_axis2: Vector,
     ) -> Result<ClearanceJoint> {
-        if self.model != ClearanceModel::Compliant {
+        if self.model == ClearanceModel::LargeStep {
             return Err(Error::invalid(
                 "model",
                 "is LargeStep, but a compliant clearance joint was asked for: insert it into a \
@@ -296,6 +302,9 @@ impl Clearance {
         }
         if let Some(name) = &self.name {
             b = b.name(name.clone());
+        }
+        if let ClearanceModel::Spatial(model) = self.model {
+            b = b.spatial(model);
         }
         b.build()
     }

@@ -16,11 +16,15 @@ use crate::rapier::ledger::{
 };
 use crate::rapier::stall::StalledContact;
 use rapier3d_f64::data::Index;
+
+mod spatial;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, IntegrationParameters, JointAxesMask,
     RigidBody, RigidBodyHandle, RigidBodySet,
 };
+pub use spatial::SpatialReport;
+use spatial::{SpatialMemory, SpatialParts};
 
 /// What holds the degrees of freedom the contact law does not (axial translation and the two tilts).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -52,6 +56,7 @@ pub enum OutOfPlaneLock {
 #[derive(Clone, Debug)]
 pub struct ClearanceJointBuilder {
     joint: ClearanceJoint,
+    spatial: Option<crate::model::spatial::SpatialModel>,
 }
 
 impl ClearanceJointBuilder {
@@ -81,7 +86,9 @@ impl ClearanceJointBuilder {
                 previous_rate: None,
                 last_wrenches: None,
                 prepared: false,
+                spatial: None,
             },
+            spatial: None,
         }
     }
     /// Bearing centre in body 1's frame.
@@ -136,6 +143,13 @@ impl ClearanceJointBuilder {
         self.joint.name = name.into();
         self
     }
+    /// Makes the joint spatial ([`crate::model::spatial`]): nothing is locked, the journal
+    /// tilts and slides axially, touching the bore along its width (the geometry's length) and
+    /// the bearing's faces with its shoulders. The [`lock`](Self::lock) is ignored (always none).
+    pub fn spatial(mut self, model: crate::model::spatial::SpatialModel) -> Self {
+        self.spatial = Some(model);
+        self
+    }
     /// Validates and returns the joint: unit axes, finite anchors, a normal law that holds a
     /// clearance (Liu's family) built for the geometry's
     /// ([`NormalModel::check_clearance`]), the floors and the validity limit.
@@ -159,6 +173,18 @@ impl ClearanceJointBuilder {
         if let Some(d) = j.max_valid_penetration {
             validate_max_valid_penetration("max_valid_penetration", d, &j.geometry)?;
         }
+        if let Some(model) = self.spatial {
+            let face_law = model
+                .validate(&j.geometry)
+                .map_err(|e| e.within("spatial"))?;
+            j.lock = OutOfPlaneLock::None;
+            j.spatial = Some(SpatialParts::new(
+                model,
+                face_law,
+                j.local_axis1,
+                j.geometry.length(),
+            ));
+        }
         Ok(self.joint)
     }
 }
@@ -180,6 +206,69 @@ impl Default for ContactHistory {
             max_gap: f64::INFINITY,
             compressing: false,
             impact_rate: 0.0,
+        }
+    }
+}
+
+/// How a contact history moved at one evaluation.
+#[derive(Clone, Copy, Debug)]
+struct Onset {
+    onset: bool,
+    impact: bool,
+    fraction: f64,
+    approach_speed: f64,
+}
+
+impl ContactHistory {
+    /// Moves the history to `state`, with `before` the state at the previous evaluation (if any):
+    /// records `delta_dot0` at an onset (MODEL.md §2), located at the crossing of delta = 0 inside
+    /// the step that led here, and whether the contact is still compressing.
+    fn advance(
+        &mut self,
+        before: Option<&JournalState>,
+        state: &JournalState,
+        min_impact_speed: f64,
+        min_separation: f64,
+    ) -> Onset {
+        let onset = state.penetration > 0.0 && !self.in_contact;
+        let impact = onset && self.max_gap >= min_separation;
+        let (fraction, approach_speed) = match (onset, before) {
+            (true, Some(before)) if before.penetration <= 0.0 => {
+                let s = crossing_fraction(-before.penetration, state.penetration);
+                let rate = speed_at_crossing(before.penetration_rate, state.penetration_rate, s);
+                (s, rate)
+            }
+            (true, _) => (1.0, state.penetration_rate),
+            (false, _) => (1.0, 0.0),
+        };
+        if state.penetration > 0.0 {
+            if onset {
+                *self = ContactHistory {
+                    in_contact: true,
+                    max_gap: 0.0,
+                    compressing: true,
+                    impact_rate: approach_speed.max(min_impact_speed),
+                };
+            } else if state.penetration_rate <= 0.0 {
+                self.compressing = false;
+            }
+        } else {
+            let gap = -state.penetration;
+            let max_gap = if self.in_contact {
+                gap
+            } else {
+                self.max_gap.max(gap)
+            };
+            *self = ContactHistory {
+                max_gap,
+                ..ContactHistory::default()
+            };
+        }
+        Onset {
+            onset,
+            impact,
+            fraction,
+            approach_speed,
         }
     }
 }
@@ -225,6 +314,11 @@ pub struct ClearanceReport {
     pub zeta: f64,
     /// Effective mass of the two bodies along the contact normal, kg.
     pub effective_mass: f64,
+    /// A spatial joint's tilt, axial offset and forces by contact kind (`None` for the planar
+    /// joint). Its `state` above is then the deepest station's (bore or face), `force` the sum
+    /// over all stations (`normal_force` the magnitude of the summed normal forces, the resultant
+    /// load on the bearing: edges loaded on opposite sides by a moment cancel in it).
+    pub spatial: Option<SpatialReport>,
 }
 
 /// A revolute hinge with radial clearance between two Rapier rigid bodies.
@@ -251,6 +345,8 @@ pub struct ClearanceJoint {
     /// The wrenches on body 1 and body 2 at the last application.
     last_wrenches: Option<[Wrench; 2]>,
     prepared: bool,
+    /// The spatial model's stations (`None`: the planar joint).
+    spatial: Option<SpatialParts>,
 }
 
 /// Default of [`ClearanceJointBuilder::min_impact_speed`], m/s.
@@ -318,13 +414,14 @@ const APPROACH_FRACTION: f64 = 0.5;
 const STABILITY_SAFETY: f64 = 0.8;
 
 /// The dynamic state of a joint between steps (what a rejected step must restore).
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug, Default)]
 struct JointDynamics {
     contact: ContactHistory,
     report: ClearanceReport,
     previous_rate: Option<f64>,
     last_wrenches: Option<[Wrench; 2]>,
     prepared: bool,
+    spatial: Option<SpatialMemory>,
 }
 
 /// Slope `dmu/dv` of a friction law at slip speed `v` (one-sided difference at 0, where the
@@ -401,10 +498,29 @@ impl ClearanceJoint {
     pub fn in_contact(&self) -> bool {
         self.contact.in_contact
     }
-    /// Elastic energy stored in the contact at the last application, J.
+    /// Elastic energy stored in the contact at the last application, J (all stations of a
+    /// spatial joint).
     pub fn elastic_energy(&self) -> f64 {
-        self.normal_law
-            .elastic_energy(self.report.state.penetration)
+        match &self.spatial {
+            Some(parts) => parts.elastic_energy,
+            None => self
+                .normal_law
+                .elastic_energy(self.report.state.penetration),
+        }
+    }
+
+    /// The spatial model, `None` for the planar joint.
+    pub fn spatial_model(&self) -> Option<&crate::model::spatial::SpatialModel> {
+        self.spatial.as_ref().map(|p| &p.model)
+    }
+
+    /// The law of the contact the report's `state` is at: the bore's normal law, or a spatial
+    /// joint's face law when its deepest station is on a face.
+    pub fn governing_law(&self) -> &NormalModel {
+        match (&self.spatial, self.report.spatial) {
+            (Some(parts), Some(r)) if r.governed_by_face => &parts.face_law,
+            _ => &self.normal_law,
+        }
     }
 
     /// The largest step that resolves this joint's contact dynamics to `tolerance`, the fraction of
@@ -433,11 +549,14 @@ impl ClearanceJoint {
                 .min(STABILITY_SAFETY * r.max_stable_dt.min(r.friction_stable_dt));
         }
         let gap = -delta;
-        let flight = flight_step(
-            tolerance,
-            self.geometry.clearance(),
-            r.state.eccentricity_rate.length(),
-        );
+        let flight = match &self.spatial {
+            Some(parts) => parts.flight_step(tolerance),
+            None => flight_step(
+                tolerance,
+                self.geometry.clearance(),
+                r.state.eccentricity_rate.length(),
+            ),
+        };
         let accel = match self.previous_rate {
             Some(prev) if last_dt > 0.0 => (rate - prev) / last_dt,
             _ => 0.0,
@@ -472,11 +591,10 @@ impl ClearanceJoint {
     /// stability limit there.
     fn contact_step(&self, approach_speed: f64, depth: f64, tolerance: f64) -> f64 {
         let m = self.report.effective_mass;
-        let energy =
-            0.5 * m * approach_speed * approach_speed + self.normal_law.elastic_energy(depth);
-        let peak =
-            crate::model::laws::penetration_for_energy(&self.normal_law, energy, 1e-6).max(depth);
-        let stiffness = self.normal_law.tangent_stiffness(peak);
+        let law = self.governing_law();
+        let energy = 0.5 * m * approach_speed * approach_speed + law.elastic_energy(depth);
+        let peak = crate::model::laws::penetration_for_energy(law, energy, 1e-6).max(depth);
+        let stiffness = law.tangent_stiffness(peak);
         if !(stiffness > 0.0) {
             return f64::INFINITY;
         }
@@ -485,7 +603,7 @@ impl ClearanceJoint {
         } else {
             approach_speed.max(self.min_impact_speed)
         };
-        if self.normal_law.uses_impact_rate() {
+        if law.uses_impact_rate() {
             impact_rate = impact_rate.max(loaded_impact_rate(energy, m));
         }
         let c = NormalContact {
@@ -493,7 +611,7 @@ impl ClearanceJoint {
             penetration_rate: approach_speed,
             impact_rate,
         };
-        let (stable, omega, _) = stable_step(stiffness, self.normal_law.damping_coefficient(&c), m);
+        let (stable, omega, _) = stable_step(stiffness, law.damping_coefficient(&c), m);
         (tolerance * std::f64::consts::TAU / omega).min(STABILITY_SAFETY * stable)
     }
 
@@ -529,25 +647,35 @@ impl ClearanceJoint {
         Some(h_c.max(0.9 * before).min(0.5 * dt))
     }
 
-    fn dynamics(&self) -> JointDynamics {
-        JointDynamics {
-            contact: self.contact,
-            report: self.report,
-            previous_rate: self.previous_rate,
-            last_wrenches: self.last_wrenches,
-            prepared: self.prepared,
+    /// Saves the dynamic state into `d` (reusing its buffers).
+    fn save_into(&self, d: &mut JointDynamics) {
+        d.contact = self.contact;
+        d.report = self.report;
+        d.previous_rate = self.previous_rate;
+        d.last_wrenches = self.last_wrenches;
+        d.prepared = self.prepared;
+        match (&self.spatial, &mut d.spatial) {
+            (Some(parts), Some(memory)) => parts.save_into(memory),
+            (Some(parts), memory) => *memory = Some(parts.memory()),
+            (None, memory) => *memory = None,
         }
     }
 
-    fn set_dynamics(&mut self, d: JointDynamics) {
+    fn set_dynamics(&mut self, d: &JointDynamics) {
         self.contact = d.contact;
         self.report = d.report;
         self.previous_rate = d.previous_rate;
         self.last_wrenches = d.last_wrenches;
         self.prepared = d.prepared;
+        if let (Some(parts), Some(memory)) = (&mut self.spatial, &d.spatial) {
+            parts.restore(memory);
+        }
     }
 
     fn evaluate(&mut self, bodies: &RigidBodySet) -> Option<(Wrench, Wrench)> {
+        if self.spatial.is_some() {
+            return self.evaluate_spatial(bodies);
+        }
         let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
         let (m1, m2) = (motion(rb1), motion(rb2));
         let axis = *rb1.rotation() * self.local_axis1;
@@ -558,41 +686,18 @@ impl ClearanceJoint {
         // Contact history: record delta_dot0 at onset (MODEL.md §2), located at the crossing of
         // delta = 0 inside the step that led here (the previous application is the state
         // before it), and classify the mode.
-        let onset = state.penetration > 0.0 && !self.contact.in_contact;
-        let impact = onset && self.contact.max_gap >= self.min_separation;
-        let before = &self.report.state;
-        let (onset_fraction, approach_speed) = match onset {
-            true if self.prepared_report() && before.penetration <= 0.0 => {
-                let s = crossing_fraction(-before.penetration, state.penetration);
-                let rate = speed_at_crossing(before.penetration_rate, state.penetration_rate, s);
-                (s, rate)
-            }
-            true => (1.0, state.penetration_rate),
-            false => (1.0, 0.0),
-        };
-        if state.penetration > 0.0 {
-            if onset {
-                self.contact = ContactHistory {
-                    in_contact: true,
-                    max_gap: 0.0,
-                    compressing: true,
-                    impact_rate: approach_speed.max(self.min_impact_speed),
-                };
-            } else if state.penetration_rate <= 0.0 {
-                self.contact.compressing = false;
-            }
-        } else {
-            let gap = -state.penetration;
-            let max_gap = if self.contact.in_contact {
-                gap
-            } else {
-                self.contact.max_gap.max(gap)
-            };
-            self.contact = ContactHistory {
-                max_gap,
-                ..ContactHistory::default()
-            };
-        }
+        let before = self.prepared_report().then_some(self.report.state);
+        let Onset {
+            onset,
+            impact,
+            fraction: onset_fraction,
+            approach_speed,
+        } = self.contact.advance(
+            before.as_ref(),
+            &state,
+            self.min_impact_speed,
+            self.min_separation,
+        );
         let mode = match (self.contact.in_contact, self.contact.compressing) {
             (false, _) => ContactMode::FreeFlight,
             (true, true) => ContactMode::Impact,
@@ -655,6 +760,7 @@ impl ClearanceJoint {
             omega,
             zeta,
             effective_mass,
+            spatial: None,
         };
         let f = force.on_journal;
         let w2 = Wrench {
@@ -876,6 +982,9 @@ impl ClearanceJointSet {
                 joint.contact = ContactHistory::default();
                 joint.report = ClearanceReport::default();
                 joint.previous_rate = None;
+                if let Some(parts) = &mut joint.spatial {
+                    parts.reset();
+                }
             }
             self.wrenches
                 .extend(joint.last_wrenches.into_iter().flatten());
@@ -942,16 +1051,18 @@ impl ClearanceJointSet {
     /// Saves every joint's contact history and report and its last wrenches (before a step that
     /// may be rejected; no allocation after the first call).
     pub(crate) fn save_state(&mut self) {
-        self.saved.clear();
         self.saved
-            .extend(self.joints.values().map(|j| j.dynamics()));
+            .resize_with(self.joints.len(), JointDynamics::default);
+        for (d, j) in self.saved.iter_mut().zip(self.joints.values()) {
+            j.save_into(d);
+        }
         self.saved_wrenches.clone_from(&self.wrenches);
     }
 
     /// Restores what [`save_state`](Self::save_state) saved.
     pub(crate) fn restore_state(&mut self) {
         for (j, d) in self.joints.values_mut().zip(&self.saved) {
-            j.set_dynamics(*d);
+            j.set_dynamics(d);
         }
         self.wrenches.clone_from(&self.saved_wrenches);
     }

@@ -96,7 +96,7 @@ impl StalledContact {
     pub fn of(handle: ClearanceJointHandle, joint: &ClearanceJoint, bodies: &RigidBodySet) -> Self {
         let r = joint.report();
         let s = &r.state;
-        let law = joint.normal_law();
+        let law = joint.governing_law();
         let m = r.effective_mass;
         let shares = [joint.body1(), joint.body2()]
             .into_iter()

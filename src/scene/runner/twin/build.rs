@@ -217,7 +217,7 @@ fn build_hinges(
             (Some(settings), TwinKind::Clearance) => {
                 let rapier = &mut world.rapier.impulse_joints;
                 match settings.model {
-                    ClearanceModel::Compliant => {
+                    ClearanceModel::Compliant | ClearanceModel::Spatial(_) => {
                         let j = settings.joint(a1, a2, axis, axis)?;
                         HingeJoint::Clearance(world.clearance.insert(b1, b2, j, rapier))
                     }

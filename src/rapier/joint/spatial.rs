@@ -1,0 +1,430 @@
+//! The spatial model of a [`ClearanceJoint`]: every bore and face station of
+//! [`crate::model::spatial`] carries its own contact history and force pair; the joint reports
+//! the deepest station as its state (what the step control and the guards read) and the sums.
+
+use super::{ClearanceJoint, ClearanceReport, ContactHistory, friction_slope, motion};
+use crate::model::kinematics::{ContactMode, ForcePair, JournalState, contact_force, stable_step};
+use crate::model::laws::{NormalContact, NormalForceLaw, NormalModel, loaded_impact_rate};
+use crate::model::spatial::{
+    FACE_POINTS, Face, Share, SpatialModel, SpatialPose, bore_station, face_station,
+};
+use crate::rapier::ledger::{Wrench, inverse_mass_along};
+use rapier3d_f64::math::Vector;
+use rapier3d_f64::prelude::{RigidBody, RigidBodySet};
+
+/// What a spatial joint computed at its last application, beyond [`ClearanceReport`]'s
+/// deepest-station state.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SpatialReport {
+    /// The journal axis's tilt against the bore's about the bearing's two transverse axes, rad
+    /// ([`SpatialPose::tilt`]).
+    pub tilt: [f64; 2],
+    /// The journal's axial offset from the bearing's centre along the bore's axis, m.
+    pub axial_offset: f64,
+    /// Normal force of the bore's inner stations (the width away from its edges), N.
+    pub bore_force: f64,
+    /// Normal force at the bore's edges (the end stations at `-L/2` and `+L/2`), N.
+    pub edge_force: [f64; 2],
+    /// Normal force of the shoulders on the lower and upper face, N.
+    pub face_force: [f64; 2],
+    /// Stations in contact (bore and faces).
+    pub stations_in_contact: u32,
+    /// Whether the deepest station (the report's `state`) is on a face.
+    pub governed_by_face: bool,
+}
+
+/// Where a station sits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Place {
+    /// A bore station at `s` (m from the bearing's centre) carrying `share` of the bore law;
+    /// `edge` 0 or 1 for the end stations.
+    Bore {
+        s: f64,
+        share: f64,
+        edge: Option<usize>,
+    },
+    /// Point `index` of a shoulder ring against `face`.
+    Face { face: Face, index: usize },
+}
+
+/// One station's memory between steps.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Station {
+    place: Place,
+    contact: ContactHistory,
+    state: Option<JournalState>,
+}
+
+/// The spatial parts of a joint: model, face law, the bearing's transverse axis, stations.
+#[derive(Clone, Debug)]
+pub(super) struct SpatialParts {
+    pub(super) model: SpatialModel,
+    pub(super) face_law: NormalModel,
+    /// A unit vector square to `local_axis1`, in body 1's frame.
+    local_transverse1: Vector,
+    pub(super) stations: Vec<Station>,
+    pub(super) report: SpatialReport,
+    /// Rate of the fastest station's path across its gap, relative to the gap (1/s).
+    flight_rate: f64,
+    /// Elastic energy of all stations at the last application, J.
+    pub(super) elastic_energy: f64,
+}
+
+/// The stations' memory, saved before a step that may be rejected.
+pub(super) type SpatialMemory = (Vec<Station>, SpatialReport, f64, f64);
+
+impl SpatialParts {
+    pub(super) fn new(
+        model: SpatialModel,
+        face_law: NormalModel,
+        local_axis1: Vector,
+        width: f64,
+    ) -> Self {
+        let n = model.geometry.slices as usize;
+        let mut stations: Vec<Station> = model
+            .geometry
+            .bore_stations(width)
+            .enumerate()
+            .map(|(k, (s, share))| Station {
+                place: Place::Bore {
+                    s,
+                    share,
+                    edge: [(0, 0), (n, 1)]
+                        .into_iter()
+                        .find_map(|(end, e)| (k == end).then_some(e)),
+                },
+                contact: ContactHistory::default(),
+                state: None,
+            })
+            .collect();
+        for face in Face::BOTH {
+            stations.extend((0..FACE_POINTS).map(|index| Station {
+                place: Place::Face { face, index },
+                contact: ContactHistory::default(),
+                state: None,
+            }));
+        }
+        SpatialParts {
+            model,
+            face_law,
+            local_transverse1: local_axis1.any_orthonormal_vector(),
+            stations,
+            report: SpatialReport::default(),
+            flight_rate: 0.0,
+            elastic_energy: 0.0,
+        }
+    }
+
+    pub(super) fn memory(&self) -> SpatialMemory {
+        (
+            self.stations.clone(),
+            self.report,
+            self.flight_rate,
+            self.elastic_energy,
+        )
+    }
+
+    pub(super) fn save_into(&self, memory: &mut SpatialMemory) {
+        memory.0.clone_from(&self.stations);
+        memory.1 = self.report;
+        memory.2 = self.flight_rate;
+        memory.3 = self.elastic_energy;
+    }
+
+    pub(super) fn restore(&mut self, memory: &SpatialMemory) {
+        self.stations.clone_from(&memory.0);
+        self.report = memory.1;
+        self.flight_rate = memory.2;
+        self.elastic_energy = memory.3;
+    }
+
+    pub(super) fn reset(&mut self) {
+        for st in &mut self.stations {
+            st.contact = ContactHistory::default();
+            st.state = None;
+        }
+        self.report = SpatialReport::default();
+        self.flight_rate = 0.0;
+        self.elastic_energy = 0.0;
+    }
+
+    /// The free-flight step: no station's path across its gap (the radial clearance for the
+    /// bore, the axial play for the faces) moves more than `tolerance` of it in one step.
+    pub(super) fn flight_step(&self, tolerance: f64) -> f64 {
+        if self.flight_rate > 0.0 {
+            tolerance / self.flight_rate
+        } else {
+            f64::INFINITY
+        }
+    }
+}
+
+/// Linearised contact sums over the stations in contact, for the step limits.
+#[derive(Default)]
+struct Linearised {
+    stiffness: f64,
+    damping: f64,
+    /// Smallest stable step of a single station, s.
+    single: f64,
+    /// `sum F_N dmu/dv` over the stations (the tangential dampers in parallel), N s/m.
+    friction: f64,
+    /// Smallest friction limit of a single station, s.
+    friction_single: f64,
+}
+
+fn effective_mass(rb1: &RigidBody, rb2: &RigidBody, point: Vector, n: Vector) -> f64 {
+    1.0 / (inverse_mass_along(rb1, point, n) + inverse_mass_along(rb2, point, n))
+}
+
+impl ClearanceJoint {
+    /// The spatial joint's evaluation (the planar one is [`ClearanceJoint::evaluate`]'s own).
+    pub(super) fn evaluate_spatial(&mut self, bodies: &RigidBodySet) -> Option<(Wrench, Wrench)> {
+        let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
+        let (m1, m2) = (motion(rb1), motion(rb2));
+        let parts = self.spatial.as_mut()?;
+        let rot1 = *rb1.rotation();
+        let pose = SpatialPose {
+            bearing_center: *rb1.position() * self.local_anchor1,
+            bearing_axis: rot1 * self.local_axis1,
+            bearing_transverse: rot1 * parts.local_transverse1,
+            journal_center: *rb2.position() * self.local_anchor2,
+            journal_axis: *rb2.rotation() * self.local_axis2,
+        };
+        let geometry = &self.geometry;
+        let spatial = parts.model.geometry;
+        let (c, a) = (geometry.clearance(), spatial.axial_play);
+        let mut report = SpatialReport {
+            tilt: pose.tilt(),
+            axial_offset: pose.axial_offset(),
+            ..SpatialReport::default()
+        };
+        let (mut force, mut normal_sum, mut friction_sum) =
+            (Vector::ZERO, Vector::ZERO, Vector::ZERO);
+        let (mut torque1, mut torque2) = (Vector::ZERO, Vector::ZERO);
+        let mut lin = Linearised {
+            single: f64::INFINITY,
+            friction_single: f64::INFINITY,
+            ..Linearised::default()
+        };
+        let (mut energy, mut flight_rate) = (0.0, 0.0_f64);
+        // Where the stations' normal forces act on average (weighted by force), for the joint's
+        // effective mass: the stations act in parallel on the same two bodies.
+        let (mut load_point, mut load) = (Vector::ZERO, 0.0);
+        // The deepest station: (index, state, effective mass, impact rate).
+        let mut deepest: Option<(usize, JournalState, f64, f64)> = None;
+        for (i, st) in parts.stations.iter_mut().enumerate() {
+            let (state, law, share, gap_scale) = match st.place {
+                Place::Bore { s, share, .. } => (
+                    bore_station(geometry, &pose, s, &m1, &m2),
+                    &self.normal_law,
+                    share,
+                    c,
+                ),
+                Place::Face { face, index } => (
+                    face_station(geometry, &spatial, &pose, face, index, &m1, &m2),
+                    &parts.face_law,
+                    1.0 / FACE_POINTS as f64,
+                    a,
+                ),
+            };
+            let law = Share { law, share };
+            flight_rate = flight_rate.max(state.eccentricity_rate.length() / gap_scale);
+            st.contact.advance(
+                st.state.as_ref(),
+                &state,
+                self.min_impact_speed,
+                self.min_separation,
+            );
+            st.state = Some(state);
+            let m = effective_mass(rb1, rb2, state.contact_point, state.normal);
+            let impact_rate = station_impact_rate(&st.contact, &law, state.penetration, m);
+            let pair = contact_force(&state, impact_rate, &law, &self.friction_law);
+            if deepest.is_none_or(|d| state.penetration > d.1.penetration) {
+                deepest = Some((i, state, m, impact_rate));
+            }
+            if pair.normal_force <= 0.0 {
+                continue;
+            }
+            energy += law.elastic_energy(state.penetration);
+            load_point += pair.normal_force * pair.point;
+            load += pair.normal_force;
+            report.stations_in_contact += 1;
+            match st.place {
+                Place::Bore { edge: Some(e), .. } => report.edge_force[e] += pair.normal_force,
+                Place::Bore { edge: None, .. } => report.bore_force += pair.normal_force,
+                Place::Face { face, .. } => report.face_force[face as usize] += pair.normal_force,
+            }
+            force += pair.on_journal;
+            normal_sum -= pair.normal_force * state.normal;
+            friction_sum += pair.on_journal + pair.normal_force * state.normal;
+            torque2 += (pair.point - m2.center_of_mass).cross(pair.on_journal);
+            torque1 += (pair.point - m1.center_of_mass).cross(-pair.on_journal);
+            linearise(
+                &mut lin,
+                &law,
+                &state,
+                impact_rate,
+                m,
+                &pair,
+                &self.friction_law,
+                rb1,
+                rb2,
+            );
+        }
+        let (index, state, m_station, impact_rate) = deepest?;
+        let governing = parts.stations[index].place;
+        report.governed_by_face = matches!(governing, Place::Face { .. });
+        // The joint's effective mass along the deepest station's normal: at the load's centre
+        // in contact; in flight at the deepest bore station moved to the bearing's mid-plane (an
+        // aligned journal is then the planar joint, whose contact sits there), or at the face.
+        let m = match governing {
+            _ if load > 0.0 => effective_mass(rb1, rb2, load_point / load, state.normal),
+            Place::Bore { s, .. } => effective_mass(
+                rb1,
+                rb2,
+                state.contact_point - s * pose.bearing_axis,
+                state.normal,
+            ),
+            Place::Face { .. } => m_station,
+        };
+        parts.report = report;
+        parts.flight_rate = flight_rate;
+        parts.elastic_energy = energy;
+
+        // The joint's own history follows the deepest station: its gap is the joint's gap.
+        let previous = self.prepared_report().then_some(self.report.state);
+        let onset = self.contact.advance(
+            previous.as_ref(),
+            &state,
+            self.min_impact_speed,
+            self.min_separation,
+        );
+        let mode = match (self.contact.in_contact, self.contact.compressing) {
+            (false, _) => ContactMode::FreeFlight,
+            (true, true) => ContactMode::Impact,
+            (true, false) => ContactMode::Continuous,
+        };
+        let (max_stable_dt, omega, zeta) = if lin.stiffness > 0.0 || lin.damping > 0.0 {
+            let (dt, omega, zeta) = stable_step(lin.stiffness, lin.damping, m);
+            (dt.min(lin.single), omega, zeta)
+        } else {
+            (f64::INFINITY, 0.0, 0.0)
+        };
+        let friction_stable_dt = if lin.friction > 0.0 {
+            let t = friction_direction(&state, pose.bearing_axis);
+            let inv_m = inverse_mass_along(rb1, state.contact_point, t)
+                + inverse_mass_along(rb2, state.contact_point, t);
+            (2.0 / (inv_m * lin.friction)).min(lin.friction_single)
+        } else {
+            f64::INFINITY
+        };
+        if self.prepared_report() {
+            self.previous_rate = Some(self.report.state.penetration_rate);
+        }
+        self.report = ClearanceReport {
+            state,
+            mode,
+            onset: onset.onset,
+            impact: onset.impact,
+            impact_rate,
+            approach_speed: onset.approach_speed,
+            onset_fraction: onset.fraction,
+            force: ForcePair {
+                on_journal: force,
+                point: state.contact_point,
+                normal_force: normal_sum.length(),
+                friction_force: friction_sum.length(),
+            },
+            max_stable_dt,
+            friction_stable_dt,
+            omega,
+            zeta,
+            effective_mass: m,
+            spatial: Some(report),
+        };
+        let w1 = Wrench {
+            body: self.body1,
+            force: -force,
+            torque: torque1,
+        };
+        let w2 = Wrench {
+            body: self.body2,
+            force,
+            torque: torque2,
+        };
+        Some((w1, w2))
+    }
+}
+
+/// `delta_dot0` for a station's law in its current contact (as
+/// [`ClearanceJoint::law_impact_rate`] for the planar joint).
+fn station_impact_rate(
+    contact: &ContactHistory,
+    law: &impl NormalForceLaw,
+    depth: f64,
+    effective_mass: f64,
+) -> f64 {
+    if contact.in_contact && law.uses_impact_rate() {
+        contact.impact_rate.max(loaded_impact_rate(
+            law.elastic_energy(depth),
+            effective_mass,
+        ))
+    } else {
+        contact.impact_rate
+    }
+}
+
+/// The slip direction, or a tangent when the station does not slip.
+fn friction_direction(state: &JournalState, axis: Vector) -> Vector {
+    let v = state.slip.length();
+    if v > 0.0 {
+        state.slip / v
+    } else {
+        let t = state.normal.cross(axis);
+        let len = t.length();
+        if len > 1e-9 {
+            t / len
+        } else {
+            state.normal.any_orthonormal_vector()
+        }
+    }
+}
+
+/// Adds one station in contact to the linearised sums (stiffness, damping, friction slope) and
+/// to the single-station limits.
+#[allow(clippy::too_many_arguments)]
+fn linearise(
+    lin: &mut Linearised,
+    law: &impl NormalForceLaw,
+    state: &JournalState,
+    impact_rate: f64,
+    m: f64,
+    pair: &ForcePair,
+    friction: &impl crate::model::laws::FrictionLaw,
+    rb1: &RigidBody,
+    rb2: &RigidBody,
+) {
+    let c = NormalContact {
+        penetration: state.penetration,
+        penetration_rate: state.penetration_rate,
+        impact_rate,
+    };
+    // dF/d delta = K_tangent + (dD/d delta) delta_dot (as the planar joint).
+    let k =
+        law.tangent_stiffness(state.penetration) + law.damping_slope(&c) * state.penetration_rate;
+    let d = law.damping_coefficient(&c);
+    lin.stiffness += k;
+    lin.damping += d;
+    lin.single = lin.single.min(stable_step(k, d, m).0);
+    let v = state.slip.length();
+    let slope = friction_slope(friction, v);
+    if slope > 0.0 {
+        let t = friction_direction(state, state.normal.any_orthonormal_vector());
+        let inv_m = inverse_mass_along(rb1, state.contact_point, t)
+            + inverse_mass_along(rb2, state.contact_point, t);
+        lin.friction += pair.normal_force * slope;
+        lin.friction_single = lin
+            .friction_single
+            .min(2.0 / (inv_m * pair.normal_force * slope));
+    }
+}

@@ -23,8 +23,8 @@ use rapier3d_f64::prelude::{
     GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, IntegrationParameters, JointAxesMask,
     RigidBody, RigidBodyHandle, RigidBodySet,
 };
-pub use spatial::SpatialReport;
 use spatial::{SpatialMemory, SpatialParts};
+pub use spatial::{SpatialReport, SpatialStation, StationPlace};
 
 /// What holds the degrees of freedom the contact law does not (axial translation and the two tilts).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]

@@ -33,18 +33,44 @@ pub struct SpatialReport {
     pub governed_by_face: bool,
 }
 
-/// Where a station sits.
+/// Where a station of a spatial joint sits ([`SpatialStation::place`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
-enum Place {
-    /// A bore station at `s` (m from the bearing's centre) carrying `share` of the bore law;
-    /// `edge` 0 or 1 for the end stations.
+pub enum StationPlace {
+    /// A bore station in the bearing's plane at `s` (m from the bearing's centre along the
+    /// bore's axis) carrying `share` of the bore law (the trapezoidal weight of its slice);
+    /// `edge` 0 or 1 for the end stations at `-L/2` and `+L/2`, `None` inside.
     Bore {
+        /// Axial position of the station's plane from the bearing's centre, m.
         s: f64,
+        /// Share of the bore law the station carries (the shares add up to 1).
         share: f64,
+        /// Which edge of the bore the station is (`None`: an inner station).
         edge: Option<usize>,
     },
-    /// Point `index` of a shoulder ring against `face`.
-    Face { face: Face, index: usize },
+    /// Point `index` (0 to [`FACE_POINTS`] - 1) of a shoulder ring against `face`.
+    Face {
+        /// The bearing face the ring meets.
+        face: Face,
+        /// The point on the ring.
+        index: usize,
+    },
+}
+
+use StationPlace as Place;
+
+/// One station of a spatial joint at the joint's last application
+/// ([`ClearanceJoint::spatial_stations`]): the pressure distribution along the width is the bore
+/// stations' `normal_force / share` against `s`, as a force per unit fraction of the width.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpatialStation {
+    /// Where the station sits.
+    pub place: StationPlace,
+    /// The station's contact state (penetration, normal, rates, contact point), world frame.
+    pub state: JournalState,
+    /// Normal force the station applies, N (0 out of contact).
+    pub normal_force: f64,
+    /// Friction force the station applies, N.
+    pub friction_force: f64,
 }
 
 /// One station's memory between steps.
@@ -53,6 +79,8 @@ pub(super) struct Station {
     place: Place,
     contact: ContactHistory,
     state: Option<JournalState>,
+    /// Normal and friction force at the last application, N.
+    force: [f64; 2],
 }
 
 /// The spatial parts of a joint: model, face law, the bearing's transverse axis, stations.
@@ -95,6 +123,7 @@ impl SpatialParts {
                 },
                 contact: ContactHistory::default(),
                 state: None,
+                force: [0.0; 2],
             })
             .collect();
         for face in Face::BOTH {
@@ -102,6 +131,7 @@ impl SpatialParts {
                 place: Place::Face { face, index },
                 contact: ContactHistory::default(),
                 state: None,
+                force: [0.0; 2],
             }));
         }
         SpatialParts {
@@ -142,6 +172,7 @@ impl SpatialParts {
         for st in &mut self.stations {
             st.contact = ContactHistory::default();
             st.state = None;
+            st.force = [0.0; 2];
         }
         self.report = SpatialReport::default();
         self.flight_rate = 0.0;
@@ -159,6 +190,26 @@ impl SpatialParts {
     }
 }
 
+impl ClearanceJoint {
+    /// A spatial joint's stations at its last application, bore stations first (from `-L/2` to
+    /// `+L/2`), then the lower face's ring points, then the upper's; empty for a planar joint or
+    /// before the first application. The bore stations' forces are the pressure distribution
+    /// along the bearing's width (edge loading, a load off-centre along the width).
+    pub fn spatial_stations(&self) -> impl Iterator<Item = SpatialStation> + '_ {
+        self.spatial
+            .iter()
+            .flat_map(|parts| parts.stations.iter())
+            .filter_map(|st| {
+                st.state.map(|state| SpatialStation {
+                    place: st.place,
+                    state,
+                    normal_force: st.force[0],
+                    friction_force: st.force[1],
+                })
+            })
+    }
+}
+
 /// Linearised contact sums over the stations in contact, for the step limits.
 #[derive(Default)]
 struct Linearised {
@@ -166,8 +217,13 @@ struct Linearised {
     damping: f64,
     /// Smallest stable step of a single station, s.
     single: f64,
-    /// `sum F_N dmu/dv` over the stations (the tangential dampers in parallel), N s/m.
+    /// `sum F_N dmu/dv` over the stations (the tangential dampers along the slip in
+    /// parallel), N s/m.
     friction: f64,
+    /// `sum F_N mu/v` over the stations: friction's damping across the slip (`F_N dmu/dv` at
+    /// zero slip), N s/m. The planar joint has no such direction (its lock holds the axial
+    /// slip); here it is the journal's axial sliding, often the lightest tangential direction.
+    friction_cross: f64,
     /// Smallest friction limit of a single station, s.
     friction_single: f64,
 }
@@ -237,11 +293,23 @@ impl ClearanceJoint {
             );
             st.state = Some(state);
             let m = effective_mass(rb1, rb2, state.contact_point, state.normal);
-            let impact_rate = station_impact_rate(&st.contact, &law, state.penetration, m);
+            // The whole contact's effective mass were it to act at this station: on the
+            // bearing's mid-plane for a bore station (where the planar joint's contact sits),
+            // on the axis for a shoulder point (an axial knock's).
+            let centre = match st.place {
+                Place::Bore { s, .. } => state.contact_point - s * pose.bearing_axis,
+                Place::Face { .. } => {
+                    let r = state.contact_point - pose.bearing_center;
+                    pose.bearing_center + r.dot(pose.bearing_axis) * pose.bearing_axis
+                }
+            };
+            let m_whole = effective_mass(rb1, rb2, centre, state.normal);
+            let impact_rate = station_impact_rate(&st.contact, &law, state.penetration, m_whole);
             let pair = contact_force(&state, impact_rate, &law, &self.friction_law);
             if deepest.is_none_or(|d| state.penetration > d.1.penetration) {
-                deepest = Some((i, state, m, impact_rate));
+                deepest = Some((i, state, m_whole, impact_rate));
             }
+            st.force = [pair.normal_force.max(0.0), pair.friction_force];
             if pair.normal_force <= 0.0 {
                 continue;
             }
@@ -271,21 +339,16 @@ impl ClearanceJoint {
                 rb2,
             );
         }
-        let (index, state, m_station, impact_rate) = deepest?;
+        let (index, state, m_whole, impact_rate) = deepest?;
         let governing = parts.stations[index].place;
         report.governed_by_face = matches!(governing, Place::Face { .. });
         // The joint's effective mass along the deepest station's normal: at the load's centre
-        // in contact; in flight at the deepest bore station moved to the bearing's mid-plane (an
-        // aligned journal is then the planar joint, whose contact sits there), or at the face.
-        let m = match governing {
-            _ if load > 0.0 => effective_mass(rb1, rb2, load_point / load, state.normal),
-            Place::Bore { s, .. } => effective_mass(
-                rb1,
-                rb2,
-                state.contact_point - s * pose.bearing_axis,
-                state.normal,
-            ),
-            Place::Face { .. } => m_station,
+        // in contact; in flight the deepest station's whole-contact mass (an aligned journal is
+        // then the planar joint, whose contact sits on the mid-plane).
+        let m = if load > 0.0 {
+            effective_mass(rb1, rb2, load_point / load, state.normal)
+        } else {
+            m_whole
         };
         parts.report = report;
         parts.flight_rate = flight_rate;
@@ -310,11 +373,16 @@ impl ClearanceJoint {
         } else {
             (f64::INFINITY, 0.0, 0.0)
         };
-        let friction_stable_dt = if lin.friction > 0.0 {
+        let friction_stable_dt = if lin.friction > 0.0 || lin.friction_cross > 0.0 {
+            // The tangential dampers act in parallel at the load's centre (as the normal's
+            // effective mass above; the planar joint's point when the journal is aligned),
+            // along the slip and across it.
             let t = friction_direction(&state, pose.bearing_axis);
-            let inv_m = inverse_mass_along(rb1, state.contact_point, t)
-                + inverse_mass_along(rb2, state.contact_point, t);
-            (2.0 / (inv_m * lin.friction)).min(lin.friction_single)
+            let centre = load_point / load;
+            let inv_m = |t| inverse_mass_along(rb1, centre, t) + inverse_mass_along(rb2, centre, t);
+            let along = 2.0 / (inv_m(t) * lin.friction);
+            let across = 2.0 / (inv_m(state.normal.cross(t)) * lin.friction_cross);
+            along.min(across).min(lin.friction_single)
         } else {
             f64::INFINITY
         };
@@ -357,16 +425,19 @@ impl ClearanceJoint {
 }
 
 /// `delta_dot0` for a station's law in its current contact (as
-/// [`ClearanceJoint::law_impact_rate`] for the planar joint).
+/// [`ClearanceJoint::law_impact_rate`] for the planar joint): a loaded contact's rate is the
+/// speed of a free impact of the whole contact (the whole law, `effective_mass` the whole
+/// contact's) reaching the station's depth. The station's share of the energy over its share
+/// of the mass is the same ratio; the planar joint's when the journal is aligned.
 fn station_impact_rate(
     contact: &ContactHistory,
-    law: &impl NormalForceLaw,
+    law: &Share<'_, NormalModel>,
     depth: f64,
     effective_mass: f64,
 ) -> f64 {
     if contact.in_contact && law.uses_impact_rate() {
         contact.impact_rate.max(loaded_impact_rate(
-            law.elastic_energy(depth),
+            law.law.elastic_energy(depth),
             effective_mass,
         ))
     } else {
@@ -416,15 +487,32 @@ fn linearise(
     lin.stiffness += k;
     lin.damping += d;
     lin.single = lin.single.min(stable_step(k, d, m).0);
+    // Friction `mu(v) F_N v/|v|` linearised: `F_N dmu/dv` along the slip, `F_N mu/v` across
+    // it (both `F_N dmu/dv(0)` at zero slip). Past the static peak `dmu/dv < 0` and only the
+    // cross term damps; it is what the explicit step must resolve (Bai's law just past `v_s`:
+    // `mu_s/v_s`, 3000 s/m dry).
     let v = state.slip.length();
     let slope = friction_slope(friction, v);
+    let cross = if v > 0.0 {
+        friction.coefficient(v) / v
+    } else {
+        slope
+    };
+    let t = friction_direction(state, state.normal.any_orthonormal_vector());
+    let inv_m = |t| {
+        inverse_mass_along(rb1, state.contact_point, t)
+            + inverse_mass_along(rb2, state.contact_point, t)
+    };
     if slope > 0.0 {
-        let t = friction_direction(state, state.normal.any_orthonormal_vector());
-        let inv_m = inverse_mass_along(rb1, state.contact_point, t)
-            + inverse_mass_along(rb2, state.contact_point, t);
         lin.friction += pair.normal_force * slope;
         lin.friction_single = lin
             .friction_single
-            .min(2.0 / (inv_m * pair.normal_force * slope));
+            .min(2.0 / (inv_m(t) * pair.normal_force * slope));
+    }
+    if cross > 0.0 {
+        lin.friction_cross += pair.normal_force * cross;
+        lin.friction_single = lin
+            .friction_single
+            .min(2.0 / (inv_m(state.normal.cross(t)) * pair.normal_force * cross));
     }
 }

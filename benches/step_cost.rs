@@ -1,10 +1,15 @@
 //! Cost of one step: ideal twin vs clearance twin, and the two ways of holding the out-of-plane
 //! degrees of freedom (a relative GenericJoint vs per-body LockedAxes). `cargo bench --bench step_cost`.
 //! Medians of 5 runs of the paper's 5-s scene at dt = 1e-4 s; ratios are measured in one run.
+//! Then the spatial joint against the planar one on a plain-API arm (`cargo bench --bench
+//! step_cost -- spatial` runs that part alone).
 
+use clearance_joint::model::laws::{Bai, FrictionModel};
+use clearance_joint::model::spatial::{DEFAULT_SLICES, SpatialModel};
+use clearance_joint::prelude::*;
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::runner::{RunOptions, Simulation, Twins};
-use rapier3d_f64::prelude::LockedAxes;
+use rapier3d_f64::prelude::{LockedAxes, MassProperties, PhysicsWorld, RigidBodyBuilder};
 use std::time::Instant;
 
 fn median_us_per_step(mut make: impl FnMut() -> Simulation) -> f64 {
@@ -20,7 +25,93 @@ fn median_us_per_step(mut make: impl FnMut() -> Simulation) -> f64 {
     samples[2]
 }
 
+/// A 2 kg arm 0.3 m from a fixed base on a steel pin (radius 10 mm, clearance 0.2 mm, width
+/// 16 mm, dry friction), released horizontal, its centre of mass `offset` m off the hinge's
+/// mid-plane along the axis; `model` None is the planar joint with its default lock.
+fn arm(model: Option<SpatialModel>, offset: f64, dt: f64) -> ClearanceWorld {
+    let mut rapier = PhysicsWorld::new();
+    rapier.gravity = Vector::new(0.0, -9.81, 0.0);
+    rapier.integration_parameters.num_solver_iterations = 1;
+    let mut world = ClearanceWorld::new(rapier, StepControl::fixed(dt));
+    let base = world.rapier.bodies.insert(RigidBodyBuilder::fixed());
+    let arm = world.rapier.bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(Vector::new(0.3, 0.0, offset))
+            .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02)))
+            .can_sleep(false),
+    );
+    let mut clearance = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
+        .unwrap()
+        .friction(FrictionModel::Bai(Bai::DRY));
+    if let Some(model) = model {
+        clearance = clearance.model(ClearanceModel::Spatial(model));
+    }
+    let pin = clearance
+        .joint(
+            Vector::ZERO,
+            Vector::new(-0.3, 0.0, -offset),
+            Vector::Z,
+            Vector::Z,
+        )
+        .unwrap();
+    world.insert_clearance(base, arm, pin);
+    world
+}
+
+/// Median us per step of 5 runs of the arm over 0.25 s at a fixed 5e-6 s (the tilted arm's
+/// edge contact, heavily damped, needs less than 1e-5 s).
+fn arm_us_per_step(model: Option<SpatialModel>, offset: f64) -> f64 {
+    let (dt, until) = (5e-6, 0.25);
+    let mut samples: Vec<f64> = (0..5)
+        .map(|_| {
+            let mut world = arm(model, offset, dt);
+            let start = Instant::now();
+            let steps = world.step_to(until).expect("stable run");
+            start.elapsed().as_secs_f64() / steps as f64 * 1e6
+        })
+        .collect();
+    samples.sort_by(f64::total_cmp);
+    samples[2]
+}
+
+fn spatial_cost() {
+    let steel = |slices| Some(SpatialModel::steel(1e-3, 0.015).slices(slices));
+    let planar = arm_us_per_step(None, 0.0);
+    println!();
+    println!("| arm on one pin (dt = 5e-6 s, 50,000 steps) | us/step | ratio to planar |");
+    println!("|---|---|---|");
+    for (name, model, offset) in [
+        ("planar joint (hook + GenericJoint lock)", None, 0.0),
+        (
+            "spatial, N = 8 (default), aligned load",
+            steel(DEFAULT_SLICES),
+            0.0,
+        ),
+        (
+            "spatial, N = 8 (default), CoM 50 mm off the mid-plane",
+            steel(DEFAULT_SLICES),
+            0.05,
+        ),
+        (
+            "spatial, N = 32, CoM 50 mm off the mid-plane",
+            steel(32),
+            0.05,
+        ),
+    ] {
+        let us = if model.is_none() {
+            planar
+        } else {
+            arm_us_per_step(model, offset)
+        };
+        println!("| {name} | {us:.2} | {:.2} |", us / planar);
+    }
+}
+
 fn main() {
+    if std::env::args().skip(1).any(|a| a == "spatial") {
+        spatial_cost();
+        return;
+    }
     // Fixed steps: the cost of one step, not of a step count that varies.
     let scene = Scene::solar_panel()
         .with_overrides(&["run.step=Fixed"])
@@ -64,4 +155,5 @@ fn main() {
     ] {
         println!("| {name} | {us:.2} | {:.2} |", us / ideal);
     }
+    spatial_cost();
 }

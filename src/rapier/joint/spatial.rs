@@ -8,7 +8,8 @@ use crate::model::laws::{NormalContact, NormalForceLaw, NormalModel, loaded_impa
 use crate::model::spatial::{
     FACE_POINTS, Face, Share, SpatialModel, SpatialPose, bore_station, face_station,
 };
-use crate::rapier::ledger::{Wrench, inverse_mass_along};
+use crate::rapier::ledger::{Wrench, world_center_of_mass};
+use rapier3d_f64::math::AngularInertia;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{RigidBody, RigidBodySet};
 
@@ -228,8 +229,46 @@ struct Linearised {
     friction_single: f64,
 }
 
-fn effective_mass(rb1: &RigidBody, rb2: &RigidBody, point: Vector, n: Vector) -> f64 {
-    1.0 / (inverse_mass_along(rb1, point, n) + inverse_mass_along(rb2, point, n))
+/// A body's inverse mass and world inverse inertia, evaluated once per application (the
+/// stations ask for them dozens of times): `inverse_mass_along` as the ledger's, to the bit.
+struct Mobility {
+    inv_mass: f64,
+    inv_inertia: AngularInertia,
+    center_of_mass: Vector,
+}
+
+impl Mobility {
+    /// `None` for a body that does not move under forces (fixed, kinematic).
+    fn of(rb: &RigidBody) -> Option<Self> {
+        rb.is_dynamic().then(|| {
+            let mp = &rb.mass_properties().local_mprops;
+            Mobility {
+                inv_mass: mp.inv_mass,
+                inv_inertia: mp.world_inv_inertia(rb.rotation()),
+                center_of_mass: world_center_of_mass(rb),
+            }
+        })
+    }
+}
+
+/// The two bodies' mobilities.
+struct Pair([Option<Mobility>; 2]);
+
+impl Pair {
+    /// `1/m` of the pair along `n` at `point` (as `ledger::inverse_mass_along` summed).
+    fn inverse_mass(&self, point: Vector, n: Vector) -> f64 {
+        let along = |b: &Option<Mobility>| {
+            b.as_ref().map_or(0.0, |b| {
+                let rn = (point - b.center_of_mass).cross(n);
+                b.inv_mass + rn.dot(b.inv_inertia * rn)
+            })
+        };
+        along(&self.0[0]) + along(&self.0[1])
+    }
+
+    fn effective_mass(&self, point: Vector, n: Vector) -> f64 {
+        1.0 / self.inverse_mass(point, n)
+    }
 }
 
 impl ClearanceJoint {
@@ -237,6 +276,7 @@ impl ClearanceJoint {
     pub(super) fn evaluate_spatial(&mut self, bodies: &RigidBodySet) -> Option<(Wrench, Wrench)> {
         let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
         let (m1, m2) = (motion(rb1), motion(rb2));
+        let bodies = Pair([Mobility::of(rb1), Mobility::of(rb2)]);
         let parts = self.spatial.as_mut()?;
         let rot1 = *rb1.rotation();
         let pose = SpatialPose {
@@ -266,8 +306,8 @@ impl ClearanceJoint {
         // Where the stations' normal forces act on average (weighted by force), for the joint's
         // effective mass: the stations act in parallel on the same two bodies.
         let (mut load_point, mut load) = (Vector::ZERO, 0.0);
-        // The deepest station: (index, state, effective mass, impact rate).
-        let mut deepest: Option<(usize, JournalState, f64, f64)> = None;
+        // The deepest station: (index, state, impact rate).
+        let mut deepest: Option<(usize, JournalState, f64)> = None;
         for (i, st) in parts.stations.iter_mut().enumerate() {
             let (state, law, share, gap_scale) = match st.place {
                 Place::Bore { s, share, .. } => (
@@ -292,22 +332,12 @@ impl ClearanceJoint {
                 self.min_separation,
             );
             st.state = Some(state);
-            let m = effective_mass(rb1, rb2, state.contact_point, state.normal);
-            // The whole contact's effective mass were it to act at this station: on the
-            // bearing's mid-plane for a bore station (where the planar joint's contact sits),
-            // on the axis for a shoulder point (an axial knock's).
-            let centre = match st.place {
-                Place::Bore { s, .. } => state.contact_point - s * pose.bearing_axis,
-                Place::Face { .. } => {
-                    let r = state.contact_point - pose.bearing_center;
-                    pose.bearing_center + r.dot(pose.bearing_axis) * pose.bearing_axis
-                }
-            };
-            let m_whole = effective_mass(rb1, rb2, centre, state.normal);
-            let impact_rate = station_impact_rate(&st.contact, &law, state.penetration, m_whole);
+            let impact_rate = station_impact_rate(&st.contact, &law, state.penetration, || {
+                bodies.effective_mass(whole_centre(&pose, st.place, &state), state.normal)
+            });
             let pair = contact_force(&state, impact_rate, &law, &self.friction_law);
             if deepest.is_none_or(|d| state.penetration > d.1.penetration) {
-                deepest = Some((i, state, m_whole, impact_rate));
+                deepest = Some((i, state, impact_rate));
             }
             st.force = [pair.normal_force.max(0.0), pair.friction_force];
             if pair.normal_force <= 0.0 {
@@ -332,23 +362,21 @@ impl ClearanceJoint {
                 &law,
                 &state,
                 impact_rate,
-                m,
                 &pair,
                 &self.friction_law,
-                rb1,
-                rb2,
+                &bodies,
             );
         }
-        let (index, state, m_whole, impact_rate) = deepest?;
+        let (index, state, impact_rate) = deepest?;
         let governing = parts.stations[index].place;
         report.governed_by_face = matches!(governing, Place::Face { .. });
         // The joint's effective mass along the deepest station's normal: at the load's centre
         // in contact; in flight the deepest station's whole-contact mass (an aligned journal is
         // then the planar joint, whose contact sits on the mid-plane).
         let m = if load > 0.0 {
-            effective_mass(rb1, rb2, load_point / load, state.normal)
+            bodies.effective_mass(load_point / load, state.normal)
         } else {
-            m_whole
+            bodies.effective_mass(whole_centre(&pose, governing, &state), state.normal)
         };
         parts.report = report;
         parts.flight_rate = flight_rate;
@@ -379,9 +407,9 @@ impl ClearanceJoint {
             // along the slip and across it.
             let t = friction_direction(&state, pose.bearing_axis);
             let centre = load_point / load;
-            let inv_m = |t| inverse_mass_along(rb1, centre, t) + inverse_mass_along(rb2, centre, t);
-            let along = 2.0 / (inv_m(t) * lin.friction);
-            let across = 2.0 / (inv_m(state.normal.cross(t)) * lin.friction_cross);
+            let along = 2.0 / (bodies.inverse_mass(centre, t) * lin.friction);
+            let across =
+                2.0 / (bodies.inverse_mass(centre, state.normal.cross(t)) * lin.friction_cross);
             along.min(across).min(lin.friction_single)
         } else {
             f64::INFINITY
@@ -424,6 +452,19 @@ impl ClearanceJoint {
     }
 }
 
+/// The point where the whole contact would act were it at this station: on the bearing's
+/// mid-plane for a bore station (where the planar joint's contact sits), on the axis for a
+/// shoulder point (an axial knock's). Its effective mass is the whole contact's.
+fn whole_centre(pose: &SpatialPose, place: Place, state: &JournalState) -> Vector {
+    match place {
+        Place::Bore { s, .. } => state.contact_point - s * pose.bearing_axis,
+        Place::Face { .. } => {
+            let r = state.contact_point - pose.bearing_center;
+            pose.bearing_center + r.dot(pose.bearing_axis) * pose.bearing_axis
+        }
+    }
+}
+
 /// `delta_dot0` for a station's law in its current contact (as
 /// [`ClearanceJoint::law_impact_rate`] for the planar joint): a loaded contact's rate is the
 /// speed of a free impact of the whole contact (the whole law, `effective_mass` the whole
@@ -433,12 +474,12 @@ fn station_impact_rate(
     contact: &ContactHistory,
     law: &Share<'_, NormalModel>,
     depth: f64,
-    effective_mass: f64,
+    effective_mass: impl FnOnce() -> f64,
 ) -> f64 {
     if contact.in_contact && law.uses_impact_rate() {
         contact.impact_rate.max(loaded_impact_rate(
             law.law.elastic_energy(depth),
-            effective_mass,
+            effective_mass(),
         ))
     } else {
         contact.impact_rate
@@ -463,18 +504,16 @@ fn friction_direction(state: &JournalState, axis: Vector) -> Vector {
 
 /// Adds one station in contact to the linearised sums (stiffness, damping, friction slope) and
 /// to the single-station limits.
-#[allow(clippy::too_many_arguments)]
 fn linearise(
     lin: &mut Linearised,
     law: &impl NormalForceLaw,
     state: &JournalState,
     impact_rate: f64,
-    m: f64,
     pair: &ForcePair,
     friction: &impl crate::model::laws::FrictionLaw,
-    rb1: &RigidBody,
-    rb2: &RigidBody,
+    bodies: &Pair,
 ) {
+    let m = bodies.effective_mass(state.contact_point, state.normal);
     let c = NormalContact {
         penetration: state.penetration,
         penetration_rate: state.penetration_rate,
@@ -499,10 +538,7 @@ fn linearise(
         slope
     };
     let t = friction_direction(state, state.normal.any_orthonormal_vector());
-    let inv_m = |t| {
-        inverse_mass_along(rb1, state.contact_point, t)
-            + inverse_mass_along(rb2, state.contact_point, t)
-    };
+    let inv_m = |t| bodies.inverse_mass(state.contact_point, t);
     if slope > 0.0 {
         lin.friction += pair.normal_force * slope;
         lin.friction_single = lin

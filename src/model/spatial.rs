@@ -37,9 +37,14 @@ use rapier3d_f64::math::Vector;
 /// Stations on each shoulder's ring.
 pub const FACE_POINTS: usize = 8;
 
-/// Default number of slices across the bearing's width (9 stations): measured in
-/// `tests/spatial.rs` (the edge forces under a moment do not depend on it; a load off-centre
-/// along the width converges as `1/N^2`).
+/// Default number of slices across the bearing's width (9 stations), measured in
+/// `tests/spatial.rs`: the edge forces under a pure moment do not depend on it (M/L); a load
+/// off-centre along the width follows Winkler's line within `2/N^2` of its slope (2.3 % of the
+/// load at the edges for N = 8); on an arm whose weight hangs 50 mm off the hinge's mid-plane
+/// (the journal tilts and loads its edges) N = 8 gives the peak tilt within 0.5 % of N = 128
+/// and the first impact's peak to all digits, the edge pressure within 5 % (N = 32: 0.1 % and
+/// 1.8 %; `cargo test --release --test spatial -- --ignored --nocapture slice_count_table`).
+/// The step count hardly depends on N; the cost per step grows with the stations.
 pub const DEFAULT_SLICES: u32 = 8;
 
 /// Upper bound on the slices (each is a contact evaluated every step).
@@ -346,7 +351,9 @@ pub fn face_station(
 pub struct Share<'a, L> {
     /// The whole law.
     pub law: &'a L,
-    /// The fraction of it this station carries, in (0, 1].
+    /// The fraction of it this station carries, in (0, 1]; for the step control's view of a
+    /// whole contact, the stations' summed stiffness over the law's (above 1 when bore and
+    /// faces press together).
     pub share: f64,
 }
 

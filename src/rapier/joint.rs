@@ -588,10 +588,30 @@ impl ClearanceJoint {
     /// The step that resolves a contact entered at `approach_speed` (m/s) and now `depth` deep
     /// (m) to `tolerance` of its natural period, taken at the deepest point the contact can reach
     /// (its elastic energy plus the kinetic energy of the approach), and within the damped
-    /// stability limit there.
+    /// stability limit there. A spatial joint's contact carries the governing law's
+    /// [`contact_share`](spatial::SpatialParts::contact_share): a tilted journal pressed at
+    /// its edge is as stiff as the few stations that touch, not the whole width.
     fn contact_step(&self, approach_speed: f64, depth: f64, tolerance: f64) -> f64 {
-        let m = self.report.effective_mass;
         let law = self.governing_law();
+        match self.spatial.as_ref().map(|p| p.contact_share()) {
+            Some(share) if share != 1.0 => self.contact_step_of(
+                &crate::model::spatial::Share { law, share },
+                approach_speed,
+                depth,
+                tolerance,
+            ),
+            _ => self.contact_step_of(law, approach_speed, depth, tolerance),
+        }
+    }
+
+    fn contact_step_of(
+        &self,
+        law: &impl NormalForceLaw,
+        approach_speed: f64,
+        depth: f64,
+        tolerance: f64,
+    ) -> f64 {
+        let m = self.report.effective_mass;
         let energy = 0.5 * m * approach_speed * approach_speed + law.elastic_energy(depth);
         let peak = crate::model::laws::penetration_for_energy(law, energy, 1e-6).max(depth);
         let stiffness = law.tangent_stiffness(peak);

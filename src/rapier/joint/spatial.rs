@@ -97,10 +97,13 @@ pub(super) struct SpatialParts {
     flight_rate: f64,
     /// Elastic energy of all stations at the last application, J.
     pub(super) elastic_energy: f64,
+    /// The stations' summed contact stiffness over the governing law's whole stiffness at the
+    /// deepest station's depth (1 in flight).
+    contact_share: f64,
 }
 
 /// The stations' memory, saved before a step that may be rejected.
-pub(super) type SpatialMemory = (Vec<Station>, SpatialReport, f64, f64);
+pub(super) type SpatialMemory = (Vec<Station>, SpatialReport, f64, f64, f64);
 
 impl SpatialParts {
     pub(super) fn new(
@@ -143,6 +146,7 @@ impl SpatialParts {
             report: SpatialReport::default(),
             flight_rate: 0.0,
             elastic_energy: 0.0,
+            contact_share: 1.0,
         }
     }
 
@@ -152,6 +156,7 @@ impl SpatialParts {
             self.report,
             self.flight_rate,
             self.elastic_energy,
+            self.contact_share,
         )
     }
 
@@ -160,6 +165,7 @@ impl SpatialParts {
         memory.1 = self.report;
         memory.2 = self.flight_rate;
         memory.3 = self.elastic_energy;
+        memory.4 = self.contact_share;
     }
 
     pub(super) fn restore(&mut self, memory: &SpatialMemory) {
@@ -167,6 +173,7 @@ impl SpatialParts {
         self.report = memory.1;
         self.flight_rate = memory.2;
         self.elastic_energy = memory.3;
+        self.contact_share = memory.4;
     }
 
     pub(super) fn reset(&mut self) {
@@ -178,6 +185,17 @@ impl SpatialParts {
         self.report = SpatialReport::default();
         self.flight_rate = 0.0;
         self.elastic_energy = 0.0;
+        self.contact_share = 1.0;
+    }
+
+    /// The share of the governing law the contact carries, for the contact's step
+    /// ([`ClearanceJoint::adaptive_step`]): the stations' summed tangent stiffness over the
+    /// whole law's at the deepest station's depth. 1 for an aligned journal pressed along the
+    /// whole width (the planar joint's step), `1/(2N)` for a journal touching at one edge, 1 in
+    /// flight (the approaching contact may take the whole width); above 1 when bore and faces
+    /// are loaded together.
+    pub(super) fn contact_share(&self) -> f64 {
+        self.contact_share
     }
 
     /// The free-flight step: no station's path across its gap (the radial clearance for the
@@ -302,7 +320,7 @@ impl ClearanceJoint {
             friction_single: f64::INFINITY,
             ..Linearised::default()
         };
-        let (mut energy, mut flight_rate) = (0.0, 0.0_f64);
+        let (mut energy, mut flight_rate, mut stiffness_sum) = (0.0, 0.0_f64, 0.0);
         // Where the stations' normal forces act on average (weighted by force), for the joint's
         // effective mass: the stations act in parallel on the same two bodies.
         let (mut load_point, mut load) = (Vector::ZERO, 0.0);
@@ -344,6 +362,7 @@ impl ClearanceJoint {
                 continue;
             }
             energy += law.elastic_energy(state.penetration);
+            stiffness_sum += law.tangent_stiffness(state.penetration);
             load_point += pair.normal_force * pair.point;
             load += pair.normal_force;
             report.stations_in_contact += 1;
@@ -381,6 +400,16 @@ impl ClearanceJoint {
         parts.report = report;
         parts.flight_rate = flight_rate;
         parts.elastic_energy = energy;
+        let governing_law = match governing {
+            Place::Bore { .. } => &self.normal_law,
+            Place::Face { .. } => &parts.face_law,
+        };
+        let whole = governing_law.tangent_stiffness(state.penetration);
+        parts.contact_share = if load > 0.0 && whole > 0.0 && stiffness_sum > 0.0 {
+            stiffness_sum / whole
+        } else {
+            1.0
+        };
 
         // The joint's own history follows the deepest station: its gap is the joint's gap.
         let previous = self.prepared_report().then_some(self.report.state);

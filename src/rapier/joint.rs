@@ -502,7 +502,7 @@ impl ClearanceJoint {
     /// spatial joint).
     pub fn elastic_energy(&self) -> f64 {
         match &self.spatial {
-            Some(parts) => parts.elastic_energy,
+            Some(parts) => parts.elastic_energy(&self.normal_law),
             None => self
                 .normal_law
                 .elastic_energy(self.report.state.penetration),

@@ -95,15 +95,13 @@ pub(super) struct SpatialParts {
     pub(super) report: SpatialReport,
     /// Rate of the fastest station's path across its gap, relative to the gap (1/s).
     flight_rate: f64,
-    /// Elastic energy of all stations at the last application, J.
-    pub(super) elastic_energy: f64,
     /// The stations' summed contact stiffness over the governing law's whole stiffness at the
     /// deepest station's depth (1 in flight).
     contact_share: f64,
 }
 
 /// The stations' memory, saved before a step that may be rejected.
-pub(super) type SpatialMemory = (Vec<Station>, SpatialReport, f64, f64, f64);
+pub(super) type SpatialMemory = (Vec<Station>, SpatialReport, f64, f64);
 
 impl SpatialParts {
     pub(super) fn new(
@@ -145,7 +143,6 @@ impl SpatialParts {
             stations,
             report: SpatialReport::default(),
             flight_rate: 0.0,
-            elastic_energy: 0.0,
             contact_share: 1.0,
         }
     }
@@ -155,7 +152,6 @@ impl SpatialParts {
             self.stations.clone(),
             self.report,
             self.flight_rate,
-            self.elastic_energy,
             self.contact_share,
         )
     }
@@ -164,16 +160,14 @@ impl SpatialParts {
         memory.0.clone_from(&self.stations);
         memory.1 = self.report;
         memory.2 = self.flight_rate;
-        memory.3 = self.elastic_energy;
-        memory.4 = self.contact_share;
+        memory.3 = self.contact_share;
     }
 
     pub(super) fn restore(&mut self, memory: &SpatialMemory) {
         self.stations.clone_from(&memory.0);
         self.report = memory.1;
         self.flight_rate = memory.2;
-        self.elastic_energy = memory.3;
-        self.contact_share = memory.4;
+        self.contact_share = memory.3;
     }
 
     pub(super) fn reset(&mut self) {
@@ -184,8 +178,26 @@ impl SpatialParts {
         }
         self.report = SpatialReport::default();
         self.flight_rate = 0.0;
-        self.elastic_energy = 0.0;
         self.contact_share = 1.0;
+    }
+
+    /// Elastic energy of all stations at the last application, J: each station in contact
+    /// carries its share of the bore's law `bore_law` or of the face law. Evaluated on demand
+    /// (a law of Liu's family integrates its force for its energy: too dear for every station at
+    /// every step).
+    pub(super) fn elastic_energy(&self, bore_law: &NormalModel) -> f64 {
+        let mut energy = 0.0;
+        for st in &self.stations {
+            let Some(state) = st.state.filter(|_| st.force[0] > 0.0) else {
+                continue;
+            };
+            let (law, share) = match st.place {
+                Place::Bore { share, .. } => (bore_law, share),
+                Place::Face { .. } => (&self.face_law, 1.0 / FACE_POINTS as f64),
+            };
+            energy += Share { law, share }.elastic_energy(state.penetration);
+        }
+        energy
     }
 
     /// The share of the governing law the contact carries, for the contact's step
@@ -320,7 +332,7 @@ impl ClearanceJoint {
             friction_single: f64::INFINITY,
             ..Linearised::default()
         };
-        let (mut energy, mut flight_rate, mut stiffness_sum) = (0.0, 0.0_f64, 0.0);
+        let (mut flight_rate, mut stiffness_sum) = (0.0_f64, 0.0);
         // Where the stations' normal forces act on average (weighted by force), for the joint's
         // effective mass: the stations act in parallel on the same two bodies.
         let (mut load_point, mut load) = (Vector::ZERO, 0.0);
@@ -361,7 +373,6 @@ impl ClearanceJoint {
             if pair.normal_force <= 0.0 {
                 continue;
             }
-            energy += law.elastic_energy(state.penetration);
             stiffness_sum += law.tangent_stiffness(state.penetration);
             load_point += pair.normal_force * pair.point;
             load += pair.normal_force;
@@ -399,7 +410,6 @@ impl ClearanceJoint {
         };
         parts.report = report;
         parts.flight_rate = flight_rate;
-        parts.elastic_energy = energy;
         let governing_law = match governing {
             Place::Bore { .. } => &self.normal_law,
             Place::Face { .. } => &parts.face_law,

@@ -143,6 +143,17 @@ fn off_centre_load_spreads_as_winkler() {
             })
             .collect();
         assert_eq!(bore.len(), slices as usize + 1);
+        // The joint's elastic energy: each station's share of K delta^2/2.
+        let energy: f64 = j
+            .spatial_stations()
+            .map(|st| match st.place {
+                StationPlace::Bore { share, .. } => {
+                    share * 0.5 * 1e8 * st.state.penetration.powi(2)
+                }
+                StationPlace::Face { .. } => 0.0,
+            })
+            .sum();
+        assert!((j.elastic_energy() - energy).abs() < 1e-12 * energy);
         let second_moment: f64 = bore.iter().map(|(s, w, _)| w * s * s).sum();
         let n2 = (slices * slices) as f64;
         assert!((second_moment - L * L / 12.0 * (1.0 + 2.0 / n2)).abs() < 1e-12 * L * L);

@@ -58,29 +58,19 @@ fn arm(model: Option<SpatialModel>, offset: f64, dt: f64) -> ClearanceWorld {
     world
 }
 
-/// Median us per step of 5 runs of the arm over 0.25 s at a fixed 5e-6 s (the tilted arm's
-/// edge contact, heavily damped, needs less than 1e-5 s).
+/// us per step of one run of the arm over 0.25 s at a fixed 5e-6 s (the tilted arm's edge
+/// contact, heavily damped, needs less than 1e-5 s).
 fn arm_us_per_step(model: Option<SpatialModel>, offset: f64) -> f64 {
     let (dt, until) = (5e-6, 0.25);
-    let mut samples: Vec<f64> = (0..5)
-        .map(|_| {
-            let mut world = arm(model, offset, dt);
-            let start = Instant::now();
-            let steps = world.step_to(until).expect("stable run");
-            start.elapsed().as_secs_f64() / steps as f64 * 1e6
-        })
-        .collect();
-    samples.sort_by(f64::total_cmp);
-    samples[2]
+    let mut world = arm(model, offset, dt);
+    let start = Instant::now();
+    let steps = world.step_to(until).expect("stable run");
+    start.elapsed().as_secs_f64() / steps as f64 * 1e6
 }
 
 fn spatial_cost() {
     let steel = |slices| Some(SpatialModel::steel(1e-3, 0.015).slices(slices));
-    let planar = arm_us_per_step(None, 0.0);
-    println!();
-    println!("| arm on one pin (dt = 5e-6 s, 50,000 steps) | us/step | ratio to planar |");
-    println!("|---|---|---|");
-    for (name, model, offset) in [
+    let cases = [
         ("planar joint (hook + GenericJoint lock)", None, 0.0),
         (
             "spatial, N = 8 (default), aligned load",
@@ -97,13 +87,29 @@ fn spatial_cost() {
             steel(32),
             0.05,
         ),
-    ] {
-        let us = if model.is_none() {
-            planar
-        } else {
-            arm_us_per_step(model, offset)
-        };
-        println!("| {name} | {us:.2} | {:.2} |", us / planar);
+    ];
+    // Interleaved rounds, so a change of the machine's load between cases moves every case
+    // alike; per case the median of 5, and the median of its 5 ratios to the planar run of the
+    // same round.
+    let rounds: Vec<Vec<f64>> = (0..5)
+        .map(|_| {
+            cases
+                .iter()
+                .map(|&(_, model, offset)| arm_us_per_step(model, offset))
+                .collect()
+        })
+        .collect();
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[2]
+    };
+    println!();
+    println!("| arm on one pin (dt = 5e-6 s, 50,000 steps) | us/step | ratio to planar |");
+    println!("|---|---|---|");
+    for (k, (name, _, _)) in cases.iter().enumerate() {
+        let us = median(rounds.iter().map(|r| r[k]).collect());
+        let ratio = median(rounds.iter().map(|r| r[k] / r[0]).collect());
+        println!("| {name} | {us:.2} | {ratio:.2} |");
     }
 }
 

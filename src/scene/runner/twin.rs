@@ -205,30 +205,33 @@ fn spatial_pose(j: &ClearanceJoint, r1: &RigidBody, r2: &RigidBody, u: Vector) -
 
 /// The work a spatial joint's damping and friction dissipated over a step, J: minus the work
 /// of its wrenches over the bodies' motion in the step (force times the centre of mass's
-/// displacement, torque times the rotation vector; the wrenches are constant over the step)
-/// minus the change of its elastic energy. (The planar joint's damping and friction work is
-/// taken from its one contact; a spatial joint's is summed over its stations this way.)
+/// displacement, torque times the rotation vector, the wrenches averaged over the step's two
+/// ends: exact for the elastic part of a linear law, whose work is then minus the change of
+/// its elastic energy) minus the change of its elastic energy. The planar joint's damping and
+/// friction work is taken from its one contact; a spatial joint's stations are summed this way.
 fn spatial_dissipation(
     before: &SpatialSample,
-    elastic_after: f64,
+    after: &ClearanceJoint,
     bodies: [&BodyTrack; 2],
     set: &RigidBodySet,
 ) -> f64 {
-    let Some(wrenches) = before.wrenches else {
+    let (Some(w0), Some(w1)) = (before.wrenches, after.last_wrenches()) else {
         return 0.0;
     };
-    let work: f64 = wrenches
-        .iter()
-        .zip(bodies)
-        .filter(|(_, b)| !b.fixed)
-        .map(|(w, b)| {
-            let rb = &set[b.handle];
+    let work: f64 = (0..2)
+        .filter(|&k| !bodies[k].fixed)
+        .map(|k| {
+            let (b, rb) = (bodies[k], &set[bodies[k].handle]);
             let moved = crate::rapier::ledger::world_center_of_mass(rb) - b.com_before;
             let turned = (*rb.rotation() * b.rotation_before.inverse()).to_scaled_axis();
-            w.force.dot(moved) + w.torque.dot(turned)
+            let (force, torque) = (
+                0.5 * (w0[k].force + w1[k].force),
+                0.5 * (w0[k].torque + w1[k].torque),
+            );
+            force.dot(moved) + torque.dot(turned)
         })
         .sum();
-    -work - (elastic_after - before.elastic_energy)
+    -work - (after.elastic_energy() - before.elastic_energy)
 }
 
 /// What a clearance hinge's hook saw at one state (read before the step it drives).
@@ -385,7 +388,7 @@ impl Twin {
                 if let Some(s) = &h.spatial_sample {
                     self.invariants.dissipated_j += spatial_dissipation(
                         s,
-                        j.elastic_energy(),
+                        j,
                         [&self.bodies[h.bearing], &self.bodies[h.journal]],
                         bodies,
                     );

@@ -641,7 +641,7 @@ mod tests {
             .unwrap();
         scene.run.output_interval_s = 1e-3;
         let spec = scene.hinges[0].clearance.as_ref().unwrap();
-        assert_eq!(spec.model, ClearanceModel::LargeStep);
+        assert_eq!(spec.model, crate::scene::ModelSpec::LargeStep);
         let v = scene.validated().unwrap();
         assert_eq!(v.clearance(0).unwrap().model, ClearanceModel::LargeStep);
         assert_eq!(error_of(&scene, Twins::IdealOnly), None);

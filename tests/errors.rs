@@ -179,6 +179,53 @@ fn invalid_clearance_parameters_name_the_api_parameter() {
     }
 }
 
+/// The spatial model's own values, and a spatial joint asked of the large-step model, are refused
+/// naming the API's field.
+#[test]
+fn invalid_spatial_values_name_the_spatial_field() {
+    use clearance_joint::model::spatial::{FaceLaw, SpatialModel};
+    let joint = |model: SpatialModel| {
+        steel()
+            .model(ClearanceModel::Spatial(model))
+            .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
+            .unwrap_err()
+    };
+    let good = SpatialModel::steel(0.3e-3, 0.015);
+    let cases = [
+        (joint(good.slices(0)), "spatial.slices"),
+        (
+            joint(SpatialModel::steel(0.3e-3, 0.009)),
+            "spatial.collar_radius",
+        ),
+        (
+            joint(SpatialModel::steel(-0.3e-3, 0.015)),
+            "spatial.axial_play",
+        ),
+        (
+            joint(good.face(FaceLaw {
+                stiffness: 1e9,
+                restitution: 1.5,
+            })),
+            "spatial.face.restitution",
+        ),
+        (
+            steel()
+                .model(ClearanceModel::Spatial(good))
+                .large_step_joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
+                .unwrap_err(),
+            "model",
+        ),
+    ];
+    for (e, field) in cases {
+        let m = e.to_string();
+        assert!(
+            matches!(&e, Error::Invalid { field: f, .. } if f == field),
+            "expected `{field}`: {m}"
+        );
+        assert_plain(&m);
+    }
+}
+
 #[test]
 fn rapiers_default_iterations_suggest_the_large_step_model() {
     let (mut world, mut set) = pendulum(steel(), 4);

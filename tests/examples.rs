@@ -7,6 +7,9 @@ use std::path::PathBuf;
 use std::process::Command;
 
 #[allow(dead_code)]
+#[path = "../examples/door_hinge.rs"]
+mod door_hinge;
+#[allow(dead_code)]
 #[path = "../examples/drop_in.rs"]
 mod drop_in;
 #[cfg(feature = "ecs")]
@@ -205,6 +208,47 @@ fn robot_backlash_shows_the_tracking_error_of_the_play() {
     assert!(text.contains("hand off the ideal arm's"), "{text}");
 }
 
+/// The gate on one pin: the planar joint's lock holds the weight's moment, so the panel swings on
+/// freely; the spatial joint tilts until the bore's edges hold the moment (about M/L each, less
+/// what the top face's one-sided contact takes), sags, knocks the face, and its edge friction
+/// stops the swing.
+#[test]
+fn door_hinge_sags_edge_loads_and_knocks_only_in_space() {
+    let runs = door_hinge::run().unwrap();
+    let (planar, spatial) = &runs;
+    assert!(planar.clean && spatial.clean, "{runs:?}");
+    assert_eq!(planar.max_tilt, 0.0);
+    assert_eq!(planar.face_knocks, 0);
+    // Diagonal edge contact: tilt at least 2c/L = 10 mrad.
+    assert!(spatial.max_tilt > 0.0099, "{}", spatial.max_tilt);
+    // Sag of the free edge: 0.4 m x the tilt, plus the 0.15 mm axial drop.
+    assert!(
+        spatial.sag_mm > 4.0 && spatial.sag_mm < 5.0,
+        "{}",
+        spatial.sag_mm
+    );
+    let moment_over_width = door_hinge::MASS * 9.81 * door_hinge::ARM / door_hinge::WIDTH;
+    for f in spatial.late_edge_force {
+        assert!(
+            f > 0.9 * moment_over_width && f < moment_over_width,
+            "{f} against M/L = {moment_over_width}"
+        );
+    }
+    let [a, b] = spatial.late_edge_force;
+    assert!((a - b).abs() < 0.01 * a, "{a} {b}");
+    assert!(
+        spatial.face_knocks >= 1 && spatial.max_face_force > 100.0,
+        "{spatial:?}"
+    );
+    // The edges' friction stops the swing the planar joint lets run on (1 rad/s for 0.6 s: 34 deg).
+    assert!(
+        planar.swing_deg > 30.0 && spatial.swing_deg < 15.0,
+        "{runs:?}"
+    );
+    let text = door_hinge::report(&runs);
+    assert!(text.contains("M/L") && text.contains("spatial"), "{text}");
+}
+
 /// `target/<profile>/examples`, next to this test's `deps` folder.
 fn examples_dir() -> PathBuf {
     let exe = std::env::current_exe().unwrap();
@@ -244,6 +288,8 @@ fn example_binaries_run_headless_and_print_the_comparison() {
     let out = build
         .args([
             "--example",
+            "door_hinge",
+            "--example",
             "drop_in",
             "--example",
             "solar_panel",
@@ -262,6 +308,7 @@ fn example_binaries_run_headless_and_print_the_comparison() {
         String::from_utf8_lossy(&out.stderr)
     );
     for (name, needles) in [
+        ("door_hinge", &["planar", "spatial", "M/L"][..]),
         ("drop_in", &["ideal", "clearance", "elbow impacts"][..]),
         ("ecs", &["ideal", "clearance", "swapped@0.5s"][..]),
         (

@@ -540,6 +540,57 @@ fn hinge_state_carries_the_readouts() {
     assert!(!impulses.is_empty(), "the journal hit the wall");
 }
 
+/// The spatial model through the ECS: the same `ClearanceHinge` with `ClearanceModel::Spatial`
+/// converts the revolute without any lock, and an arm whose centre of mass sits 30 mm along the
+/// axis from the pin's mid-plane tilts the journal until the bore's edges carry its moment.
+#[test]
+fn a_spatial_hinge_tilts_under_a_moment_across_its_axis() {
+    use crate::model::spatial::SpatialModel;
+    let mut world = World::new();
+    let mut physics = Physics::new(1e-5, Vector::new(0.0, -9.81, 0.0));
+    physics
+        .world
+        .rapier
+        .integration_parameters
+        .num_solver_iterations = 1;
+    world.insert_resource(physics);
+    let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
+    let arm = world
+        .spawn(Body::new(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(0.0, -0.3, 0.03))
+                .additional_mass_properties(MassProperties::new(
+                    Vector::ZERO,
+                    2.0,
+                    Vector::splat(0.02),
+                ))
+                .can_sleep(false),
+        ))
+        .id();
+    let spatial = clearance().model(ClearanceModel::Spatial(SpatialModel::steel(0.2e-3, 0.015)));
+    let hinge = world
+        .spawn((
+            Hinge::new(base, arm, Vector::Z).local_anchor2(Vector::new(0.0, 0.3, -0.03)),
+            ClearanceHinge(spatial),
+        ))
+        .id();
+    let mut schedule = physics_schedule();
+    steps(&mut world, &mut schedule, 20_000).unwrap();
+    let p = world.resource::<Physics>();
+    assert_eq!(p.world.rapier.impulse_joints.len(), 0, "nothing locked");
+    let j = p.clearance_joint(hinge).expect("converted");
+    assert!(j.spatial_model().is_some());
+    let r = j.report().spatial.expect("a spatial report");
+    // The weight's moment across the axis, 2 kg x 9.81 x 0.03 m = 0.59 N m, tilts the journal
+    // about x (the arm hangs along -y, its weight offset along z).
+    let tilt = r.tilt[0].hypot(r.tilt[1]);
+    assert!(tilt > 1e-3, "{r:?}");
+    assert!(r.edge_force[0] + r.edge_force[1] > 19.0, "{r:?}");
+    let s = *world.get::<HingeState>(hinge).unwrap();
+    assert_eq!(s.mode, HingeMode::Clearance);
+    assert_eq!(s.penetration, j.report().state.penetration);
+}
+
 #[test]
 fn unchanged_hinges_are_not_reconciled_again_but_changes_are_seen() {
     let (mut world, mut schedule, arm, hinge) = pendulum(1e-5);

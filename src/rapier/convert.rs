@@ -96,6 +96,38 @@ use rapier3d_f64::prelude::{
 /// | [`Compliant`](Self::Compliant) | contact law, force hook outside Rapier's solver | about 1e-5..1e-4 s for steel, `num_solver_iterations = 1` | force histories, peak forces, penetrations |
 /// | [`LargeStep`](Self::LargeStep) | radial limit inside Rapier's solver, Newton restitution, friction moment | any step (1/60 s, 1e-3 s), any iterations | play, rattle, orbit, sustained forces, impulses |
 /// | [`Spatial`](Self::Spatial) | contact laws along the width and on the faces, nothing locked | as `Compliant` | tilt, edge loading, axial knocks, moments across the hinge |
+///
+/// The spatial joint is one line more than the planar one: the journal then tilts and slides
+/// axially, and its report says how far and what each kind of contact carries.
+///
+/// ```
+/// use clearance_joint::model::spatial::SpatialModel;
+/// use clearance_joint::prelude::*;
+/// use rapier3d_f64::prelude::*;
+///
+/// let mut rapier = PhysicsWorld::new();
+/// rapier.gravity = Vector::new(0.0, -9.81, 0.0);
+/// rapier.integration_parameters.num_solver_iterations = 1;
+/// let post = rapier.bodies.insert(RigidBodyBuilder::fixed());
+/// // A 2 kg arm whose centre of mass sits 0.2 m out from a vertical pin: a moment across the axis.
+/// let arm = rapier.bodies.insert(
+///     RigidBodyBuilder::dynamic()
+///         .translation(Vector::new(0.2, 0.0, 0.0))
+///         .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02))),
+/// );
+/// // 0.1 mm of radial play in a 12 mm steel bore 20 mm wide; 0.3 mm of axial play, 10 mm collars.
+/// let pin = Clearance::steel_improved_liu(0.006, 0.1e-3, 0.020)?
+///     .model(ClearanceModel::Spatial(SpatialModel::steel(0.3e-3, 0.010)))
+///     .joint(Vector::ZERO, Vector::new(-0.2, 0.0, 0.0), Vector::Y, Vector::Y)?;
+/// let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.0075));
+/// let hinge = world.insert_clearance(post, arm, pin);
+/// world.step_to(0.05)?;
+/// let report = world.clearance.get(hinge).unwrap().report().spatial.unwrap();
+/// // The journal tilted until the bore's two edges hold the moment (2c/L = 10 mrad of tilt).
+/// assert!(report.tilt[0].hypot(report.tilt[1]) > 0.009);
+/// assert!(report.edge_force[0] > 0.0 && report.edge_force[1] > 0.0);
+/// # Ok::<(), clearance_joint::Error>(())
+/// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 pub enum ClearanceModel {
     /// The compliant contact-law joint ([`ClearanceJoint`] in a [`ClearanceJointSet`]).
@@ -322,6 +354,15 @@ impl Clearance {
         local_axis1: Vector,
         local_axis2: Vector,
     ) -> Result<LargeStepJoint> {
+        if let ClearanceModel::Spatial(_) = self.model {
+            return Err(Error::invalid(
+                "model",
+                "is Spatial, but a large-step joint was asked for: the large-step model is \
+                 planar (Rapier's solver locks its axial motion and tilts). Build the spatial \
+                 joint with `Clearance::joint` into a ClearanceJointSet (or a ClearanceWorld), or \
+                 choose ClearanceModel::LargeStep",
+            ));
+        }
         // The law's restitution is evaluated at the law's clearance: it must be the bearing's.
         self.normal
             .check_clearance("normal", self.geometry.clearance())?;

@@ -482,6 +482,12 @@ impl ClearanceJoint {
     pub fn report(&self) -> &ClearanceReport {
         &self.report
     }
+    /// The force and torque (about each centre of mass) the joint applied at its last
+    /// application: on the bearing's body, then the journal's (`None` before the first, or when
+    /// a body is gone). A spatial joint's sum over its stations.
+    pub fn last_wrenches(&self) -> Option<[Wrench; 2]> {
+        self.last_wrenches
+    }
     /// The deepest penetration at which the contact law is trusted, m
     /// ([`ClearanceJointBuilder::max_valid_penetration`]; default
     /// [`default_max_valid_penetration`]).

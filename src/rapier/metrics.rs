@@ -156,6 +156,36 @@ pub struct HingeMetrics {
     pub max_restitution: f64,
     /// Final relative angle, deg (set by the scene runner; 0 from a bare recorder).
     pub final_angle_deg: f64,
+    /// A spatial joint's tilt, axial travel and forces by contact kind
+    /// ([`ImpactRecorder::record_spatial`]); absent for a planar joint.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub spatial: Option<SpatialMetrics>,
+}
+
+/// What a spatial clearance joint did over the recorded states
+/// ([`SpatialReport`](crate::rapier::joint::SpatialReport)): how far its journal tilted and
+/// slid, and the largest force of each kind of contact. Lower and upper are the bearing's ends
+/// at `-L/2` and `+L/2` along the hinge's axis (its edges, its faces).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct SpatialMetrics {
+    /// Largest tilt of the journal's axis against the bore's (the length of the two tilt
+    /// components), deg.
+    pub max_tilt_deg: f64,
+    /// Largest axial offset of the journal from the bearing's centre (either way), mm.
+    pub max_axial_offset_mm: f64,
+    /// Largest force of the bore's inner stations (the width between the edges), N.
+    pub peak_bore_force_n: f64,
+    /// Largest force at the bore's lower and upper edges, N.
+    pub peak_edge_force_n: [f64; 2],
+    /// Largest force of the shoulders on the lower and upper faces, N.
+    pub peak_face_force_n: [f64; 2],
+    /// Contact onsets on the lower and upper faces (axial knocks, chatter included).
+    pub face_contacts: [u64; 2],
+    /// Fraction of the recorded time a face carried load.
+    pub face_contact_fraction: f64,
+    /// Fraction of the recorded time an edge carried more than the bore's inner stations
+    /// together: the journal bears on the bearing's ends (tilted, or loaded by a moment).
+    pub edge_loaded_fraction: f64,
 }
 
 /// Records a joint's states, one per step, into [`HingeMetrics`] and an impact list. The
@@ -174,6 +204,11 @@ pub struct ImpactRecorder {
     /// The step that led to the state being recorded (the last recorded `dt`), s.
     last_dt: f64,
     finished: bool,
+    /// A spatial joint: whether each face carried load at the last state, and the time a face
+    /// carried load and an edge was loaded, s.
+    face_was_loaded: [bool; 2],
+    face_time: f64,
+    edge_time: f64,
 }
 
 impl ImpactRecorder {
@@ -254,6 +289,36 @@ impl ImpactRecorder {
         }
     }
 
+    /// Records a spatial joint's report at a state ([`ClearanceReport::spatial`]), which held
+    /// for the step `dt` (s) that followed it, into [`HingeMetrics::spatial`]: call it beside
+    /// [`record`](Self::record) with the same state (and with `dt = 0` for the final one).
+    /// Time fractions are completed by [`finish`](Self::finish).
+    ///
+    /// [`ClearanceReport::spatial`]: crate::rapier::joint::ClearanceReport::spatial
+    pub fn record_spatial(&mut self, dt: f64, report: &crate::rapier::joint::SpatialReport) {
+        let first = self.metrics.spatial.is_none();
+        let m = self.metrics.spatial.get_or_insert_with(Default::default);
+        let tilt = report.tilt[0].hypot(report.tilt[1]).to_degrees();
+        m.max_tilt_deg = m.max_tilt_deg.max(tilt);
+        m.max_axial_offset_mm = m.max_axial_offset_mm.max(report.axial_offset.abs() * 1e3);
+        m.peak_bore_force_n = m.peak_bore_force_n.max(report.bore_force);
+        for k in 0..2 {
+            m.peak_edge_force_n[k] = m.peak_edge_force_n[k].max(report.edge_force[k]);
+            m.peak_face_force_n[k] = m.peak_face_force_n[k].max(report.face_force[k]);
+            let on = report.face_force[k] > 0.0;
+            if on && (first || !self.face_was_loaded[k]) {
+                m.face_contacts[k] += 1;
+            }
+            self.face_was_loaded[k] = on;
+        }
+        if report.face_force.iter().any(|&f| f > 0.0) {
+            self.face_time += dt;
+        }
+        if report.edge_force.iter().any(|&f| f > report.bore_force) {
+            self.edge_time += dt;
+        }
+    }
+
     /// Records the final state at time `t` (it carries no time) and completes the time-weighted
     /// figures over the recorded time `t` (from 0). Recording after it is not meaningful.
     pub fn finish(&mut self, t: f64, last: &ContactObservation) {
@@ -265,6 +330,10 @@ impl ImpactRecorder {
         if t > 0.0 {
             self.metrics.rms_force_n = (self.force_sq_time / t).sqrt();
             self.metrics.contact_fraction = self.contact_time / t;
+            if let Some(m) = &mut self.metrics.spatial {
+                m.face_contact_fraction = self.face_time / t;
+                m.edge_loaded_fraction = self.edge_time / t;
+            }
         }
     }
 

@@ -253,6 +253,50 @@ pub fn summary_json(summary: &Summary) -> Result<String> {
     serde_json::to_string_pretty(&value).map_err(|e| Error::invalid("summary", e.to_string()))
 }
 
+/// The comparison table's rows of each spatial hinge (a planar scene has none): its largest
+/// tilt and the peaks of its edge and face forces (lower / upper); `-` in a twin where the hinge
+/// is ideal.
+fn spatial_rows(twins: &[(&String, &TwinSummary)], rows: &mut Vec<(String, Vec<String>)>) {
+    let names: std::collections::BTreeSet<&String> = twins
+        .iter()
+        .flat_map(|(_, t)| t.hinges.iter())
+        .filter(|(_, m)| m.spatial.is_some())
+        .map(|(name, _)| name)
+        .collect();
+    type Cell = fn(&crate::rapier::metrics::SpatialMetrics) -> String;
+    let cells: [(&str, Cell); 3] = [
+        ("max tilt (deg)", |m| format!("{:.4}", m.max_tilt_deg)),
+        ("peak edge forces (N)", |m| {
+            format!(
+                "{:.1}/{:.1}",
+                m.peak_edge_force_n[0], m.peak_edge_force_n[1]
+            )
+        }),
+        ("peak face forces (N)", |m| {
+            format!(
+                "{:.1}/{:.1}",
+                m.peak_face_force_n[0], m.peak_face_force_n[1]
+            )
+        }),
+    ];
+    for name in names {
+        for (label, cell) in cells {
+            rows.push((
+                format!("{name} {label}"),
+                twins
+                    .iter()
+                    .map(|(_, t)| {
+                        t.hinges
+                            .get(name)
+                            .and_then(|m| m.spatial.as_ref())
+                            .map_or("-".to_string(), cell)
+                    })
+                    .collect(),
+            ));
+        }
+    }
+}
+
 /// A short side-by-side table of the twins for the terminal.
 pub fn comparison_table(summary: &Summary) -> String {
     let twins: Vec<(&String, &TwinSummary)> = summary.twins.iter().rev().collect(); // ideal, clearance
@@ -301,6 +345,7 @@ pub fn comparison_table(summary: &Summary) -> String {
             .map(|(_, t)| format!("{:.3}", t.max_penetration_um))
             .collect(),
     ));
+    spatial_rows(&twins, &mut rows);
     rows.push((
         "momentum drift lin/ang".into(),
         twins

@@ -7,6 +7,7 @@ use crate::model::laws::{
     FrictionModel, GonthierEtAl, Hertz, HuntCrossley, ImprovedLiu, KelvinVoigt, LankaraniNikravesh,
     LiuEtAl, Material, MaxDamping, NormalModel, Threlfall, effective_modulus,
 };
+use crate::model::spatial::{DEFAULT_SLICES, FaceLaw, SpatialGeometry, SpatialModel};
 use crate::rapier::convert::{Clearance, ClearanceModel};
 use crate::rapier::joint::OutOfPlaneLock;
 use serde::{Deserialize, Serialize};
@@ -45,10 +46,11 @@ pub struct ClearanceSpec {
     #[serde(default)]
     pub lock: OutOfPlaneLock,
     /// Which model solves the hinge: `Compliant` (the default: the contact law as a force, the
-    /// paper's model) or `LargeStep` (the radial limit inside Rapier's solver, for 1/60 s and
-    /// 1 kHz worlds). See docs/scene-format.md.
+    /// paper's model), `LargeStep` (the radial limit inside Rapier's solver, for 1/60 s and
+    /// 1 kHz worlds) or `Spatial(..)` (the compliant joint in space: tilt, edge contact, axial
+    /// play and thrust faces). See docs/scene-format.md.
     #[serde(default, skip_serializing_if = "is_compliant")]
-    pub model: ClearanceModel,
+    pub model: ModelSpec,
     /// The large-step model's coefficient of restitution, in [0, 1] (default `None`: the contact
     /// law's own restitution at each impact). Only the large-step model takes it: the compliant
     /// model's restitution is its contact law's.
@@ -56,8 +58,137 @@ pub struct ClearanceSpec {
     pub restitution: Option<f64>,
 }
 
-fn is_compliant(model: &ClearanceModel) -> bool {
-    *model == ClearanceModel::Compliant
+fn is_compliant(model: &ModelSpec) -> bool {
+    *model == ModelSpec::Compliant
+}
+
+/// Which model solves a clearance hinge ([`ClearanceModel`] in the scene's words: the spatial
+/// model's face law and slice count may be left out).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum ModelSpec {
+    /// The compliant contact-law joint, planar (the paper's model).
+    #[default]
+    Compliant,
+    /// The large-step joint (the radial limit inside Rapier's solver).
+    LargeStep,
+    /// The spatial compliant joint ([`crate::model::spatial`]): nothing locked, the journal
+    /// tilts and slides axially.
+    Spatial(SpatialSpec),
+}
+
+/// The spatial model's settings, lengths in metres as the plain API's
+/// [`SpatialModel`](crate::model::spatial::SpatialModel).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpatialSpec {
+    /// Axial play, shoulders and slices.
+    pub geometry: SpatialGeometrySpec,
+    /// The shoulders' law against the bearing's faces; default (left out): a flat punch of the
+    /// collar's radius on the hinge's materials ([`FaceLaw::flat_punch`], restitution
+    /// [`FaceLaw::DEFAULT_RESTITUTION`]).
+    #[serde(
+        default,
+        deserialize_with = "present",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub face: Option<FaceSpec>,
+}
+
+/// The spatial geometry along the axis ([`SpatialGeometry`]), m.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SpatialGeometrySpec {
+    /// Axial play `a`: the journal's free axial travel when centred, m (> 0, at most the
+    /// bearing's width).
+    pub axial_play: f64,
+    /// Outer radius of the journal's shoulders (collars), m (above the journal radius, at most
+    /// ten bearing radii).
+    pub collar_radius: f64,
+    /// Slices across the bearing's width (1 to [`MAX_SLICES`](crate::model::spatial::MAX_SLICES); default [`DEFAULT_SLICES`]).
+    #[serde(default = "default_slices")]
+    pub slices: u32,
+}
+
+/// The face law ([`FaceLaw`]): a linear spring with Flores et al.'s hysteresis damping.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FaceSpec {
+    /// Axial stiffness of one shoulder against its face, N/m.
+    pub stiffness: f64,
+    /// Coefficient of restitution of a face knock, in (0, 1].
+    pub restitution: f64,
+}
+
+fn default_slices() -> u32 {
+    DEFAULT_SLICES
+}
+
+/// An optional field written as its value (`face: (..)`, not `face: Some((..))`).
+fn present<'de, D: serde::Deserializer<'de>, T: Deserialize<'de>>(
+    d: D,
+) -> std::result::Result<Option<T>, D::Error> {
+    T::deserialize(d).map(Some)
+}
+
+impl SpatialSpec {
+    /// The [`SpatialModel`] these settings describe for the radial geometry `radial` between
+    /// the two materials, validated (errors name `model.geometry.<field>` and
+    /// `model.face.<field>`).
+    fn model(
+        &self,
+        radial: &BearingGeometry,
+        bearing: &Material,
+        journal: &Material,
+    ) -> Result<SpatialModel> {
+        let g = &self.geometry;
+        let geometry = SpatialGeometry {
+            axial_play: g.axial_play,
+            collar_radius: g.collar_radius,
+            slices: g.slices,
+        };
+        geometry.validate(radial).map_err_within("model.geometry")?;
+        // Metres, not the spec's millimetres: a value in mm is caught by these bounds.
+        let in_m = |field: &str, value: f64, hi: f64, what: &str| -> Result<()> {
+            if value > hi {
+                return Err(Error::invalid(
+                    format!("model.geometry.{field}"),
+                    format!(
+                        "must be at most {what}, {} m (got {} m; this field is in metres, not mm)",
+                        sig4(hi),
+                        sig4(value)
+                    ),
+                ));
+            }
+            Ok(())
+        };
+        in_m(
+            "axial_play",
+            g.axial_play,
+            radial.length(),
+            "the bearing's width",
+        )?;
+        in_m(
+            "collar_radius",
+            g.collar_radius,
+            10.0 * radial.bearing_radius(),
+            "ten bearing radii",
+        )?;
+        let face = match self.face {
+            Some(f) => FaceLaw {
+                stiffness: f.stiffness,
+                restitution: f.restitution,
+            },
+            None => FaceLaw::flat_punch(
+                effective_modulus(bearing, journal),
+                g.collar_radius,
+                FaceLaw::DEFAULT_RESTITUTION,
+            ),
+        };
+        let model = SpatialModel { geometry, face };
+        model.validate(radial).map_err_within("model")?;
+        Ok(model)
+    }
 }
 
 fn default_min_impact_speed() -> f64 {
@@ -222,17 +353,26 @@ impl ClearanceSpec {
             speed_mm_s("min_impact_speed_mm_s", self.min_impact_speed_mm_s)? * mm;
         let min_separation =
             in_range("min_separation_um", self.min_separation_um, 0.0, 1e4, "um")? * 1e-6;
+        let model = match &self.model {
+            ModelSpec::Compliant => ClearanceModel::Compliant,
+            ModelSpec::LargeStep => ClearanceModel::LargeStep,
+            ModelSpec::Spatial(spec) => ClearanceModel::Spatial(spec.model(
+                &geometry,
+                &self.bearing_material,
+                &self.journal_material,
+            )?),
+        };
         let mut clearance = Clearance::new(geometry, normal)
             .friction(friction)
             .min_impact_speed(min_impact_speed)
             .min_separation(min_separation)
             .lock(self.lock)
-            .model(self.model);
+            .model(model);
         if let Some(depth) = self.max_valid_penetration(&geometry)? {
             clearance = clearance.max_valid_penetration(depth);
         }
         if let Some(e) = self.restitution {
-            if self.model != ClearanceModel::LargeStep {
+            if self.model != ModelSpec::LargeStep {
                 return Err(Error::invalid(
                     "restitution",
                     "only the large-step model takes a restitution (`model: LargeStep`): the \

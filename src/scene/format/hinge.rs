@@ -1,7 +1,7 @@
 //! Hinges (ideal or with a clearance), their validation, the planar model's limits, warnings.
 
 use super::limits::*;
-use super::{ClearanceSpec, FrictionSpec, Scene};
+use super::{ClearanceSpec, FrictionSpec, ModelSpec, Scene};
 use crate::error::{Error, Result, sig4};
 use crate::rapier::convert::Clearance;
 use crate::rapier::joint::OutOfPlaneLock;
@@ -25,6 +25,26 @@ pub struct HingeSpec {
     /// Radial play; `None` makes the hinge ideal in both twins.
     #[serde(default)]
     pub clearance: Option<ClearanceSpec>,
+    /// Where the journal's centre starts from the bearing's (`point_m`) in the clearance twin,
+    /// world, mm (default centred): within the radial clearance, and along the axis only for a
+    /// spatial hinge (within half its axial play). The journal body's anchor follows: place its
+    /// centre of mass accordingly. The ideal twin's hinge has no play and starts at `point_m`.
+    #[serde(default, skip_serializing_if = "is_centred")]
+    pub journal_offset_mm: [f64; 3],
+}
+
+fn is_centred(offset: &[f64; 3]) -> bool {
+    *offset == [0.0; 3]
+}
+
+impl HingeSpec {
+    /// Whether the hinge's clearance uses the spatial model.
+    pub fn is_spatial(&self) -> bool {
+        matches!(
+            self.clearance.as_ref().map(|c| &c.model),
+            Some(ModelSpec::Spatial(_))
+        )
+    }
 }
 
 impl Scene {
@@ -71,6 +91,7 @@ impl Scene {
                 Some(c) => Some(Self::hinge_clearance(c, &p)?.name(h.name.clone())),
                 None => None,
             };
+            journal_offset(h, clearance.as_ref(), &p)?;
             clearances.push(clearance);
         }
         Ok(clearances)
@@ -81,7 +102,7 @@ impl Scene {
         let clearance = c
             .clearance()
             .map_err(|e| e.within(&format!("{p}.clearance")))?;
-        if c.lock == OutOfPlaneLock::None {
+        if c.lock == OutOfPlaneLock::None && !matches!(c.model, ModelSpec::Spatial(_)) {
             return Err(Error::invalid(
                 format!("{p}.clearance.lock"),
                 "`None` leaves the axial translation and the tilts free, and a scene has no locked axes to \
@@ -90,6 +111,66 @@ impl Scene {
         }
         Ok(clearance)
     }
+}
+
+/// The journal's starting offset of hinge `h` (at path `p`) with its clearance settings: finite,
+/// only on a clearance hinge, radially within the clearance, axially only on a spatial hinge and
+/// within half its axial play.
+fn journal_offset(h: &HingeSpec, clearance: Option<&Clearance>, p: &str) -> Result<()> {
+    let field = format!("{p}.journal_offset_mm");
+    for (i, x) in h.journal_offset_mm.iter().enumerate() {
+        crate::error::finite(&format!("{field}[{i}]"), *x)?;
+    }
+    if is_centred(&h.journal_offset_mm) {
+        return Ok(());
+    }
+    let Some(c) = clearance else {
+        return Err(Error::invalid(
+            field,
+            "only a clearance hinge has play to start off-centre in: give the hinge a clearance or \
+             leave this out",
+        ));
+    };
+    let offset = Vector::from(h.journal_offset_mm) * 1e-3;
+    let axis = Vector::from(h.axis).normalize();
+    let axial = offset.dot(axis);
+    let radial = (offset - axial * axis).length();
+    let gap = c.geometry.clearance();
+    if radial > gap {
+        return Err(Error::invalid(
+            field,
+            format!(
+                "its part across the axis, {} mm, exceeds the radial clearance {} mm: the journal \
+                 would start inside the bearing",
+                sig4(radial * 1e3),
+                sig4(gap * 1e3)
+            ),
+        ));
+    }
+    let play = match c.model {
+        crate::rapier::convert::ClearanceModel::Spatial(m) => m.geometry.axial_play,
+        _ => 0.0,
+    };
+    if axial.abs() > 0.5 * play * (1.0 + 1e-12) {
+        return Err(Error::invalid(
+            field,
+            if play == 0.0 {
+                format!(
+                    "has a part along the axis ({} mm): only the spatial model \
+                     (`clearance.model: Spatial(..)`) has axial play",
+                    sig4(axial * 1e3)
+                )
+            } else {
+                format!(
+                    "its part along the axis, {} mm, exceeds half the axial play, {} mm: a \
+                     shoulder would start inside its face",
+                    sig4(axial * 1e3),
+                    sig4(0.5 * play * 1e3)
+                )
+            },
+        ));
+    }
+    Ok(())
 }
 
 impl Scene {
@@ -121,7 +202,12 @@ impl Scene {
     pub(super) fn validate_planar(&self) -> Result<()> {
         let a_ref = Vector::from(self.reference_axis);
         let g = Vector::from(self.gravity);
-        for h in self.hinges.iter().filter(|h| h.clearance.is_some()) {
+        // A spatial hinge carries axial loads and moments across its axis through contact.
+        for h in self
+            .hinges
+            .iter()
+            .filter(|h| h.clearance.is_some() && !h.is_spatial())
+        {
             let p = format!("hinges[{}]", h.name);
             let a = Vector::from(h.axis).normalize();
             if a.cross(a_ref).length() > 1e-9 {
@@ -129,7 +215,8 @@ impl Scene {
                     format!("{p}.axis"),
                     "a clearance hinge must be parallel to the scene's reference_axis: the planar clearance \
                      model has no axial or tilting contact, so non-parallel hinges (out-of-plane motion) \
-                     cannot be represented; make this hinge ideal or align it",
+                     cannot be represented; make this hinge ideal, align it, or make it spatial \
+                     (`clearance.model: Spatial(..)`)",
                 ));
             }
             if g.dot(a).abs() > 1e-9 * g.length().max(1e-300) && g.length() > 0.0 {
@@ -138,7 +225,7 @@ impl Scene {
                     format!(
                         "has a component along the axis of clearance hinge `{}`: an axial (out-of-plane) load, \
                          which the planar clearance model cannot carry through contact; put gravity in the \
-                         hinge plane or make the hinge ideal",
+                         hinge plane, make the hinge ideal, or make it spatial (`clearance.model: Spatial(..)`)",
                         h.name
                     ),
                 ));

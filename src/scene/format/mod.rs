@@ -13,7 +13,9 @@ mod run;
 mod validated;
 
 pub use body::{BodySpec, MotionSpec};
-pub use clearance::{ClearanceSpec, ContactSpec, FrictionSpec};
+pub use clearance::{
+    ClearanceSpec, ContactSpec, FaceSpec, FrictionSpec, ModelSpec, SpatialGeometrySpec, SpatialSpec,
+};
 pub use drive::DriveSpec;
 pub use hinge::HingeSpec;
 pub use joint::{JointKindSpec, JointSpec, MotorSpec};

@@ -134,12 +134,18 @@ enum Step {
 }
 
 /// Writes out the clearance fields a scene leaves unwritten at their defaults (`model`,
-/// `restitution`: skipped so that a scene written back reads as before), so that overrides can
+/// `restitution`, a clearance hinge's `journal_offset_mm`: skipped so that a scene written back reads as before), so that overrides can
 /// name them.
 fn with_skipped_defaults(root: &mut serde_json::Value) {
     let Some(hinges) = root.get_mut("hinges").and_then(|h| h.as_array_mut()) else {
         return;
     };
+    for h in hinges.iter_mut().filter_map(|h| h.as_object_mut()) {
+        if h.get("clearance").is_some_and(|c| !c.is_null()) {
+            h.entry("journal_offset_mm")
+                .or_insert_with(|| serde_json::json!([0.0, 0.0, 0.0]));
+        }
+    }
     let clearances = hinges
         .iter_mut()
         .filter_map(|h| h.get_mut("clearance").and_then(|c| c.as_object_mut()));

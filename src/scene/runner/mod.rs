@@ -384,9 +384,7 @@ impl Simulation {
         self.t_prev = t;
         for twin in &mut self.twins {
             for h in &mut twin.hinges {
-                let obs = h.observation();
-                h.recorder.finish(t, &obs);
-                h.recorder.set_final_angle_deg(h.angle.value().to_degrees());
+                h.finish_recording(t);
             }
         }
         t
@@ -475,9 +473,7 @@ impl Simulation {
         for twin in &mut self.twins {
             // The final state counts for peaks and onsets (it carries no time).
             for h in &mut twin.hinges {
-                let obs = h.observation();
-                h.recorder.finish(duration, &obs);
-                h.recorder.set_final_angle_deg(h.angle.value().to_degrees());
+                h.finish_recording(duration);
             }
         }
         Ok(())

@@ -7,9 +7,11 @@ use super::invariants::{BodyBefore, Invariants};
 use crate::error::Result;
 use crate::model::angle::{HingeAngle, UnwrappedAngle, twist_angle};
 use crate::model::laws::NormalForceLaw;
+use crate::model::spatial::SpatialPose;
 use crate::rapier::drive::DriveHandle;
-use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle};
+use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle, SpatialReport};
 use crate::rapier::large_step::{LargeStepJoint, LargeStepJointHandle};
+use crate::rapier::ledger::Wrench;
 use crate::rapier::metrics::{ContactObservation, ImpactRecorder};
 use crate::rapier::reaction::{IdealJoint, ReactionSolver};
 use crate::rapier::replay::ReplayRecorder;
@@ -86,10 +88,35 @@ pub(super) struct HingeTrack {
     pub(super) force: f64,
     /// The clearance contact at the state before the current step.
     sample: ContactSample,
+    /// The scene's hinge is spatial: its rows carry the tilt, axial offset and forces by
+    /// contact kind (zero in the ideal twin).
+    spatial: bool,
+    /// A spatial joint at the state before the current step: its report, the wrenches it
+    /// applies over the step and its elastic energy, J.
+    spatial_sample: Option<SpatialSample>,
     pub(super) recorder: ImpactRecorder,
 }
 
+/// A spatial joint at the state before a step.
+#[derive(Clone, Copy, Debug)]
+struct SpatialSample {
+    report: SpatialReport,
+    wrenches: Option<[Wrench; 2]>,
+    elastic_energy: f64,
+}
+
 impl HingeTrack {
+    /// Records the final state at time `t` into the recorder and completes its figures.
+    pub(super) fn finish_recording(&mut self, t: f64) {
+        if let Some(s) = &self.spatial_sample {
+            self.recorder.record_spatial(0.0, &s.report);
+        }
+        let obs = self.observation();
+        self.recorder.finish(t, &obs);
+        self.recorder
+            .set_final_angle_deg(self.angle.value().to_degrees());
+    }
+
     /// The state before the current step, for the recorder.
     pub(super) fn observation(&self) -> ContactObservation {
         match self.joint {
@@ -149,6 +176,62 @@ fn large_step_sample(j: &LargeStepJoint) -> ContactSample {
         damping_force: 0.0,
         friction_force: 0.0,
     }
+}
+
+/// The columns a spatial hinge adds to its rows (after `contact`): the journal's tilt about the
+/// `ecc_u`/`ecc_v` axes, its axial offset, and the normal force of each contact kind.
+pub(super) const SPATIAL_COLUMNS: [&str; 8] = [
+    "tilt_u_deg",
+    "tilt_v_deg",
+    "axial_mm",
+    "bore_force_n",
+    "edge_lower_force_n",
+    "edge_upper_force_n",
+    "face_lower_force_n",
+    "face_upper_force_n",
+];
+
+/// Where a spatial joint's two bodies are, its tilt measured about the runner's `u` axis
+/// (`u`, world: the `ecc_u` column's axis) and `a_i x u` (the `ecc_v` axis).
+fn spatial_pose(j: &ClearanceJoint, r1: &RigidBody, r2: &RigidBody, u: Vector) -> SpatialPose {
+    SpatialPose {
+        bearing_center: *r1.position() * j.local_anchor1(),
+        bearing_axis: *r1.rotation() * j.local_axis1(),
+        bearing_transverse: u,
+        journal_center: *r2.position() * j.local_anchor2(),
+        journal_axis: *r2.rotation() * j.local_axis2(),
+    }
+}
+
+/// The work a spatial joint's damping and friction dissipated over a step, J: minus the work
+/// of its wrenches over the bodies' motion in the step (force times the centre of mass's
+/// displacement, torque times the rotation vector, the wrenches averaged over the step's two
+/// ends: exact for the elastic part of a linear law, whose work is then minus the change of
+/// its elastic energy) minus the change of its elastic energy. The planar joint's damping and
+/// friction work is taken from its one contact; a spatial joint's stations are summed this way.
+fn spatial_dissipation(
+    before: &SpatialSample,
+    after: &ClearanceJoint,
+    bodies: [&BodyTrack; 2],
+    set: &RigidBodySet,
+) -> f64 {
+    let (Some(w0), Some(w1)) = (before.wrenches, after.last_wrenches()) else {
+        return 0.0;
+    };
+    let work: f64 = (0..2)
+        .filter(|&k| !bodies[k].fixed)
+        .map(|k| {
+            let (b, rb) = (bodies[k], &set[bodies[k].handle]);
+            let moved = crate::rapier::ledger::world_center_of_mass(rb) - b.com_before;
+            let turned = (*rb.rotation() * b.rotation_before.inverse()).to_scaled_axis();
+            let (force, torque) = (
+                0.5 * (w0[k].force + w1[k].force),
+                0.5 * (w0[k].torque + w1[k].torque),
+            );
+            force.dot(moved) + torque.dot(turned)
+        })
+        .sum();
+    -work - (after.elastic_energy() - before.elastic_energy)
 }
 
 /// What a clearance hinge's hook saw at one state (read before the step it drives).
@@ -236,6 +319,11 @@ impl Twin {
                     let j = world.clearance.get(c).expect("handle of this twin");
                     h.force = j.report().force.on_journal.length();
                     h.sample = compliant_sample(j);
+                    h.spatial_sample = j.report().spatial.map(|report| SpatialSample {
+                        report,
+                        wrenches: j.last_wrenches(),
+                        elastic_energy: j.elastic_energy(),
+                    });
                 }
                 HingeJoint::LargeStep(k) => {
                     let j = world.large_step.get(k).expect("handle of this twin");
@@ -296,11 +384,17 @@ impl Twin {
         // penetration change, and the slip at the step's velocity.
         for h in &self.hinges {
             if let HingeJoint::Clearance(c) = h.joint {
-                let r = world
-                    .clearance
-                    .get(c)
-                    .expect("handle of this twin")
-                    .report();
+                let j = world.clearance.get(c).expect("handle of this twin");
+                if let Some(s) = &h.spatial_sample {
+                    self.invariants.dissipated_j += spatial_dissipation(
+                        s,
+                        j,
+                        [&self.bodies[h.bearing], &self.bodies[h.journal]],
+                        bodies,
+                    );
+                    continue;
+                }
+                let r = j.report();
                 let sample = &h.sample;
                 if sample.penetration > 0.0 {
                     self.invariants.dissipated_j += sample.damping_force
@@ -388,6 +482,9 @@ impl Twin {
         for h in &mut self.hinges {
             let obs = h.observation();
             h.recorder.record(t, dt, &obs);
+            if let Some(s) = &h.spatial_sample {
+                h.recorder.record_spatial(dt, &s.report);
+            }
         }
     }
 
@@ -441,16 +538,36 @@ impl Twin {
             v.push(h.force);
             match h.joint {
                 HingeJoint::Clearance(c) => {
-                    let r = world
-                        .clearance
-                        .get(c)
-                        .expect("handle of this twin")
-                        .report();
-                    let e = r.state.eccentricity;
-                    v.push(e.dot(*r1.rotation() * h.local_u1) * 1e3);
-                    v.push(e.dot(*r1.rotation() * h.local_v1) * 1e3);
+                    let j = world.clearance.get(c).expect("handle of this twin");
+                    let r = j.report();
+                    let (u, v_axis) = (*r1.rotation() * h.local_u1, *r1.rotation() * h.local_v1);
+                    let pose = r.spatial.map(|_| spatial_pose(j, r1, r2, u));
+                    // A spatial joint's eccentricity at the bearing's mid-plane (its report's
+                    // state is the deepest station's, which may be a face's).
+                    let e = match &pose {
+                        Some(p) => {
+                            let d = p.journal_center - p.bearing_center;
+                            d - d.dot(p.bearing_axis) * p.bearing_axis
+                        }
+                        None => r.state.eccentricity,
+                    };
+                    v.push(e.dot(u) * 1e3);
+                    v.push(e.dot(v_axis) * 1e3);
                     v.push(r.state.penetration.max(0.0) * 1e6);
                     v.push(if r.state.penetration > 0.0 { 1.0 } else { 0.0 });
+                    if let (Some(p), Some(s)) = (pose, r.spatial) {
+                        let [tu, tv] = p.tilt();
+                        v.extend_from_slice(&[
+                            tu.to_degrees(),
+                            tv.to_degrees(),
+                            p.axial_offset() * 1e3,
+                            s.bore_force,
+                            s.edge_force[0],
+                            s.edge_force[1],
+                            s.face_force[0],
+                            s.face_force[1],
+                        ]);
+                    }
                 }
                 HingeJoint::LargeStep(k) => {
                     let r = world
@@ -465,6 +582,9 @@ impl Twin {
                     v.push(if r.contact { 1.0 } else { 0.0 });
                 }
                 HingeJoint::Ideal => v.extend_from_slice(&[0.0, 0.0, 0.0, 0.0]),
+            }
+            if h.spatial && !matches!(h.joint, HingeJoint::Clearance(_)) {
+                v.extend_from_slice(&[0.0; SPATIAL_COLUMNS.len()]);
             }
         }
         for (_, f) in &self.joints {

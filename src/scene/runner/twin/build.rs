@@ -1,7 +1,7 @@
 //! Building a twin from a validated scene, step by step: bodies, hinges, drives, the ideal
 //! joints the reactions are solved for, the scene's other joints and their motors, columns.
 
-use super::{BodyTrack, ContactSample, HingeJoint, HingeTrack, Twin, TwinKind};
+use super::{BodyTrack, ContactSample, HingeJoint, HingeTrack, SPATIAL_COLUMNS, Twin, TwinKind};
 use crate::error::Result;
 use crate::model::angle::{HingeAngle, UnwrappedAngle};
 use crate::rapier::convert::ClearanceModel;
@@ -216,6 +216,8 @@ fn build_hinges(
         let joint = match (scene.clearance(i), kind) {
             (Some(settings), TwinKind::Clearance) => {
                 let rapier = &mut world.rapier.impulse_joints;
+                // The journal's centre starts off the bearing's by the hinge's offset.
+                let a2 = a2 + Vector::from(h.journal_offset_mm) * 1e-3;
                 match settings.model {
                     ClearanceModel::Compliant | ClearanceModel::Spatial(_) => {
                         let j = settings.joint(a1, a2, axis, axis)?;
@@ -248,6 +250,8 @@ fn build_hinges(
             angle: HingeAngle::default(),
             force: 0.0,
             sample: ContactSample::default(),
+            spatial: h.is_spatial(),
+            spatial_sample: None,
             recorder: ImpactRecorder::new(),
         });
     }
@@ -529,7 +533,7 @@ fn columns(
             }
         }
     }
-    for h in hinges {
+    for (i, h) in hinges.iter().enumerate() {
         for c in [
             "angle_deg",
             "rate_deg_s",
@@ -540,6 +544,11 @@ fn columns(
             "contact",
         ] {
             columns.push(format!("{}_{c}", h.name));
+        }
+        if scene.hinges[i].is_spatial() {
+            for c in SPATIAL_COLUMNS {
+                columns.push(format!("{}_{c}", h.name));
+            }
         }
     }
     for (name, _) in joints {
@@ -632,7 +641,7 @@ mod tests {
             .unwrap();
         scene.run.output_interval_s = 1e-3;
         let spec = scene.hinges[0].clearance.as_ref().unwrap();
-        assert_eq!(spec.model, ClearanceModel::LargeStep);
+        assert_eq!(spec.model, crate::scene::ModelSpec::LargeStep);
         let v = scene.validated().unwrap();
         assert_eq!(v.clearance(0).unwrap().model, ClearanceModel::LargeStep);
         assert_eq!(error_of(&scene, Twins::IdealOnly), None);

@@ -121,11 +121,17 @@ use rapier3d_f64::prelude::{
 ///     .joint(Vector::ZERO, Vector::new(-0.2, 0.0, 0.0), Vector::Y, Vector::Y)?;
 /// let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.0075));
 /// let hinge = world.insert_clearance(post, arm, pin);
-/// world.step_to(0.05)?;
-/// let report = world.clearance.get(hinge).unwrap().report().spatial.unwrap();
-/// // The journal tilted until the bore's two edges hold the moment (2c/L = 10 mrad of tilt).
-/// assert!(report.tilt[0].hypot(report.tilt[1]) > 0.009);
-/// assert!(report.edge_force[0] > 0.0 && report.edge_force[1] > 0.0);
+/// let (mut tilt, mut edges) = (0.0_f64, [0.0_f64; 2]);
+/// while world.time() < 0.03 {
+///     world.step(0.03)?;
+///     let s = world.clearance.get(hinge).unwrap().report().spatial.unwrap();
+///     tilt = tilt.max(s.tilt[0].hypot(s.tilt[1]));
+///     edges = [edges[0].max(s.edge_force[0]), edges[1].max(s.edge_force[1])];
+/// }
+/// // The journal tilted until the bore's two edges took the moment (free tilt 2c/L = 10 mrad).
+/// // Frictionless, it then rocks between its edges and the top face: see `examples/door_hinge.rs`.
+/// assert!(tilt > 0.0099, "{tilt}");
+/// assert!(edges[0] > 0.0 && edges[1] > 0.0, "{edges:?}");
 /// # Ok::<(), clearance_joint::Error>(())
 /// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]

@@ -129,13 +129,9 @@ pub fn run_twin(spatial: bool) -> Result<Outcome> {
         o.impacts += r.impact as u32;
         if let Some(s) = r.spatial {
             o.max_tilt = o.max_tilt.max(s.tilt[0].hypot(s.tilt[1]));
-            for e in 0..2 {
-                o.max_edge_force[e] = o.max_edge_force[e].max(s.edge_force[e]);
-                if world.time() > END - 0.2 {
-                    late_sum[e] += s.edge_force[e] * dt;
-                }
-            }
+            o.max_edge_force = [0, 1].map(|e| o.max_edge_force[e].max(s.edge_force[e]));
             if world.time() > END - 0.2 {
+                late_sum = [0, 1].map(|e| late_sum[e] + s.edge_force[e] * dt);
                 late_face += (s.face_force[0] + s.face_force[1]) * dt;
                 late_time += dt;
             }

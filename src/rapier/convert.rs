@@ -181,7 +181,8 @@ pub struct Clearance {
     /// violations ([`ClearanceJointBuilder::max_valid_penetration`]). `None` (the default): 1 % of
     /// the journal radius ([`crate::rapier::joint::default_max_valid_penetration`]).
     pub max_valid_penetration: Option<f64>,
-    /// What holds the out-of-plane degrees of freedom (default [`OutOfPlaneLock::Joint`]).
+    /// What holds the out-of-plane degrees of freedom (default [`OutOfPlaneLock::Joint`]);
+    /// ignored by [`ClearanceModel::Spatial`], which locks nothing.
     pub lock: OutOfPlaneLock,
     /// Name used in errors and reports (default: the builder's default name).
     pub name: Option<String>,
@@ -189,7 +190,7 @@ pub struct Clearance {
     pub model: ClearanceModel,
     /// Coefficient of restitution of the large-step model's impacts; `None` (the default): the
     /// normal law's own restitution at each impact ([`crate::rapier::large_step::Restitution::Law`]).
-    /// The compliant model takes its restitution from the law and ignores this.
+    /// The compliant and spatial models take their restitution from their laws and ignore this.
     pub restitution: Option<f64>,
 }
 
@@ -286,7 +287,8 @@ impl Clearance {
         self
     }
 
-    /// Sets what holds the out-of-plane degrees of freedom.
+    /// Sets what holds the out-of-plane degrees of freedom of the planar joint (the spatial
+    /// model locks nothing and ignores it).
     pub fn lock(mut self, lock: OutOfPlaneLock) -> Self {
         self.lock = lock;
         self
@@ -298,7 +300,8 @@ impl Clearance {
         self
     }
 
-    /// Chooses the model: `.model(ClearanceModel::LargeStep)` for 1/60 s or 1 kHz worlds.
+    /// Chooses the model: `.model(ClearanceModel::LargeStep)` for 1/60 s or 1 kHz worlds,
+    /// `.model(ClearanceModel::Spatial(..))` for a journal that tilts and slides axially.
     pub fn model(mut self, model: ClearanceModel) -> Self {
         self.model = model;
         self

@@ -12,6 +12,11 @@
 //!
 //! Each twin is a `ClearanceWorld` on the default adaptive steps.
 //!
+//! A closed form checks the spatial twin once the swing has died down: the weight's moment
+//! `m g x` is held by the couple of the two edge forces, `F_edge L`, plus the moment of the face
+//! force `W` at the shoulder's contact ring, `W r_f` (the ring's radius `r_f =
+//! sqrt((R_j^2 + R_o^2)/2)`, see `clearance_joint::model::spatial`).
+//!
 //! `cargo run --release --example door_hinge`
 
 use clearance_joint::Result;
@@ -23,7 +28,7 @@ use rapier3d_f64::prelude::*;
 use std::process::ExitCode;
 
 /// Simulated time, s.
-pub const END: f64 = 0.6;
+pub const END: f64 = 1.0;
 /// Panel mass, kg.
 pub const MASS: f64 = 2.0;
 /// Distance of the panel's centre of mass from the hinge axis, m.
@@ -48,6 +53,8 @@ pub struct Outcome {
     pub max_edge_force: [f64; 2],
     /// Edge forces averaged over the last 0.2 s, N.
     pub late_edge_force: [f64; 2],
+    /// Force on both faces averaged over the last 0.2 s, N.
+    pub late_face_force: f64,
     /// Face knocks: contacts of a shoulder with a face that began after a free flight.
     pub face_knocks: u32,
     /// Largest force on the faces, N.
@@ -56,6 +63,25 @@ pub struct Outcome {
     pub impacts: u32,
     /// Whether the guards stayed clean.
     pub clean: bool,
+}
+
+/// The pin: steel improved-Liu, bearing radius 6 mm, radial clearance 0.1 mm, dry friction.
+pub fn pin() -> Result<Clearance> {
+    Ok(Clearance::steel_improved_liu(0.006, 0.1e-3, WIDTH)?.friction(FrictionModel::Bai(Bai::DRY)))
+}
+
+/// The spatial model: axial play 0.3 mm, collars of 10 mm radius.
+pub fn spatial_model() -> SpatialModel {
+    SpatialModel::steel(0.3e-3, 0.010)
+}
+
+/// The moments that hold the weight's moment `m g x` once the swing has died down (last 0.2 s):
+/// `[F_edge L, W r_f]`, N m (edge couple, with the two edges' mean force; face force at the
+/// shoulder's contact ring).
+pub fn holding_moments(o: &Outcome) -> Result<[f64; 2]> {
+    let ring = spatial_model().geometry.face_ring_radius(&pin()?.geometry);
+    let edge = 0.5 * (o.late_edge_force[0] + o.late_edge_force[1]);
+    Ok([edge * WIDTH, o.late_face_force * ring])
 }
 
 fn panel_world(spatial: bool) -> Result<(ClearanceWorld, RigidBodyHandle, ClearanceJointHandle)> {
@@ -74,11 +100,9 @@ fn panel_world(spatial: bool) -> Result<(ClearanceWorld, RigidBodyHandle, Cleara
             .additional_mass_properties(MassProperties::new(Vector::ZERO, MASS, inertia))
             .can_sleep(false),
     );
-    let mut pin = Clearance::steel_improved_liu(0.006, 0.1e-3, WIDTH)?
-        .friction(FrictionModel::Bai(Bai::DRY))
-        .name(if spatial { "spatial pin" } else { "planar pin" });
+    let mut pin = pin()?.name(if spatial { "spatial pin" } else { "planar pin" });
     if spatial {
-        pin = pin.model(ClearanceModel::Spatial(SpatialModel::steel(0.3e-3, 0.010)));
+        pin = pin.model(ClearanceModel::Spatial(spatial_model()));
     }
     let joint = pin.joint(
         Vector::ZERO,
@@ -96,7 +120,7 @@ pub fn run_twin(spatial: bool) -> Result<Outcome> {
     let (mut world, panel, hinge) = panel_world(spatial)?;
     let mut o = Outcome::default();
     let mut was_on_face = false;
-    let (mut late_sum, mut late_time) = ([0.0; 2], 0.0);
+    let (mut late_sum, mut late_face, mut late_time) = ([0.0; 2], 0.0, 0.0);
     while world.time() < END {
         let t0 = world.time();
         world.step(END)?;
@@ -105,13 +129,10 @@ pub fn run_twin(spatial: bool) -> Result<Outcome> {
         o.impacts += r.impact as u32;
         if let Some(s) = r.spatial {
             o.max_tilt = o.max_tilt.max(s.tilt[0].hypot(s.tilt[1]));
-            for e in 0..2 {
-                o.max_edge_force[e] = o.max_edge_force[e].max(s.edge_force[e]);
-                if world.time() > END - 0.2 {
-                    late_sum[e] += s.edge_force[e] * dt;
-                }
-            }
+            o.max_edge_force = [0, 1].map(|e| o.max_edge_force[e].max(s.edge_force[e]));
             if world.time() > END - 0.2 {
+                late_sum = [0, 1].map(|e| late_sum[e] + s.edge_force[e] * dt);
+                late_face += (s.face_force[0] + s.face_force[1]) * dt;
                 late_time += dt;
             }
             let on_face = s.face_force[0] + s.face_force[1] > 0.0;
@@ -130,6 +151,7 @@ pub fn run_twin(spatial: bool) -> Result<Outcome> {
     o.sag_mm = -edge.y * 1e3;
     if late_time > 0.0 {
         o.late_edge_force = late_sum.map(|f| f / late_time);
+        o.late_face_force = late_face / late_time;
     }
     o.steps = world.steps();
     o.clean = world.guards().is_clean();
@@ -142,7 +164,7 @@ pub fn run() -> Result<(Outcome, Outcome)> {
 }
 
 /// The comparison as text.
-pub fn report(runs: &(Outcome, Outcome)) -> String {
+pub fn report(runs: &(Outcome, Outcome)) -> Result<String> {
     let moment = MASS * 9.81 * ARM;
     let mut s = format!(
         "gate on one pin, {END} s: weight moment across the axis m g x = {moment:.3} N m, \
@@ -167,13 +189,21 @@ pub fn report(runs: &(Outcome, Outcome)) -> String {
             if o.clean { "clean" } else { "flagged" }
         );
     }
-    s
+    let [edges, face] = holding_moments(&runs.1)?;
+    s += &format!(
+        "spatial, last 0.2 s: edge couple F L = {edges:.3} N m + face W r_f = {face:.3} N m \
+         (W = {:.2} N) = {:.3} N m against m g x = {moment:.3} N m ({:+.2} %)\n",
+        runs.1.late_face_force,
+        edges + face,
+        100.0 * ((edges + face) / moment - 1.0)
+    );
+    Ok(s)
 }
 
 fn main() -> ExitCode {
-    match run() {
-        Ok(runs) => {
-            print!("{}", report(&runs));
+    match run().and_then(|runs| report(&runs)) {
+        Ok(text) => {
+            print!("{text}");
             ExitCode::SUCCESS
         }
         Err(e) => {

@@ -183,7 +183,7 @@ fn invalid_clearance_parameters_name_the_api_parameter() {
 /// naming the API's field.
 #[test]
 fn invalid_spatial_values_name_the_spatial_field() {
-    use clearance_joint::model::spatial::{FaceLaw, SpatialModel};
+    use clearance_joint::model::spatial::{FaceLaw, MAX_SLICES, SpatialModel};
     let joint = |model: SpatialModel| {
         steel()
             .model(ClearanceModel::Spatial(model))
@@ -205,6 +205,49 @@ fn invalid_spatial_values_name_the_spatial_field() {
             joint(good.face(FaceLaw {
                 stiffness: 1e9,
                 restitution: 1.5,
+            })),
+            "spatial.face.restitution",
+        ),
+        (joint(good.slices(MAX_SLICES + 1)), "spatial.slices"),
+        // The journal radius is 10 mm - 0.2 mm: a collar of that radius is no ring.
+        (
+            joint(SpatialModel::steel(0.3e-3, 0.0098)),
+            "spatial.collar_radius",
+        ),
+        (
+            joint(SpatialModel::steel(0.3e-3, f64::NAN)),
+            "spatial.collar_radius",
+        ),
+        (joint(SpatialModel::steel(0.0, 0.015)), "spatial.axial_play"),
+        (
+            joint(SpatialModel::steel(f64::NAN, 0.015)),
+            "spatial.axial_play",
+        ),
+        (
+            joint(good.face(FaceLaw {
+                stiffness: -1e9,
+                restitution: 0.9,
+            })),
+            "spatial.face.stiffness",
+        ),
+        (
+            joint(good.face(FaceLaw {
+                stiffness: f64::INFINITY,
+                restitution: 0.9,
+            })),
+            "spatial.face.stiffness",
+        ),
+        (
+            joint(good.face(FaceLaw {
+                stiffness: 1e9,
+                restitution: 0.0,
+            })),
+            "spatial.face.restitution",
+        ),
+        (
+            joint(good.face(FaceLaw {
+                stiffness: 1e9,
+                restitution: f64::NAN,
             })),
             "spatial.face.restitution",
         ),

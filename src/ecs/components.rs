@@ -145,7 +145,10 @@ pub struct IdealHinge;
 /// steps and a world with `num_solver_iterations = 1`, which you set: a world with more is
 /// refused, see the [module docs](super)) or the large-step constraint,
 /// `ClearanceHinge(Clearance::steel_improved_liu(..)?.model(ClearanceModel::LargeStep))`, for 1/60 s or 1 kHz
-/// worlds with any number of solver iterations.
+/// worlds with any number of solver iterations. The spatial model,
+/// `.model(ClearanceModel::Spatial(SpatialModel::steel(axial_play, collar_radius)))`, frees the
+/// journal's tilt and axial slide (no lock joint; [`HingeState::spatial`] reports them); it steps
+/// as the compliant model does.
 #[derive(Component, Clone, Debug, PartialEq)]
 pub struct ClearanceHinge(pub Clearance);
 
@@ -233,6 +236,12 @@ pub struct HingeState {
     /// eccentricity and force may be off by more than the model's resolution promises (large
     /// step; `false` for the other modes).
     pub under_resolved: bool,
+    /// A spatial hinge's tilt, axial offset and forces by contact kind over the last step
+    /// ([`ClearanceModel::Spatial`](crate::rapier::convert::ClearanceModel::Spatial)); `None`
+    /// for the other models and for ideal hinges. For a spatial hinge, `penetration`,
+    /// `eccentricity` and `contact` are its deepest station's (a bore station or, when
+    /// [`governed_by_face`](crate::rapier::joint::SpatialReport::governed_by_face), a face's).
+    pub spatial: Option<crate::rapier::joint::SpatialReport>,
     /// The unwrapped relative angle, referenced where the hinge was first realised.
     pub(super) angle_tracker: HingeAngle,
 }

@@ -328,7 +328,7 @@ impl Physics {
         if let Some(Some(c)) = desired
             && c.model != ClearanceModel::LargeStep
         {
-            check_compliant(&self.world.rapier, entity)?;
+            check_compliant(&self.world.rapier, entity, &c.model)?;
         }
         if let Some(r) = self.hinges.get(&entity) {
             let same_place = r.bodies == bodies && r.frame == *frame;
@@ -546,20 +546,24 @@ impl Physics {
 
 /// Refuses a compliant clearance hinge in a world whose settings cannot step it, naming what it
 /// needs and why; the world's settings are the user's and stay as they are.
-fn check_compliant(world: &PhysicsWorld, entity: Entity) -> Result<()> {
+fn check_compliant(world: &PhysicsWorld, entity: Entity, model: &ClearanceModel) -> Result<()> {
     let n = world.integration_parameters.num_solver_iterations;
     if n == 1 {
         return Ok(());
     }
+    let (kind, alternative) = match model {
+        ClearanceModel::Spatial(_) => ("spatial", " (planar: it cannot tilt or slide axially)"),
+        _ => ("compliant", ""),
+    };
     Err(Error::invalid(
         "Physics::world.rapier.integration_parameters.num_solver_iterations",
         format!(
-            "the compliant clearance model of hinge {entity} needs 1 (the world has {n}): its \
+            "the {kind} clearance model of hinge {entity} needs 1 (the world has {n}): its \
              contact force is evaluated once per step and held over it, and Rapier's substeps \
              would make every impact gain energy. Set it to 1 (every body of the world then gets \
              one iteration: stacks of resting bodies soften), or give the hinge the large-step \
-             model, `Clearance::model(ClearanceModel::LargeStep)`, which works with any number \
-             of iterations"
+             model{alternative}, `Clearance::model(ClearanceModel::LargeStep)`, which works with \
+             any number of iterations"
         ),
     ))
 }

@@ -210,6 +210,7 @@ pub fn record(
                 state.eccentricity_ratio = 0.0;
                 state.contact = ContactMode::FreeFlight;
                 (state.impulse, state.substeps, state.under_resolved) = (0.0, 0, false);
+                state.spatial = None;
             }
             HingeJoint::Clearance(c) => {
                 if let Some(j) = physics.clearance().get(c) {
@@ -220,6 +221,7 @@ pub fn record(
                     state.eccentricity_ratio =
                         rep.state.eccentricity.length() / j.geometry().clearance();
                     state.contact = rep.mode;
+                    state.spatial = rep.spatial;
                     (state.impulse, state.substeps, state.under_resolved) = (0.0, 0, false);
                     if rep.onset {
                         state.impacts += 1;
@@ -236,6 +238,7 @@ pub fn record(
                     state.impulse = rep.impact_impulse;
                     state.substeps = rep.substeps;
                     state.under_resolved = rep.under_resolved;
+                    state.spatial = None;
                     state.contact = match (rep.contact, rep.onset) {
                         (false, _) => ContactMode::FreeFlight,
                         (true, true) => ContactMode::Impact,

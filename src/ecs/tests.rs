@@ -476,6 +476,29 @@ fn the_worlds_settings_stay_the_users() {
     steps(&mut world, &mut schedule, 2).unwrap();
     let p = world.resource::<Physics>();
     assert!(matches!(p.joint(hinge), Some(HingeJoint::Clearance(_))));
+
+    // A spatial hinge is refused the same way, naming its model, and is told that the way out
+    // is planar.
+    let (mut world, mut schedule, _, hinge) = pendulum(1e-5);
+    world
+        .resource_mut::<Physics>()
+        .world
+        .rapier
+        .integration_parameters
+        .num_solver_iterations = 4;
+    let spatial = clearance().model(ClearanceModel::Spatial(
+        crate::model::spatial::SpatialModel::steel(0.2e-3, 0.015),
+    ));
+    world.entity_mut(hinge).insert(ClearanceHinge(spatial));
+    let msg = run_step(&mut world, &mut schedule).unwrap_err().to_string();
+    for needle in [
+        "num_solver_iterations",
+        "the spatial clearance model",
+        "planar: it cannot tilt",
+    ] {
+        assert!(msg.contains(needle), "{needle:?} not in: {msg}");
+    }
+    assert!(world.resource::<Physics>().clearance().is_empty());
 }
 
 #[test]
@@ -589,6 +612,94 @@ fn a_spatial_hinge_tilts_under_a_moment_across_its_axis() {
     let s = *world.get::<HingeState>(hinge).unwrap();
     assert_eq!(s.mode, HingeMode::Clearance);
     assert_eq!(s.penetration, j.report().state.penetration);
+    assert_eq!(s.spatial, Some(r), "HingeState carries the spatial report");
+}
+
+/// A hinge swapped in place between the planar model, the spatial one and an ideal revolute: the
+/// lock comes and goes with the planar model, the spatial report with the spatial one, and the
+/// arm's off-plane weight tilts the journal only while it is spatial.
+#[test]
+fn a_hinge_swaps_between_planar_spatial_and_ideal() {
+    use crate::model::spatial::SpatialModel;
+    let mut world = World::new();
+    let mut physics = Physics::new(1e-5, Vector::new(0.0, -9.81, 0.0));
+    physics
+        .world
+        .rapier
+        .integration_parameters
+        .num_solver_iterations = 1;
+    world.insert_resource(physics);
+    let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
+    // A 2 kg arm whose centre of mass sits 30 mm along the axis from the pin's mid-plane.
+    let arm = world
+        .spawn(Body::new(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(0.0, -0.3, 0.03))
+                .additional_mass_properties(MassProperties::new(
+                    Vector::ZERO,
+                    2.0,
+                    Vector::splat(0.02),
+                ))
+                .can_sleep(false),
+        ))
+        .id();
+    let hinge = world
+        .spawn((
+            Hinge::new(base, arm, Vector::Z).local_anchor2(Vector::new(0.0, 0.3, -0.03)),
+            IdealHinge,
+        ))
+        .id();
+    let mut schedule = physics_schedule();
+    let planar = clearance();
+    let spatial = planar
+        .clone()
+        .model(ClearanceModel::Spatial(SpatialModel::steel(0.2e-3, 0.015)));
+    let tilt = |world: &World| {
+        world
+            .get::<HingeState>(hinge)
+            .unwrap()
+            .spatial
+            .map(|r| r.tilt[0].hypot(r.tilt[1]))
+    };
+    world
+        .entity_mut(hinge)
+        .remove::<IdealHinge>()
+        .insert(ClearanceHinge(planar));
+    steps(&mut world, &mut schedule, 5_000).unwrap();
+    assert_eq!(
+        world
+            .resource::<Physics>()
+            .world
+            .rapier
+            .impulse_joints
+            .len(),
+        1,
+        "the lock"
+    );
+    assert_eq!(tilt(&world), None);
+
+    world.entity_mut(hinge).insert(ClearanceHinge(spatial));
+    steps(&mut world, &mut schedule, 20_000).unwrap();
+    let p = world.resource::<Physics>();
+    assert_eq!(p.world.rapier.impulse_joints.len(), 0, "no lock");
+    assert_eq!(p.clearance().len(), 1);
+    let t = tilt(&world).expect("a spatial report");
+    assert!(t > 1e-3, "{t}");
+    assert_eq!(
+        world.get::<HingeState>(hinge).unwrap().mode,
+        HingeMode::Clearance
+    );
+
+    world
+        .entity_mut(hinge)
+        .remove::<ClearanceHinge>()
+        .insert(IdealHinge);
+    steps(&mut world, &mut schedule, 10).unwrap();
+    let p = world.resource::<Physics>();
+    assert!(p.clearance().is_empty());
+    assert!(matches!(p.joint(hinge), Some(HingeJoint::Ideal(_))));
+    assert_eq!(p.world.rapier.impulse_joints.len(), 1, "the revolute alone");
+    assert_eq!(tilt(&world), None);
 }
 
 #[test]

@@ -563,12 +563,10 @@ fn hinge_state_carries_the_readouts() {
     assert!(!impulses.is_empty(), "the journal hit the wall");
 }
 
-/// The spatial model through the ECS: the same `ClearanceHinge` with `ClearanceModel::Spatial`
-/// converts the revolute without any lock, and an arm whose centre of mass sits 30 mm along the
-/// axis from the pin's mid-plane tilts the journal until the bore's edges carry its moment.
-#[test]
-fn a_spatial_hinge_tilts_under_a_moment_across_its_axis() {
-    use crate::model::spatial::SpatialModel;
+/// A 2 kg arm hanging 0.3 m below a fixed base, its centre of mass 30 mm along the hinge's axis
+/// (z) from the pin's mid-plane (its weight makes a moment across the axis), in a compliant-ready
+/// world at 1e-5 s steps: `(world, base, arm)`.
+fn offset_arm() -> (World, Entity, Entity) {
     let mut world = World::new();
     let mut physics = Physics::new(1e-5, Vector::new(0.0, -9.81, 0.0));
     physics
@@ -590,6 +588,16 @@ fn a_spatial_hinge_tilts_under_a_moment_across_its_axis() {
                 .can_sleep(false),
         ))
         .id();
+    (world, base, arm)
+}
+
+/// The spatial model through the ECS: the same `ClearanceHinge` with `ClearanceModel::Spatial`
+/// converts the revolute without any lock, and an arm whose centre of mass sits 30 mm along the
+/// axis from the pin's mid-plane tilts the journal until the bore's edges carry its moment.
+#[test]
+fn a_spatial_hinge_tilts_under_a_moment_across_its_axis() {
+    use crate::model::spatial::SpatialModel;
+    let (mut world, base, arm) = offset_arm();
     let spatial = clearance().model(ClearanceModel::Spatial(SpatialModel::steel(0.2e-3, 0.015)));
     let hinge = world
         .spawn((
@@ -621,28 +629,7 @@ fn a_spatial_hinge_tilts_under_a_moment_across_its_axis() {
 #[test]
 fn a_hinge_swaps_between_planar_spatial_and_ideal() {
     use crate::model::spatial::SpatialModel;
-    let mut world = World::new();
-    let mut physics = Physics::new(1e-5, Vector::new(0.0, -9.81, 0.0));
-    physics
-        .world
-        .rapier
-        .integration_parameters
-        .num_solver_iterations = 1;
-    world.insert_resource(physics);
-    let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
-    // A 2 kg arm whose centre of mass sits 30 mm along the axis from the pin's mid-plane.
-    let arm = world
-        .spawn(Body::new(
-            RigidBodyBuilder::dynamic()
-                .translation(Vector::new(0.0, -0.3, 0.03))
-                .additional_mass_properties(MassProperties::new(
-                    Vector::ZERO,
-                    2.0,
-                    Vector::splat(0.02),
-                ))
-                .can_sleep(false),
-        ))
-        .id();
+    let (mut world, base, arm) = offset_arm();
     let hinge = world
         .spawn((
             Hinge::new(base, arm, Vector::Z).local_anchor2(Vector::new(0.0, 0.3, -0.03)),

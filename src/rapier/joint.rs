@@ -220,6 +220,15 @@ struct Onset {
 }
 
 impl ContactHistory {
+    /// The motion mode the history is in (paper Fig. 1b).
+    fn mode(&self) -> ContactMode {
+        match (self.in_contact, self.compressing) {
+            (false, _) => ContactMode::FreeFlight,
+            (true, true) => ContactMode::Impact,
+            (true, false) => ContactMode::Continuous,
+        }
+    }
+
     /// Moves the history to `state`, with `before` the state at the previous evaluation (if any):
     /// records `delta_dot0` at an onset (MODEL.md §2), located at the crossing of delta = 0 inside
     /// the step that led here, and whether the contact is still compressing.
@@ -724,11 +733,7 @@ impl ClearanceJoint {
             self.min_impact_speed,
             self.min_separation,
         );
-        let mode = match (self.contact.in_contact, self.contact.compressing) {
-            (false, _) => ContactMode::FreeFlight,
-            (true, true) => ContactMode::Impact,
-            (true, false) => ContactMode::Continuous,
-        };
+        let mode = self.contact.mode();
         let effective_mass = 1.0
             / (inverse_mass_along(rb1, state.contact_point, state.normal)
                 + inverse_mass_along(rb2, state.contact_point, state.normal));

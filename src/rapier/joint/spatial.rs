@@ -429,11 +429,7 @@ impl ClearanceJoint {
             self.min_impact_speed,
             self.min_separation,
         );
-        let mode = match (self.contact.in_contact, self.contact.compressing) {
-            (false, _) => ContactMode::FreeFlight,
-            (true, true) => ContactMode::Impact,
-            (true, false) => ContactMode::Continuous,
-        };
+        let mode = self.contact.mode();
         let (max_stable_dt, omega, zeta) = if lin.stiffness > 0.0 || lin.damping > 0.0 {
             let (dt, omega, zeta) = stable_step(lin.stiffness, lin.damping, m);
             (dt.min(lin.single), omega, zeta)

@@ -3,7 +3,7 @@
 //! the deepest station as its state (what the step control and the guards read) and the sums.
 
 use super::{ClearanceJoint, ClearanceReport, ContactHistory, friction_slope, motion};
-use crate::model::kinematics::{ContactMode, ForcePair, JournalState, contact_force, stable_step};
+use crate::model::kinematics::{ForcePair, JournalState, contact_force, stable_step};
 use crate::model::laws::{NormalContact, NormalForceLaw, NormalModel, loaded_impact_rate};
 use crate::model::spatial::{
     FACE_POINTS, Face, Share, SpatialModel, SpatialPose, bore_station, face_station,
@@ -324,9 +324,7 @@ impl ClearanceJoint {
             axial_offset: pose.axial_offset(),
             ..SpatialReport::default()
         };
-        let (mut force, mut normal_sum, mut friction_sum) =
-            (Vector::ZERO, Vector::ZERO, Vector::ZERO);
-        let (mut torque1, mut torque2) = (Vector::ZERO, Vector::ZERO);
+        let mut totals = Totals::default();
         let mut lin = Linearised {
             single: f64::INFINITY,
             friction_single: f64::INFINITY,
@@ -376,17 +374,8 @@ impl ClearanceJoint {
             stiffness_sum += law.tangent_stiffness(state.penetration);
             load_point += pair.normal_force * pair.point;
             load += pair.normal_force;
-            report.stations_in_contact += 1;
-            match st.place {
-                Place::Bore { edge: Some(e), .. } => report.edge_force[e] += pair.normal_force,
-                Place::Bore { edge: None, .. } => report.bore_force += pair.normal_force,
-                Place::Face { face, .. } => report.face_force[face as usize] += pair.normal_force,
-            }
-            force += pair.on_journal;
-            normal_sum -= pair.normal_force * state.normal;
-            friction_sum += pair.on_journal + pair.normal_force * state.normal;
-            torque2 += (pair.point - m2.center_of_mass).cross(pair.on_journal);
-            torque1 += (pair.point - m1.center_of_mass).cross(-pair.on_journal);
+            report.add(st.place, pair.normal_force);
+            totals.add(&state, &pair, [m1.center_of_mass, m2.center_of_mass]);
             linearise(
                 &mut lin,
                 &law,
@@ -430,25 +419,9 @@ impl ClearanceJoint {
             self.min_separation,
         );
         let mode = self.contact.mode();
-        let (max_stable_dt, omega, zeta) = if lin.stiffness > 0.0 || lin.damping > 0.0 {
-            let (dt, omega, zeta) = stable_step(lin.stiffness, lin.damping, m);
-            (dt.min(lin.single), omega, zeta)
-        } else {
-            (f64::INFINITY, 0.0, 0.0)
-        };
-        let friction_stable_dt = if lin.friction > 0.0 || lin.friction_cross > 0.0 {
-            // The tangential dampers act in parallel at the load's centre (as the normal's
-            // effective mass above; the planar joint's point when the journal is aligned),
-            // along the slip and across it.
-            let t = friction_direction(&state, pose.bearing_axis);
-            let centre = load_point / load;
-            let along = 2.0 / (bodies.inverse_mass(centre, t) * lin.friction);
-            let across =
-                2.0 / (bodies.inverse_mass(centre, state.normal.cross(t)) * lin.friction_cross);
-            along.min(across).min(lin.friction_single)
-        } else {
-            f64::INFINITY
-        };
+        // (The load's centre is read only when a station is in contact, `load > 0`.)
+        let (max_stable_dt, omega, zeta, friction_stable_dt) =
+            step_limits(&lin, m, &state, &pose, &bodies, load_point / load);
         if self.prepared_report() {
             self.previous_rate = Some(self.report.state.penetration_rate);
         }
@@ -461,10 +434,10 @@ impl ClearanceJoint {
             approach_speed: onset.approach_speed,
             onset_fraction: onset.fraction,
             force: ForcePair {
-                on_journal: force,
+                on_journal: totals.force,
                 point: state.contact_point,
-                normal_force: normal_sum.length(),
-                friction_force: friction_sum.length(),
+                normal_force: totals.normal.length(),
+                friction_force: totals.friction.length(),
             },
             max_stable_dt,
             friction_stable_dt,
@@ -475,16 +448,81 @@ impl ClearanceJoint {
         };
         let w1 = Wrench {
             body: self.body1,
-            force: -force,
-            torque: torque1,
+            force: -totals.force,
+            torque: totals.torque[0],
         };
         let w2 = Wrench {
             body: self.body2,
-            force,
-            torque: torque2,
+            force: totals.force,
+            torque: totals.torque[1],
         };
         Some((w1, w2))
     }
+}
+
+/// The stations' force pairs summed: the force on the journal, its normal and friction parts, and
+/// the torque on each body about its centre of mass.
+#[derive(Default)]
+struct Totals {
+    force: Vector,
+    normal: Vector,
+    friction: Vector,
+    torque: [Vector; 2],
+}
+
+impl Totals {
+    /// Adds one station's pair; `centres` are the bearing's and the journal's centres of mass.
+    fn add(&mut self, state: &JournalState, pair: &ForcePair, centres: [Vector; 2]) {
+        self.force += pair.on_journal;
+        self.normal -= pair.normal_force * state.normal;
+        self.friction += pair.on_journal + pair.normal_force * state.normal;
+        self.torque[1] += (pair.point - centres[1]).cross(pair.on_journal);
+        self.torque[0] += (pair.point - centres[0]).cross(-pair.on_journal);
+    }
+}
+
+impl SpatialReport {
+    /// Adds a station's normal force to its kind's total.
+    fn add(&mut self, place: Place, normal_force: f64) {
+        self.stations_in_contact += 1;
+        match place {
+            Place::Bore { edge: Some(e), .. } => self.edge_force[e] += normal_force,
+            Place::Bore { edge: None, .. } => self.bore_force += normal_force,
+            Place::Face { face, .. } => self.face_force[face as usize] += normal_force,
+        }
+    }
+}
+
+/// The joint's stability and friction limits from the stations' linearised sums, against the
+/// effective mass `m` at the load's centre `centre`: `(max_stable_dt, omega, zeta,
+/// friction_stable_dt)`. Each station's own limit holds too.
+fn step_limits(
+    lin: &Linearised,
+    m: f64,
+    state: &JournalState,
+    pose: &SpatialPose,
+    bodies: &Pair,
+    centre: Vector,
+) -> (f64, f64, f64, f64) {
+    let (max_stable_dt, omega, zeta) = if lin.stiffness > 0.0 || lin.damping > 0.0 {
+        let (dt, omega, zeta) = stable_step(lin.stiffness, lin.damping, m);
+        (dt.min(lin.single), omega, zeta)
+    } else {
+        (f64::INFINITY, 0.0, 0.0)
+    };
+    let friction_stable_dt = if lin.friction > 0.0 || lin.friction_cross > 0.0 {
+        // The tangential dampers act in parallel at the load's centre (as the normal's
+        // effective mass; the planar joint's point when the journal is aligned), along the slip
+        // and across it.
+        let t = friction_direction(state, pose.bearing_axis);
+        let along = 2.0 / (bodies.inverse_mass(centre, t) * lin.friction);
+        let across =
+            2.0 / (bodies.inverse_mass(centre, state.normal.cross(t)) * lin.friction_cross);
+        along.min(across).min(lin.friction_single)
+    } else {
+        f64::INFINITY
+    };
+    (max_stable_dt, omega, zeta, friction_stable_dt)
 }
 
 /// The point where the whole contact would act were it at this station: on the bearing's

@@ -18,17 +18,22 @@ fn clearance() -> Clearance {
 
 /// A 2 kg arm whose centre of mass hangs 0.3 m below `(x, 0, 0)`.
 fn arm_at(x: f64) -> Body {
+    arm_with_centre(Vector::new(x, -0.3, 0.0))
+}
+
+/// A 2 kg arm with its centre of mass at `centre`.
+fn arm_with_centre(centre: Vector) -> Body {
     Body::new(
         RigidBodyBuilder::dynamic()
-            .translation(Vector::new(x, -0.3, 0.0))
+            .translation(centre)
             .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02)))
             .can_sleep(false),
     )
 }
 
-/// A 2 kg arm hanging 0.3 m below a fixed base on an ideal hinge about z, in a world with one
-/// solver iteration (ready for the compliant model).
-fn pendulum(dt: f64) -> (World, Schedule, Entity, Entity) {
+/// A world with gravity along -y, one solver iteration (ready for the compliant model) and
+/// steps of `dt`, with a fixed base: `(world, base)`.
+fn compliant_world(dt: f64) -> (World, Entity) {
     let mut world = World::new();
     let mut physics = Physics::new(dt, Vector::new(0.0, -9.81, 0.0));
     physics
@@ -38,6 +43,13 @@ fn pendulum(dt: f64) -> (World, Schedule, Entity, Entity) {
         .num_solver_iterations = 1;
     world.insert_resource(physics);
     let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
+    (world, base)
+}
+
+/// A 2 kg arm hanging 0.3 m below a fixed base on an ideal hinge about z, in a world with one
+/// solver iteration (ready for the compliant model).
+fn pendulum(dt: f64) -> (World, Schedule, Entity, Entity) {
+    let (mut world, base) = compliant_world(dt);
     let arm = world.spawn(arm_at(0.0)).id();
     let hinge = world
         .spawn((
@@ -567,26 +579,9 @@ fn hinge_state_carries_the_readouts() {
 /// (z) from the pin's mid-plane (its weight makes a moment across the axis), in a compliant-ready
 /// world at 1e-5 s steps: `(world, base, arm)`.
 fn offset_arm() -> (World, Entity, Entity) {
-    let mut world = World::new();
-    let mut physics = Physics::new(1e-5, Vector::new(0.0, -9.81, 0.0));
-    physics
-        .world
-        .rapier
-        .integration_parameters
-        .num_solver_iterations = 1;
-    world.insert_resource(physics);
-    let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
+    let (mut world, base) = compliant_world(1e-5);
     let arm = world
-        .spawn(Body::new(
-            RigidBodyBuilder::dynamic()
-                .translation(Vector::new(0.0, -0.3, 0.03))
-                .additional_mass_properties(MassProperties::new(
-                    Vector::ZERO,
-                    2.0,
-                    Vector::splat(0.02),
-                ))
-                .can_sleep(false),
-        ))
+        .spawn(arm_with_centre(Vector::new(0.0, -0.3, 0.03)))
         .id();
     (world, base, arm)
 }

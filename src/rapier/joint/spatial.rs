@@ -59,6 +59,20 @@ pub enum StationPlace {
 
 use StationPlace as Place;
 
+impl StationPlace {
+    /// The law this station carries: its share of the bore's law `bore` (its slice's
+    /// trapezoidal weight) or of the face law `face` (one ring point's).
+    fn law<'a>(self, bore: &'a NormalModel, face: &'a NormalModel) -> Share<'a, NormalModel> {
+        match self {
+            Place::Bore { share, .. } => Share { law: bore, share },
+            Place::Face { .. } => Share {
+                law: face,
+                share: 1.0 / FACE_POINTS as f64,
+            },
+        }
+    }
+}
+
 /// One station of a spatial joint at the joint's last application
 /// ([`ClearanceJoint::spatial_stations`]): the pressure distribution along the width is the bore
 /// stations' `normal_force / share` against `s`, as a force per unit fraction of the width.
@@ -191,11 +205,10 @@ impl SpatialParts {
             let Some(state) = st.state.filter(|_| st.force[0] > 0.0) else {
                 continue;
             };
-            let (law, share) = match st.place {
-                Place::Bore { share, .. } => (bore_law, share),
-                Place::Face { .. } => (&self.face_law, 1.0 / FACE_POINTS as f64),
-            };
-            energy += Share { law, share }.elastic_energy(state.penetration);
+            energy += st
+                .place
+                .law(bore_law, &self.face_law)
+                .elastic_energy(state.penetration);
         }
         energy
     }
@@ -222,6 +235,26 @@ impl SpatialParts {
 }
 
 impl ClearanceJoint {
+    /// Where the joint's bearing (`rb1`, its body 1) and journal (`rb2`) are now, in world
+    /// coordinates, with `transverse` (world, square to the bore's axis) as the first tilt axis
+    /// of [`SpatialPose::tilt`]: the pose a spatial joint's stations are evaluated at (the
+    /// joint's own transverse axis is fixed in body 1; a caller may measure the tilt about its
+    /// own).
+    pub fn spatial_pose(
+        &self,
+        rb1: &RigidBody,
+        rb2: &RigidBody,
+        transverse: Vector,
+    ) -> SpatialPose {
+        SpatialPose {
+            bearing_center: *rb1.position() * self.local_anchor1,
+            bearing_axis: *rb1.rotation() * self.local_axis1,
+            bearing_transverse: transverse,
+            journal_center: *rb2.position() * self.local_anchor2,
+            journal_axis: *rb2.rotation() * self.local_axis2,
+        }
+    }
+
     /// A spatial joint's stations at its last application, bore stations first (from `-L/2` to
     /// `+L/2`), then the lower face's ring points, then the upper's; empty for a planar joint or
     /// before the first application. The bore stations' forces are the pressure distribution
@@ -307,15 +340,9 @@ impl ClearanceJoint {
         let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
         let (m1, m2) = (motion(rb1), motion(rb2));
         let bodies = Pair([Mobility::of(rb1), Mobility::of(rb2)]);
+        let transverse = *rb1.rotation() * self.spatial.as_ref()?.local_transverse1;
+        let pose = self.spatial_pose(rb1, rb2, transverse);
         let parts = self.spatial.as_mut()?;
-        let rot1 = *rb1.rotation();
-        let pose = SpatialPose {
-            bearing_center: *rb1.position() * self.local_anchor1,
-            bearing_axis: rot1 * self.local_axis1,
-            bearing_transverse: rot1 * parts.local_transverse1,
-            journal_center: *rb2.position() * self.local_anchor2,
-            journal_axis: *rb2.rotation() * self.local_axis2,
-        };
         let geometry = &self.geometry;
         let spatial = parts.model.geometry;
         let (c, a) = (geometry.clearance(), spatial.axial_play);
@@ -337,21 +364,14 @@ impl ClearanceJoint {
         // The deepest station: (index, state, impact rate).
         let mut deepest: Option<(usize, JournalState, f64)> = None;
         for (i, st) in parts.stations.iter_mut().enumerate() {
-            let (state, law, share, gap_scale) = match st.place {
-                Place::Bore { s, share, .. } => (
-                    bore_station(geometry, &pose, s, &m1, &m2),
-                    &self.normal_law,
-                    share,
-                    c,
-                ),
+            let (state, gap_scale) = match st.place {
+                Place::Bore { s, .. } => (bore_station(geometry, &pose, s, &m1, &m2), c),
                 Place::Face { face, index } => (
                     face_station(geometry, &spatial, &pose, face, index, &m1, &m2),
-                    &parts.face_law,
-                    1.0 / FACE_POINTS as f64,
                     a,
                 ),
             };
-            let law = Share { law, share };
+            let law = st.place.law(&self.normal_law, &parts.face_law);
             flight_rate = flight_rate.max(state.eccentricity_rate.length() / gap_scale);
             st.contact.advance(
                 st.state.as_ref(),

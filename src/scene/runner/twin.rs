@@ -7,7 +7,6 @@ use super::invariants::{BodyBefore, Invariants};
 use crate::error::Result;
 use crate::model::angle::{HingeAngle, UnwrappedAngle, twist_angle};
 use crate::model::laws::NormalForceLaw;
-use crate::model::spatial::SpatialPose;
 use crate::rapier::drive::DriveHandle;
 use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle, SpatialReport};
 use crate::rapier::large_step::{LargeStepJoint, LargeStepJointHandle};
@@ -190,18 +189,6 @@ pub(super) const SPATIAL_COLUMNS: [&str; 8] = [
     "face_lower_force_n",
     "face_upper_force_n",
 ];
-
-/// Where a spatial joint's two bodies are, its tilt measured about the runner's `u` axis
-/// (`u`, world: the `ecc_u` column's axis) and `a_i x u` (the `ecc_v` axis).
-fn spatial_pose(j: &ClearanceJoint, r1: &RigidBody, r2: &RigidBody, u: Vector) -> SpatialPose {
-    SpatialPose {
-        bearing_center: *r1.position() * j.local_anchor1(),
-        bearing_axis: *r1.rotation() * j.local_axis1(),
-        bearing_transverse: u,
-        journal_center: *r2.position() * j.local_anchor2(),
-        journal_axis: *r2.rotation() * j.local_axis2(),
-    }
-}
 
 /// The work a spatial joint's damping and friction dissipated over a step, J: minus the work
 /// of its wrenches over the bodies' motion in the step (force times the centre of mass's
@@ -541,7 +528,7 @@ impl Twin {
                     let j = world.clearance.get(c).expect("handle of this twin");
                     let r = j.report();
                     let (u, v_axis) = (*r1.rotation() * h.local_u1, *r1.rotation() * h.local_v1);
-                    let pose = r.spatial.map(|_| spatial_pose(j, r1, r2, u));
+                    let pose = r.spatial.map(|_| j.spatial_pose(r1, r2, u));
                     // A spatial joint's eccentricity at the bearing's mid-plane (its report's
                     // state is the deepest station's, which may be a face's).
                     let e = match &pose {

@@ -256,7 +256,9 @@ fn main() {
             }
         ));
     }
-    let dir = Path::new("bench_out");
+    // The workspace's `bench_out/` (cargo runs a bench in its package's folder, `app/`).
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../bench_out");
+    std::fs::create_dir_all(&dir).unwrap();
     write_atomic(&dir.join("work_precision.csv"), csv.as_bytes()).unwrap();
     write_atomic(&dir.join("work_precision.md"), md.as_bytes()).unwrap();
     plot(&dir.join("work_precision.svg"), &points).unwrap();

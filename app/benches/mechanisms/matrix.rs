@@ -278,13 +278,12 @@ pub fn assets() -> PathBuf {
 /// The case's scene with its variant, `end_s` and the stepping applied.
 pub fn scene(case: &Case, stepping: Stepping, end_s: f64) -> Scene {
     let base = Scene::load(&assets().join(case.file)).expect("the matrix's scenes load");
-    let mut set = case.set.clone();
-    set.extend([
+    let mut set = vec![
         format!("run.end_s={end_s}"),
         format!("run.output_interval_s={}", case.output_interval_s),
         "run.body_motion=true".into(),
         "run.strict=false".into(),
-    ]);
+    ];
     match stepping {
         Stepping::Default => set.extend(
             [
@@ -298,6 +297,8 @@ pub fn scene(case: &Case, stepping: Stepping, end_s: f64) -> Scene {
             set.extend(["run.step=Fixed".into(), format!("run.dt_s={dt}")]);
         }
     }
+    // The case's own settings last: a case may override the stepping's (a study of one knob).
+    set.extend(case.set.iter().cloned());
     base.with_overrides(&set)
         .expect("the matrix's overrides apply")
 }

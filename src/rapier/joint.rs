@@ -83,6 +83,7 @@ impl ClearanceJointBuilder {
                 lock_handle: None,
                 contact: ContactHistory::default(),
                 report: ClearanceReport::default(),
+                elastic: 0.0,
                 previous_rate: None,
                 last_wrenches: None,
                 prepared: false,
@@ -350,6 +351,9 @@ pub struct ClearanceJoint {
     lock_handle: Option<ImpulseJointHandle>,
     contact: ContactHistory,
     report: ClearanceReport,
+    /// The planar contact's elastic energy at the last application, J, computed once there: the
+    /// step control, a hysteresis law's loaded rate and the energy balance all read it.
+    elastic: f64,
     previous_rate: Option<f64>,
     /// The wrenches on body 1 and body 2 at the last application.
     last_wrenches: Option<[Wrench; 2]>,
@@ -427,6 +431,7 @@ const STABILITY_SAFETY: f64 = 0.8;
 struct JointDynamics {
     contact: ContactHistory,
     report: ClearanceReport,
+    elastic: f64,
     previous_rate: Option<f64>,
     last_wrenches: Option<[Wrench; 2]>,
     prepared: bool,
@@ -518,9 +523,7 @@ impl ClearanceJoint {
     pub fn elastic_energy(&self) -> f64 {
         match &self.spatial {
             Some(parts) => parts.elastic_energy(&self.normal_law),
-            None => self
-                .normal_law
-                .elastic_energy(self.report.state.penetration),
+            None => self.elastic,
         }
     }
 
@@ -615,26 +618,33 @@ impl ClearanceJoint {
     /// at its edge is as stiff as the few stations that touch, not the whole width.
     fn contact_step(&self, approach_speed: f64, depth: f64, tolerance: f64) -> f64 {
         let law = self.governing_law();
-        match self.spatial.as_ref().map(|p| p.contact_share()) {
-            Some(share) if share != 1.0 => self.contact_step_of(
-                &crate::model::spatial::Share { law, share },
-                approach_speed,
-                depth,
-                tolerance,
-            ),
-            _ => self.contact_step_of(law, approach_speed, depth, tolerance),
+        let share = self.spatial.as_ref().map_or(1.0, |p| p.contact_share());
+        if share != 1.0 {
+            let law = crate::model::spatial::Share { law, share };
+            let elastic = law.elastic_energy(depth);
+            return self.contact_step_of(&law, elastic, approach_speed, depth, tolerance);
         }
+        // The planar joint's elastic energy at its own depth is known from its application.
+        let elastic = if self.spatial.is_none() && depth == self.report.state.penetration {
+            self.elastic
+        } else {
+            law.elastic_energy(depth)
+        };
+        self.contact_step_of(law, elastic, approach_speed, depth, tolerance)
     }
 
+    /// [`contact_step`](Self::contact_step) for `law`, whose elastic energy at `depth` is
+    /// `elastic` (J).
     fn contact_step_of(
         &self,
         law: &impl NormalForceLaw,
+        elastic: f64,
         approach_speed: f64,
         depth: f64,
         tolerance: f64,
     ) -> f64 {
         let m = self.report.effective_mass;
-        let energy = 0.5 * m * approach_speed * approach_speed + law.elastic_energy(depth);
+        let energy = 0.5 * m * approach_speed * approach_speed + elastic;
         let peak = crate::model::laws::penetration_for_energy(law, energy, 1e-6).max(depth);
         let stiffness = law.tangent_stiffness(peak);
         if !(stiffness > 0.0) {
@@ -693,6 +703,7 @@ impl ClearanceJoint {
     fn save_into(&self, d: &mut JointDynamics) {
         d.contact = self.contact;
         d.report = self.report;
+        d.elastic = self.elastic;
         d.previous_rate = self.previous_rate;
         d.last_wrenches = self.last_wrenches;
         d.prepared = self.prepared;
@@ -706,6 +717,7 @@ impl ClearanceJoint {
     fn set_dynamics(&mut self, d: &JointDynamics) {
         self.contact = d.contact;
         self.report = d.report;
+        self.elastic = d.elastic;
         self.previous_rate = d.previous_rate;
         self.last_wrenches = d.last_wrenches;
         self.prepared = d.prepared;
@@ -744,7 +756,8 @@ impl ClearanceJoint {
         let effective_mass = 1.0
             / (inverse_mass_along(rb1, state.contact_point, state.normal)
                 + inverse_mass_along(rb2, state.contact_point, state.normal));
-        let impact_rate = self.law_impact_rate(state.penetration, effective_mass);
+        let elastic = self.normal_law.elastic_energy(state.penetration);
+        let impact_rate = self.law_impact_rate(elastic, effective_mass);
         let force = contact_force(&state, impact_rate, &self.normal_law, &self.friction_law);
 
         // Linearised contact for the step-size limit.
@@ -784,6 +797,7 @@ impl ClearanceJoint {
         if self.prepared_report() {
             self.previous_rate = Some(self.report.state.penetration_rate);
         }
+        self.elastic = elastic;
         self.report = ClearanceReport {
             state,
             mode,
@@ -816,18 +830,16 @@ impl ClearanceJoint {
 }
 
 impl ClearanceJoint {
-    /// `delta_dot0` for the law in the current contact at `depth` (m): the contact's own,
-    /// raised for a hysteresis law to [`loaded_impact_rate`] at that depth (0 in free flight).
-    fn law_impact_rate(&self, depth: f64, effective_mass: f64) -> f64 {
+    /// `delta_dot0` for the law in the current contact whose elastic energy is `elastic` (J):
+    /// the contact's own, raised for a hysteresis law to [`loaded_impact_rate`] there (0 in free
+    /// flight).
+    fn law_impact_rate(&self, elastic: f64, effective_mass: f64) -> f64 {
         if !self.contact.in_contact {
             return self.contact.impact_rate;
         }
         let rate = self.contact.impact_rate;
         if self.normal_law.uses_impact_rate() {
-            rate.max(loaded_impact_rate(
-                self.normal_law.elastic_energy(depth),
-                effective_mass,
-            ))
+            rate.max(loaded_impact_rate(elastic, effective_mass))
         } else {
             rate
         }
@@ -1019,6 +1031,7 @@ impl ClearanceJointSet {
             if joint.last_wrenches.is_none() {
                 joint.contact = ContactHistory::default();
                 joint.report = ClearanceReport::default();
+                joint.elastic = 0.0;
                 joint.previous_rate = None;
                 if let Some(parts) = &mut joint.spatial {
                     parts.reset();

@@ -16,6 +16,7 @@ use crate::rapier::ledger::{
 };
 use crate::rapier::stall::StalledContact;
 use rapier3d_f64::data::Index;
+use std::sync::OnceLock;
 
 mod spatial;
 use rapier3d_f64::math::Vector;
@@ -83,7 +84,7 @@ impl ClearanceJointBuilder {
                 lock_handle: None,
                 contact: ContactHistory::default(),
                 report: ClearanceReport::default(),
-                elastic: 0.0,
+                elastic: OnceLock::new(),
                 previous_rate: None,
                 last_wrenches: None,
                 prepared: false,
@@ -351,9 +352,11 @@ pub struct ClearanceJoint {
     lock_handle: Option<ImpulseJointHandle>,
     contact: ContactHistory,
     report: ClearanceReport,
-    /// The planar contact's elastic energy at the last application, J, computed once there: the
-    /// step control, a hysteresis law's loaded rate and the energy balance all read it.
-    elastic: f64,
+    /// The planar contact's elastic energy at the last application, J, computed on first use and
+    /// then shared: the step control, a hysteresis law's loaded rate and the energy balance read
+    /// it (a law of Liu's family integrates its force for it; a fixed-step loop that reads none
+    /// of them does not pay for it).
+    elastic: OnceLock<f64>,
     previous_rate: Option<f64>,
     /// The wrenches on body 1 and body 2 at the last application.
     last_wrenches: Option<[Wrench; 2]>,
@@ -431,7 +434,7 @@ const STABILITY_SAFETY: f64 = 0.8;
 struct JointDynamics {
     contact: ContactHistory,
     report: ClearanceReport,
-    elastic: f64,
+    elastic: OnceLock<f64>,
     previous_rate: Option<f64>,
     last_wrenches: Option<[Wrench; 2]>,
     prepared: bool,
@@ -523,7 +526,10 @@ impl ClearanceJoint {
     pub fn elastic_energy(&self) -> f64 {
         match &self.spatial {
             Some(parts) => parts.elastic_energy(&self.normal_law),
-            None => self.elastic,
+            None => *self.elastic.get_or_init(|| {
+                self.normal_law
+                    .elastic_energy(self.report.state.penetration)
+            }),
         }
     }
 
@@ -626,7 +632,7 @@ impl ClearanceJoint {
         }
         // The planar joint's elastic energy at its own depth is known from its application.
         let elastic = if self.spatial.is_none() && depth == self.report.state.penetration {
-            self.elastic
+            self.elastic_energy()
         } else {
             law.elastic_energy(depth)
         };
@@ -703,7 +709,7 @@ impl ClearanceJoint {
     fn save_into(&self, d: &mut JointDynamics) {
         d.contact = self.contact;
         d.report = self.report;
-        d.elastic = self.elastic;
+        d.elastic.clone_from(&self.elastic);
         d.previous_rate = self.previous_rate;
         d.last_wrenches = self.last_wrenches;
         d.prepared = self.prepared;
@@ -717,7 +723,7 @@ impl ClearanceJoint {
     fn set_dynamics(&mut self, d: &JointDynamics) {
         self.contact = d.contact;
         self.report = d.report;
-        self.elastic = d.elastic;
+        self.elastic.clone_from(&d.elastic);
         self.previous_rate = d.previous_rate;
         self.last_wrenches = d.last_wrenches;
         self.prepared = d.prepared;
@@ -756,8 +762,11 @@ impl ClearanceJoint {
         let effective_mass = 1.0
             / (inverse_mass_along(rb1, state.contact_point, state.normal)
                 + inverse_mass_along(rb2, state.contact_point, state.normal));
-        let elastic = self.normal_law.elastic_energy(state.penetration);
-        let impact_rate = self.law_impact_rate(elastic, effective_mass);
+        let elastic = OnceLock::new();
+        let impact_rate = self.law_impact_rate(
+            || *elastic.get_or_init(|| self.normal_law.elastic_energy(state.penetration)),
+            effective_mass,
+        );
         let force = contact_force(&state, impact_rate, &self.normal_law, &self.friction_law);
 
         // Linearised contact for the step-size limit.
@@ -830,16 +839,16 @@ impl ClearanceJoint {
 }
 
 impl ClearanceJoint {
-    /// `delta_dot0` for the law in the current contact whose elastic energy is `elastic` (J):
-    /// the contact's own, raised for a hysteresis law to [`loaded_impact_rate`] there (0 in free
-    /// flight).
-    fn law_impact_rate(&self, elastic: f64, effective_mass: f64) -> f64 {
+    /// `delta_dot0` for the law in the current contact whose elastic energy `elastic()` gives
+    /// (J): the contact's own, raised for a hysteresis law to [`loaded_impact_rate`] there (0 in
+    /// free flight).
+    fn law_impact_rate(&self, elastic: impl FnOnce() -> f64, effective_mass: f64) -> f64 {
         if !self.contact.in_contact {
             return self.contact.impact_rate;
         }
         let rate = self.contact.impact_rate;
         if self.normal_law.uses_impact_rate() {
-            rate.max(loaded_impact_rate(elastic, effective_mass))
+            rate.max(loaded_impact_rate(elastic(), effective_mass))
         } else {
             rate
         }
@@ -1031,7 +1040,7 @@ impl ClearanceJointSet {
             if joint.last_wrenches.is_none() {
                 joint.contact = ContactHistory::default();
                 joint.report = ClearanceReport::default();
-                joint.elastic = 0.0;
+                joint.elastic = OnceLock::new();
                 joint.previous_rate = None;
                 if let Some(parts) = &mut joint.spatial {
                     parts.reset();

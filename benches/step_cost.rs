@@ -9,8 +9,11 @@ use clearance_joint::model::spatial::{DEFAULT_SLICES, SpatialModel};
 use clearance_joint::prelude::*;
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::runner::{RunOptions, Simulation, Twins};
-use rapier3d_f64::prelude::{LockedAxes, MassProperties, PhysicsWorld, RigidBodyBuilder};
+use rapier3d_f64::prelude::LockedAxes;
 use std::time::Instant;
+
+#[path = "../tests/support/arm.rs"]
+mod support;
 
 fn median_us_per_step(mut make: impl FnMut() -> Simulation) -> f64 {
     let mut samples: Vec<f64> = (0..5)
@@ -25,37 +28,17 @@ fn median_us_per_step(mut make: impl FnMut() -> Simulation) -> f64 {
     samples[2]
 }
 
-/// A 2 kg arm 0.3 m from a fixed base on a steel pin (radius 10 mm, clearance 0.2 mm, width
-/// 16 mm, dry friction), released horizontal, its centre of mass `offset` m off the hinge's
+/// The shared arm (`tests/support/arm.rs`) on a steel pin (radius 10 mm, clearance 0.2 mm, width
+/// 16 mm, dry friction) at fixed steps of `dt`, its centre of mass `offset` m off the hinge's
 /// mid-plane along the axis; `model` None is the planar joint with its default lock.
 fn arm(model: Option<SpatialModel>, offset: f64, dt: f64) -> ClearanceWorld {
-    let mut rapier = PhysicsWorld::new();
-    rapier.gravity = Vector::new(0.0, -9.81, 0.0);
-    rapier.integration_parameters.num_solver_iterations = 1;
-    let mut world = ClearanceWorld::new(rapier, StepControl::fixed(dt));
-    let base = world.rapier.bodies.insert(RigidBodyBuilder::fixed());
-    let arm = world.rapier.bodies.insert(
-        RigidBodyBuilder::dynamic()
-            .translation(Vector::new(0.3, 0.0, offset))
-            .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02)))
-            .can_sleep(false),
-    );
     let mut clearance = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
         .friction(FrictionModel::Bai(Bai::DRY));
     if let Some(model) = model {
         clearance = clearance.model(ClearanceModel::Spatial(model));
     }
-    let pin = clearance
-        .joint(
-            Vector::ZERO,
-            Vector::new(-0.3, 0.0, -offset),
-            Vector::Z,
-            Vector::Z,
-        )
-        .unwrap();
-    world.insert_clearance(base, arm, pin);
-    world
+    support::arm(clearance, offset, StepControl::fixed(dt)).0
 }
 
 /// us per step of one run of the arm over 0.25 s at a fixed 5e-6 s (the tilted arm's edge

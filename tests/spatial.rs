@@ -13,6 +13,9 @@ use clearance_joint::rapier::guards::GuardKind;
 use clearance_joint::rapier::joint::StationPlace;
 use rapier3d_f64::prelude::*;
 
+#[path = "support/arm.rs"]
+mod support;
+
 /// Bearing radius, radial clearance and width of the test hinges, m.
 const R: f64 = 0.010;
 const C: f64 = 0.2e-3;
@@ -277,28 +280,9 @@ fn axial_knock_restitution_is_the_face_law_s() {
     );
 }
 
-/// A 2 kg arm whose centre of mass sits 0.3 m from a fixed base at the origin (and `offset` m
-/// along the hinge's axis from its mid-plane), released horizontal under gravity, with friction.
+/// The shared arm (`tests/support/arm.rs`) with friction on its pin, ready to run.
 fn arm(clearance: Clearance, offset: f64, control: StepControl) -> ArmRun {
-    let mut rapier = empty_world();
-    rapier.gravity = Vector::new(0.0, -9.81, 0.0);
-    let mut world = ClearanceWorld::new(rapier, control);
-    let base = world.rapier.bodies.insert(RigidBodyBuilder::fixed());
-    let arm = world.rapier.bodies.insert(
-        RigidBodyBuilder::dynamic()
-            .translation(Vector::new(0.3, 0.0, offset))
-            .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02)))
-            .can_sleep(false),
-    );
-    let joint = clearance
-        .joint(
-            Vector::ZERO,
-            Vector::new(-0.3, 0.0, -offset),
-            Vector::Z,
-            Vector::Z,
-        )
-        .unwrap();
-    let pin = world.insert_clearance(base, arm, joint);
+    let (world, arm, pin) = support::arm(clearance, offset, control);
     ArmRun { world, arm, pin }
 }
 

@@ -41,7 +41,11 @@
 //! iterations give them (a stack of eight 0.5 m boxes at 60 Hz stands with Rapier's 4 and has
 //! fallen within 10 s with one). A compliant [`ClearanceHinge`] in a world with more iterations is refused
 //! with an error that says so; nothing is changed. A game world that keeps its iterations gives
-//! its hinges the large-step model, which works with any number.
+//! its hinges the large-step model, which works with any number. One substep is also one
+//! Gauss-Seidel sweep over the ideal joints a step: a chain with a light body between stiff joints
+//! (a motor-driven crank carrying a heavier coupler) wants more sweeps,
+//! `integration_parameters.num_internal_pgs_iterations` (see
+//! [`ClearanceWorld`](crate::rapier::world)'s docs), which keeps the one substep.
 //!
 //! ```
 //! use bevy_ecs::prelude::*;

@@ -37,6 +37,14 @@
 //! assert!(peak > 19.62, "the first impact exceeds the static load: {peak} N");
 //! # Ok::<(), clearance_joint::Error>(())
 //! ```
+//!
+//! **Chains of ideal joints.** With one substep Rapier sweeps its joints' constraints once per
+//! step (Gauss-Seidel): exact for a body held by one joint, only in part for a chain or a loop,
+//! and what it leaves grows with the step, which the adaptive step makes long in free flight.
+//! Where a light body sits between stiff joints (a crank on a velocity motor carrying a heavier
+//! coupler) raise `integration_parameters.num_internal_pgs_iterations`, which keeps the one
+//! substep: on the four-bar of `assets/four_bar.ron` the first impact came 19.7 us late at one
+//! sweep and 0.3 us at 64, against a fixed 1e-6 s run (the scene format's `run.solver_sweeps`).
 
 use crate::error::Result;
 use crate::rapier::drive::{DriveHandle, DriveSet, TorsionSpring};

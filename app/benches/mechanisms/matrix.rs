@@ -169,9 +169,9 @@ pub fn cases() -> Vec<Case> {
             window_start_s: 0.1,
             quick_window_start_s: 0.025,
             unit: Unit::Turn(0.1),
-            // Fixed steps converge only at first order here (Rapier's velocity motor and the
-            // loop's joints, one solver iteration): the first impact's peak moved 1.5, 1.0 and
-            // 0.6 % from 5e-7 s to 2.5e-7, 1.25e-7 and 6.25e-8 s (5,100, 5,177, 5,229, 5,257 N).
+            // Fixed steps converge only at first order here: with the scene's 32 sweeps over the
+            // joints the first impact's peak is 5,400, 5,341, 5,312 and 5,297 N from 5e-7 s to
+            // 2.5e-7, 1.25e-7 and 6.25e-8 s (with one sweep 5,100, 5,177, 5,229 and 5,257 N).
             fixed_dt: [2.5e-7, 1.25e-7, 6.25e-8],
             output_interval_s: 1e-4,
             closed_form: None,

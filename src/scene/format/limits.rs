@@ -27,6 +27,8 @@ pub const DT_RANGE: (f64, f64) = (1e-9, 1.0);
 pub const END_RANGE: (f64, f64) = (1e-6, 1e7);
 /// Smallest `run.tolerance` (the largest is 1).
 pub const TOLERANCE_MIN: f64 = 1e-4;
+/// Most Gauss-Seidel sweeps a step (`run.solver_sweeps`): each costs a pass over every joint.
+pub const SWEEPS_MAX: usize = 1000;
 /// Range of a bearing diameter or width, mm (1 um to 10 m).
 pub const LENGTH_MM_RANGE: (f64, f64) = (1e-3, 1e4);
 /// Range of a radial clearance, mm (1 nm to 1 m; it must also be below the bearing radius).

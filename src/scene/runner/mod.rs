@@ -123,6 +123,7 @@ impl Simulation {
         physics.integration_parameters.dt = scene.run.dt_s;
         // One substep: the hook's force is constant over the step (substeps gain energy).
         physics.integration_parameters.num_solver_iterations = 1;
+        physics.integration_parameters.num_internal_pgs_iterations = scene.run.solver_sweeps;
         let mut world = ClearanceWorld::new(physics, control);
         let kinds: &[TwinKind] = match options.twins {
             Twins::Both => &[TwinKind::Ideal, TwinKind::Clearance],

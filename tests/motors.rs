@@ -691,7 +691,7 @@ fn the_four_bars_joint_sweeps_bring_its_first_impact_to_the_fine_run() {
     // The light crank sits between its stiff motor and a coupler 4.5 times its inertia about the
     // pivot: one Gauss-Seidel sweep over the joints a step leaves part of their constraints
     // unsolved, and at the library's default steps (up to 1e-3 s, tolerance 0.0075) the first
-    // impact came 19.7 us late (measured); the scene's 64 sweeps bring it within 0.3 us.
+    // impact came 19.7 us late (measured); the scene's 32 sweeps bring it within 0.7 us.
     let fine = four_bar_first_onset(&["run.step=Fixed", "run.dt_s=1e-6"]);
     let defaults = ["run.max_dt_s=1e-3", "run.tolerance=0.0075"];
     let swept = four_bar_first_onset(&defaults);

@@ -44,7 +44,8 @@
 //! Where a light body sits between stiff joints (a crank on a velocity motor carrying a heavier
 //! coupler) raise `integration_parameters.num_internal_pgs_iterations`, which keeps the one
 //! substep: on the four-bar of `assets/four_bar.ron` the first impact came 19.7 us late at one
-//! sweep and 0.3 us at 64, against a fixed 1e-6 s run (the scene format's `run.solver_sweeps`).
+//! sweep, 0.7 us at 32 and 0.3 us at 64, against a fixed 1e-6 s run (the scene format's
+//! `run.solver_sweeps`; the scene takes 32).
 
 use crate::error::Result;
 use crate::rapier::drive::{DriveHandle, DriveSet, TorsionSpring};

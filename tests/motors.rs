@@ -541,6 +541,25 @@ fn motor_fields_are_validated_with_their_paths() {
     }
 }
 
+/// `assets/four_bar.ron` over its first `end` seconds with `overrides`, run with `twins`.
+fn run_four_bar(
+    end: f64,
+    overrides: &[&str],
+    twins: Twins,
+    skip_rows: bool,
+) -> clearance_joint::scene::runner::RunResult {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/four_bar.ron");
+    let mut scene = Scene::load(&path)
+        .unwrap()
+        .with_overrides(overrides)
+        .unwrap();
+    scene.run.end_s = end;
+    Simulation::new(&scene, RunOptions { twins, skip_rows })
+        .unwrap()
+        .run()
+        .unwrap()
+}
+
 /// The ideal twin's rows of `assets/four_bar.ron` (the crank on a held velocity motor, a
 /// closed loop of ideal revolutes) over its first `end` seconds, with `overrides`; only the
 /// ideal twin when `alone`. With the run's guard violations.
@@ -549,23 +568,8 @@ fn four_bar(
     overrides: &[&str],
     alone: bool,
 ) -> (clearance_joint::table::Table, Vec<String>) {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/four_bar.ron");
-    let mut scene = Scene::load(&path)
-        .unwrap()
-        .with_overrides(overrides)
-        .unwrap();
-    scene.run.end_s = end;
     let twins = if alone { Twins::IdealOnly } else { Twins::Both };
-    let result = Simulation::new(
-        &scene,
-        RunOptions {
-            twins,
-            skip_rows: false,
-        },
-    )
-    .unwrap()
-    .run()
-    .unwrap();
+    let result = run_four_bar(end, overrides, twins, false);
     (
         result.twin(TwinKind::Ideal).unwrap().table.clone(),
         result.guards.messages(),
@@ -666,22 +670,7 @@ fn a_velocity_motor_that_misses_its_speed_is_flagged() {
 /// The clearance twin's first impact onset (s) of `assets/four_bar.ron` over its first 1.5 ms,
 /// with `overrides`.
 fn four_bar_first_onset(overrides: &[&str]) -> f64 {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/four_bar.ron");
-    let mut scene = Scene::load(&path)
-        .unwrap()
-        .with_overrides(overrides)
-        .unwrap();
-    scene.run.end_s = 0.0015;
-    let result = Simulation::new(
-        &scene,
-        RunOptions {
-            twins: Twins::ClearanceOnly,
-            skip_rows: true,
-        },
-    )
-    .unwrap()
-    .run()
-    .unwrap();
+    let result = run_four_bar(0.0015, overrides, Twins::ClearanceOnly, true);
     let twin = result.twin(TwinKind::Clearance).unwrap();
     twin.hinge_recorders()["rocker_pin"].impacts()[0].onset_t_s
 }

@@ -1,7 +1,7 @@
 //! The mechanism matrix (issue 16): each scene of the benchmark set at the library's defaults
 //! against the project's own converged fixed-step runs, step halving shown.
 //!
-//! `cargo bench --bench mechanisms` runs the full scenes (about 10 minutes on a 2-core machine)
+//! `cargo bench --bench mechanisms` runs the full scenes (about 13 minutes on a 2-core machine)
 //! and prints two markdown tables, also written to `bench_out/mechanisms.md`. Options after
 //! `--`: `--quick` (or `MECHANISMS_QUICK=1`) runs the shortened scenes (the first crank turn, the
 //! first impacts); any other word keeps only the cases whose name contains it

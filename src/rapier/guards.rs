@@ -182,7 +182,9 @@ impl Violation {
                     ),
                 };
                 let advice = if self.note.is_empty() {
-                    "; raise its damping `factor` or shorten the steps (`StepControl`'s `max_dt`)"
+                    "; raise its damping `factor`, shorten the steps (`StepControl`'s `max_dt`) or, \
+                     in a chain of ideal joints, raise the world's \
+                     `integration_parameters.num_internal_pgs_iterations`"
                 } else {
                     &self.note
                 };

@@ -191,9 +191,10 @@ pub fn cases() -> Vec<Case> {
             window_start_s: 0.5,
             quick_window_start_s: 0.15,
             unit: Unit::Second,
-            // Its fixed runs' first onset converges at first order: 17.2084, 17.1984 and 17.1963
-            // ms at 2e-5, 1e-5 and 5e-6 s, 17.19395, 17.19366 and 17.19351 ms at 1e-6 to 2.5e-7 s;
-            // a reference at 5e-6 s was 2.9 us from the limit, more than the default's own error.
+            // Its fixed runs' first onset moves with the step: 17.2084, 17.1984 and 17.1963 ms at
+            // 2e-5, 1e-5 and 5e-6 s, then 17.1948, 17.1941 and 17.1937 ms at these steps (first
+            // order there); a reference at 5e-6 s was 2.9 us from the limit, more than the
+            // default's own error.
             fixed_dt: [2.5e-6, 1.25e-6, 6.25e-7],
             output_interval_s: 1e-3,
             closed_form: None,

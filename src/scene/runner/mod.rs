@@ -331,7 +331,9 @@ impl Simulation {
                 };
                 let advice = match &inv.motor_start_mismatch {
                     Some(_) if *t == 0.0 => start_mismatch_note(inv),
-                    _ => "; raise its `factor` or shorten the steps (`run.max_dt_s`)".to_string(),
+                    _ => "; raise its `factor`, shorten the steps (`run.max_dt_s`) or, in a chain \
+                          of ideal joints, raise `run.solver_sweeps`"
+                        .to_string(),
                 };
                 let mut v = Violation::new(GuardKind::MotorSpeed, worst, limit, *t)
                     .twin(twin.kind.name())

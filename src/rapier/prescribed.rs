@@ -91,7 +91,20 @@ impl Table {
         let i = self.t.partition_point(|&x| x <= t) - 1;
         let h = self.t[i + 1] - self.t[i];
         let s = (t - self.t[i]) / h;
-        let (p0, p1, m0, m1) = (self.v[i], self.v[i + 1], self.m[i] * h, self.m[i + 1] * h);
+        // Scaled by a power of two near the segment's largest magnitude (exact: the result is
+        // the unscaled sum's to the bit): values and slopes near f64::MAX would otherwise
+        // overflow in the products (a slope times h, a basis term) and meet as inf - inf = NaN.
+        let largest = [self.v[i], self.v[i + 1], self.m[i], self.m[i + 1]]
+            .iter()
+            .fold(0.0f64, |a, x| a.max(x.abs()));
+        if largest == 0.0 {
+            return (0.0, 0.0, 0.0);
+        }
+        // 2^e with e the exponent of `largest` (`log2` rounds f64::MAX up to 1024).
+        let e = (((largest.to_bits() >> 52) & 0x7ff) as i32 - 1023).max(-1022);
+        let scale = f64::from_bits(((e + 1023) as u64) << 52);
+        let (p0, p1) = (self.v[i] / scale, self.v[i + 1] / scale);
+        let (m0, m1) = (self.m[i] / scale * h, self.m[i + 1] / scale * h);
         // Hermite basis and its derivatives in s.
         let (s2, s3) = (s * s, s * s * s);
         let v = (2.0 * s3 - 3.0 * s2 + 1.0) * p0
@@ -106,7 +119,7 @@ impl Table {
             + (6.0 * s - 4.0) * m0
             + (-12.0 * s + 6.0) * p1
             + (6.0 * s - 2.0) * m1;
-        (v, d / h, dd / (h * h))
+        (v * scale, d / h * scale, dd / (h * h) * scale)
     }
 
     /// The largest magnitude of the rate over the table (the rate is constant beyond it): at the
@@ -214,6 +227,28 @@ impl StepHooks for PrescribedSet {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn values_near_the_largest_float_give_no_nan() {
+        // Found by tests/numeric_inputs.rs: a slope times the segment's length overflowed, and
+        // the Hermite sum met inf - inf.
+        let table = Table::new(
+            &[-1.3250567694746097e-14, 85212.86925059001],
+            &[f64::MAX, 0.0],
+        )
+        .unwrap();
+        let (v, d, dd) = table.eval(0.0);
+        assert!(
+            v.is_finite() && d.is_finite() && dd.is_finite(),
+            "{v} {d} {dd}"
+        );
+        // The segment is a straight line (both end slopes are the secant's): v, the secant.
+        let secant = -f64::MAX / (85212.86925059001 + 1.3250567694746097e-14);
+        assert!((d / secant - 1.0).abs() < 1e-12, "{d} against {secant}");
+        assert!((v / f64::MAX - 1.0).abs() < 1e-12, "{v}");
+        let all_zero = Table::new(&[0.0, 1.0], &[0.0, 0.0]).unwrap();
+        assert_eq!(all_zero.eval(0.5), (0.0, 0.0, 0.0));
+    }
 
     #[test]
     fn hermite_table_by_hand() {

@@ -91,8 +91,8 @@ impl Table {
         let i = self.t.partition_point(|&x| x <= t) - 1;
         let h = self.t[i + 1] - self.t[i];
         let s = (t - self.t[i]) / h;
-        // Scaled by a power of two near the segment's largest magnitude (exact: the result is
-        // the unscaled sum's to the bit): values and slopes near f64::MAX would otherwise
+        // Scaled by a power of two near the segment's largest magnitude (exact while the scaled
+        // terms stay out of the subnormal range): values and slopes near f64::MAX would otherwise
         // overflow in the products (a slope times h, a basis term) and meet as inf - inf = NaN.
         let largest = [self.v[i], self.v[i + 1], self.m[i], self.m[i + 1]]
             .iter()

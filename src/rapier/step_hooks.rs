@@ -9,14 +9,16 @@
 //!
 //! One step of the stepper, in the order the hooks are called:
 //! 1. [`check_world`](StepHooks::check_world) once before the first step (the solver settings a
-//!    participant needs), then [`evaluate`](StepHooks::evaluate) at the state before the step.
+//!    participant needs), then [`set_last_step`](StepHooks::set_last_step) and
+//!    [`evaluate`](StepHooks::evaluate) at the state before the step.
 //! 2. The step's length: the smallest [`step_limit`](StepHooks::step_limit) (adaptive), or a
 //!    fixed step checked by [`check_step`](StepHooks::check_step).
 //! 3. [`save_state`](StepHooks::save_state) (adaptive: the step may be rejected); the
 //!    [`wrenches`](StepHooks::wrenches) are added to the bodies for this step only;
 //!    [`before_rapier_step`](StepHooks::before_rapier_step), Rapier's step,
 //!    [`after_rapier_step`](StepHooks::after_rapier_step); then
-//!    [`evaluate`](StepHooks::evaluate) at the new state.
+//!    [`set_last_step`](StepHooks::set_last_step) and [`evaluate`](StepHooks::evaluate) at the
+//!    new state.
 //! 4. [`judge_step`](StepHooks::judge_step) (adaptive): a participant that asks for a shorter
 //!    step has the step undone ([`restore_state`](StepHooks::restore_state), the bodies restored
 //!    by the stepper) and retried from 3.
@@ -83,6 +85,11 @@ pub trait StepHooks {
     /// length `dt`, s (`world.integration_parameters.dt` is set to it): e.g. the next poses of
     /// prescribed kinematic bodies, or the substeps of large-step joints. Default: nothing.
     fn before_rapier_step(&mut self, _world: &mut PhysicsWorld, _t0: f64, _dt: f64) {}
+    /// The length of the step that led to the state the next [`evaluate`](Self::evaluate) sees,
+    /// s: 0 before the first step (and after a restart, when the velocities are the state's own).
+    /// Rapier's velocities are the mean over that step; a source that reads rates can carry them
+    /// to the state.
+    fn set_last_step(&mut self, _dt: f64) {}
 
     /// Right after each Rapier step, before [`evaluate`](Self::evaluate): e.g. reading the
     /// constraint forces of large-step joints and bouncing their impacts. Default: nothing.

@@ -362,6 +362,7 @@ impl Stepper {
         }
         self.control.validate()?;
         for s in sources.iter_mut() {
+            s.set_last_step(self.last_dt);
             s.evaluate(&mut world.bodies);
             s.check_world(&world.integration_parameters)?;
         }
@@ -569,6 +570,7 @@ impl Stepper {
             s.after_rapier_step(world);
         }
         for s in sources.iter_mut() {
+            s.set_last_step(dt);
             s.evaluate(&mut world.bodies);
         }
         kick

@@ -3,7 +3,9 @@
 //! the deepest station as its state (what the step control and the guards read) and the sums.
 
 use super::{ClearanceJoint, ClearanceReport, ContactHistory, friction_slope, motion};
-use crate::model::kinematics::{ForcePair, JournalState, contact_force, stable_step};
+use crate::model::kinematics::{
+    ForcePair, JournalState, contact_force, rate_at_state, rest_acceleration, stable_step,
+};
 use crate::model::laws::{NormalContact, NormalForceLaw, NormalModel, loaded_impact_rate};
 use crate::model::spatial::{
     FACE_POINTS, Face, Share, SpatialModel, SpatialPose, bore_station, face_station,
@@ -96,6 +98,10 @@ pub(super) struct Station {
     state: Option<JournalState>,
     /// Normal and friction force at the last application, N.
     force: [f64; 2],
+    /// This application's `delta_dot0` and the penetration rate the state before it had (NaN
+    /// without one), between the evaluation's two passes.
+    impact_rate: f64,
+    rate_before: f64,
 }
 
 /// The spatial parts of a joint: model, face law, the bearing's transverse axis, stations.
@@ -140,6 +146,8 @@ impl SpatialParts {
                 contact: ContactHistory::default(),
                 state: None,
                 force: [0.0; 2],
+                impact_rate: 0.0,
+                rate_before: f64::NAN,
             })
             .collect();
         for face in Face::BOTH {
@@ -148,6 +156,8 @@ impl SpatialParts {
                 contact: ContactHistory::default(),
                 state: None,
                 force: [0.0; 2],
+                impact_rate: 0.0,
+                rate_before: f64::NAN,
             }));
         }
         SpatialParts {
@@ -336,7 +346,17 @@ impl Pair {
 
 impl ClearanceJoint {
     /// The spatial joint's evaluation (the planar one is [`ClearanceJoint::evaluate`]'s own).
-    pub(super) fn evaluate_spatial(&mut self, bodies: &RigidBodySet) -> Option<(Wrench, Wrench)> {
+    ///
+    /// Two passes over the stations: their states and contact histories, then their forces with
+    /// the penetration rates carried to the state ([`rate_at_state`]): the stations in contact
+    /// act in parallel on the same two bodies, so each carries its rate with the summed force
+    /// and damping of all of them through the joint's effective mass (the planar joint's
+    /// contact when the journal is aligned).
+    pub(super) fn evaluate_spatial(
+        &mut self,
+        bodies: &RigidBodySet,
+        steps: [f64; 2],
+    ) -> Option<(Wrench, Wrench)> {
         let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
         let (m1, m2) = (motion(rb1), motion(rb2));
         let bodies = Pair([Mobility::of(rb1), Mobility::of(rb2)]);
@@ -361,9 +381,12 @@ impl ClearanceJoint {
         // Where the stations' normal forces act on average (weighted by force), for the joint's
         // effective mass: the stations act in parallel on the same two bodies.
         let (mut load_point, mut load) = (Vector::ZERO, 0.0);
-        // The deepest station: (index, state, impact rate).
-        let mut deepest: Option<(usize, JournalState, f64)> = None;
-        for (i, st) in parts.stations.iter_mut().enumerate() {
+        // The deepest station: (index, state, impact rate, the rate its law was given).
+        let mut deepest: Option<(usize, JournalState, f64, f64)> = None;
+        // The stations' forces and dampings at their stored rates, and the force they applied
+        // over the step that led here, for the rates at the state.
+        let mut carry = Carry::default();
+        for st in parts.stations.iter_mut() {
             let (state, gap_scale) = match st.place {
                 Place::Bore { s, .. } => (bore_station(geometry, &pose, s, &m1, &m2), c),
                 Place::Face { face, index } => (
@@ -379,13 +402,25 @@ impl ClearanceJoint {
                 self.min_impact_speed,
                 self.min_separation,
             );
+            st.rate_before = st.state.map_or(f64::NAN, |s| s.penetration_rate);
             st.state = Some(state);
-            let impact_rate = station_impact_rate(&st.contact, &law, state.penetration, || {
+            st.impact_rate = station_impact_rate(&st.contact, &law, state.penetration, || {
                 bodies.effective_mass(whole_centre(&pose, st.place, &state), state.normal)
             });
+            carry.add(&law, &state, st.impact_rate, st.force[0]);
+        }
+        let carry_mass = carry.effective_mass(&bodies);
+        for (i, st) in parts.stations.iter_mut().enumerate() {
+            let Some(stored) = st.state else { continue };
+            let law = st.place.law(&self.normal_law, &parts.face_law);
+            let impact_rate = st.impact_rate;
+            let state = JournalState {
+                penetration_rate: carry.rate_at_state(&stored, st.rate_before, carry_mass, steps),
+                ..stored
+            };
             let pair = contact_force(&state, impact_rate, &law, &self.friction_law);
-            if deepest.is_none_or(|d| state.penetration > d.1.penetration) {
-                deepest = Some((i, state, impact_rate));
+            if deepest.is_none_or(|d| stored.penetration > d.1.penetration) {
+                deepest = Some((i, stored, impact_rate, state.penetration_rate));
             }
             st.force = [pair.normal_force.max(0.0), pair.friction_force];
             if pair.normal_force <= 0.0 {
@@ -406,7 +441,7 @@ impl ClearanceJoint {
                 &bodies,
             );
         }
-        let (index, state, impact_rate) = deepest?;
+        let (index, state, impact_rate, contact_rate) = deepest?;
         let governing = parts.stations[index].place;
         report.governed_by_face = matches!(governing, Place::Face { .. });
         // The joint's effective mass along the deepest station's normal: at the load's centre
@@ -452,6 +487,7 @@ impl ClearanceJoint {
             impact: onset.impact,
             impact_rate,
             approach_speed: onset.approach_speed,
+            contact_rate,
             onset_fraction: onset.fraction,
             force: ForcePair {
                 on_journal: totals.force,
@@ -477,6 +513,77 @@ impl ClearanceJoint {
             torque: totals.torque[1],
         };
         Some((w1, w2))
+    }
+}
+
+/// What the stations carry their rates to the state with ([`rate_at_state`]): their normal forces
+/// and dampings at the stored rates, the normal force they applied over the step that led here,
+/// and where the load acts (for the effective mass).
+#[derive(Default)]
+struct Carry {
+    force: f64,
+    damping: f64,
+    force_before: f64,
+    load_point: Vector,
+    normal: Vector,
+}
+
+impl Carry {
+    /// Adds a station at `state` (its stored rate), whose normal force over the last step was
+    /// `force_before` (N).
+    fn add(
+        &mut self,
+        law: &impl NormalForceLaw,
+        state: &JournalState,
+        impact_rate: f64,
+        force_before: f64,
+    ) {
+        self.force_before += force_before;
+        if !(state.penetration > 0.0) {
+            return;
+        }
+        let c = NormalContact {
+            penetration: state.penetration,
+            penetration_rate: state.penetration_rate,
+            impact_rate,
+        };
+        // No adhesion: a negative law force is no force, whatever the rate.
+        let force = law.normal_force(&c);
+        if force > 0.0 {
+            self.force += force;
+            self.damping += law.damping_coefficient(&c);
+            self.load_point += force * state.contact_point;
+            self.normal += force * state.normal;
+        }
+    }
+
+    /// The effective mass at the load's centre along its mean normal (0 without a load).
+    fn effective_mass(&self, bodies: &Pair) -> f64 {
+        let n = self.normal.length();
+        if self.force > 0.0 && n > 0.0 {
+            bodies.effective_mass(self.load_point / self.force, self.normal / n)
+        } else {
+            0.0
+        }
+    }
+
+    /// The penetration rate of a station at `state` (its stored rate; `rate_before` the state
+    /// before it had, NaN if none) at the state: in contact with a known step, the stored
+    /// rate carried by the stations' summed force and damping; the stored rate otherwise.
+    fn rate_at_state(
+        &self,
+        state: &JournalState,
+        rate_before: f64,
+        m: f64,
+        steps: [f64; 2],
+    ) -> f64 {
+        let stored = state.penetration_rate;
+        if !(state.penetration > 0.0 && steps[1] > 0.0 && m > 0.0 && rate_before.is_finite()) {
+            return stored;
+        }
+        let kick = 0.5 * (steps[0] + steps[1]);
+        let rest = rest_acceleration(rate_before, stored, kick, self.force_before, m);
+        rate_at_state(stored, steps[1], rest, self.force, self.damping, m)
     }
 }
 

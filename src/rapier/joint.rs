@@ -790,16 +790,18 @@ impl ClearanceJoint {
         };
         let force = contact_force(&at_state, impact_rate, &self.normal_law, &self.friction_law);
 
-        // Linearised contact for the step-size limit.
+        // Linearised contact for the step-size limit, at the stored rate: carried over a step
+        // longer than that limit, the rate is no longer a rate of the contact (a 1 ms step
+        // through the paper's first impact carried it to a negative stiffness).
         let (max_stable_dt, omega, zeta) = if state.penetration > 0.0 {
             let c = NormalContact {
                 penetration: state.penetration,
-                penetration_rate: contact_rate,
+                penetration_rate: state.penetration_rate,
                 impact_rate,
             };
             // dF/d delta = K_tangent + (dD/d delta) delta_dot (MODEL.md §2 laws, linearised).
             let stiffness = self.normal_law.tangent_stiffness(state.penetration)
-                + self.normal_law.damping_slope(&c) * contact_rate;
+                + self.normal_law.damping_slope(&c) * state.penetration_rate;
             stable_step(
                 stiffness,
                 self.normal_law.damping_coefficient(&c),

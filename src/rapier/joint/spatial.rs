@@ -431,10 +431,11 @@ impl ClearanceJoint {
             load += pair.normal_force;
             report.add(st.place, pair.normal_force);
             totals.add(&state, &pair, [m1.center_of_mass, m2.center_of_mass]);
+            // The stability limit at the stored rate, as the planar joint's.
             linearise(
                 &mut lin,
                 &law,
-                &state,
+                &stored,
                 impact_rate,
                 &pair,
                 &self.friction_law,

@@ -652,7 +652,7 @@ fn four_bar_reactions_under_adaptive_steps_match_a_fine_fixed_run() {
 
 #[test]
 fn a_velocity_motor_that_misses_its_speed_is_flagged() {
-    // The first impact (1.3 ms) slows a crank on a softer motor by 2.4 %: its torque and the
+    // The first impact (1.3 ms) slows a crank on a softer motor by 2.2 %: its torque and the
     // reactions, solved as if it held its speed, are off by that much, and the run says so.
     let (_, guards) = four_bar(0.003, &["motor.factor=1e6"], false);
     assert!(

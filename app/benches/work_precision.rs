@@ -1,9 +1,10 @@
 //! Work-precision of fixed and adaptive stepping on the paper's scene (clearance twin).
 //! `cargo bench --bench work_precision` writes `bench_out/work_precision.{csv,md,svg}`.
 //!
-//! Errors are against the finest fixed run (dt = 1e-6 s); its own error is estimated by step
-//! halving (Richardson: for a first-order method the error of the finer run is about the
-//! difference to the run at twice its step) and printed with the table.
+//! Errors are against the finest fixed run (dt = 1e-6 s); its own error is bounded by step
+//! halving (the difference to the run at twice its step: Richardson gives the finer run's error as
+//! that difference for a first-order quantity and a third of it at second order, as the contact
+//! peaks are) and printed with the table.
 
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::output::write_atomic;

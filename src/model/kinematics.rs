@@ -156,6 +156,16 @@ pub fn rest_acceleration(
     (rate_after - rate_before) / kick + force_before / effective_mass
 }
 
+/// The normal force `F` (N) and damping `D = dF/d delta_dot` (N s/m) of `law` at `contact`, as
+/// [`rate_at_state`] takes them: both 0 where the law's force is not positive (no adhesion: the
+/// contact force is then 0 whatever the rate).
+pub fn force_and_damping(law: &impl NormalForceLaw, contact: &NormalContact) -> (f64, f64) {
+    match law.normal_force(contact) {
+        f if f > 0.0 => (f, law.damping_coefficient(contact)),
+        _ => (0.0, 0.0),
+    }
+}
+
 /// The penetration rate at the state, m/s, from the rate `stored` in the bodies' velocities.
 ///
 /// Verlet's velocities are the mean over the step that led to the state (`step`, s), so they lag
@@ -244,6 +254,16 @@ mod tests {
         // (0.3 - 0.1)/2e-3 + 40/2 = 120 m/s².
         let a = rest_acceleration(0.1, 0.3, 2e-3, 40.0, 2.0);
         assert!((a - 120.0).abs() < 1e-12, "{a}");
+        // Kelvin-Voigt 1e6 delta + 1e3 delta_dot: 1e-6 m in at 0.5 m/s gives 1 + 500 N, slope
+        // 1e3; pulling out at 0.5 m/s, 1 - 500 < 0: no force, no damping.
+        let law = crate::model::laws::KelvinVoigt::new(1e6, 1e3).unwrap();
+        let at = |rate| NormalContact {
+            penetration: 1e-6,
+            penetration_rate: rate,
+            impact_rate: 0.5,
+        };
+        assert_eq!(force_and_damping(&law, &at(0.5)), (501.0, 1e3));
+        assert_eq!(force_and_damping(&law, &at(-0.5)), (0.0, 0.0));
     }
 
     #[test]

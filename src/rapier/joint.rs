@@ -3,8 +3,8 @@
 
 use crate::error::{Error, Result};
 use crate::model::kinematics::{
-    BodyMotion, ContactMode, ForcePair, JournalState, contact_force, journal_state, rate_at_state,
-    rest_acceleration, stable_step,
+    BodyMotion, ContactMode, ForcePair, JournalState, contact_force, force_and_damping,
+    journal_state, rate_at_state, rest_acceleration, stable_step,
 };
 use crate::model::laws::{
     BearingGeometry, FrictionLaw, FrictionModel, NormalContact, NormalForceLaw, NormalModel,
@@ -309,10 +309,10 @@ pub struct ClearanceReport {
     pub approach_speed: f64,
     /// The penetration rate the normal law was given, m/s. `state.penetration_rate` is read from
     /// the bodies' velocities, the mean over the step that led here, half a step behind the
-    /// state; in contact the planar joint carries it to the state ([`rate_at_state`], with the
-    /// step of [`ClearanceJointSet::set_last_step`]) so that the damping force is second order in
-    /// the step. Equal to `state.penetration_rate` in free flight, at the first application, and
-    /// for the spatial joint.
+    /// state; in contact the joint carries it to the state ([`rate_at_state`], with the step of
+    /// [`ClearanceJointSet::set_last_step`]) so that the damping force is second order in the
+    /// step. Equal to `state.penetration_rate` in free flight and when the step is unknown (at
+    /// the first application). A spatial joint's is its deepest station's.
     pub contact_rate: f64,
     /// At an onset, the fraction of the step that led here at which delta crossed 0
     /// ([`crossing_fraction`]; the onset time is the step's end minus `(1 - fraction)` steps);
@@ -908,11 +908,7 @@ impl ClearanceJoint {
             penetration_rate: stored,
             impact_rate,
         };
-        // No adhesion: where the law's force is negative the contact force is 0, whatever the rate.
-        let (force, damping) = match self.normal_law.normal_force(&c) {
-            f if f > 0.0 => (f, self.normal_law.damping_coefficient(&c)),
-            _ => (0.0, 0.0),
-        };
+        let (force, damping) = force_and_damping(&self.normal_law, &c);
         rate_at_state(stored, steps[1], rest, force, damping, effective_mass)
     }
 

@@ -80,8 +80,8 @@ pub struct Case {
     /// Overrides of perturbed reference runs (fixed, at the reference step) whose window
     /// statistics widen the converged spread: the fixed runs of `fixed_dt` follow one trajectory,
     /// while a chaotic window's statistics move by far more under a perturbation of the start no
-    /// measurement could see (the slider-crank's largest force in turns 2-3 from 12.4 to 29.6 kN
-    /// for the rod's initial speed times 1 +- 1e-4 to 1e-3). Empty: not measured.
+    /// measurement could see (the slider-crank's largest force in turns 2-3 from 7.3 to 29.7 kN
+    /// for the rod's initial speed times 1 +- 1e-4 and 1 +- 1e-3). Empty: not measured.
     pub perturbed: Vec<Vec<String>>,
 }
 
@@ -169,9 +169,9 @@ pub fn cases() -> Vec<Case> {
             window_start_s: 0.1,
             quick_window_start_s: 0.025,
             unit: Unit::Turn(0.1),
-            // Fixed steps converge only at first order here: with the scene's 32 sweeps over the
-            // joints the first impact's peak is 5,400, 5,341, 5,312 and 5,297 N from 5e-7 s to
-            // 2.5e-7, 1.25e-7 and 6.25e-8 s (with one sweep 5,100, 5,177, 5,229 and 5,257 N).
+            // With the scene's 32 sweeps over the joints the first impact's peak is 5,283 N at all
+            // three steps (it moved at first order, 5,341, 5,312 and 5,297 N, while the contact
+            // laws read the stored rate; with one sweep 5,177, 5,229 and 5,257 N then).
             fixed_dt: [2.5e-7, 1.25e-7, 6.25e-8],
             output_interval_s: 1e-4,
             closed_form: None,
@@ -191,10 +191,10 @@ pub fn cases() -> Vec<Case> {
             window_start_s: 0.5,
             quick_window_start_s: 0.15,
             unit: Unit::Second,
-            // Its fixed runs' first onset moves with the step: 17.2084, 17.1984 and 17.1963 ms at
-            // 2e-5, 1e-5 and 5e-6 s, then 17.1948, 17.1941 and 17.1937 ms at these steps (first
-            // order there); a reference at 5e-6 s was 2.9 us from the limit, more than the
-            // default's own error.
+            // Its fixed runs' first onset is 17.1933-17.1934 ms at these steps. While the contact
+            // laws read the stored rate it moved at first order with the step (17.2084, 17.1984
+            // and 17.1963 ms at 2e-5, 1e-5 and 5e-6 s, 17.1948, 17.1941 and 17.1937 ms at these),
+            // and a reference at 5e-6 s was 2.9 us from the limit.
             fixed_dt: [2.5e-6, 1.25e-6, 6.25e-7],
             output_interval_s: 1e-3,
             closed_form: None,
@@ -211,9 +211,9 @@ pub fn cases() -> Vec<Case> {
             window_start_s: 0.25,
             quick_window_start_s: 0.125,
             unit: Unit::Second,
-            // Its window's RMS acceleration difference moves with the step: 0.3550 and 0.3382 at 4e-6
-            // and 1e-6 s, 0.33772 and 0.33751 at 5e-7 and 2.5e-7 s; references down to 1e-6 s
-            // made a spread too wide.
+            // Its window's RMS acceleration difference moves with the step: 0.3408, 0.3385 and
+            // 0.3378 at these steps (0.3550 and 0.3382 at 4e-6 and 1e-6 s while the contact laws
+            // read the stored rate); references down to 1e-6 s made a spread too wide.
             fixed_dt: [1e-6, 5e-7, 2.5e-7],
             output_interval_s: 1e-4,
             closed_form: None,

@@ -4,7 +4,8 @@
 
 use super::{ClearanceJoint, ClearanceReport, ContactHistory, friction_slope, motion};
 use crate::model::kinematics::{
-    ForcePair, JournalState, contact_force, rate_at_state, rest_acceleration, stable_step,
+    ForcePair, JournalState, contact_force, force_and_damping, rate_at_state, rest_acceleration,
+    stable_step,
 };
 use crate::model::laws::{NormalContact, NormalForceLaw, NormalModel, loaded_impact_rate};
 use crate::model::spatial::{
@@ -548,14 +549,11 @@ impl Carry {
             penetration_rate: state.penetration_rate,
             impact_rate,
         };
-        // No adhesion: a negative law force is no force, whatever the rate.
-        let force = law.normal_force(&c);
-        if force > 0.0 {
-            self.force += force;
-            self.damping += law.damping_coefficient(&c);
-            self.load_point += force * state.contact_point;
-            self.normal += force * state.normal;
-        }
+        let (force, damping) = force_and_damping(law, &c);
+        self.force += force;
+        self.damping += damping;
+        self.load_point += force * state.contact_point;
+        self.normal += force * state.normal;
     }
 
     /// The effective mass at the load's centre along its mean normal (0 without a load).

@@ -116,10 +116,10 @@ pub fn study_report(
     if study.paper && study.kind == StudyKind::Torque {
         let _ = writeln!(
             s,
-            "- The paper's fixed step of 1e-4 s under-resolves the stronger impacts: at 3T and 5T it gives first-impact peaks \
-             of 327 N and 437 N against 358 N and 503 N with the default adaptive steps, and it is longer than friction's \
-             limit near zero slip (a guard violation). Adaptive steps shorten inside contacts as the contact requires, so \
-             the three cases run with the same step control as the other studies."
+            "- The paper's fixed step of 1e-4 s under-resolves the stronger impacts (`study torque --set run.step=Fixed` \
+             gives their first-impact peaks against these), and it is longer than friction's limit near zero slip (a \
+             guard violation). Adaptive steps shorten inside contacts as the contact requires, so the three cases run \
+             with the same step control as the other studies."
         );
     }
     let _ = writeln!(

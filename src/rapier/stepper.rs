@@ -341,7 +341,10 @@ impl Stepper {
     /// Forgets the force sources' evaluation: the next step evaluates them again first. Call it
     /// after changing the world between steps (bodies moved by hand, joints or drives added or
     /// removed). With `restart_kick` the next step is a half kick again, as from a new initial
-    /// state (after setting velocities by hand).
+    /// state (after setting velocities by hand), and the clearance joints' contact laws get the
+    /// stored rate at that evaluation. Without it they carry the rate to the state with its change
+    /// since their last evaluation, across your edit: off by at most half that change, once
+    /// ([`ClearanceJointSet::set_last_step`](crate::rapier::joint::ClearanceJointSet::set_last_step)).
     pub fn invalidate(&mut self, restart_kick: bool) {
         self.prepared = false;
         if restart_kick {

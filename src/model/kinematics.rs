@@ -156,6 +156,35 @@ pub fn rest_acceleration(
     (rate_after - rate_before) / kick + force_before / effective_mass
 }
 
+/// What the state before the last step tells [`rate_at_state`]: the penetration rate stored there
+/// (m/s), the contact's normal force applied over the step (N), and the steps `[the one before
+/// that state, the last one]` (s; the last 0 when unknown).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepBefore {
+    /// The stored penetration rate at the state before the step, m/s.
+    pub rate: f64,
+    /// The contact's normal force over the step, N.
+    pub force: f64,
+    /// The step before that state and the step itself, s.
+    pub steps: [f64; 2],
+}
+
+impl StepBefore {
+    /// The rate `stored` at the state after the step carried to it ([`rate_at_state`]), with
+    /// the rest of the mechanism's acceleration from the step ([`rest_acceleration`] over the
+    /// kick `(h_before + h)/2`) and the contact's `force` (N) and `damping` (N s/m) at `stored`
+    /// through the `effective_mass` (kg); `stored` itself when the step is unknown.
+    pub fn carry(&self, stored: f64, force: f64, damping: f64, effective_mass: f64) -> f64 {
+        let [before, step] = self.steps;
+        if !(step > 0.0) {
+            return stored;
+        }
+        let kick = 0.5 * (before + step);
+        let rest = rest_acceleration(self.rate, stored, kick, self.force, effective_mass);
+        rate_at_state(stored, step, rest, force, damping, effective_mass)
+    }
+}
+
 /// The normal force `F` (N) and damping `D = dF/d delta_dot` (N s/m) of `law` at `contact`, as
 /// [`rate_at_state`] takes them: both 0 where the law's force is not positive (no adhesion: the
 /// contact force is then 0 whatever the rate).

@@ -3,8 +3,8 @@
 
 use crate::error::{Error, Result};
 use crate::model::kinematics::{
-    BodyMotion, ContactMode, ForcePair, JournalState, contact_force, force_and_damping,
-    journal_state, rate_at_state, rest_acceleration, stable_step,
+    BodyMotion, ContactMode, ForcePair, JournalState, StepBefore, contact_force, force_and_damping,
+    journal_state, stable_step,
 };
 use crate::model::laws::{
     BearingGeometry, FrictionLaw, FrictionModel, NormalContact, NormalForceLaw, NormalModel,
@@ -309,7 +309,7 @@ pub struct ClearanceReport {
     pub approach_speed: f64,
     /// The penetration rate the normal law was given, m/s. `state.penetration_rate` is read from
     /// the bodies' velocities, the mean over the step that led here, half a step behind the
-    /// state; in contact the joint carries it to the state ([`rate_at_state`], with the step of
+    /// state; in contact the joint carries it to the state ([`StepBefore::carry`], with the step of
     /// [`ClearanceJointSet::set_last_step`]) so that the damping force is second order in the
     /// step. Equal to `state.penetration_rate` in free flight and when the step is unknown (at
     /// the first application). A spatial joint's is its deepest station's.
@@ -880,8 +880,8 @@ impl ClearanceJoint {
 
     /// The penetration rate for the normal law at `state` (whose rate is the bodies' stored one),
     /// `steps` the step before the last application's state and the step since: in contact, the
-    /// rate at the state ([`rate_at_state`]), with the rest of the mechanism's acceleration from
-    /// the last application ([`rest_acceleration`]); the stored rate without a contact, a known
+    /// rate at the state ([`StepBefore::carry`]), with the rest of the mechanism's acceleration from
+    /// the last application ([`StepBefore`]); the stored rate without a contact, a known
     /// step or an earlier application.
     fn contact_rate(
         &self,
@@ -891,25 +891,21 @@ impl ClearanceJoint {
         steps: [f64; 2],
     ) -> f64 {
         let stored = state.penetration_rate;
-        let kick = 0.5 * (steps[0] + steps[1]);
-        if !(state.penetration > 0.0 && steps[1] > 0.0 && self.prepared_report()) {
+        if !(state.penetration > 0.0 && self.prepared_report()) {
             return stored;
         }
-        let before = &self.report;
-        let rest = rest_acceleration(
-            before.state.penetration_rate,
-            stored,
-            kick,
-            before.force.normal_force,
-            effective_mass,
-        );
         let c = NormalContact {
             penetration: state.penetration,
             penetration_rate: stored,
             impact_rate,
         };
         let (force, damping) = force_and_damping(&self.normal_law, &c);
-        rate_at_state(stored, steps[1], rest, force, damping, effective_mass)
+        let before = StepBefore {
+            rate: self.report.state.penetration_rate,
+            force: self.report.force.normal_force,
+            steps,
+        };
+        before.carry(stored, force, damping, effective_mass)
     }
 
     /// Whether a report from an earlier application exists.

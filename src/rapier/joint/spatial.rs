@@ -4,8 +4,7 @@
 
 use super::{ClearanceJoint, ClearanceReport, ContactHistory, friction_slope, motion};
 use crate::model::kinematics::{
-    ForcePair, JournalState, contact_force, force_and_damping, rate_at_state, rest_acceleration,
-    stable_step,
+    ForcePair, JournalState, StepBefore, contact_force, force_and_damping, stable_step,
 };
 use crate::model::laws::{NormalContact, NormalForceLaw, NormalModel, loaded_impact_rate};
 use crate::model::spatial::{
@@ -349,7 +348,7 @@ impl ClearanceJoint {
     /// The spatial joint's evaluation (the planar one is [`ClearanceJoint::evaluate`]'s own).
     ///
     /// Two passes over the stations: their states and contact histories, then their forces with
-    /// the penetration rates carried to the state ([`rate_at_state`]): the stations in contact
+    /// the penetration rates carried to the state ([`StepBefore::carry`]): the stations in contact
     /// act in parallel on the same two bodies, so each carries its rate with the summed force
     /// and damping of all of them through the joint's effective mass (the planar joint's
     /// contact when the journal is aligned).
@@ -518,9 +517,9 @@ impl ClearanceJoint {
     }
 }
 
-/// What the stations carry their rates to the state with ([`rate_at_state`]): their normal forces
-/// and dampings at the stored rates, the normal force they applied over the step that led here,
-/// and where the load acts (for the effective mass).
+/// What the stations carry their rates to the state with ([`StepBefore::carry`]): their normal
+/// forces and dampings at the stored rates, the normal force they applied over the step that led
+/// here, and where the load acts (for the effective mass).
 #[derive(Default)]
 struct Carry {
     force: f64,
@@ -577,12 +576,15 @@ impl Carry {
         steps: [f64; 2],
     ) -> f64 {
         let stored = state.penetration_rate;
-        if !(state.penetration > 0.0 && steps[1] > 0.0 && m > 0.0 && rate_before.is_finite()) {
+        if !(state.penetration > 0.0 && m > 0.0 && rate_before.is_finite()) {
             return stored;
         }
-        let kick = 0.5 * (steps[0] + steps[1]);
-        let rest = rest_acceleration(rate_before, stored, kick, self.force_before, m);
-        rate_at_state(stored, steps[1], rest, self.force, self.damping, m)
+        let before = StepBefore {
+            rate: rate_before,
+            force: self.force_before,
+            steps,
+        };
+        before.carry(stored, self.force, self.damping, m)
     }
 }
 

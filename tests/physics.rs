@@ -266,6 +266,54 @@ fn ln_restitution(dt: f64, carried: bool) -> f64 {
 }
 
 #[test]
+fn a_last_step_that_is_not_a_step_gives_the_stored_rate() {
+    // NaN, infinite, negative and zero steps count as unknown: the law gets the stored rate, and
+    // nothing turns NaN. The same impact as `ln_restitution`, stepped by hand.
+    for bad in [f64::NAN, f64::INFINITY, -1e-6, 0.0] {
+        let mut world = PhysicsWorld::new();
+        world.integration_parameters.dt = 1e-6;
+        world.integration_parameters.num_solver_iterations = 1;
+        let bearing = world.bodies.insert(RigidBodyBuilder::fixed());
+        let journal = world.bodies.insert(
+            RigidBodyBuilder::dynamic()
+                .additional_mass_properties(MassProperties::new(
+                    Vector::ZERO,
+                    1.0,
+                    Vector::splat(1e-3),
+                ))
+                .linvel(Vector::new(0.1, 0.0, 0.0))
+                .can_sleep(false),
+        );
+        let geometry = BearingGeometry::from_clearance(0.010, 0.1e-3, 0.016).unwrap();
+        let k = LankaraniNikravesh::stiffness_from_geometry(
+            &geometry,
+            &Material::STEEL,
+            &Material::STEEL,
+        );
+        let law = NormalModel::LankaraniNikravesh(LankaraniNikravesh::new(k, 1.5, 0.9).unwrap());
+        let joint = ClearanceJointBuilder::new(Vector::Z, geometry, law)
+            .lock(OutOfPlaneLock::None)
+            .build()
+            .unwrap();
+        let mut set = ClearanceJointSet::new();
+        let pin = set.insert(bearing, journal, joint, &mut world.impulse_joints);
+        let mut in_contact = 0;
+        for _ in 0..3000 {
+            set.set_last_step(bad);
+            set.apply_forces(&mut world.bodies);
+            let r = *set.get(pin).unwrap().report();
+            assert!(r.contact_rate.is_finite() && r.force.normal_force.is_finite());
+            if r.state.penetration > 0.0 {
+                in_contact += 1;
+                assert_eq!(r.contact_rate, r.state.penetration_rate, "step {bad}");
+            }
+            world.step();
+        }
+        assert!(in_contact > 10, "the journal hit the wall: {in_contact}");
+    }
+}
+
+#[test]
 fn lankarani_nikravesh_impact_restitution() {
     let e = ln_restitution(1e-6, true);
     assert!((e - 0.9).abs() < 0.02, "restitution {e}");

@@ -214,11 +214,9 @@ fn first_impact_peak_converges_at_second_order() {
     }
 }
 
-/// One Lankarani-Nikravesh impact (cr = 0.9) of a 1 kg journal thrown at 0.1 m/s against a fixed
-/// bearing, stepped at `dt` by a plain Rapier loop: the restitution `v_out/v_in`. `carried`: the
-/// loop calls `apply` (which tells the joints the step, so the law gets the rate at the state);
-/// otherwise `apply_forces` without `set_last_step` (the stored rate, half a step old).
-fn ln_restitution(dt: f64, carried: bool) -> f64 {
+/// A 1 kg journal thrown at 0.1 m/s against a fixed bearing with a Lankarani-Nikravesh law
+/// (cr = 0.9), in a plain Rapier world stepping at `dt`: the world, the set and the pin.
+fn ln_impact(dt: f64) -> (PhysicsWorld, ClearanceJointSet, ClearanceJointHandle) {
     let mut world = PhysicsWorld::new();
     world.integration_parameters.dt = dt;
     world.integration_parameters.num_solver_iterations = 1;
@@ -239,6 +237,14 @@ fn ln_restitution(dt: f64, carried: bool) -> f64 {
         .unwrap();
     let mut set = ClearanceJointSet::new();
     let pin = set.insert(bearing, journal, joint, &mut world.impulse_joints);
+    (world, set, pin)
+}
+
+/// The impact of [`ln_impact`] stepped at `dt`: the restitution `v_out/v_in`. `carried`: the
+/// loop calls `apply` (which tells the joints the step, so the law gets the rate at the state);
+/// otherwise `apply_forces` without `set_last_step` (the stored rate, half a step old).
+fn ln_restitution(dt: f64, carried: bool) -> f64 {
+    let (mut world, mut set, pin) = ln_impact(dt);
     let (mut v_in, mut touched) = (None, false);
     let steps = (0.01 / dt) as usize;
     for _ in 0..steps {
@@ -268,35 +274,9 @@ fn ln_restitution(dt: f64, carried: bool) -> f64 {
 #[test]
 fn a_last_step_that_is_not_a_step_gives_the_stored_rate() {
     // NaN, infinite, negative and zero steps count as unknown: the law gets the stored rate, and
-    // nothing turns NaN. The same impact as `ln_restitution`, stepped by hand.
+    // nothing turns NaN. The impact of `ln_impact`, stepped by hand.
     for bad in [f64::NAN, f64::INFINITY, -1e-6, 0.0] {
-        let mut world = PhysicsWorld::new();
-        world.integration_parameters.dt = 1e-6;
-        world.integration_parameters.num_solver_iterations = 1;
-        let bearing = world.bodies.insert(RigidBodyBuilder::fixed());
-        let journal = world.bodies.insert(
-            RigidBodyBuilder::dynamic()
-                .additional_mass_properties(MassProperties::new(
-                    Vector::ZERO,
-                    1.0,
-                    Vector::splat(1e-3),
-                ))
-                .linvel(Vector::new(0.1, 0.0, 0.0))
-                .can_sleep(false),
-        );
-        let geometry = BearingGeometry::from_clearance(0.010, 0.1e-3, 0.016).unwrap();
-        let k = LankaraniNikravesh::stiffness_from_geometry(
-            &geometry,
-            &Material::STEEL,
-            &Material::STEEL,
-        );
-        let law = NormalModel::LankaraniNikravesh(LankaraniNikravesh::new(k, 1.5, 0.9).unwrap());
-        let joint = ClearanceJointBuilder::new(Vector::Z, geometry, law)
-            .lock(OutOfPlaneLock::None)
-            .build()
-            .unwrap();
-        let mut set = ClearanceJointSet::new();
-        let pin = set.insert(bearing, journal, joint, &mut world.impulse_joints);
+        let (mut world, mut set, pin) = ln_impact(1e-6);
         let mut in_contact = 0;
         for _ in 0..3000 {
             set.set_last_step(bad);

@@ -44,6 +44,7 @@
 //! ```
 
 use crate::error::{Error, Result, sig4};
+use crate::model::laws::crossing_fraction;
 use crate::rapier::joint::ClearanceJoint;
 use crate::table::Table;
 use serde::Serialize;
@@ -111,7 +112,7 @@ impl ContactObservation {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Impact {
     /// Time of the crossing of delta = 0, s: interpolated inside the step that led to the first
-    /// state in contact ([`crossing_fraction`](crate::model::laws::crossing_fraction)).
+    /// state in contact ([`crossing_fraction`]).
     pub onset_t_s: f64,
     /// Penetration rate at the crossing, m/s (positive approaching;
     /// [`speed_at_crossing`](crate::model::laws::speed_at_crossing)).
@@ -120,7 +121,9 @@ pub struct Impact {
     pub peak_force_n: f64,
     /// Deepest penetration during the contact, um.
     pub max_penetration_um: f64,
-    /// Time in contact, s (up to the end of the run for a contact still closed there).
+    /// Time in contact, s, from the onset to the crossing of delta = 0 at lift-off, interpolated
+    /// inside the step that led to the first state out of contact as the onset is (up to the end
+    /// of the run for a contact still closed there).
     pub duration_s: f64,
     /// Whether the onset came after a free flight that opened at least the joint's
     /// `min_separation` (an impact; otherwise chatter of a journal following the wall).
@@ -145,7 +148,8 @@ pub struct HingeMetrics {
     pub max_penetration_um: f64,
     /// Steps spent in contact.
     pub contact_steps: u64,
-    /// Fraction of recorded time in contact.
+    /// Fraction of recorded time in contact, each contact from its onset to its lift-off as in
+    /// [`Impact::duration_s`].
     pub contact_fraction: f64,
     /// Root-mean-square joint force over the run (time-weighted), N.
     pub rms_force_n: f64,
@@ -203,6 +207,8 @@ pub struct ImpactRecorder {
     open: bool,
     /// The step that led to the state being recorded (the last recorded `dt`), s.
     last_dt: f64,
+    /// The penetration at the last recorded state, m.
+    last_penetration: f64,
     finished: bool,
     /// A spatial joint: whether each face carried load at the last state, and the time a face
     /// carried load and an edge was loaded, s.
@@ -236,7 +242,20 @@ impl ImpactRecorder {
         } else {
             (t, obs.rate)
         };
+        // A lift-off: the last state's step was counted in contact whole; the contact ended at
+        // the crossing of delta = 0 inside it, interpolated as the onset is.
+        if self.was_in_contact && !in_contact {
+            let after =
+                (1.0 - crossing_fraction(self.last_penetration, -obs.penetration)) * self.last_dt;
+            self.contact_time -= after;
+            if self.open
+                && let Some(i) = self.impacts.last_mut()
+            {
+                i.duration_s -= after;
+            }
+        }
         self.last_dt = dt;
+        self.last_penetration = obs.penetration;
         if obs.onset {
             self.onset_rate = approach;
         }
@@ -526,7 +545,9 @@ mod tests {
         assert_eq!(i[0].approach_speed_m_s, 0.02);
         assert_eq!(i[0].peak_force_n, 30.0);
         assert_eq!(i[0].max_penetration_um, 3.0);
-        assert!((i[0].duration_s - 0.2).abs() < 1e-15);
+        // Lifted off inside the step from 0.2 (3 um deep) to 0.3 (0.5 um of gap): at 3/3.5 of it.
+        let lift_off = 0.2 + 0.1 * 3.0 / 3.5;
+        assert!((i[0].duration_s - (lift_off - 0.1)).abs() < 1e-15);
         assert_eq!(i[1].peak_force_n, 6.0);
         assert_eq!(i[1].duration_s, 0.5);
         let m = r.metrics();
@@ -534,7 +555,7 @@ mod tests {
         assert_eq!(m.first_impact_t_s, Some(0.1));
         assert_eq!(m.first_impact_peak_n, Some(30.0));
         assert_eq!(m.peak_force_n, 30.0);
-        assert!((m.contact_fraction - 0.7).abs() < 1e-15);
+        assert!((m.contact_fraction - (lift_off - 0.1 + 0.5)).abs() < 1e-15);
         // Sum of F^2 dt = 100*0.1 + 900*0.1 + 25*0.5 = 112.5 over 1 s.
         assert!((m.rms_force_n - 112.5f64.sqrt()).abs() < 1e-12);
         // Restitution: left at 0.01 m/s after approaching at 0.02.

@@ -35,7 +35,7 @@
 //! );
 //! let hinge = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0));
 //! let hinge = rapier.impulse_joints.insert(base, arm, hinge, true);
-//! // Adaptive steps of at most 1 ms, 0.75 % of a contact period inside contacts.
+//! // Adaptive steps of at most 1 ms, 1.5 % of a contact period inside contacts.
 //! let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.0075));
 //!
 //! // 0.2 mm of play in a 20 mm steel bearing, 16 mm wide; the base carries the bearing.

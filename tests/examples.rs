@@ -219,7 +219,8 @@ fn door_hinge_sags_edge_loads_and_knocks_only_in_space() {
     assert!(planar.clean && spatial.clean, "{runs:?}");
     assert_eq!(planar.max_tilt, 0.0);
     assert_eq!(planar.face_knocks, 0);
-    assert!(planar.sag_mm.abs() < 1e-9, "{}", planar.sag_mm);
+    // Rounding only (1.4e-9 mm measured; 4-5 mm in space).
+    assert!(planar.sag_mm.abs() < 1e-8, "{}", planar.sag_mm);
     // Diagonal edge contact: tilt at least 2c/L = 10 mrad.
     assert!(spatial.max_tilt > 0.0099, "{}", spatial.max_tilt);
     // Sag of the free edge: 0.4 m x the tilt, plus the 0.15 mm axial drop.

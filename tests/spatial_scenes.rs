@@ -55,11 +55,14 @@ fn rel(a: f64, b: f64) -> f64 {
 }
 
 /// Issue 19, item 2: the spatial joint's aligned limit is the planar joint. On the paper's
-/// scene (5 s) the two runs take the same steps to one (33,950 and 33,951: the stations carry
+/// scene (5 s) the two runs take the same steps to one (20,570 and 20,571: the stations carry
 /// their rates to the state with their summed forces, which round differently from the planar
-/// joint's one force) and count the same impacts; the peaks agree to the last bit, the final
-/// angles to 2e-8 and the time integrals (RMS force, restitution) to 2e-6, the steps in
-/// contact to one of 25,735: rounding, grown over the rattle's 280 impacts.
+/// joint's one force, and a step in contact follows the contact's energy) and count the same
+/// impacts, the first at the same instant to the bit. The rest is that rounding, grown over the
+/// rattle's 281 impacts and read at states a rounding apart (measured): the peaks agree to 1.9e-6,
+/// the deepest penetration to 4.9e-5, the final angles to 4.6e-8, the RMS force and restitution to
+/// 5.4e-5, the steps in contact to 2 of 12,910. (With the contact step at one tolerance of a period
+/// the peaks agreed to the last bit.)
 #[test]
 fn spatial_joint_aligned_is_the_planar_joint_on_the_paper_scene() {
     let planar = Scene::solar_panel();
@@ -71,7 +74,7 @@ fn spatial_joint_aligned_is_the_planar_joint_on_the_paper_scene() {
     assert!(p.is_complete() && s.is_complete());
     assert!(p.guards.is_clean() && s.guards.is_clean(), "{:?}", s.guards);
     assert!(
-        p.steps.abs_diff(s.steps) <= 1,
+        p.steps.abs_diff(s.steps) <= 2,
         "step count {} vs {}",
         p.steps,
         s.steps
@@ -85,33 +88,31 @@ fn spatial_joint_aligned_is_the_planar_joint_on_the_paper_scene() {
         "the paper's scene rattles: {}",
         hp.impacts
     );
-    for (name, a, b) in [
-        ("peak force", hp.peak_force_n, hs.peak_force_n),
-        (
-            "first impact t",
-            hp.first_impact_t_s.unwrap(),
-            hs.first_impact_t_s.unwrap(),
-        ),
+    assert_eq!(hp.first_impact_t_s, hs.first_impact_t_s, "first impact");
+    for (name, a, b, bound) in [
+        ("peak force", hp.peak_force_n, hs.peak_force_n, 1e-5),
         (
             "first impact peak",
             hp.first_impact_peak_n.unwrap(),
             hs.first_impact_peak_n.unwrap(),
+            1e-5,
         ),
         (
             "max penetration",
             hp.max_penetration_um,
             hs.max_penetration_um,
+            2e-4,
         ),
+        ("RMS force", hp.rms_force_n, hs.rms_force_n, 2e-4),
+        ("restitution", hp.max_restitution, hs.max_restitution, 2e-4),
     ] {
-        assert!(rel(a, b) < 1e-12, "{name}: {a} vs {b}");
+        assert!(rel(a, b) < bound, "{name}: {a} vs {b}");
     }
     for (body, a) in &p.final_angles_deg {
         let b = s.final_angles_deg[body];
-        assert!(rel(*a, b) < 2e-8, "final angle of {body}: {a} vs {b}");
+        assert!(rel(*a, b) < 2e-7, "final angle of {body}: {a} vs {b}");
     }
-    assert!(rel(hp.rms_force_n, hs.rms_force_n) < 2e-6);
-    assert!(rel(hp.max_restitution, hs.max_restitution) < 2e-6);
-    assert!(hp.contact_steps.abs_diff(hs.contact_steps) <= 1);
+    assert!(hp.contact_steps.abs_diff(hs.contact_steps) <= 10);
     // Nothing tilted, nothing slid, no face touched; the edges carried their share.
     let m = spatial(&s);
     assert!(

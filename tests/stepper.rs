@@ -337,13 +337,16 @@ fn a_driven_mechanism_at_the_default_step_control_never_enters_deeper_than_allow
     // step. With the joint correction the finer run converges (16.5 um), and the default is left
     // 11 % deep (18.2 um; 17.3 at 0.002): a first-order error in the tolerance on this crank with
     // the improved Liu law, still open (the Flores-Ambrosio slider-crank's first impact, with the
-    // Lankarani-Nikravesh law, is within 0.1 % at the defaults).
+    // Lankarani-Nikravesh law, is within 0.1 % at the defaults). Since a contact step covers
+    // twice the tolerance of a period the error plateaus to a finer tolerance: 11.2, 11.1 and
+    // 10.8 % at 0.0075, 0.004 and 0.002, then 5.8 and 2.2 % at 0.001 and 0.0005; a run at half
+    // the tolerance (what `--check` compares with) does not see it.
     let converged = crank_run(StepControl::fixed(5e-8), 0.004).unwrap().first;
     let error = |tolerance: f64| {
         let r = crank_run(control.with_tolerance(tolerance), 0.004).unwrap();
         (r.first - converged).abs() / converged
     };
-    let (coarse, finer, finest) = (error(0.0075), error(0.002), error(0.0005));
+    let (coarse, finer, finest) = (error(0.0075), error(0.001), error(0.0005));
     assert!(
         coarse < 0.15,
         "first impact {coarse} of the converged depth off"

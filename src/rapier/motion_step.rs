@@ -12,7 +12,7 @@
 //! acceleration within 0.08 %, 0.3 % and (at 30 deg) 55 % of its peak; at the default
 //! tolerance 0.0075 (0.43 deg) it is within 0.02 %. A contact's own time scale is bounded
 //! separately ([`ClearanceJoint::adaptive_step`](crate::rapier::joint::ClearanceJoint::adaptive_step):
-//! `tol` of its natural period in contact; in free flight `tol` of the clearance per step of the
+//! `2 tol` of its natural period in contact; in free flight `tol` of the clearance per step of the
 //! journal's path across the gap, [`flight_step`](crate::rapier::joint::flight_step)); the step
 //! is the smallest of these and `max_dt`, which is a safety cap.
 //!

@@ -90,10 +90,9 @@ pub enum StepMode {
     /// A constant step (the paper's way); the last step is shortened to land on the end.
     Fixed,
     /// The step changes between Rapier steps: no body turns more than `tolerance` rad in a step
-    /// ([`motion_step`]), shorter as a contact
-    /// approaches and inside it (`tolerance` of the contact's natural period, within its damped
-    /// and friction stability limits), at most the largest step (a safety cap), with rejected
-    /// steps retried. The default.
+    /// ([`motion_step`]), shorter as a contact approaches and inside it (twice `tolerance` of the
+    /// contact's natural period, within its damped and friction stability limits), at most the
+    /// largest step (a safety cap), with rejected steps retried. The default.
     #[default]
     Adaptive,
 }
@@ -112,8 +111,11 @@ pub struct StepControl {
     pub mode: StepMode,
     /// The fixed step, or the largest adaptive step, s.
     pub max_dt: f64,
-    /// Adaptive: the fraction of a contact's natural period one step may cover, and the angle
-    /// (rad) a body may turn in one step.
+    /// Adaptive: the local error each bound of the step holds to: a step covers at most twice
+    /// this fraction of a contact's natural period
+    /// ([`CONTACT_PERIODS_PER_TOLERANCE`](crate::rapier::joint::CONTACT_PERIODS_PER_TOLERANCE)),
+    /// turns no body by more than this angle (rad), and moves a journal across its gap by at
+    /// most this fraction of the clearance.
     pub tolerance: f64,
     /// Adaptive: the smallest step, s (the floor; see [`STALL_STEPS`]).
     pub min_dt: f64,
@@ -142,7 +144,7 @@ impl StepControl {
         }
     }
 
-    /// Adaptive steps of at most `max_dt` seconds, `tolerance` of a contact period inside
+    /// Adaptive steps of at most `max_dt` seconds, `2 tolerance` of a contact period inside
     /// contacts and `tolerance` rad of any body's turn; floor 1e-10 s, growth at most 2 per step,
     /// not strict.
     pub fn adaptive(max_dt: f64, tolerance: f64) -> Self {
@@ -157,8 +159,8 @@ impl StepControl {
         }
     }
 
-    /// Sets the adaptive tolerance, the fraction of a contact period one step may cover (and the
-    /// angle in rad a body may turn in one step).
+    /// Sets the adaptive tolerance ([`tolerance`](Self::tolerance): half the fraction of a
+    /// contact period one step may cover, and the angle in rad a body may turn in one step).
     pub fn with_tolerance(mut self, tolerance: f64) -> Self {
         self.tolerance = tolerance;
         self
@@ -206,7 +208,8 @@ impl StepControl {
                 return Err(Error::invalid(
                     "tolerance",
                     format!(
-                        "must be in (0, 1], a fraction of a contact period (got {})",
+                        "must be in (0, 1]: a step covers twice it of a contact's period and \
+                         turns a body by it in rad (got {})",
                         self.tolerance
                     ),
                 ));

@@ -96,6 +96,18 @@ pub enum Error {
         /// The violations in words.
         violations: String,
     },
+    /// A convergence check found metrics that move beyond their bounds at a tighter step
+    /// control ([`ConvergenceCheck::strict`](crate::scene::runner::convergence::ConvergenceCheck::strict)).
+    #[error(
+        "not converged at this step control: against half its tolerance (or half its fixed step) \
+         {flagged} metric(s) moved beyond their bounds, the worst {worst}"
+    )]
+    NotConverged {
+        /// How many metrics were flagged.
+        flagged: usize,
+        /// The worst, in words.
+        worst: String,
+    },
     /// A file could not be read or written.
     #[error("{action} `{path}`: {source}")]
     Io {

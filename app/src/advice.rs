@@ -26,6 +26,11 @@ pub fn describe(e: &Error) -> String {
             "{message} (`--strict` made these guard violations an error; without it the run is \
              written, its summary listing them)"
         ),
+        Error::NotConverged { .. } => format!(
+            "{message} (`--strict` made the convergence check an error; the run is written, \
+             `convergence.json` listing every metric; a smaller `--set run.tolerance=...` or \
+             `--dt` is what converges them)"
+        ),
         _ => message,
     }
 }

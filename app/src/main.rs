@@ -237,6 +237,13 @@ struct RunArgs {
     /// written beside the CSVs by default).
     #[arg(long)]
     no_replay: bool,
+    /// Check convergence: run the scene again at half its tolerance (half its fixed step), the
+    /// clearance twin only, and compare every clearance hinge's first impact, largest force and
+    /// penetration, onsets and impacts after a separation, contact fraction and final angle. A metric whose estimated error
+    /// exceeds its bound is flagged on the console and in `convergence.json`, and fails the run
+    /// (exit code 1, the set written) under `--strict`. About twice the run's time again.
+    #[arg(long)]
+    check: bool,
 }
 
 impl RunArgs {
@@ -302,9 +309,34 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
         )?;
         drawn.push(job.set.final_path(&path));
     }
-    let files = job.files(&result);
+    // The convergence check: a run of it that fails does not lose the set; the command fails
+    // after writing it.
+    let (check, check_failed) = match (args.check, result.is_complete()) {
+        (true, true) => {
+            let mut progress = RunProgress::new(progress_mode(&args.progress));
+            let check = job.check_convergence(&result, |p| progress.update(p));
+            progress.finish();
+            match check.and_then(|c| job.write_convergence(&c).map(|()| c)) {
+                Ok(c) => (Some(c), None),
+                Err(e) => (None, Some(e)),
+            }
+        }
+        (true, false) => {
+            eprintln!("no convergence check: the run did not reach its end");
+            (None, None)
+        }
+        (false, _) => (None, None),
+    };
+    let mut files = job.files(&result);
+    if check.is_some() {
+        files.push("convergence.json".into());
+    }
+    let strict = scene.run.strict;
     let out = job.commit()?;
     println!("{}", comparison_table(&summary));
+    if let Some(check) = &check {
+        println!("{}", cli::run::convergence_lines(check));
+    }
     println!(
         "{} steps in {:.2} s wall; wrote {}/{{{}}}",
         result.steps,
@@ -316,9 +348,16 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
         println!("wrote {}", p.display());
     }
     // A stalled run: its set is written (marked incomplete) and the command fails.
-    match result.stopped.take() {
-        Some(e) => Err(e),
-        None => Ok(()),
+    if let Some(e) = result.stopped.take() {
+        return Err(e);
+    }
+    if let Some(e) = check_failed {
+        eprintln!("the convergence check's run at the tighter step control failed");
+        return Err(e);
+    }
+    match &check {
+        Some(check) if strict => check.strict(),
+        _ => Ok(()),
     }
 }
 

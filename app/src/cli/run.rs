@@ -4,7 +4,8 @@
 use crate::resultset::ResultSet;
 use clearance_joint::error::Result;
 use clearance_joint::scene::output::{MemoryEstimate, available_memory};
-use clearance_joint::scene::runner::{Progress, RunOptions, RunResult, Simulation};
+use clearance_joint::scene::runner::convergence::{self, ConvergenceCheck};
+use clearance_joint::scene::runner::{Progress, RunOptions, RunResult, Simulation, Twins};
 use clearance_joint::scene::{StepMode, ValidatedScene};
 use std::path::PathBuf;
 
@@ -66,6 +67,37 @@ impl SceneRun {
             .map_err(|e| e.with_step_mode(self.scene.run.step == StepMode::Adaptive))
     }
 
+    /// The convergence check (`--check`): the scene again at half its tolerance (half its fixed
+    /// step), the clearance twin only, compared with `result`'s
+    /// ([`clearance_joint::scene::runner::convergence`]).
+    pub fn check_convergence(
+        &self,
+        result: &RunResult,
+        progress: impl FnMut(&Progress),
+    ) -> Result<ConvergenceCheck> {
+        let tighter = convergence::tightened(&self.scene)?;
+        let options = RunOptions {
+            twins: Twins::ClearanceOnly,
+            skip_rows: true,
+        };
+        let finer = Simulation::from_validated(&tighter, options)?
+            .run_with_progress(progress)
+            .map_err(|e| e.with_step_mode(tighter.run.step == StepMode::Adaptive))?;
+        Ok(ConvergenceCheck::compare(result, &finer))
+    }
+
+    /// Writes `check` as `convergence.json` into the result set.
+    pub fn write_convergence(&self, check: &ConvergenceCheck) -> Result<()> {
+        let path = self.set.dir().join("convergence.json");
+        let json = serde_json::to_string_pretty(check)
+            .map_err(|e| clearance_joint::Error::invalid("convergence", e.to_string()))?;
+        std::fs::write(&path, json).map_err(|source| clearance_joint::Error::Io {
+            action: "cannot write",
+            path,
+            source,
+        })
+    }
+
     /// The files `result` writes (see [`RunResult::write`]), in the order they are listed.
     pub fn files(&self, result: &RunResult) -> Vec<String> {
         let mut files = vec!["ideal.csv".to_string(), "clearance.csv".to_string()];
@@ -80,4 +112,29 @@ impl SceneRun {
         files.push("summary.json".into());
         files
     }
+}
+
+/// The convergence check for the console: one line per metric (flagged ones marked), then the
+/// verdict naming the worst.
+pub fn convergence_lines(check: &ConvergenceCheck) -> String {
+    let mut out = format!(
+        "convergence check against {} ({} steps against {}):\n",
+        check.tighter, check.steps[1], check.steps[0]
+    );
+    for m in &check.metrics {
+        let mark = if m.flagged { "NOT CONVERGED" } else { "ok" };
+        out.push_str(&format!("  {mark:>13}  {}\n", m.describe()));
+    }
+    match check.worst() {
+        None => out.push_str("every metric within its bound at this step control"),
+        Some(w) => out.push_str(&format!(
+            "WARNING: {} metric(s) not converged at this step control; the worst: {}. A tighter \
+             step control (`--set run.tolerance=...`, `--dt`) converges what converges; what \
+             keeps moving (the onsets of a chaotic rattle) is a statistic to compare over several \
+             runs, not a number to trust from one",
+            check.flagged().count(),
+            w.describe()
+        )),
+    }
+    out
 }

@@ -3,6 +3,7 @@
 //! both together, and records both.
 
 mod comparison;
+pub mod convergence;
 mod invariants;
 mod twin;
 

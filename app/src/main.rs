@@ -239,9 +239,10 @@ struct RunArgs {
     no_replay: bool,
     /// Check convergence: run the scene again at half its tolerance (half its fixed step), the
     /// clearance twin only, and compare every clearance hinge's first impact, largest force and
-    /// penetration, onsets and impacts after a separation, contact fraction and final angle. A metric whose estimated error
-    /// exceeds its bound is flagged on the console and in `convergence.json`, and fails the run
-    /// (exit code 1, the set written) under `--strict`. About twice the run's time again.
+    /// penetration, onsets and impacts after a separation, contact fraction and final angle. A
+    /// metric whose estimated error exceeds its bound is flagged on the console and in
+    /// `convergence.json`, and fails the run (exit code 1, the set written) under `--strict`.
+    /// About twice the run's time again.
     #[arg(long)]
     check: bool,
 }

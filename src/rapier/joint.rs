@@ -577,8 +577,8 @@ impl ClearanceJoint {
     /// - In contact: twice `tolerance` ([`CONTACT_PERIODS_PER_TOLERANCE`]) of the contact's
     ///   natural period `2 pi/omega`, with `omega` at the deepest point the contact's energy
     ///   reaches (its elastic energy plus the kinetic energy of its normal motion, in or out), and
-    ///   within the damped stability limit there. The step follows the contact's energy, not the phase of its
-    ///   oscillation.
+    ///   within the damped stability limit there. The step follows the contact's energy, not the
+    ///   phase of its oscillation.
     /// - In free flight: the journal's centre moves at most `tolerance` times the clearance
     ///   relative to the bearing's in one step ([`flight_step`]: its path across the gap decides
     ///   where and how fast the next impact comes), and the contact ahead is predicted from the
@@ -643,9 +643,10 @@ impl ClearanceJoint {
     /// The step that resolves a contact now `depth` deep (m) whose journal moves at
     /// `approach_speed` (m/s) along the normal to `2 tolerance` of its natural period
     /// ([`CONTACT_PERIODS_PER_TOLERANCE`]), taken at the deepest point the contact can reach (its
-    /// elastic energy plus that kinetic energy), and within the damped stability limit there. A spatial joint's contact carries the governing
-    /// law's [`contact_share`](spatial::SpatialParts::contact_share): a tilted journal pressed
-    /// at its edge is as stiff as the few stations that touch, not the whole width.
+    /// elastic energy plus that kinetic energy), and within the damped stability limit there. A
+    /// spatial joint's contact carries the governing law's
+    /// [`contact_share`](spatial::SpatialParts::contact_share): a tilted journal pressed at its
+    /// edge is as stiff as the few stations that touch, not the whole width.
     fn contact_step(&self, approach_speed: f64, depth: f64, tolerance: f64) -> f64 {
         let law = self.governing_law();
         let share = self.spatial.as_ref().map_or(1.0, |p| p.contact_share());

@@ -435,7 +435,7 @@ fn figures_render_to_valid_png_and_svg_files() {
 
 /// The paper's conclusion 2 on our model, at the study's settings (5 s, the default adaptive
 /// steps): more impacts (contact onsets) and a higher peak force as the clearance grows (218, 249,
-/// 280 onsets; 97.9, 137.5, 179.2 N). Over short runs the impact order is reversed (smaller clearances strike more often
+/// 281 onsets; 97.9, 137.5, 179.2 N). Over short runs the impact order is reversed (smaller clearances strike more often
 /// at first; the report shows the counts per second), so this needs the whole 5 s.
 #[test]
 fn clearance_study_shows_more_impacts_and_higher_peaks_as_c_grows() {

@@ -201,13 +201,12 @@ pub struct ImpactRecorder {
     force_sq_time: f64,
     contact_time: f64,
     onset_rate: f64,
-    was_in_contact: bool,
     in_first_contact: bool,
     /// Whether the last impact of the list is still open.
     open: bool,
     /// The step that led to the state being recorded (the last recorded `dt`), s.
     last_dt: f64,
-    /// The penetration at the last recorded state, m.
+    /// The penetration at the last recorded state, m (positive: it was in contact).
     last_penetration: f64,
     finished: bool,
     /// A spatial joint: whether each face carried load at the last state, and the time a face
@@ -230,6 +229,8 @@ impl ImpactRecorder {
         m.peak_force_n = m.peak_force_n.max(obs.force);
         self.force_sq_time += obs.force * obs.force * dt;
         let in_contact = obs.in_contact();
+        // The last state was in contact and this one is not.
+        let lift_off = self.last_penetration > 0.0 && !in_contact;
         if obs.impact {
             m.separated_impacts += 1;
         }
@@ -244,7 +245,7 @@ impl ImpactRecorder {
         };
         // A lift-off: the last state's step was counted in contact whole; the contact ended at
         // the crossing of delta = 0 inside it, interpolated as the onset is.
-        if self.was_in_contact && !in_contact {
+        if lift_off {
             let after =
                 (1.0 - crossing_fraction(self.last_penetration, -obs.penetration)) * self.last_dt;
             self.contact_time -= after;
@@ -259,10 +260,9 @@ impl ImpactRecorder {
         if obs.onset {
             self.onset_rate = approach;
         }
-        if self.was_in_contact && !in_contact && self.onset_rate > RESTITUTION_MIN_SPEED {
+        if lift_off && self.onset_rate > RESTITUTION_MIN_SPEED {
             m.max_restitution = m.max_restitution.max(-obs.rate / self.onset_rate);
         }
-        self.was_in_contact = in_contact;
         if self.open && (!in_contact || obs.onset) {
             self.open = false;
         }

@@ -471,13 +471,14 @@ pub fn window(impacts: &[Impact], start: f64, end: f64, unit: Unit) -> WindowSta
 }
 
 /// How many of the first impacts of `a` match those of `b` in sequence: onsets within 1 us and
-/// peaks within 1 %.
+/// peaks within 1 % (the bounds `run --check` holds a first impact to).
 pub fn matched(a: &[Impact], b: &[Impact]) -> usize {
+    use clearance_joint::scene::runner::convergence::{FORCE_BOUND, ONSET_BOUND_S};
     a.iter()
         .zip(b)
         .take_while(|(x, y)| {
-            (x.onset_t_s - y.onset_t_s).abs() <= 1e-6
-                && (x.peak_force_n / y.peak_force_n - 1.0).abs() <= 0.01
+            (x.onset_t_s - y.onset_t_s).abs() <= ONSET_BOUND_S
+                && (x.peak_force_n / y.peak_force_n - 1.0).abs() <= FORCE_BOUND
         })
         .count()
 }

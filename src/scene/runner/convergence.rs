@@ -45,12 +45,13 @@ pub const ANGLE_BOUND_DEG: f64 = 0.01;
 /// The scene at the tighter step control the check compares with: half the tolerance of
 /// adaptive steps, or half the fixed step.
 pub fn tightened(scene: &ValidatedScene) -> Result<ValidatedScene> {
-    let run = &scene.run;
-    let set = match run.step {
-        StepMode::Adaptive => format!("run.tolerance={:e}", 0.5 * run.tolerance),
-        StepMode::Fixed => format!("run.dt_s={:e}", 0.5 * run.dt_s),
-    };
-    scene.with_overrides(&[set])
+    let mut tighter = scene.scene().clone();
+    let run = &mut tighter.run;
+    match run.step {
+        StepMode::Adaptive => run.tolerance *= 0.5,
+        StepMode::Fixed => run.dt_s *= 0.5,
+    }
+    tighter.validated()
 }
 
 /// One metric of one clearance hinge at the run's step control and at the tighter one.

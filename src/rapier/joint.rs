@@ -420,12 +420,19 @@ pub fn validate_max_valid_penetration(
     Ok(depth)
 }
 
-/// The free-flight step of a journal whose centre moves at `speed` (m/s) relative to the
+/// The journal-path step of a journal whose centre moves at `speed` (m/s) relative to the
 /// bearing's, in a clearance `clearance` (m): the step that moves it `tolerance` times the
-/// clearance, `tol c/|de/dt|`, s (infinite at rest). Without it a free flight took the step of
-/// the bodies' turn: on Flores and Ambrósio's slider-crank a journal crossed its 0.5 mm gap in
-/// a few steps of 14 us, and the impacts after the first left the converged sequence within two
-/// (measured, `cargo bench --bench mechanisms`); the four-bar's first impact was 60 % high.
+/// clearance, `tol c/|de/dt|`, s (infinite at rest), in free flight and in contact (along the
+/// wall the contact's normal then turns by at most about `tolerance` rad a step). Without it a
+/// free flight took the step of the bodies' turn: on Flores and Ambrósio's slider-crank a journal
+/// crossed its 0.5 mm gap in a few steps of 14 us, and the impacts after the first left the
+/// converged sequence within two (measured, `cargo bench --bench mechanisms`); the four-bar's
+/// first impact was 60 % high. Without it in contact the slider-crank at c = 0.1 mm rode its
+/// wall through the load reversals where converged runs lift off: 0 to 0.5 lift-offs per turn
+/// in turns 2-3 against 5 to 6.5 (fixed 1e-6 to 2.5e-7 s), and at tolerances 0.00375, 0.002 and
+/// 0.001 1.5-4.5, 3.5-5 and 5-9: a bias of the step, not chaos. With it 4 per turn for 4.6 %
+/// more steps; the paper's scene at T, 3T and 5T, the four-bar, the deployable array and the
+/// double pendulum take the same steps as without.
 pub fn flight_step(tolerance: f64, clearance: f64, speed: f64) -> f64 {
     if speed > 0.0 {
         tolerance * clearance / speed
@@ -445,11 +452,37 @@ const APPROACH_FRACTION: f64 = 0.5;
 /// impacts need (Flores and Ambrósio's slider-crank took 42,417 steps, 0.91 of them in contact,
 /// and missed its first peak by 0.045 %, as much as a fixed 1.5e-6 s run of 24,000 steps); at 2
 /// it takes 21,764 and misses by 0.02 % (a fixed step as accurate, 1e-6 s, takes 36,000); at 3
-/// (a scratch run) 16,350 and 0.05 %. The paper's scene takes 20,570 steps at 2 (33,950 at 1),
-/// its first peak within 0.014 % of a fixed 1e-6 s run.
+/// (a scratch run) 16,350 and 0.05 % (measured before the turn bound became `tol/8` and the
+/// journal-path bound held in contact: the default now takes 25,413 steps there). The paper's
+/// scene takes 20,570 steps at 2 (33,950 at 1), its first peak within 0.014 % of a fixed 1e-6 s
+/// run.
 pub const CONTACT_PERIODS_PER_TOLERANCE: f64 = 2.0;
 /// Margin on the damped stability limit used by the adaptive step.
 const STABILITY_SAFETY: f64 = 0.8;
+/// The fraction of the damped stability limit one adaptive step in contact may cover, per unit
+/// of tolerance: `100 tol` (0.75 at the default 0.0075; at most 0.8, the margin kept on that
+/// limit). A step near the stability limit is stable, not accurate: the limit is `2/lambda` for
+/// a contact whose fast mode relaxes at `lambda` (`omega (zeta + sqrt(1 + zeta^2))`, about `D/m`
+/// when heavily damped). The improved law's damping ramps up with depth, and on a light body
+/// (the slider-crank of `assets/slider_crank.ron`, 0.5 kg rod and slider, damping ratio about 30
+/// at 16 um) that mode, not the period, limits the step. Bounded by stability alone the steps
+/// there did not depend on the tolerance: the first impact was 11 % too deep from 0.0075 down to
+/// 0.002, and a run at half the tolerance (`run --check`) could not see it. Scaled with the
+/// tolerance, the default's steps are about as before (10,309 over that crank's first 4 ms,
+/// 9,749 before) and tightening reaches them: measured (`tests/stepper.rs`), +11.7 %, +6.1 % and
+/// +1.7 % at 0.0075, 0.00375 and 0.001 against the limit of fixed steps (16.21 um; fixed steps
+/// converge at first order there, 16.63, 16.42, 16.31 and 16.26 um at 1e-7 to 1.25e-8 s). Below a
+/// damping ratio of about 8 the period's bound ([`CONTACT_PERIODS_PER_TOLERANCE`]) is the finer:
+/// the paper's scene takes the same steps; the four-bar's first peak moved by 0.2 % and Flores
+/// and Ambrósio's slider-crank took one step more (a slow re-contact, where the
+/// Lankarani-Nikravesh damping grows as `1/delta_dot0`).
+pub const STABLE_FRACTION_PER_TOLERANCE: f64 = 100.0;
+
+/// The fraction of a contact's damped stability limit an adaptive step may take at `tolerance`
+/// ([`STABLE_FRACTION_PER_TOLERANCE`], [`STABILITY_SAFETY`]).
+fn stable_fraction(tolerance: f64) -> f64 {
+    (STABLE_FRACTION_PER_TOLERANCE * tolerance).min(STABILITY_SAFETY)
+}
 
 /// The dynamic state of a joint between steps (what a rejected step must restore).
 #[derive(Clone, Debug, Default)]
@@ -594,16 +627,6 @@ impl ClearanceJoint {
         let rate = r.state.penetration_rate;
         let contact_step =
             |approach_speed: f64, depth: f64| self.contact_step(approach_speed, depth, tolerance);
-        if delta > 0.0 {
-            // |rate|, not the approach only: a step that grows as the journal moves out of the
-            // wall and shrinks as it moves in pumps energy into a long contact's oscillation
-            // (variable-step Verlet is not symplectic). On the paper's scene at 3T the journal
-            // then lifted off where converged runs stay on the wall: 148 onsets per second
-            // against 120 (docs/stepper-and-accuracy.md, "steps in a long contact").
-            return contact_step(rate.abs(), delta)
-                .min(STABILITY_SAFETY * r.max_stable_dt.min(r.friction_stable_dt));
-        }
-        let gap = -delta;
         let flight = match &self.spatial {
             Some(parts) => parts.flight_step(tolerance),
             None => flight_step(
@@ -612,6 +635,21 @@ impl ClearanceJoint {
                 r.state.eccentricity_rate.length(),
             ),
         };
+        if delta > 0.0 {
+            // |rate|, not the approach only: a step that grows as the journal moves out of the
+            // wall and shrinks as it moves in pumps energy into a long contact's oscillation
+            // (variable-step Verlet is not symplectic). On the paper's scene at 3T the journal
+            // then lifted off where converged runs stay on the wall: 148 onsets per second
+            // against 120 (docs/stepper-and-accuracy.md, "steps in a long contact").
+            // The journal's path bound holds in contact too ([`flight_step`]): a contact whose
+            // load turns, and a light one about to lift off, have a long period, and the
+            // journal's path along the wall decides where it leaves it.
+            return contact_step(rate.abs(), delta)
+                .min(flight)
+                .min(stable_fraction(tolerance) * r.max_stable_dt)
+                .min(STABILITY_SAFETY * r.friction_stable_dt);
+        }
+        let gap = -delta;
         let accel = match self.previous_rate {
             Some(prev) if last_dt > 0.0 => (rate - prev) / last_dt,
             _ => 0.0,
@@ -696,7 +734,8 @@ impl ClearanceJoint {
         };
         let (stable, omega, _) = stable_step(stiffness, law.damping_coefficient(&c), m);
         let period = std::f64::consts::TAU / omega;
-        (CONTACT_PERIODS_PER_TOLERANCE * tolerance * period).min(STABILITY_SAFETY * stable)
+        (CONTACT_PERIODS_PER_TOLERANCE * tolerance * period)
+            .min(stable_fraction(tolerance) * stable)
     }
 
     /// Judges a step of `dt` that ended in the state of the last application, for a joint that

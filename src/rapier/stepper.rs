@@ -20,7 +20,7 @@
 //!   correction rate of the longest recent step
 //!   ([`joint_correction`](crate::rapier::joint_correction); [`StepControl::joint_correction`]).
 //! - **Step choice** ([`StepControl`]): fixed, or adaptive from the motion (no body turns more
-//!   than `tolerance` rad in a step: [`motion_step`](crate::rapier::motion_step)) and the
+//!   than `tolerance/8` rad in a step: [`motion_step`](crate::rapier::motion_step)) and the
 //!   contacts (the joints'
 //!   [`adaptive_step`](crate::rapier::joint::ClearanceJoint::adaptive_step)), growing by at most
 //!   [`StepControl::max_growth`] per step and landing exactly on the time given to
@@ -89,9 +89,10 @@ pub use crate::rapier::step_hooks::StepHooks;
 pub enum StepMode {
     /// A constant step (the paper's way); the last step is shortened to land on the end.
     Fixed,
-    /// The step changes between Rapier steps: no body turns more than `tolerance` rad in a step
+    /// The step changes between Rapier steps: no body turns more than `tolerance/8` rad in a step
     /// ([`motion_step`]), shorter as a contact approaches and inside it (twice `tolerance` of the
-    /// contact's natural period, within its damped and friction stability limits), at most the
+    /// contact's natural period, at most `100 tolerance` of its damped stability limit, within
+    /// friction's), at most the
     /// largest step (a safety cap), with rejected steps retried. The default.
     #[default]
     Adaptive,
@@ -114,8 +115,9 @@ pub struct StepControl {
     /// Adaptive: the local error each bound of the step holds to: a step covers at most twice
     /// this fraction of a contact's natural period
     /// ([`CONTACT_PERIODS_PER_TOLERANCE`](crate::rapier::joint::CONTACT_PERIODS_PER_TOLERANCE)),
-    /// turns no body by more than this angle (rad), and moves a journal across its gap by at
-    /// most this fraction of the clearance.
+    /// turns no body by more than an eighth of it in rad
+    /// ([`TURN_PER_TOLERANCE`](crate::rapier::motion_step::TURN_PER_TOLERANCE)), and moves a
+    /// journal's centre relative to its bearing's by at most this fraction of the clearance.
     pub tolerance: f64,
     /// Adaptive: the smallest step, s (the floor; see [`STALL_STEPS`]).
     pub min_dt: f64,
@@ -145,7 +147,7 @@ impl StepControl {
     }
 
     /// Adaptive steps of at most `max_dt` seconds, `2 tolerance` of a contact period inside
-    /// contacts and `tolerance` rad of any body's turn; floor 1e-10 s, growth at most 2 per step,
+    /// contacts and `tolerance/8` rad of any body's turn; floor 1e-10 s, growth at most 2 per step,
     /// not strict.
     pub fn adaptive(max_dt: f64, tolerance: f64) -> Self {
         StepControl {
@@ -160,7 +162,8 @@ impl StepControl {
     }
 
     /// Sets the adaptive tolerance ([`tolerance`](Self::tolerance): half the fraction of a
-    /// contact period one step may cover, and the angle in rad a body may turn in one step).
+    /// contact period one step may cover, and 8 times the angle in rad a body may turn in one
+    /// step).
     pub fn with_tolerance(mut self, tolerance: f64) -> Self {
         self.tolerance = tolerance;
         self
@@ -209,7 +212,7 @@ impl StepControl {
                     "tolerance",
                     format!(
                         "must be in (0, 1]: a step covers twice it of a contact's period and \
-                         turns a body by it in rad (got {})",
+                         turns a body by an eighth of it in rad (got {})",
                         self.tolerance
                     ),
                 ));

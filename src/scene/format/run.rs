@@ -12,7 +12,7 @@ pub struct RunSettings {
     #[serde(default = "default_dt")]
     pub dt_s: f64,
     /// Adaptive steps: the largest step, s (default 1e-3), a safety cap. The step is chosen from
-    /// the motion (no body turns more than `tolerance` rad in a step) and the contacts
+    /// the motion (no body turns more than `tolerance/8` rad in a step) and the contacts
     /// (twice `tolerance` of a contact's period); what neither sees, a stiff force of your own on a
     /// body that does not turn, needs this cap below a tenth of its period.
     #[serde(default = "default_max_dt")]
@@ -30,10 +30,11 @@ pub struct RunSettings {
     pub step: StepMode,
     /// Adaptive steps (default 0.0075): half the fraction of a contact's natural period
     /// `2 pi/omega` one step may cover inside and ahead of a contact (a step covers `2 tolerance`
-    /// of it: 1.5 % at the default), the angle in radians any movable body may turn in one step
-    /// (0.43 deg at the default: the ideal slider-crank at 5000 rpm then keeps its slider
-    /// acceleration within 0.02 % of the closed form), and the fraction of the clearance a
-    /// journal may cross in one step of free flight.
+    /// of it: 1.5 % at the default), 8 times the angle in radians any movable body may turn in
+    /// one step (0.054 deg at the default: the ideal slider-crank at 5000 rpm then keeps its
+    /// slider acceleration within 6.5e-7 of its peak from the closed form), and the fraction of
+    /// the clearance a journal's centre may move relative to its bearing's in one step, in free
+    /// flight and in contact.
     #[serde(default = "default_tolerance")]
     pub tolerance: f64,
     /// Whether a guard violation (a penetration beyond the law's validity, energy gained, steps
@@ -94,12 +95,12 @@ impl RunSettings {
     }
 
     /// The step control in words, e.g. "adaptive steps of at most 1e-3 s (tolerance 0.0075:
-    /// twice it of a contact period, in rad of a body's turn)".
+    /// twice it of a contact period, an eighth of it in rad of a body's turn)".
     pub fn stepping(&self) -> String {
         match self.step {
             StepMode::Fixed => format!("fixed step {:e} s", self.dt_s),
             StepMode::Adaptive => format!(
-                "adaptive steps of at most {:e} s (tolerance {}: twice it of a contact period, in rad of a body's turn)",
+                "adaptive steps of at most {:e} s (tolerance {}: twice it of a contact period, an eighth of it in rad of a body's turn)",
                 self.max_dt_s, self.tolerance
             ),
         }

@@ -10,7 +10,7 @@ pub struct Setup {
     /// Step, s (the largest step with adaptive stepping).
     pub dt_s: f64,
     /// The step control in words, e.g. "adaptive steps of at most 1e-3 s (tolerance 0.0075:
-    /// twice it of a contact period, in rad of a body's turn)".
+    /// twice it of a contact period, an eighth of it in rad of a body's turn)".
     pub stepping: String,
     /// Interval between rows, s.
     pub output_interval_s: f64,

@@ -337,6 +337,8 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     println!("{}", comparison_table(&summary));
     if let Some(check) = &check {
         println!("{}", cli::run::convergence_lines(check));
+    } else if result.is_complete() {
+        println!("{}", cli::run::UNCHECKED);
     }
     println!(
         "{} steps in {:.2} s wall; wrote {}/{{{}}}",

@@ -187,6 +187,7 @@ fn the_convergence_check_flags_a_coarse_run_and_strict_fails() {
     assert!(flagged(&check).is_empty(), "{check}");
     assert_eq!(check["metrics"].as_array().unwrap().len(), 8, "{check}");
     assert!(stdout.contains("every metric within its bound"), "{stdout}");
+    assert!(!stdout.contains("convergence: not checked"), "{stdout}");
 
     let coarse = ["--set", "run.tolerance=0.03"];
     let (out, check) = run("check-coarse", &coarse);
@@ -202,6 +203,21 @@ fn the_convergence_check_flags_a_coarse_run_and_strict_fails() {
         stdout.contains("NOT CONVERGED  hinge first impact peak (N)")
             && stdout.contains("WARNING: ")
             && stdout.contains("convergence.json"),
+        "{stdout}"
+    );
+
+    // Without `--check` the console says the numbers are unchecked, and how to check them.
+    let dir = temp("check-none");
+    let out = bin()
+        .args(["--end", "0.1", "--no-figures", "--no-replay", "--out"])
+        .arg(&dir)
+        .output()
+        .unwrap();
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stdout}{stderr}");
+    assert!(
+        stdout.contains("convergence: not checked. `--check`")
+            && !dir.join("convergence.json").exists(),
         "{stdout}"
     );
 

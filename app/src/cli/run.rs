@@ -114,6 +114,12 @@ impl SceneRun {
     }
 }
 
+/// What the console says of a run without `--check`: its numbers are one run's, not shown to
+/// converge, and how to find out.
+pub const UNCHECKED: &str = "convergence: not checked. `--check` runs the scene again at half \
+the tolerance (about twice the time) and flags every metric that moves beyond its bound; a \
+chaotic rattle's later statistics are compared over several runs, not read from one";
+
 /// The convergence check for the console: one line per metric (flagged ones marked), then the
 /// verdict naming the worst.
 pub fn convergence_lines(check: &ConvergenceCheck) -> String {

@@ -312,7 +312,10 @@ fn summary_row(case: &Case, rows: &[Row]) -> String {
         .into_iter()
         .flatten()
         .collect();
-        outside = if out.is_empty() {
+        outside = if defaults.is_empty() || fixed.is_empty() {
+            // No completed run on one side: nothing to compare (the guards column says why).
+            "-".into()
+        } else if out.is_empty() {
             "none".into()
         } else {
             out.join("; ")

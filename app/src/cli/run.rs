@@ -3,7 +3,7 @@
 
 use crate::resultset::ResultSet;
 use clearance_joint::error::Result;
-use clearance_joint::scene::output::{MemoryEstimate, available_memory};
+use clearance_joint::scene::output::{MemoryEstimate, available_memory, write_atomic};
 use clearance_joint::scene::runner::convergence::{self, ConvergenceCheck};
 use clearance_joint::scene::runner::{Progress, RunOptions, RunResult, Simulation, Twins};
 use clearance_joint::scene::{StepMode, ValidatedScene};
@@ -88,14 +88,9 @@ impl SceneRun {
 
     /// Writes `check` as `convergence.json` into the result set.
     pub fn write_convergence(&self, check: &ConvergenceCheck) -> Result<()> {
-        let path = self.set.dir().join("convergence.json");
         let json = serde_json::to_string_pretty(check)
             .map_err(|e| clearance_joint::Error::invalid("convergence", e.to_string()))?;
-        std::fs::write(&path, json).map_err(|source| clearance_joint::Error::Io {
-            action: "cannot write",
-            path,
-            source,
-        })
+        write_atomic(&self.set.dir().join("convergence.json"), json.as_bytes())
     }
 
     /// The files `result` writes (see [`RunResult::write`]), in the order they are listed.

@@ -312,7 +312,11 @@ fn simulate(scene: &Scene, model: Model, dt: f64) -> Trace {
         match model {
             Model::Compliant => {
                 b.compliant
-                    .apply(&mut b.world.bodies, &b.world.integration_parameters)
+                    .apply(
+                        &mut b.world.bodies,
+                        &b.world.impulse_joints,
+                        &b.world.integration_parameters,
+                    )
                     .expect("the reference step is stable");
             }
             Model::LargeStep => b.play.before_step(

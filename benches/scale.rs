@@ -164,7 +164,11 @@ fn run(model: Model, dt: f64, end: f64, start: Start) -> Option<(f64, usize, f64
             ),
             Model::Compliant => c
                 .compliant
-                .apply(&mut c.world.bodies, &c.world.integration_parameters)
+                .apply(
+                    &mut c.world.bodies,
+                    &c.world.impulse_joints,
+                    &c.world.integration_parameters,
+                )
                 .ok()?,
         }
         c.world.step();

@@ -138,7 +138,11 @@ fn the_force_hook_in_a_users_own_loop_names_rapiers_dt() {
     world.integration_parameters.dt = 1e-3;
     let e = (0..1000)
         .find_map(|_| {
-            let r = set.apply(&mut world.bodies, &world.integration_parameters);
+            let r = set.apply(
+                &mut world.bodies,
+                &world.impulse_joints,
+                &world.integration_parameters,
+            );
             world.step();
             r.err()
         })

@@ -249,10 +249,14 @@ fn ln_restitution(dt: f64, carried: bool) -> f64 {
     let steps = (0.01 / dt) as usize;
     for _ in 0..steps {
         if carried {
-            set.apply(&mut world.bodies, &world.integration_parameters)
-                .unwrap();
+            set.apply(
+                &mut world.bodies,
+                &world.impulse_joints,
+                &world.integration_parameters,
+            )
+            .unwrap();
         } else {
-            set.apply_forces(&mut world.bodies);
+            set.apply_forces(&mut world.bodies, &world.impulse_joints);
         }
         let r = *set.get(pin).unwrap().report();
         if r.onset {
@@ -280,7 +284,7 @@ fn a_last_step_that_is_not_a_step_gives_the_stored_rate() {
         let mut in_contact = 0;
         for _ in 0..3000 {
             set.set_last_step(bad);
-            set.apply_forces(&mut world.bodies);
+            set.apply_forces(&mut world.bodies, &world.impulse_joints);
             let r = *set.get(pin).unwrap().report();
             assert!(r.contact_rate.is_finite() && r.force.normal_force.is_finite());
             if r.state.penetration > 0.0 {
@@ -383,8 +387,12 @@ fn ln_recorded(dt: f64) -> (f64, f64) {
     let mut recorder = ImpactRecorder::new();
     let steps = (0.003 / dt).round() as usize;
     for k in 0..steps {
-        set.apply(&mut world.bodies, &world.integration_parameters)
-            .unwrap();
+        set.apply(
+            &mut world.bodies,
+            &world.impulse_joints,
+            &world.integration_parameters,
+        )
+        .unwrap();
         recorder.record(
             k as f64 * dt,
             dt,

@@ -3,6 +3,7 @@
 
 use clap::{Args, Parser, Subcommand};
 use clearance_joint::scene::report::comparison_table;
+use clearance_joint::scene::runner::convergence::{self, Convergence, ConvergenceVerdict};
 use clearance_joint::scene::{Scene, ValidatedScene};
 use clearance_joint_app::cli::{self, merge::Merged, run::SceneRun, sweep::SweepJob};
 use clearance_joint_app::figures::run::{can_draw, draw_run_figures};
@@ -114,6 +115,11 @@ struct SweepArgs {
     /// Write each point's replay (`points/<dir>/replay.html`, the table's `dir`); off by default.
     #[arg(long)]
     replay: bool,
+    /// Check each point's convergence (off by default for a sweep, whose points are many): the
+    /// point again at half its tolerance, the clearance twin only; the verdict in the point's
+    /// `summary.json`, the table's `convergence` (JSON) and `not_converged` (CSV).
+    #[arg(long)]
+    check: bool,
     #[command(flatten)]
     exec: ExecArgs,
 }
@@ -147,6 +153,11 @@ struct StudyArgs {
     /// Skip the replays (each case's `replay.html`, linked from the report; written by default).
     #[arg(long)]
     no_replay: bool,
+    /// Skip the convergence check of each case (by default each case runs again at half its
+    /// tolerance, the clearance twin only, and the report says per case which metrics
+    /// converged; on `study all` the checks take about as long as the runs).
+    #[arg(long)]
+    no_check: bool,
     #[command(flatten)]
     exec: ExecArgs,
 }
@@ -237,14 +248,21 @@ struct RunArgs {
     /// written beside the CSVs by default).
     #[arg(long)]
     no_replay: bool,
-    /// Check convergence: run the scene again at half its tolerance (half its fixed step), the
-    /// clearance twin only, and compare every clearance hinge's first impact, largest force and
-    /// penetration, onsets and impacts after a separation, contact fraction and final angle. A
-    /// metric whose estimated error exceeds its bound is flagged on the console and in
-    /// `convergence.json`, and fails the run (exit code 1, the set written) under `--strict`.
-    /// About twice the run's time again.
-    #[arg(long)]
+    /// Check convergence (the default). The check runs the scene again at half its tolerance
+    /// (half its fixed step), the clearance twin only, and compares every clearance hinge's first
+    /// impact, largest force and penetration, onsets and impacts after a separation, contact
+    /// fraction and final angle. A metric whose estimated error exceeds its bound is flagged on
+    /// the console, in `summary.json`'s `convergence` and in `convergence.json`, and fails the
+    /// run (exit code 1, the set written) under `--strict`. About the run's own time again on
+    /// the paper's scene. The flag itself changes two things: a check whose own run fails fails
+    /// the command (it warns otherwise), and with `--strict` a scene with nothing to check (no
+    /// clearance hinge) is refused before it runs.
+    #[arg(long, conflicts_with = "no_check")]
     check: bool,
+    /// Skip the convergence check (on the paper's scene the command then takes about 2/3 of the
+    /// time); the summary says the run was not checked.
+    #[arg(long)]
+    no_check: bool,
 }
 
 impl RunArgs {
@@ -264,6 +282,24 @@ fn warn(scene: &Scene) {
 fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     let scene = args.scene()?;
     warn(&scene);
+    // Asked to confirm convergence strictly, a scene with nothing to check fails before any
+    // run: it could only pass by checking nothing.
+    if let (true, true, Some(reason)) = (
+        args.check,
+        scene.run.strict,
+        convergence::nothing_to_check(&scene),
+    ) {
+        return Err(clearance_joint::Error::invalid(
+            "--check",
+            format!(
+                "nothing to check ({reason}) in scene `{}`: the convergence check compares \
+                 clearance hinges' metrics at two step controls, so with `--strict` it could only \
+                 pass by checking nothing; give a hinge a clearance, or drop `--check` (the run \
+                 then says there is nothing to check) or `--strict`",
+                scene.name
+            ),
+        ));
+    }
     // Whether the figures can be drawn is known before the run.
     let figures = match can_draw(&scene) {
         Ok(()) => !args.no_figures,
@@ -291,9 +327,37 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     let result = job.execute_recorded(|p| progress.update(p), !args.no_replay);
     progress.finish();
     let (mut result, recording) = result?;
+    // The convergence check, before the set is written (its summary records the verdict). A
+    // check that fails loses nothing: the set is written, then the command fails when the
+    // check was asked for (`--check`) or under `--strict`, and warns otherwise.
+    let (check, check_failed) = match (args.no_check, result.is_complete()) {
+        (true, _) => (None, None),
+        (false, true) => {
+            let mut progress = RunProgress::new(progress_mode(&args.progress));
+            let check = job.check_convergence(&result, |p| progress.update(p));
+            progress.finish();
+            match check {
+                Ok(c) => (Some(c), None),
+                Err(e) => (None, Some(e)),
+            }
+        }
+        (false, false) => (None, None),
+    };
+    let verdict = match (&check, &check_failed) {
+        (Some(c), _) => c.verdict(),
+        (None, Some(e)) => ConvergenceVerdict::Failed {
+            error: e.to_string(),
+        },
+        (None, None) if args.no_check => ConvergenceVerdict::NotChecked {
+            reason: "`--no-check`".into(),
+        },
+        (None, None) => ConvergenceVerdict::NotChecked {
+            reason: "the run did not reach its end".into(),
+        },
+    };
     // The whole set (tables, summary, figures, replay) goes to the staging folder, then into
     // place.
-    let summary = result.write(job.set.dir())?;
+    let summary = result.write_checked(job.set.dir(), &verdict)?;
     let mut drawn = Vec::new();
     if figures {
         // A figure that cannot be written fails the command; the old set stays whole.
@@ -310,35 +374,24 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
         )?;
         drawn.push(job.set.final_path(&path));
     }
-    // The convergence check: a run of it that fails does not lose the set; the command fails
-    // after writing it.
-    let (check, check_failed) = match (args.check, result.is_complete()) {
-        (true, true) => {
-            let mut progress = RunProgress::new(progress_mode(&args.progress));
-            let check = job.check_convergence(&result, |p| progress.update(p));
-            progress.finish();
-            match check.and_then(|c| job.write_convergence(&c).map(|()| c)) {
-                Ok(c) => (Some(c), None),
-                Err(e) => (None, Some(e)),
-            }
-        }
-        (true, false) => {
-            eprintln!("no convergence check: the run did not reach its end");
-            (None, None)
-        }
-        (false, _) => (None, None),
-    };
     let mut files = job.files(&result);
-    if check.is_some() {
+    if let Some(c) = check.as_ref().and_then(Convergence::checked) {
+        job.write_convergence(c)?;
         files.push("convergence.json".into());
     }
     let strict = scene.run.strict;
     let out = job.commit()?;
     println!("{}", comparison_table(&summary));
-    if let Some(check) = &check {
-        println!("{}", cli::run::convergence_lines(check));
-    } else if result.is_complete() {
-        println!("{}", cli::run::UNCHECKED);
+    match (&check, &check_failed) {
+        (Some(Convergence::Checked(c)), _) => println!("{}", cli::run::convergence_lines(c)),
+        (Some(Convergence::NothingToCheck { reason }), _) => {
+            println!("{}", cli::run::nothing_to_check(reason))
+        }
+        (None, Some(_)) => println!("convergence: {}", verdict.describe()),
+        (None, None) if args.no_check => println!("{}", cli::run::UNCHECKED),
+        (None, None) => println!(
+            "convergence: not checked: the run did not reach its end, so there is no end to compare"
+        ),
     }
     println!(
         "{} steps in {:.2} s wall; wrote {}/{{{}}}",
@@ -355,8 +408,14 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
         return Err(e);
     }
     if let Some(e) = check_failed {
-        eprintln!("the convergence check's run at the tighter step control failed");
-        return Err(e);
+        if args.check || strict {
+            eprintln!("the convergence check's run at the tighter step control failed");
+            return Err(e);
+        }
+        eprintln!(
+            "WARNING: the convergence check's run at the tighter step control failed, so this \
+             run's numbers are unchecked (`--check` or `--strict` make that an error): {e}"
+        );
     }
     match &check {
         Some(check) if strict => check.strict(),
@@ -369,6 +428,7 @@ fn sweep(args: &SweepArgs) -> clearance_joint::Result<()> {
     warn(&base);
     let mut exec = args.exec.options()?;
     exec.replay = args.replay;
+    exec.check = args.check;
     let out = args
         .out
         .clone()
@@ -435,6 +495,7 @@ fn study(args: &StudyArgs) -> clearance_joint::Result<()> {
         .unwrap_or_else(|| PathBuf::from("out/studies"));
     let mut exec = args.exec.options()?;
     exec.replay = !args.no_replay;
+    exec.check = !args.no_check;
     let options = StudyOptions {
         exec,
         extra_overrides: args
@@ -460,6 +521,11 @@ fn study(args: &StudyArgs) -> clearance_joint::Result<()> {
                     h.final_angle_deg,
                     h.final_angle_ideal_deg,
                     if c.reused { "  [reused]" } else { "" }
+                );
+                println!(
+                    "  {:<22} convergence: {}",
+                    "",
+                    c.metrics.convergence.describe()
                 );
             }
         }

@@ -69,6 +69,12 @@ fn a_stalled_run_writes_an_incomplete_set_and_fails() {
         serde_json::from_str(&std::fs::read_to_string(out_dir.join("summary.json")).unwrap())
             .unwrap();
     assert_eq!(summary["complete"], false);
+    // An incomplete run has no end to compare: not checked, and why.
+    assert_eq!(summary["convergence"]["status"], "not_checked");
+    assert_eq!(
+        summary["convergence"]["reason"],
+        "the run did not reach its end"
+    );
     assert!(summary["error"].as_str().unwrap().contains("stalled"));
     let reached = summary["reached_s"].as_f64().unwrap();
     assert!(reached > 0.05 && reached < 0.3, "{reached}");
@@ -105,6 +111,7 @@ fn the_console_shows_the_worst_violation_and_strict_fails() {
             "--end",
             "0.1",
             "--no-figures",
+            "--no-check",
             "--out",
         ])
         .arg(&dir)
@@ -133,6 +140,7 @@ fn the_console_shows_the_worst_violation_and_strict_fails() {
             "--end",
             "0.1",
             "--no-figures",
+            "--no-check",
             "--strict",
             "--out",
         ])
@@ -153,7 +161,8 @@ fn the_console_shows_the_worst_violation_and_strict_fails() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// `--check` runs the scene again at half its tolerance and flags what moved beyond its bound:
+/// The check (`--check` is the default, accepted as it was) runs the scene again at half its
+/// tolerance and flags what moved beyond its bound:
 /// the paper's first impact at the defaults passes; at a tolerance four times the default its peak
 /// moves by 3.5 % (185.3 against 178.9 N, an estimated error of 4.8 %) and is flagged on the
 /// console and in `convergence.json`, and `--strict` fails the command with the set written.
@@ -186,7 +195,10 @@ fn the_convergence_check_flags_a_coarse_run_and_strict_fails() {
     assert!(out.status.success(), "{stdout}{stderr}");
     assert!(flagged(&check).is_empty(), "{check}");
     assert_eq!(check["metrics"].as_array().unwrap().len(), 8, "{check}");
-    assert!(stdout.contains("every metric within its bound"), "{stdout}");
+    assert!(
+        stdout.contains("every metric (8) within its bound"),
+        "{stdout}"
+    );
     assert!(!stdout.contains("convergence: not checked"), "{stdout}");
 
     let coarse = ["--set", "run.tolerance=0.03"];
@@ -206,21 +218,6 @@ fn the_convergence_check_flags_a_coarse_run_and_strict_fails() {
         "{stdout}"
     );
 
-    // Without `--check` the console says the numbers are unchecked, and how to check them.
-    let dir = temp("check-none");
-    let out = bin()
-        .args(["--end", "0.1", "--no-figures", "--no-replay", "--out"])
-        .arg(&dir)
-        .output()
-        .unwrap();
-    let (stdout, stderr) = text(&out);
-    assert!(out.status.success(), "{stdout}{stderr}");
-    assert!(
-        stdout.contains("convergence: not checked. `--check`")
-            && !dir.join("convergence.json").exists(),
-        "{stdout}"
-    );
-
     let (out, _) = run("check-coarse-strict", &[coarse[0], coarse[1], "--strict"]);
     let (stdout, stderr) = text(&out);
     assert_eq!(out.status.code(), Some(1), "{stdout}{stderr}");
@@ -228,4 +225,120 @@ fn the_convergence_check_flags_a_coarse_run_and_strict_fails() {
         stderr.contains("not converged at this step control") && stderr.contains("--strict"),
         "{stderr}"
     );
+}
+
+fn summary_of(dir: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
+}
+
+/// The check is the default: a run without flags prints which metrics converged and what the
+/// check cost, and records both in `summary.json` (beside `convergence.json`); `--no-check`
+/// skips it and says so. A scene without a clearance hinge has nothing to check: the run says
+/// so, makes no second run and claims no convergence; asked for strictly (`--strict --check`)
+/// that is an error before anything runs.
+#[test]
+fn the_check_runs_by_default_and_says_when_there_is_nothing_to_check() {
+    let run = |name: &str, args: &[&str]| {
+        let dir = temp(name);
+        let out = bin()
+            .args([
+                "--end",
+                "0.1",
+                "--no-figures",
+                "--no-replay",
+                "--progress",
+                "quiet",
+            ])
+            .args(args)
+            .arg("--out")
+            .arg(&dir)
+            .output()
+            .unwrap();
+        (out, dir)
+    };
+    // Without flags: the verdict, metric by metric, and the cost against the run.
+    let (out, dir) = run("default-check", &[]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stdout}{stderr}");
+    assert!(
+        stdout.contains("convergence check against")
+            && stdout.contains("converged: every metric (8) within its bound")
+            && stdout.contains("check: ")
+            && stdout.contains("times the run's wall time"),
+        "{stdout}"
+    );
+    assert!(dir.join("convergence.json").is_file());
+    let summary = summary_of(&dir);
+    let c = &summary["convergence"];
+    assert_eq!(c["status"], "checked", "{c}");
+    let converged: Vec<&str> = c["converged"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|n| n.as_str().unwrap())
+        .collect();
+    assert_eq!(converged.len(), 8, "{c}");
+    assert!(converged.contains(&"hinge first impact peak (N)"), "{c}");
+    assert!(c["not_converged"].as_array().unwrap().is_empty() && c["worst"].is_null());
+    // The cost: the tighter run's steps against the run's, both wall times measured.
+    let cost = &c["cost"];
+    let run_steps = summary["twins"]["clearance"]["steps"].as_u64().unwrap();
+    assert_eq!(cost["run_steps"].as_u64(), Some(run_steps), "{cost}");
+    assert!(cost["steps"].as_u64().unwrap() > run_steps, "{cost}");
+    assert!(cost["wall_s"].as_f64().unwrap() > 0.0, "{cost}");
+    std::fs::remove_dir_all(&dir).ok();
+
+    // `--no-check`: no second run, no verdict claimed.
+    let (out, dir) = run("no-check", &["--no-check"]);
+    let (stdout, stderr) = text(&out);
+    assert!(out.status.success(), "{stdout}{stderr}");
+    assert!(
+        stdout.contains("convergence: not checked (`--no-check`)")
+            && !stdout.contains("convergence check against")
+            && !stdout.contains("check: "),
+        "{stdout}"
+    );
+    assert!(!dir.join("convergence.json").exists());
+    let c = &summary_of(&dir)["convergence"];
+    assert_eq!(c["status"], "not_checked", "{c}");
+    assert!(c.get("converged").is_none(), "{c}");
+    std::fs::remove_dir_all(&dir).ok();
+
+    // No clearance hinge: nothing to check, said as such, with or without `--check`.
+    for (name, extra) in [
+        ("nothing", &[][..]),
+        ("nothing-check", &["--check"][..]),
+        ("nothing-strict", &["--strict"][..]),
+    ] {
+        let args = [&["--set", "hinge.clearance=null"][..], extra].concat();
+        let (out, dir) = run(name, &args);
+        let (stdout, stderr) = text(&out);
+        assert!(out.status.success(), "{args:?}: {stdout}{stderr}");
+        assert!(
+            stdout.contains("convergence: nothing to check (no clearance hinge)")
+                && !stdout.contains("within its bound")
+                && !stdout.contains("converged")
+                && !stdout.contains("check: "),
+            "{args:?}: {stdout}"
+        );
+        assert!(!dir.join("convergence.json").exists(), "{args:?}");
+        let c = &summary_of(&dir)["convergence"];
+        assert_eq!(c["status"], "nothing_to_check", "{c}");
+        assert_eq!(c["reason"], "no clearance hinge", "{c}");
+        std::fs::remove_dir_all(&dir).ok();
+    }
+    // Asked for strictly, a check with nothing to check fails before anything runs.
+    let (out, dir) = run(
+        "nothing-strict-check",
+        &["--set", "hinge.clearance=null", "--strict", "--check"],
+    );
+    let (stdout, stderr) = text(&out);
+    assert_eq!(out.status.code(), Some(1), "{stdout}{stderr}");
+    assert!(
+        stderr.contains("invalid `--check`: nothing to check (no clearance hinge)")
+            && stderr.contains("give a hinge a clearance")
+            && !stderr.contains("running `"),
+        "{stderr}"
+    );
+    assert!(!dir.exists(), "{} written", dir.display());
 }

@@ -27,7 +27,7 @@ fn shortened() -> Vec<(Case, f64, f64)> {
             // The first impacts (and, at 5000 rpm, the re-contacts where the defaults blow up).
             n if n.starts_with("slider-crank") && n.contains("2000") => (0.003, 1e-6),
             n if n.starts_with("slider-crank") => (0.004, 1e-6),
-            "four-bar" => (0.002, 1e-6),
+            "four-bar" | "four-bar Flores" => (0.002, 1e-6),
             n if n.starts_with("solar panel") => (0.1, 4e-6),
             "deployable array" => (0.03, 1e-5),
             "double pendulum" => (0.03, 4e-6),

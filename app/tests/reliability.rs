@@ -410,7 +410,7 @@ fn names_paths_fixed_bodies_and_warnings() {
     let path = dir.with_extension("ron");
     std::fs::write(&path, &bai).unwrap();
     let o = bin()
-        .args(["--end", "0.01", "--scene"])
+        .args(["--end", "0.01", "--no-check", "--scene"])
         .arg(&path)
         .arg("--out")
         .arg(&dir)
@@ -685,7 +685,7 @@ fn stale_temporaries_are_cleaned() {
         std::fs::write(f, b"x").unwrap();
     }
     let o = bin()
-        .args(["--end", "0.01", "--no-figures", "--out"])
+        .args(["--end", "0.01", "--no-figures", "--no-check", "--out"])
         .arg(&dir)
         .output()
         .unwrap();
@@ -720,6 +720,7 @@ fn concurrent_runs_and_interrupts() {
             "--output-interval",
             "0.01",
             "--no-figures",
+            "--no-check",
             "--out",
         ])
         .arg(&dir)
@@ -739,7 +740,7 @@ fn concurrent_runs_and_interrupts() {
         std::thread::sleep(Duration::from_millis(20));
     }
     let second = bin()
-        .args(["--end", "0.01", "--no-figures", "--out"])
+        .args(["--end", "0.01", "--no-figures", "--no-check", "--out"])
         .arg(&dir)
         .output()
         .unwrap();
@@ -766,7 +767,7 @@ fn concurrent_runs_and_interrupts() {
     );
     // The folder is free again.
     let o = bin()
-        .args(["--end", "0.01", "--no-figures", "--out"])
+        .args(["--end", "0.01", "--no-figures", "--no-check", "--out"])
         .arg(&dir)
         .output()
         .unwrap();
@@ -1040,6 +1041,7 @@ fn killed_reruns_leave_no_mixed_sets() {
             end,
             "--progress",
             "quiet",
+            "--no-check",
             "--out",
         ]
         .iter()
@@ -1063,6 +1065,7 @@ fn killed_reruns_leave_no_mixed_sets() {
             "quiet".into(),
             "--jobs".into(),
             "1".into(),
+            "--no-check".into(),
         ])
         .chain(["--out".into(), study_root.to_string_lossy().into_owned()])
         .collect()
@@ -1175,17 +1178,24 @@ fn study_strict_fails_on_a_guard() {
     let root = scratch("study-strict");
     let study = |strict: bool| {
         let mut cmd = bin();
-        cmd.args(["study", "clearance", "--no-figures", "--progress", "quiet"])
-            .args([
-                // A validity limit below every case's first impact (a drive spring too stiff
-                // for the step, used before, is now refused at load).
-                "--set",
-                "hinge.max_valid_penetration_um=0.1",
-                "--set",
-                "run.end_s=0.12",
-            ])
-            .arg("--out")
-            .arg(&root);
+        cmd.args([
+            "study",
+            "clearance",
+            "--no-figures",
+            "--no-check",
+            "--progress",
+            "quiet",
+        ])
+        .args([
+            // A validity limit below every case's first impact (a drive spring too stiff
+            // for the step, used before, is now refused at load).
+            "--set",
+            "hinge.max_valid_penetration_um=0.1",
+            "--set",
+            "run.end_s=0.12",
+        ])
+        .arg("--out")
+        .arg(&root);
         if strict {
             cmd.arg("--strict");
         }

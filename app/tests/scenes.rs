@@ -327,7 +327,7 @@ fn cli_runs_the_new_scenes() {
         let out = Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
             .arg("--scene")
             .arg(asset_path(name))
-            .args(["--end", end, "--out"])
+            .args(["--end", end, "--no-check", "--out"])
             .arg(&dir)
             .output()
             .unwrap();
@@ -546,6 +546,7 @@ fn the_scene_runs_from_the_command_line_with_figures() {
             "--set",
             "run.end_s=0.013",
             "--figures",
+            "--no-check",
             "--progress",
             "quiet",
             "--out",

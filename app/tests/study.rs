@@ -583,7 +583,14 @@ fn a_scene_declares_its_own_study() {
     let o = std::process::Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
         .args(["study", "pin_clearance", "--scene"])
         .arg(&scene)
-        .args(["--set", "run.end_s=0.002", "--progress", "quiet", "--out"])
+        .args([
+            "--set",
+            "run.end_s=0.002",
+            "--no-check",
+            "--progress",
+            "quiet",
+            "--out",
+        ])
         .arg(&root)
         .output()
         .unwrap();
@@ -860,6 +867,98 @@ fn report_labels_are_escaped() {
     assert!(
         report.contains("c \\| small") && report.contains("two lines"),
         "{report}"
+    );
+    let _ = std::fs::remove_dir_all(&root);
+}
+
+/// A study checks each case's convergence by default: the console and the report say per case
+/// which metrics converged and what the check cost, the table records the verdict (JSON) and
+/// the count not converged (CSV). `--no-check` skips it and the report says so; a later run
+/// with the check runs those cases again (they have no verdict), and the next reuses them.
+#[test]
+fn a_study_checks_each_case_and_reports_which_metrics_converged() {
+    let study = |root: &PathBuf, extra: &[&str]| {
+        let o = std::process::Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
+            .args(["study", "clearance", "--set", "run.end_s=0.1"])
+            .args(["--no-figures", "--no-replay", "--progress", "quiet"])
+            .args(extra)
+            .arg("--out")
+            .arg(root)
+            .output()
+            .unwrap();
+        let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        let dir = root.join("clearance");
+        let report = std::fs::read_to_string(dir.join("report.md")).unwrap();
+        let table = MetricsTable::load(&dir.join("metrics.json")).unwrap();
+        let csv = std::fs::read_to_string(dir.join("metrics.csv")).unwrap();
+        (stdout, report, table, csv)
+    };
+    let labels = ["c = 0.10 mm", "c = 0.25 mm", "c = 0.50 mm"];
+    let root = scratch("check");
+    let (stdout, report, table, csv) = study(&root, &[]);
+    assert_eq!(
+        stdout
+            .matches("convergence: converged: all 8 metrics within their bounds")
+            .count(),
+        3,
+        "{stdout}"
+    );
+    assert!(report.contains("Convergence (each case against itself at half the tolerance"));
+    for label in labels {
+        let line = report
+            .lines()
+            .find(|l| l.starts_with(&format!("- {label}: ")))
+            .unwrap_or_else(|| panic!("no convergence line for {label}: {report}"));
+        assert!(
+            line.contains("converged: all 8 metrics within their bounds")
+                && line.contains("the check ")
+                && line.contains("times the run's wall time"),
+            "{line}"
+        );
+    }
+    for row in &table.rows {
+        let v = &row.metrics.convergence;
+        assert!(v.is_checked() && v.not_converged().is_empty(), "{v:?}");
+    }
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "not_converged").unwrap();
+    assert!(lines.all(|l| l.split(',').nth(col) == Some("0")), "{csv}");
+    let _ = std::fs::remove_dir_all(&root);
+
+    let root = scratch("no-check");
+    let (stdout, report, table, csv) = study(&root, &["--no-check"]);
+    assert_eq!(
+        stdout.matches("convergence: not checked").count(),
+        3,
+        "{stdout}"
+    );
+    assert!(
+        report.contains("- c = 0.10 mm: not checked") && !report.contains("the check "),
+        "{report}"
+    );
+    assert!(
+        table
+            .rows
+            .iter()
+            .all(|r| !r.metrics.convergence.is_checked())
+    );
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = header.iter().position(|h| *h == "not_converged").unwrap();
+    assert!(lines.all(|l| l.split(',').nth(col) == Some("")), "{csv}");
+    // Checked now: the unchecked cases run again; then they are reused with their verdicts.
+    let (stdout, report, _, _) = study(&root, &[]);
+    assert!(!stdout.contains("[reused]"), "{stdout}");
+    assert!(!report.contains("not checked"), "{report}");
+    let (stdout, _, table, _) = study(&root, &[]);
+    assert_eq!(stdout.matches("[reused]").count(), 3, "{stdout}");
+    assert!(
+        table
+            .rows
+            .iter()
+            .all(|r| r.metrics.convergence.is_checked())
     );
     let _ = std::fs::remove_dir_all(&root);
 }

@@ -928,8 +928,12 @@ mod tests {
             };
             assert_eq!([j.local_anchor1(), j.local_anchor2()], anchors);
             for _ in 0..2_000 {
-                set.apply(&mut r.world.bodies, &r.world.integration_parameters)
-                    .unwrap();
+                set.apply(
+                    &mut r.world.bodies,
+                    &r.world.impulse_joints,
+                    &r.world.integration_parameters,
+                )
+                .unwrap();
                 r.world.step();
             }
             assert!(set.get(c).unwrap().report().spatial.is_some());
@@ -964,8 +968,12 @@ mod tests {
         );
         let mut set = ClearanceJointSet::new();
         for _ in 0..100 {
-            set.apply(&mut r.world.bodies, &r.world.integration_parameters)
-                .unwrap();
+            set.apply(
+                &mut r.world.bodies,
+                &r.world.impulse_joints,
+                &r.world.integration_parameters,
+            )
+            .unwrap();
             r.world.step();
         }
         let c = set
@@ -977,8 +985,12 @@ mod tests {
             )
             .unwrap();
         for _ in 0..20_000 {
-            set.apply(&mut r.world.bodies, &r.world.integration_parameters)
-                .unwrap();
+            set.apply(
+                &mut r.world.bodies,
+                &r.world.impulse_joints,
+                &r.world.integration_parameters,
+            )
+            .unwrap();
             r.world.step();
         }
         let report = set.get(c).unwrap().report();
@@ -997,8 +1009,12 @@ mod tests {
         let mut r = rig();
         let (mut set, c, _) = converted(&mut r, BearingSide::Body1);
         for _ in 0..20_000 {
-            set.apply(&mut r.world.bodies, &r.world.integration_parameters)
-                .unwrap();
+            set.apply(
+                &mut r.world.bodies,
+                &r.world.impulse_joints,
+                &r.world.integration_parameters,
+            )
+            .unwrap();
             r.world.step();
         }
         let energy = |w: &PhysicsWorld| {

@@ -203,7 +203,11 @@ impl DriveSet {
 /// The drives take part in the stepper's steps: their torques, saved and restored with a rejected
 /// step ([`crate::rapier::step_hooks`]).
 impl StepHooks for DriveSet {
-    fn evaluate(&mut self, bodies: &mut RigidBodySet) {
+    fn evaluate(
+        &mut self,
+        bodies: &mut RigidBodySet,
+        _impulse_joints: &rapier3d_f64::prelude::ImpulseJointSet,
+    ) {
         DriveSet::evaluate(self, bodies);
     }
     fn wrenches(&self) -> &[Wrench] {

@@ -19,7 +19,9 @@ use crate::rapier::stall::StalledContact;
 use rapier3d_f64::data::Index;
 use std::sync::OnceLock;
 
+mod effective_mass;
 mod spatial;
+use effective_mass::Mechanism;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, IntegrationParameters, JointAxesMask,
@@ -460,23 +462,12 @@ pub const CONTACT_PERIODS_PER_TOLERANCE: f64 = 2.0;
 /// Margin on the damped stability limit used by the adaptive step.
 const STABILITY_SAFETY: f64 = 0.8;
 /// The fraction of the damped stability limit one adaptive step in contact may cover, per unit
-/// of tolerance: `100 tol` (0.75 at the default 0.0075; at most 0.8, the margin kept on that
-/// limit). A step near the stability limit is stable, not accurate: the limit is `2/lambda` for
-/// a contact whose fast mode relaxes at `lambda` (`omega (zeta + sqrt(1 + zeta^2))`, about `D/m`
-/// when heavily damped). The improved law's damping ramps up with depth, and on a light body
-/// (the slider-crank of `assets/slider_crank.ron`, 0.5 kg rod and slider, damping ratio about 30
-/// at 16 um) that mode, not the period, limits the step. Bounded by stability alone the steps
-/// there did not depend on the tolerance: the first impact was 11 % too deep from 0.0075 down to
-/// 0.002, and a run at half the tolerance (`run --check`) could not see it. Scaled with the
-/// tolerance, the default's steps are about as before (10,309 over that crank's first 4 ms,
-/// 9,749 before) and tightening reaches them: measured (`tests/stepper.rs`), +11.7 %, +6.1 % and
-/// +1.7 % at 0.0075, 0.00375 and 0.001 against the limit of fixed steps (16.21 um; fixed steps
-/// converge at first order there, 16.63, 16.42, 16.31 and 16.26 um at 1e-7 to 1.25e-8 s). Below a
-/// damping ratio of about 8 the period's bound ([`CONTACT_PERIODS_PER_TOLERANCE`]) is the finer:
-/// the paper's scene takes the same steps; the four-bar's first peak moved by 0.2 % and Flores
-/// and Ambrósio's slider-crank took one step more (a slow re-contact, where the
-/// Lankarani-Nikravesh damping grows as `1/delta_dot0`).
-pub const STABLE_FRACTION_PER_TOLERANCE: f64 = 100.0;
+/// of tolerance: `50 tol` (0.375 at the default 0.0075; at most 0.8, the margin kept on that
+/// limit). A heavily damped contact (damping ratio above about 4) relaxes at `2/limit`, and a step
+/// near the limit is stable, not accurate: scaled with the tolerance, tightening converges it.
+/// Measured on `assets/slider_crank.ron`'s first impact in `tests/stepper.rs`; the mechanism
+/// matrix (docs/stepper-and-accuracy.md, `cargo bench --bench mechanisms`) shows the rest.
+pub const STABLE_FRACTION_PER_TOLERANCE: f64 = 50.0;
 
 /// The fraction of a contact's damped stability limit an adaptive step may take at `tolerance`
 /// ([`STABLE_FRACTION_PER_TOLERANCE`], [`STABILITY_SAFETY`]).
@@ -799,11 +790,17 @@ impl ClearanceJoint {
         }
     }
 
-    /// Evaluates the joint at the bodies' state, reached by a step of `step` s (0: unknown).
-    fn evaluate(&mut self, bodies: &RigidBodySet, step: f64) -> Option<(Wrench, Wrench)> {
+    /// Evaluates the joint at the bodies' state, reached by a step of `step` s (0: unknown),
+    /// with `mechanism` the ideal joints around it at that state (its effective masses).
+    fn evaluate(
+        &mut self,
+        bodies: &RigidBodySet,
+        step: f64,
+        mechanism: &Mechanism,
+    ) -> Option<(Wrench, Wrench)> {
         let steps = [std::mem::replace(&mut self.last_step, step), step];
         if self.spatial.is_some() {
-            return self.evaluate_spatial(bodies, steps);
+            return self.evaluate_spatial(bodies, steps, mechanism);
         }
         let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
         let (m1, m2) = (motion(rb1), motion(rb2));
@@ -828,9 +825,13 @@ impl ClearanceJoint {
             self.min_separation,
         );
         let mode = self.contact.mode();
-        let effective_mass = 1.0
-            / (inverse_mass_along(rb1, state.contact_point, state.normal)
-                + inverse_mass_along(rb2, state.contact_point, state.normal));
+        // Through the mechanism's ideal joints: the mass the contact moves, not the free
+        // bodies' (effective_mass.rs).
+        let inverse_mass = |point: Vector, n: Vector| {
+            let free = inverse_mass_along(rb1, point, n) + inverse_mass_along(rb2, point, n);
+            mechanism.inverse_mass(free, point, n)
+        };
+        let effective_mass = 1.0 / inverse_mass(state.contact_point, state.normal);
         let elastic = OnceLock::new();
         let impact_rate = self.law_impact_rate(
             || *elastic.get_or_init(|| self.normal_law.elastic_energy(state.penetration)),
@@ -874,8 +875,7 @@ impl ClearanceJoint {
                 } else {
                     state.normal.cross(axis)
                 };
-                let inv_m = inverse_mass_along(rb1, state.contact_point, t)
-                    + inverse_mass_along(rb2, state.contact_point, t);
+                let inv_m = inverse_mass(state.contact_point, t);
                 friction_stable_dt = 2.0 / (inv_m * force.normal_force * slope);
             }
         }
@@ -1011,6 +1011,8 @@ pub struct ClearanceJointSet {
     saved_wrenches: Vec<Wrench>,
     /// The step that led to the bodies' state, for the next evaluation, s.
     last_step: f64,
+    /// Scratch: the mechanism around the joint being evaluated.
+    mechanism: Mechanism,
 }
 
 impl ClearanceJointSet {
@@ -1117,9 +1119,10 @@ impl ClearanceJointSet {
     pub fn apply(
         &mut self,
         bodies: &mut RigidBodySet,
+        impulse_joints: &ImpulseJointSet,
         params: &IntegrationParameters,
     ) -> Result<()> {
-        self.apply_forces(bodies);
+        self.apply_forces(bodies, impulse_joints);
         // The step about to be taken is the one the next call's state comes from.
         self.set_last_step(params.dt);
         self.check_substeps(params)?;
@@ -1145,8 +1148,8 @@ impl ClearanceJointSet {
     /// The force evaluation of [`apply`](Self::apply) without its checks, for callers that choose
     /// the step after seeing the contact state (adaptive stepping) and then call
     /// [`check_step`](Self::check_step) themselves.
-    pub fn apply_forces(&mut self, bodies: &mut RigidBodySet) {
-        self.evaluate(bodies);
+    pub fn apply_forces(&mut self, bodies: &mut RigidBodySet, impulse_joints: &ImpulseJointSet) {
+        self.evaluate(bodies, impulse_joints);
         self.ledger.replace(bodies, self.wrenches.iter().copied());
     }
 
@@ -1155,7 +1158,11 @@ impl ClearanceJointSet {
     /// [`Stepper`](crate::rapier::stepper::Stepper) adds the wrenches for the duration of its step only,
     /// so the bodies carry nothing but the user's own forces between steps. A joint whose body is
     /// gone reports free flight and applies nothing.
-    pub fn evaluate(&mut self, bodies: &mut RigidBodySet) {
+    ///
+    /// `impulse_joints` are the world's Rapier joints: the contact's effective mass is taken
+    /// through the ideal joints that hold its bodies (an arm's pivot, a slider's guide), which
+    /// set how hard a journal strikes its wall (the laws' damping, the step bounds).
+    pub fn evaluate(&mut self, bodies: &mut RigidBodySet, impulse_joints: &ImpulseJointSet) {
         self.wrenches.clear();
         for joint in self.joints.values_mut() {
             if !joint.prepared {
@@ -1163,8 +1170,10 @@ impl ClearanceJointSet {
                 ensure_mass_properties(bodies, None, joint.body2);
                 joint.prepared = true;
             }
+            self.mechanism
+                .rebuild(bodies, impulse_joints, joint.body1, joint.body2);
             joint.last_wrenches = joint
-                .evaluate(bodies, self.last_step)
+                .evaluate(bodies, self.last_step, &self.mechanism)
                 .map(|(w1, w2)| [w1, w2]);
             if joint.last_wrenches.is_none() {
                 joint.contact = ContactHistory::default();
@@ -1290,8 +1299,8 @@ impl ClearanceJointSet {
 /// The clearance joints take part in the stepper's steps: their contact forces, step limits,
 /// acceptance and guards ([`crate::rapier::step_hooks`]).
 impl crate::rapier::step_hooks::StepHooks for ClearanceJointSet {
-    fn evaluate(&mut self, bodies: &mut RigidBodySet) {
-        ClearanceJointSet::evaluate(self, bodies);
+    fn evaluate(&mut self, bodies: &mut RigidBodySet, impulse_joints: &ImpulseJointSet) {
+        ClearanceJointSet::evaluate(self, bodies, impulse_joints);
     }
     fn wrenches(&self) -> &[Wrench] {
         ClearanceJointSet::wrenches(self)

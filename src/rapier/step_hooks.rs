@@ -33,14 +33,17 @@ use crate::error::Result;
 use crate::rapier::guards::GuardReport;
 use crate::rapier::ledger::Wrench;
 use crate::rapier::stall::StalledContact;
-use rapier3d_f64::prelude::{IntegrationParameters, PhysicsWorld, RigidBodyHandle, RigidBodySet};
+use rapier3d_f64::prelude::{
+    ImpulseJointSet, IntegrationParameters, PhysicsWorld, RigidBodyHandle, RigidBodySet,
+};
 
 /// What the stepper asks of a participant in a step; every method has a default that does
 /// nothing (see the [module](self) docs for the order of the calls).
 pub trait StepHooks {
     /// Evaluates at the bodies' current state, without touching their forces: the wrenches of
-    /// the next step. Default: nothing.
-    fn evaluate(&mut self, _bodies: &mut RigidBodySet) {}
+    /// the next step. `impulse_joints` are the world's Rapier joints (the mechanism a force
+    /// source acts in). Default: nothing.
+    fn evaluate(&mut self, _bodies: &mut RigidBodySet, _impulse_joints: &ImpulseJointSet) {}
 
     /// The wrenches of the last evaluation, added to the bodies for the next step only.
     /// Default: none.

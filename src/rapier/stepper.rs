@@ -91,7 +91,7 @@ pub enum StepMode {
     Fixed,
     /// The step changes between Rapier steps: no body turns more than `tolerance/8` rad in a step
     /// ([`motion_step`]), shorter as a contact approaches and inside it (twice `tolerance` of the
-    /// contact's natural period, at most `100 tolerance` of its damped stability limit, within
+    /// contact's natural period, at most `50 tolerance` of its damped stability limit, within
     /// friction's), at most the
     /// largest step (a safety cap), with rejected steps retried. The default.
     #[default]
@@ -372,7 +372,7 @@ impl Stepper {
         self.control.validate()?;
         for s in sources.iter_mut() {
             s.set_last_step(self.last_dt);
-            s.evaluate(&mut world.bodies);
+            s.evaluate(&mut world.bodies, &world.impulse_joints);
             s.check_world(&world.integration_parameters)?;
         }
         self.prepared = true;
@@ -580,7 +580,7 @@ impl Stepper {
         }
         for s in sources.iter_mut() {
             s.set_last_step(dt);
-            s.evaluate(&mut world.bodies);
+            s.evaluate(&mut world.bodies, &world.impulse_joints);
         }
         kick
     }

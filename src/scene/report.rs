@@ -2,6 +2,7 @@
 
 use crate::error::{Error, Result};
 use crate::scene::output::{Render, write_set};
+use crate::scene::runner::convergence::ConvergenceVerdict;
 use crate::scene::runner::{HingeMetrics, Invariants, RunResult, Twin};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -35,6 +36,10 @@ pub struct Summary {
     /// What the run-time guards saw: rejected steps, the deepest penetration against its law's
     /// validity, steps at the floor, and violations in words (empty when the run stayed valid).
     pub guards: crate::rapier::stepper::GuardReport,
+    /// The convergence check's verdict: which metrics converged against a run at half the
+    /// tolerance, which did not, and what the check cost; or why none was made
+    /// ([`ConvergenceVerdict`]).
+    pub convergence: ConvergenceVerdict,
 }
 
 /// Metrics of one twin.
@@ -96,7 +101,8 @@ impl TwinSummary {
 }
 
 impl RunResult {
-    /// The summary of this run.
+    /// The summary of this run, its convergence not checked
+    /// ([`write_checked`](Self::write_checked) records a check's verdict).
     pub fn summary(&self) -> Summary {
         Summary {
             scene: self.scene.name.clone(),
@@ -120,6 +126,7 @@ impl RunResult {
                 && self.scene.bodies.iter().all(|b| !b.fixed),
             stepping: self.scene.run.stepping(),
             guards: self.guards.clone(),
+            convergence: ConvergenceVerdict::default(),
         }
     }
 
@@ -136,9 +143,18 @@ impl RunResult {
     /// ([`write_set`]): the tables are streamed (and checked finite) into temporary files, then
     /// renamed into place, `summary.json` last. An incomplete run ([`RunResult::stopped`])
     /// writes the same files, each up to the time it reached, and says so in `summary.json`
-    /// (`"complete": false`, `reached_s`, `error`).
+    /// (`"complete": false`, `reached_s`, `error`). Its `convergence` says no check was run;
+    /// [`write_checked`](Self::write_checked) records one.
     pub fn write(&self, dir: &Path) -> Result<Summary> {
-        let summary = self.summary();
+        self.write_checked(dir, &ConvergenceVerdict::default())
+    }
+
+    /// As [`write`](Self::write), `summary.json` recording `convergence`, the verdict of the
+    /// run's convergence check
+    /// ([`Convergence::verdict`](crate::scene::runner::convergence::Convergence::verdict)).
+    pub fn write_checked(&self, dir: &Path, convergence: &ConvergenceVerdict) -> Result<Summary> {
+        let mut summary = self.summary();
+        summary.convergence = convergence.clone();
         let json = summary_json(&summary)?;
         // One impact list per clearance joint, `<twin>_<joint>_impacts.csv`.
         let mut impact_tables: Vec<(std::path::PathBuf, crate::table::Table)> = Vec::new();
@@ -222,8 +238,9 @@ pub fn summary_json(summary: &Summary) -> Result<String> {
         serde_json::to_value(summary).map_err(|e| Error::invalid("summary", e.to_string()))?;
     // serde_json writes a non-finite float as null: a null is allowed only where a metric is
     // legitimately absent (no impact yet, only one twin), so a NaN anywhere else is caught here.
-    const MAY_BE_NULL: [&str; 9] = [
+    const MAY_BE_NULL: [&str; 10] = [
         "error",
+        "worst",
         "first_impact_t_s",
         "first_impact_peak_n",
         "comparison",

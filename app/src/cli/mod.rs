@@ -81,6 +81,7 @@ pub fn exec_options(
         rerun,
         max_memory: memory_budget(max_memory)?,
         replay: false,
+        check: false,
     };
     Ok((options, note))
 }

@@ -4,8 +4,8 @@
 use crate::resultset::ResultSet;
 use clearance_joint::error::Result;
 use clearance_joint::scene::output::{MemoryEstimate, available_memory, write_atomic};
-use clearance_joint::scene::runner::convergence::{self, ConvergenceCheck};
-use clearance_joint::scene::runner::{Progress, RunOptions, RunResult, Simulation, Twins};
+use clearance_joint::scene::runner::convergence::{self, Convergence, ConvergenceCheck};
+use clearance_joint::scene::runner::{Progress, RunOptions, RunResult, Simulation};
 use clearance_joint::scene::{StepMode, ValidatedScene};
 use std::path::PathBuf;
 
@@ -67,23 +67,16 @@ impl SceneRun {
             .map_err(|e| e.with_step_mode(self.scene.run.step == StepMode::Adaptive))
     }
 
-    /// The convergence check (`--check`): the scene again at half its tolerance (half its fixed
-    /// step), the clearance twin only, compared with `result`'s
-    /// ([`clearance_joint::scene::runner::convergence`]).
+    /// The convergence check (the default; `--no-check` skips it): the library's
+    /// [`convergence::check`], the scene again at half its tolerance (half its fixed step), the
+    /// clearance twin only, compared with `result`'s; nothing to check, and no second run, for
+    /// a scene without a clearance hinge.
     pub fn check_convergence(
         &self,
         result: &RunResult,
         progress: impl FnMut(&Progress),
-    ) -> Result<ConvergenceCheck> {
-        let tighter = convergence::tightened(&self.scene)?;
-        let options = RunOptions {
-            twins: Twins::ClearanceOnly,
-            skip_rows: true,
-        };
-        let finer = Simulation::from_validated(&tighter, options)?
-            .run_with_progress(progress)
-            .map_err(|e| e.with_step_mode(tighter.run.step == StepMode::Adaptive))?;
-        Ok(ConvergenceCheck::compare(result, &finer))
+    ) -> Result<Convergence> {
+        convergence::check(&self.scene, result, progress)
     }
 
     /// Writes `check` as `convergence.json` into the result set.
@@ -109,33 +102,51 @@ impl SceneRun {
     }
 }
 
-/// What the console says of a run without `--check`: its numbers are one run's, not shown to
+/// What the console says of a run with `--no-check`: its numbers are one run's, not shown to
 /// converge, and how to find out.
-pub const UNCHECKED: &str = "convergence: not checked. `--check` runs the scene again at half \
-the tolerance (about twice the time) and flags every metric that moves beyond its bound; a \
-chaotic rattle's later statistics are compared over several runs, not read from one";
+pub const UNCHECKED: &str = "convergence: not checked (`--no-check`). Without it the run is \
+checked against the scene at half the tolerance (about twice the run's time again) and every \
+metric that moves beyond its bound is flagged; a chaotic rattle's later statistics are compared \
+over several runs, not read from one";
 
-/// The convergence check for the console: one line per metric (flagged ones marked), then the
-/// verdict naming the worst.
+/// What the console says of a scene with nothing to check (`reason`: no clearance hinge).
+pub fn nothing_to_check(reason: &str) -> String {
+    format!(
+        "convergence: nothing to check ({reason}): the check compares clearance hinges' metrics, \
+         so no metric is checked and no second run is made"
+    )
+}
+
+/// The convergence check for the console: one line per metric (flagged ones marked), the
+/// verdict naming the worst, then what the check cost against the run.
 pub fn convergence_lines(check: &ConvergenceCheck) -> String {
-    let mut out = format!(
-        "convergence check against {} ({} steps against {}):\n",
-        check.tighter, check.steps[1], check.steps[0]
-    );
+    let mut out = format!("convergence check against {}:\n", check.tighter);
     for m in &check.metrics {
         let mark = if m.flagged { "NOT CONVERGED" } else { "ok" };
         out.push_str(&format!("  {mark:>13}  {}\n", m.describe()));
     }
     match check.worst() {
-        None => out.push_str("every metric within its bound at this step control"),
-        Some(w) => out.push_str(&format!(
-            "WARNING: {} metric(s) not converged at this step control; the worst: {}. A tighter \
-             step control (`--set run.tolerance=...`, `--dt`) converges what converges; what \
-             keeps moving (the onsets of a chaotic rattle) is a statistic to compare over several \
-             runs, not a number to trust from one",
-            check.flagged().count(),
-            w.describe()
+        None => out.push_str(&format!(
+            "converged: every metric ({}) within its bound at this step control\n",
+            check.metrics.len()
         )),
+        Some(w) => {
+            let flagged = check.flagged().count();
+            out.push_str(&format!(
+                "WARNING: {flagged} of {} metric(s) not converged at this step control (the other {} \
+                 converged); the worst: {}. A tighter step control (`--set run.tolerance=...`, \
+                 `--dt`) converges what converges; what keeps moving (the onsets of a chaotic \
+                 rattle) is a statistic to compare over several runs, not a number to trust from \
+                 one\n",
+                check.metrics.len(),
+                check.metrics.len() - flagged,
+                w.describe()
+            ))
+        }
     }
+    out.push_str(&format!(
+        "check: {}; `--no-check` skips it",
+        check.cost().describe()
+    ));
     out
 }

@@ -7,6 +7,7 @@ use clearance_joint::error::{Error, Result};
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::report::Summary;
 use clearance_joint::scene::runner::RunResult;
+use clearance_joint::scene::runner::convergence::ConvergenceVerdict;
 use clearance_joint::table::Table;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -37,6 +38,10 @@ pub struct RunMetrics {
     /// validity; see `summary.json`'s `guards`).
     #[serde(default)]
     pub guard_violations: Vec<String>,
+    /// The convergence check's verdict (`summary.json`'s `convergence`): which metrics
+    /// converged against the point at half its tolerance, or why none was checked.
+    #[serde(default)]
+    pub convergence: ConvergenceVerdict,
 }
 
 /// Metrics of one body: the clearance twin against the ideal twin, about the scene's reference axis.
@@ -147,6 +152,7 @@ impl RunMetrics {
             wall_s: sc.wall_s,
             rejected_steps: summary.guards.rejected_steps,
             guard_violations: summary.guards.messages(),
+            convergence: summary.convergence.clone(),
             ..Default::default()
         };
         for b in scene.bodies.iter().filter(|b| !b.fixed) {
@@ -233,6 +239,13 @@ impl RunMetrics {
             (
                 "guard_violations".into(),
                 Some(self.guard_violations.len() as f64),
+            ),
+            // The metrics the convergence check flagged (empty when it compared none).
+            (
+                "not_converged".into(),
+                self.convergence
+                    .is_checked()
+                    .then(|| self.convergence.not_converged().len() as f64),
             ),
         ];
         for (name, b) in &self.bodies {

@@ -16,6 +16,7 @@ use clearance_joint::error::{Error, Result};
 use clearance_joint::scene::output::{
     DirLock, MemoryEstimate, bytes_text, write_all_atomic, write_atomic,
 };
+use clearance_joint::scene::runner::convergence::{self, ConvergenceVerdict};
 use clearance_joint::scene::{Scene, ValidatedScene};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
@@ -123,6 +124,11 @@ pub struct ExecOptions {
     /// Write each point's replay (`replay.html`, see [`crate::replay`]); a finished point
     /// without one is run again.
     pub replay: bool,
+    /// Check each point's convergence ([`clearance_joint::scene::runner::convergence::check`]:
+    /// the point again at half its tolerance, the clearance twin only), its verdict in the
+    /// point's `summary.json` and metrics ([`RunMetrics::convergence`]); a finished point
+    /// without a verdict is run again.
+    pub check: bool,
 }
 
 /// The number of worker threads for `requested` (`None`: one per core), at most one per core:
@@ -290,6 +296,13 @@ impl Sweep {
             metrics.hinges.insert(h.name.clone(), Default::default());
         }
         metrics.guard_violations = vec!["x".repeat(200)];
+        // A check's verdict names 8 metrics per hinge and describes the worst.
+        metrics.convergence = ConvergenceVerdict::Checked {
+            converged: vec!["x".repeat(40); 8 * base.hinges.len()],
+            not_converged: Vec::new(),
+            worst: Some("x".repeat(200)),
+            cost: Default::default(),
+        };
         let point = self.grid.point(self.grid.len() - 1);
         let row = TableRow {
             dir: format!("points/{}", point.dir),
@@ -428,6 +441,13 @@ impl Job {
 
     /// As [`run`](Self::run), also writing the point's replay (`replay.html`) when `replay`.
     pub fn run_replay(&self, replay: bool) -> Result<Manifest> {
+        self.run_point(replay, false)
+    }
+
+    /// As [`run_replay`](Self::run_replay), also checking the point's convergence when `check`
+    /// ([`ExecOptions::check`]). A check whose own run fails does not fail the point: its
+    /// verdict says so.
+    pub fn run_point(&self, replay: bool, check: bool) -> Result<Manifest> {
         // One process per point folder: a second sweep running the same point is refused
         // rather than mixing its files with ours.
         let _lock = DirLock::acquire(&self.dir)?;
@@ -439,8 +459,21 @@ impl Job {
         if let Some(e) = result.stopped.take() {
             return Err(e.with_step_mode(adaptive));
         }
-        let metrics = RunMetrics::of(&result)?;
-        result.write(&self.dir)?;
+        let convergence = if check {
+            match convergence::check(&self.scene, &result, |_| {}) {
+                Ok(c) => c.verdict(),
+                Err(e) => ConvergenceVerdict::Failed {
+                    error: e.to_string(),
+                },
+            }
+        } else {
+            ConvergenceVerdict::NotChecked {
+                reason: "not asked for".into(),
+            }
+        };
+        let mut metrics = RunMetrics::of(&result)?;
+        metrics.convergence = convergence.clone();
+        result.write_checked(&self.dir, &convergence)?;
         match &recording {
             Some(recording) => {
                 crate::replay::write_run_replay(&self.scene, &result, recording, &self.dir)?;
@@ -528,14 +561,15 @@ fn execute_with(
                 .map_err(|e| memory_options(e, &estimate, &job.scene, concurrent, budget))
                 .map_err(|e| in_point(e, &job.point))?;
         }
-        // A finished point is reused unless a replay is asked for and it has none.
+        // A finished point is reused unless a replay or a check is asked for and it has none.
         let finished = (!options.rerun)
             .then(|| job.finished())
             .flatten()
-            .filter(|_| !options.replay || job.dir.join(crate::replay::FILE).is_file());
+            .filter(|_| !options.replay || job.dir.join(crate::replay::FILE).is_file())
+            .filter(|m| !options.check || m.metrics.convergence.is_answered());
         let (manifest, reused) = match finished {
             Some(manifest) => (manifest, true),
-            None => (job.run_replay(options.replay)?, false),
+            None => (job.run_point(options.replay, options.check)?, false),
         };
         Ok(PointOutcome {
             manifest: Manifest {
@@ -632,13 +666,23 @@ impl Reporter {
         let n = self.done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
         let what = match outcome {
             Ok(o) if o.reused => "reused (finished earlier)".to_string(),
-            Ok(o) => match o.manifest.metrics.guard_violations.as_slice() {
-                [] => format!("done in {seconds:.2} s"),
-                v => format!(
-                    "done in {seconds:.2} s; WARNING, outside the model's validity: {}",
-                    v.join("; ")
-                ),
-            },
+            Ok(o) => {
+                let mut what = format!("done in {seconds:.2} s");
+                let m = &o.manifest.metrics;
+                if !m.guard_violations.is_empty() {
+                    what += &format!(
+                        "; WARNING, outside the model's validity: {}",
+                        m.guard_violations.join("; ")
+                    );
+                }
+                if !m.convergence.not_converged().is_empty() {
+                    what += &format!(
+                        "; not converged: {}",
+                        m.convergence.not_converged().join(", ")
+                    );
+                }
+                what
+            }
             Err(e) => format!("FAILED: {e}"),
         };
         let line = format!("[{n}/{}] {name}: {what}", self.total);
@@ -956,9 +1000,17 @@ pub fn merge(tables: &[MetricsTable]) -> Result<MetricsTable> {
     })
 }
 
-/// Two runs' metrics equal in everything but the wall time.
+/// Two runs' metrics equal in everything but the wall times (the run's, and its check's).
 fn same_physics(a: &super::metrics::RunMetrics, b: &super::metrics::RunMetrics) -> bool {
     let mut b = b.clone();
     b.wall_s = a.wall_s;
+    if let (
+        ConvergenceVerdict::Checked { cost: ca, .. },
+        ConvergenceVerdict::Checked { cost: cb, .. },
+    ) = (&a.convergence, &mut b.convergence)
+    {
+        cb.wall_s = ca.wall_s;
+        cb.run_wall_s = ca.run_wall_s;
+    }
     *a == b
 }

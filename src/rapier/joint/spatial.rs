@@ -2,7 +2,7 @@
 //! [`crate::model::spatial`] carries its own contact history and force pair; the joint reports
 //! the deepest station as its state (what the step control and the guards read) and the sums.
 
-use super::{ClearanceJoint, ClearanceReport, ContactHistory, friction_slope, motion};
+use super::{ClearanceJoint, ClearanceReport, ContactHistory, Mechanism, friction_slope, motion};
 use crate::model::kinematics::{
     ForcePair, JournalState, StepBefore, contact_force, force_and_damping, stable_step,
 };
@@ -324,11 +324,12 @@ impl Mobility {
     }
 }
 
-/// The two bodies' mobilities.
-struct Pair([Option<Mobility>; 2]);
+/// The two bodies' mobilities, and the mechanism around them.
+struct Pair<'a>([Option<Mobility>; 2], &'a Mechanism);
 
-impl Pair {
-    /// `1/m` of the pair along `n` at `point` (as `ledger::inverse_mass_along` summed).
+impl Pair<'_> {
+    /// `1/m` of the pair along `n` at `point` (as `ledger::inverse_mass_along` summed), less
+    /// what the mechanism's ideal joints hold ([`Mechanism::inverse_mass`]).
     fn inverse_mass(&self, point: Vector, n: Vector) -> f64 {
         let along = |b: &Option<Mobility>| {
             b.as_ref().map_or(0.0, |b| {
@@ -336,7 +337,8 @@ impl Pair {
                 b.inv_mass + rn.dot(b.inv_inertia * rn)
             })
         };
-        along(&self.0[0]) + along(&self.0[1])
+        let free = along(&self.0[0]) + along(&self.0[1]);
+        self.1.inverse_mass(free, point, n)
     }
 
     fn effective_mass(&self, point: Vector, n: Vector) -> f64 {
@@ -356,10 +358,11 @@ impl ClearanceJoint {
         &mut self,
         bodies: &RigidBodySet,
         steps: [f64; 2],
+        mechanism: &Mechanism,
     ) -> Option<(Wrench, Wrench)> {
         let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
         let (m1, m2) = (motion(rb1), motion(rb2));
-        let bodies = Pair([Mobility::of(rb1), Mobility::of(rb2)]);
+        let bodies = Pair([Mobility::of(rb1), Mobility::of(rb2)], mechanism);
         let transverse = *rb1.rotation() * self.spatial.as_ref()?.local_transverse1;
         let pose = self.spatial_pose(rb1, rb2, transverse);
         let parts = self.spatial.as_mut()?;

@@ -15,7 +15,7 @@ const REGULARISED_PIVOT_TOLERANCE: f64 = 1e-2 * REGULARISATION;
 /// LU factors of the `n x n` row-major `a` into `lu`, with a relative regularisation
 /// ([`REGULARISATION`]) on the diagonal when `a` is singular (redundant constraints: a
 /// least-norm share). False when even that fails (a non-finite entry).
-pub(super) fn factor_regularised(
+pub(crate) fn factor_regularised(
     a: &[f64],
     lu: &mut Vec<f64>,
     piv: &mut Vec<usize>,
@@ -72,7 +72,7 @@ pub(super) fn lu_factor(a: &mut [f64], piv: &mut Vec<usize>, n: usize, tolerance
 }
 
 /// Solves `A x = b` from the factors of [`lu_factor`]; the solution replaces `b`.
-pub(super) fn lu_solve(lu: &[f64], piv: &[usize], b: &mut [f64], scratch: &mut Vec<f64>, n: usize) {
+pub(crate) fn lu_solve(lu: &[f64], piv: &[usize], b: &mut [f64], scratch: &mut Vec<f64>, n: usize) {
     scratch.clear();
     scratch.extend(piv.iter().map(|&p| b[p]));
     b.copy_from_slice(scratch);

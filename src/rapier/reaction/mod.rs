@@ -69,7 +69,7 @@
 
 mod body;
 mod joints;
-mod lu;
+pub(crate) mod lu;
 mod motor;
 mod rows;
 mod solve;

@@ -11,25 +11,34 @@
 //! crank entering its first impact 11 % too deep at the default tolerance and 10.8 % at 0.002
 //! (`tests/stepper.rs`) passes a check at half the tolerance.
 //!
+//! One call runs a scene and checks it ([`run_checked`]); [`check`] checks a run you already
+//! have (from [`Simulation::run`](super::Simulation::run) or a run recording its replay). A scene
+//! without a clearance hinge has nothing to compare: the check says so
+//! ([`Convergence::NothingToCheck`]) and runs nothing more.
+//!
 //! ```no_run
-//! use clearance_joint::scene::runner::convergence::{ConvergenceCheck, tightened};
-//! use clearance_joint::scene::runner::{RunOptions, Simulation};
+//! use clearance_joint::scene::runner::convergence::{self, Convergence};
 //! use clearance_joint::scene::ValidatedScene;
 //!
 //! let scene = ValidatedScene::load("assets/solar_panel.ron".as_ref())?;
-//! let run = Simulation::from_validated(&scene, RunOptions::default())?.run()?;
-//! let finer = Simulation::from_validated(&tightened(&scene)?, RunOptions::default())?.run()?;
-//! let check = ConvergenceCheck::compare(&run, &finer);
-//! for m in check.flagged() {
-//!     println!("not converged: {} {} vs {}", m.name, m.value, m.tighter);
+//! let (run, convergence) = convergence::run_checked(&scene)?;
+//! match &convergence {
+//!     Convergence::Checked(check) => {
+//!         for m in check.flagged() {
+//!             println!("not converged: {} {} vs {}", m.name, m.value, m.tighter);
+//!         }
+//!         println!("the check: {}", check.cost().describe());
+//!     }
+//!     Convergence::NothingToCheck { reason } => println!("nothing to check ({reason})"),
 //! }
+//! println!("{} steps", run.steps);
 //! # Ok::<(), clearance_joint::Error>(())
 //! ```
 
-use super::{RunResult, TwinKind};
+use super::{Progress, RunOptions, RunResult, Simulation, TwinKind, Twins};
 use crate::error::Result;
-use crate::scene::{StepMode, ValidatedScene};
-use serde::Serialize;
+use crate::scene::{Scene, StepMode, ValidatedScene};
+use serde::{Deserialize, Serialize};
 
 /// Bound on the estimated error of a first impact's onset, s (the mechanism benchmark's).
 pub const ONSET_BOUND_S: f64 = 1e-6;
@@ -52,6 +61,267 @@ pub fn tightened(scene: &ValidatedScene) -> Result<ValidatedScene> {
         StepMode::Fixed => run.dt_s *= 0.5,
     }
     tighter.validated()
+}
+
+/// Why `scene` gives the check nothing to compare (`None` when it has a clearance hinge): every
+/// metric the check compares is a clearance hinge's.
+pub fn nothing_to_check(scene: &Scene) -> Option<&'static str> {
+    scene
+        .hinges
+        .iter()
+        .all(|h| h.clearance.is_none())
+        .then_some("no clearance hinge")
+}
+
+/// Checks `run`, a complete run of `scene`: runs the scene again at the tighter step control
+/// ([`tightened`]), the clearance twin only and without output rows, calling `progress` after
+/// each of its steps, and compares ([`ConvergenceCheck::compare`]). A scene without a clearance
+/// hinge, or a run without the clearance twin, is [`Convergence::NothingToCheck`], with no
+/// second run. An incomplete run ([`RunResult::stopped`]) is refused: there is no end to
+/// compare. Errors of the tighter run are returned as they are (a stall, a strict guard).
+pub fn check(
+    scene: &ValidatedScene,
+    run: &RunResult,
+    progress: impl FnMut(&Progress),
+) -> Result<Convergence> {
+    if let Some(e) = &run.stopped {
+        return Err(crate::Error::invalid(
+            "convergence",
+            format!(
+                "the run stopped at t = {} s ({e}): an incomplete run has no end to compare",
+                crate::error::sig4(run.reached_s)
+            ),
+        ));
+    }
+    let reason = match run.twin(TwinKind::Clearance) {
+        None => Some("no clearance twin in the run"),
+        Some(t) if t.clearance_hinges().is_empty() => Some("no clearance hinge"),
+        Some(_) => nothing_to_check(scene),
+    };
+    if let Some(reason) = reason {
+        return Ok(Convergence::NothingToCheck {
+            reason: reason.to_string(),
+        });
+    }
+    let tighter = tightened(scene)?;
+    let options = RunOptions {
+        twins: Twins::ClearanceOnly,
+        skip_rows: true,
+    };
+    let finer = Simulation::from_validated(&tighter, options)?
+        .run_with_progress(progress)
+        .map_err(|e| e.with_step_mode(tighter.run.step == StepMode::Adaptive))?;
+    Ok(Convergence::Checked(ConvergenceCheck::compare(run, &finer)))
+}
+
+/// Runs `scene` (both twins, with their rows: [`RunOptions::default`]) and checks it
+/// ([`check`]): the run and its check in one call. A run the step control stops is an error, as
+/// from [`Simulation::run`].
+pub fn run_checked(scene: &ValidatedScene) -> Result<(RunResult, Convergence)> {
+    let run = Simulation::from_validated(scene, RunOptions::default())?
+        .run()
+        .map_err(|e| e.with_step_mode(scene.run.step == StepMode::Adaptive))?;
+    let convergence = check(scene, &run, |_| {})?;
+    Ok((run, convergence))
+}
+
+/// What [`check`] found.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Convergence {
+    /// The run against the tighter one, metric by metric.
+    Checked(ConvergenceCheck),
+    /// Nothing to compare (`reason`: no clearance hinge); no second run was made. This is not a
+    /// convergence: no metric was checked.
+    NothingToCheck {
+        /// Why, in words.
+        reason: String,
+    },
+}
+
+impl Convergence {
+    /// The comparison, if one was made.
+    pub fn checked(&self) -> Option<&ConvergenceCheck> {
+        match self {
+            Convergence::Checked(c) => Some(c),
+            Convergence::NothingToCheck { .. } => None,
+        }
+    }
+
+    /// The verdict in brief, as a run's summary records it.
+    pub fn verdict(&self) -> ConvergenceVerdict {
+        match self {
+            Convergence::Checked(c) => c.verdict(),
+            Convergence::NothingToCheck { reason } => ConvergenceVerdict::NothingToCheck {
+                reason: reason.clone(),
+            },
+        }
+    }
+
+    /// [`ConvergenceCheck::strict`] of a comparison; `Ok` when there was nothing to compare
+    /// (whoever asked for a check decides whether that is an error).
+    pub fn strict(&self) -> Result<()> {
+        self.checked().map_or(Ok(()), ConvergenceCheck::strict)
+    }
+}
+
+/// What the check cost, against the run it checks: the tighter run's internal steps and wall
+/// time, and the run's.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct CheckCost {
+    /// Internal steps of the tighter run.
+    pub steps: u64,
+    /// Wall time of the tighter run, s.
+    pub wall_s: f64,
+    /// Internal steps of the run checked.
+    pub run_steps: u64,
+    /// Wall time of the run checked, s.
+    pub run_wall_s: f64,
+}
+
+impl CheckCost {
+    /// The check's wall time over the run's (`None` when the run took no measurable time).
+    pub fn wall_ratio(&self) -> Option<f64> {
+        (self.run_wall_s > 0.0).then(|| self.wall_s / self.run_wall_s)
+    }
+
+    /// The cost in words: `41,210 steps in 1.9 s, 2.1 times the run's wall time (20,570 steps
+    /// in 0.9 s)`.
+    pub fn describe(&self) -> String {
+        let ratio = match self.wall_ratio() {
+            Some(r) if r >= 1.0 => format!("{r:.1} times the run's wall time"),
+            Some(r) => format!("{r:.2} times the run's wall time"),
+            None => "the run's wall time too short to compare".to_string(),
+        };
+        format!(
+            "{} steps in {} s, {ratio} ({} steps in {} s)",
+            thousands(self.steps),
+            seconds(self.wall_s),
+            thousands(self.run_steps),
+            seconds(self.run_wall_s)
+        )
+    }
+}
+
+/// `n` with a comma every three digits: `41,210`.
+fn thousands(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+/// A wall time in seconds to 0.01 s below 10 s, to 0.1 s above.
+fn seconds(s: f64) -> String {
+    if s < 10.0 {
+        format!("{s:.2}")
+    } else {
+        format!("{s:.1}")
+    }
+}
+
+/// A run's convergence in brief, as its `summary.json` records it (`status`, then the fields of
+/// that status): which metrics converged, which did not, the worst, and what the check cost.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "status", rename_all = "snake_case")]
+pub enum ConvergenceVerdict {
+    /// No check was run (`reason`: not asked for, or the run did not reach its end).
+    NotChecked {
+        /// Why, in words.
+        reason: String,
+    },
+    /// Nothing to compare (no clearance hinge); no second run.
+    NothingToCheck {
+        /// Why, in words.
+        reason: String,
+    },
+    /// The tighter run failed (`error`), so nothing was compared.
+    Failed {
+        /// Its error, in words.
+        error: String,
+    },
+    /// Compared metric by metric ([`ConvergenceCheck`]).
+    Checked {
+        /// The metrics within their bounds, by name (`hinge peak force (N)`).
+        converged: Vec<String>,
+        /// The metrics beyond their bounds, by name.
+        not_converged: Vec<String>,
+        /// The worst of those in words ([`MetricCheck::describe`]; null when none).
+        worst: Option<String>,
+        /// What the check cost.
+        cost: CheckCost,
+    },
+}
+
+impl Default for ConvergenceVerdict {
+    fn default() -> Self {
+        ConvergenceVerdict::NotChecked {
+            reason: "no convergence check was run".to_string(),
+        }
+    }
+}
+
+impl ConvergenceVerdict {
+    /// Whether metrics were compared ([`ConvergenceVerdict::Checked`]).
+    pub fn is_checked(&self) -> bool {
+        matches!(self, ConvergenceVerdict::Checked { .. })
+    }
+
+    /// Whether a check answered: compared, or found nothing to compare (neither skipped nor
+    /// failed).
+    pub fn is_answered(&self) -> bool {
+        matches!(
+            self,
+            ConvergenceVerdict::Checked { .. } | ConvergenceVerdict::NothingToCheck { .. }
+        )
+    }
+
+    /// The metrics beyond their bounds (none unless checked).
+    pub fn not_converged(&self) -> &[String] {
+        match self {
+            ConvergenceVerdict::Checked { not_converged, .. } => not_converged,
+            _ => &[],
+        }
+    }
+
+    /// The verdict in one line: `converged: all 8 metrics within their bounds`, `NOT
+    /// CONVERGED: 1 of 8 metrics (hinge onsets), the worst ...; the other 7 converged`,
+    /// `nothing to check (no clearance hinge)`, `not checked (...)`, `check failed: ...`.
+    pub fn describe(&self) -> String {
+        match self {
+            ConvergenceVerdict::NotChecked { reason } => format!("not checked ({reason})"),
+            ConvergenceVerdict::NothingToCheck { reason } => {
+                format!("nothing to check ({reason})")
+            }
+            ConvergenceVerdict::Failed { error } => {
+                format!("check failed (its run at the tighter step control: {error})")
+            }
+            ConvergenceVerdict::Checked {
+                converged,
+                not_converged,
+                worst,
+                ..
+            } => {
+                let total = converged.len() + not_converged.len();
+                if not_converged.is_empty() {
+                    format!("converged: all {total} metrics within their bounds")
+                } else {
+                    format!(
+                        "NOT CONVERGED: {} of {total} metrics ({}), the worst {}; the other {} \
+                         converged",
+                        not_converged.len(),
+                        not_converged.join(", "),
+                        worst.as_deref().unwrap_or("-"),
+                        converged.len()
+                    )
+                }
+            }
+        }
+    }
 }
 
 /// One metric of one clearance hinge at the run's step control and at the tighter one.
@@ -152,6 +422,8 @@ pub struct ConvergenceCheck {
     pub tighter: String,
     /// Internal steps of the run and of the tighter run.
     pub steps: [u64; 2],
+    /// Wall time of the run and of the tighter run, s.
+    pub wall_s: [f64; 2],
     /// Every metric of every clearance hinge, hinge by hinge.
     pub metrics: Vec<MetricCheck>,
 }
@@ -251,7 +523,35 @@ impl ConvergenceCheck {
         ConvergenceCheck {
             tighter: tighter.scene.run.stepping(),
             steps: [run.steps, tighter.steps],
+            wall_s: [run.wall_s, tighter.wall_s],
             metrics,
+        }
+    }
+
+    /// What the check cost against the run.
+    pub fn cost(&self) -> CheckCost {
+        CheckCost {
+            steps: self.steps[1],
+            wall_s: self.wall_s[1],
+            run_steps: self.steps[0],
+            run_wall_s: self.wall_s[0],
+        }
+    }
+
+    /// The verdict in brief: which metrics converged, which did not, the worst, the cost.
+    pub fn verdict(&self) -> ConvergenceVerdict {
+        let names = |flagged: bool| {
+            self.metrics
+                .iter()
+                .filter(|m| m.flagged == flagged)
+                .map(|m| m.name.clone())
+                .collect()
+        };
+        ConvergenceVerdict::Checked {
+            converged: names(false),
+            not_converged: names(true),
+            worst: self.worst().map(MetricCheck::describe),
+            cost: self.cost(),
         }
     }
 
@@ -289,6 +589,88 @@ impl ConvergenceCheck {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn counts_and_times_in_words() {
+        assert_eq!(thousands(0), "0");
+        assert_eq!(thousands(999), "999");
+        assert_eq!(thousands(41_210), "41,210");
+        assert_eq!(thousands(1_234_567), "1,234,567");
+        let cost = CheckCost {
+            steps: 34_540,
+            wall_s: 0.42,
+            run_steps: 20_570,
+            run_wall_s: 0.2,
+        };
+        assert_eq!(
+            cost.describe(),
+            "34,540 steps in 0.42 s, 2.1 times the run's wall time (20,570 steps in 0.20 s)"
+        );
+        let instant = CheckCost {
+            run_wall_s: 0.0,
+            ..cost
+        };
+        assert_eq!(instant.wall_ratio(), None);
+    }
+
+    /// The one call: the paper's scene to its first impact, checked metric by metric with its
+    /// cost; without a clearance hinge, nothing to check and no claim of convergence. The
+    /// verdict reads back from its JSON.
+    #[test]
+    fn run_checked_compares_or_says_there_is_nothing_to_check() {
+        let scene = |set: &[&str]| {
+            let mut overrides = vec!["run.end_s=0.1"];
+            overrides.extend_from_slice(set);
+            Scene::solar_panel()
+                .with_overrides(&overrides)
+                .unwrap()
+                .validated()
+                .unwrap()
+        };
+        let (run, convergence) = run_checked(&scene(&[])).unwrap();
+        let check = convergence.checked().expect("a clearance hinge to check");
+        assert_eq!(check.metrics.len(), 8, "{check:?}");
+        assert!(check.is_clean(), "{check:?}");
+        let verdict = convergence.verdict();
+        let ConvergenceVerdict::Checked {
+            converged,
+            not_converged,
+            worst,
+            cost,
+        } = &verdict
+        else {
+            panic!("{verdict:?}");
+        };
+        assert_eq!(converged.len(), 8);
+        assert!(not_converged.is_empty() && worst.is_none());
+        assert_eq!(cost.run_steps, run.steps);
+        assert!(cost.steps > run.steps && cost.wall_s > 0.0, "{cost:?}");
+        assert_eq!(
+            verdict.describe(),
+            "converged: all 8 metrics within their bounds"
+        );
+        let json = serde_json::to_string(&verdict).unwrap();
+        assert!(json.contains("\"status\":\"checked\""), "{json}");
+        assert_eq!(
+            serde_json::from_str::<ConvergenceVerdict>(&json).unwrap(),
+            verdict
+        );
+
+        let ideal = scene(&["hinge.clearance=null"]);
+        assert_eq!(nothing_to_check(&ideal), Some("no clearance hinge"));
+        let (_, convergence) = run_checked(&ideal).unwrap();
+        assert_eq!(
+            convergence,
+            Convergence::NothingToCheck {
+                reason: "no clearance hinge".into()
+            }
+        );
+        assert!(convergence.strict().is_ok() && convergence.checked().is_none());
+        assert_eq!(
+            convergence.verdict().describe(),
+            "nothing to check (no clearance hinge)"
+        );
+    }
 
     #[test]
     fn values_shown_to_their_difference() {

@@ -8,6 +8,7 @@ use super::verdict::{ANGLE_SLIGHT, Conclusion, EQUAL_TOL, FORCE_STRONG, RATE_VIS
 use crate::figures::FigureKind;
 use crate::study::case::StudyCase;
 use crate::study::preset::{Study, StudyKind};
+use clearance_joint::scene::runner::convergence::ConvergenceVerdict;
 use std::fmt::Write as _;
 
 /// The caption of a study's figure, citing the paper's figure for one of its studies.
@@ -161,6 +162,7 @@ pub fn study_report(
         }
         s.push('\n');
     }
+    s.push_str(&convergence_section(cases));
     if let Some(tl) = timeline {
         let _ = writeln!(
             s,
@@ -215,6 +217,28 @@ pub fn study_report(
     s
 }
 
+/// The convergence of every case, one line each: which metrics converged against the case at
+/// half its tolerance, the worst of those that did not, and what the check cost; or why a case
+/// was not checked.
+fn convergence_section(cases: &[StudyCase]) -> String {
+    let mut s = String::from(
+        "Convergence (each case against itself at half the tolerance, the clearance twin only: \
+         each clearance hinge's first impact and its peak, largest force and penetration, onsets, \
+         impacts after a separation, contact fraction and final angle, each held to its bound; \
+         `--no-check` skips it; the metrics per case in its `summary.json`):\n\n",
+    );
+    for c in cases {
+        let v = &c.metrics.convergence;
+        let _ = write!(s, "- {}: {}", c.label, md_cell(&v.describe()));
+        if let ConvergenceVerdict::Checked { cost, .. } = v {
+            let _ = write!(s, "; the check {}", cost.describe());
+        }
+        s.push('\n');
+    }
+    s.push('\n');
+    s
+}
+
 /// What the summary of `study all` shows of one finished study.
 #[derive(Clone, Copy, Debug)]
 pub struct IndexEntry<'a> {
@@ -250,6 +274,19 @@ pub fn index_report(entries: &[IndexEntry]) -> String {
         let _ = writeln!(s, "{}, {} s simulated.\n", o.setup.stepping, o.setup.end_s);
         s.push_str(&key_tables(&escaped(o.cases), o.setup));
         s.push('\n');
+        let _ = writeln!(
+            s,
+            "Convergence: {}.\n",
+            o.cases
+                .iter()
+                .map(|c| format!(
+                    "{} {}",
+                    md_cell(&c.label),
+                    md_cell(&c.metrics.convergence.describe())
+                ))
+                .collect::<Vec<_>>()
+                .join("; ")
+        );
         for c in o
             .conclusions
             .iter()

@@ -333,8 +333,8 @@ fn a_driven_mechanism_at_the_default_step_control_never_enters_deeper_than_allow
     // The first impact against the limit of fixed steps. They converge at first order on this
     // crank (16.63, 16.42, 16.31 and 16.26 um at 1e-7 to 1.25e-8 s), so the limit is Richardson's
     // extrapolation of two of them, 16.21 um. Its deepest contacts are heavily damped (the
-    // improved law's damping at 16 um, on 0.5 kg bodies: a damping ratio of about 15 at the
-    // contact's effective mass through the crank and the guide), and their steps are bounded by a
+    // improved law's damping at 16 um, on 0.5 kg bodies: their damped stability limit, not their
+    // period, bounds the step), and their steps are bounded by a
     // fraction of the stability limit that scales with the tolerance
     // (`STABLE_FRACTION_PER_TOLERANCE`): the default is left 12.2 % deep, half the tolerance
     // 6.3 %, 0.001 1.7 %. Bounded by stability alone the steps did not depend on

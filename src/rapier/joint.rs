@@ -449,15 +449,8 @@ const APPROACH_FRACTION: f64 = 0.5;
 /// The fraction of a contact's natural period one adaptive step in contact may cover, per unit
 /// of tolerance: `2 tol` (0.015 of the period at the default 0.0075). The contact laws get the
 /// rate at the state (MODEL.md §6), so a contact is integrated at second order like the free
-/// motion, and both error sources shrink alike as the tolerance tightens; the factor balances
-/// them. Measured (`cargo bench --bench mechanisms`): at 1 the contact steps were finer than the
-/// impacts need (Flores and Ambrósio's slider-crank took 42,417 steps, 0.91 of them in contact,
-/// and missed its first peak by 0.045 %, as much as a fixed 1.5e-6 s run of 24,000 steps); at 2
-/// it takes 21,764 and misses by 0.02 % (a fixed step as accurate, 1e-6 s, takes 36,000); at 3
-/// (a scratch run) 16,350 and 0.05 % (measured before the turn bound became `tol/8` and the
-/// journal-path bound held in contact: the default now takes 25,413 steps there). The paper's
-/// scene takes 20,570 steps at 2 (33,950 at 1), its first peak within 0.014 % of a fixed 1e-6 s
-/// run.
+/// motion; the factor balances the two error sources. The first-impact errors and steps it gives
+/// are the mechanism matrix's (docs/stepper-and-accuracy.md, `cargo bench --bench mechanisms`).
 pub const CONTACT_PERIODS_PER_TOLERANCE: f64 = 2.0;
 /// Margin on the damped stability limit used by the adaptive step.
 const STABILITY_SAFETY: f64 = 0.8;

@@ -71,7 +71,10 @@ pub fn impact_restitution(
 /// of the mechanism is no such impact: with its own `delta_dot0` its damping would grow without
 /// bound (`1/delta_dot0`) and its stable step would fall to nothing. The joint takes the larger
 /// of the approach speed and this speed as `delta_dot0`: the damping of a contact never exceeds
-/// that of a free impact reaching the same depth, and a real impact is left untouched.
+/// that of a free impact reaching the same depth. A free impact is left untouched only when `m`
+/// is the mass the contact really moves: the joint passes its effective mass through the
+/// mechanism's ideal joints (a free body's mass along the normal would be too light for a pinned
+/// one, and the raise would act mid-impact).
 pub fn loaded_impact_rate(elastic_energy: f64, effective_mass: f64) -> f64 {
     if elastic_energy > 0.0 && effective_mass > 0.0 && effective_mass.is_finite() {
         (2.0 * elastic_energy / effective_mass).sqrt()

@@ -111,7 +111,7 @@ fn panel_world(spatial: bool) -> Result<(ClearanceWorld, RigidBodyHandle, Cleara
         Vector::Y,
     )?;
     let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.0075));
-    let hinge = world.insert_clearance(post, panel, joint);
+    let hinge = world.insert_clearance(post, panel, joint)?;
     Ok((world, panel, hinge))
 }
 

@@ -157,7 +157,7 @@ pub fn simulate(with_play: bool, max_substeps: usize) -> Result<Run> {
         .max_substeps(max_substeps)
         .name("sign pin")
         .build()?;
-        Some(world.insert_large_step(cart, body, joint))
+        Some(world.insert_large_step(cart, body, joint)?)
     } else {
         world.rapier.impulse_joints.insert(
             cart,

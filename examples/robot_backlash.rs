@@ -141,7 +141,7 @@ impl Arm {
                 .friction(0.1)
                 .name(["shoulder", "elbow"][i])
                 .build()?;
-                pins.push(world.insert_large_step(b1, b2, joint));
+                pins.push(world.insert_large_step(b1, b2, joint)?);
             } else {
                 world.rapier.impulse_joints.insert(
                     b1,

@@ -106,7 +106,7 @@ fn add_twin(world: &mut ClearanceWorld, with_clearance: bool) -> Result<Twin> {
         .friction(FrictionModel::Bai(Bai::DRY))
         .name("hinge")
         .build()?;
-        Some(world.insert_clearance(satellite, panel, joint))
+        Some(world.insert_clearance(satellite, panel, joint)?)
     } else {
         let revolute = RevoluteJointBuilder::new(AXIS)
             .local_anchor1(a1)

@@ -116,7 +116,7 @@ fn a_fixed_step_too_large_names_the_api() {
             Vector::Z,
         )
         .unwrap();
-    world.insert_clearance(base, arm, pin);
+    world.insert_clearance(base, arm, pin).unwrap();
     let e = loop {
         match world.step(1.0) {
             Ok(_) => assert!(world.time() < 1.0, "never refused"),

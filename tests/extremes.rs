@@ -251,7 +251,7 @@ fn api_names_a_journal_body_removed_after_the_joint() {
         }
     };
     assert!(
-        e.contains("not in the body set") && !e.contains(" 0 s"),
+        e.contains("`body2`") && e.contains("not in the world's bodies") && !e.contains(" 0 s"),
         "{e}"
     );
 }

@@ -387,7 +387,7 @@ fn library_arm(law: NormalModel, dt: f64, end: f64) -> Vec<LibraryImpact> {
         .lock(OutOfPlaneLock::None)
         .joint(anchor, anchor, Vector::Z, Vector::Z)
         .expect("the arm's pin");
-    let pin = world.insert_clearance(base, arm, joint);
+    let pin = world.insert_clearance(base, arm, joint).unwrap();
     record(&mut world, pin, end)
 }
 
@@ -476,7 +476,7 @@ fn library_single(law: NormalModel, dt: f64, end: f64) -> (Vec<LibraryImpact>, f
     let joint = clearance(law, SINGLE_RB, SINGLE_C)
         .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
         .expect("the journal's bearing");
-    let pin = world.insert_clearance(base, journal, joint);
+    let pin = world.insert_clearance(base, journal, joint).unwrap();
     let impacts = record(&mut world, pin, end);
     (impacts, world.rapier.bodies[journal].linvel().x)
 }

@@ -65,7 +65,7 @@ fn fixed_bearing(
     let joint = clearance
         .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
         .unwrap();
-    let h = world.insert_clearance(base, pin, joint);
+    let h = world.insert_clearance(base, pin, joint).unwrap();
     (world, pin, h)
 }
 
@@ -215,7 +215,7 @@ fn free_floating_pair_conserves_momentum() {
         .friction(FrictionModel::Bai(Bai::DRY))
         .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
         .unwrap();
-    let h = world.insert_clearance(bearing, pin, joint);
+    let h = world.insert_clearance(bearing, pin, joint).unwrap();
     let bodies = [(bearing, 1.0, 2e-4), (pin, 0.5, 1e-4)];
     let (p0, l0) = momentum(&world, &bodies);
     let (mut impacts, mut edge, mut inner, mut face) = (0, 0.0_f64, 0.0_f64, [0.0_f64; 2]);

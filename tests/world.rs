@@ -51,7 +51,9 @@ fn large_step_pin() -> LargeStepJoint {
 fn large_step_hooks_run_inside_the_world_step() {
     let (rapier, base, arm) = arm_world(4);
     let mut world = ClearanceWorld::new(rapier, StepControl::fixed(1.0 / 60.0));
-    let pin = world.insert_large_step(base, arm, large_step_pin());
+    let pin = world
+        .insert_large_step(base, arm, large_step_pin())
+        .unwrap();
     let mut worst: f64 = 0.0;
     while world.time() < 20.0 {
         world.step(20.0).unwrap();
@@ -78,7 +80,7 @@ fn the_world_steps_like_the_stepper_with_the_same_sets() {
     let control = StepControl::adaptive(1e-3, 0.0075);
     let (rapier, base, arm) = arm_world(1);
     let mut world = ClearanceWorld::new(rapier, control);
-    world.insert_clearance(base, arm, compliant_pin());
+    world.insert_clearance(base, arm, compliant_pin()).unwrap();
     world.step_to(0.05).unwrap();
 
     let (mut rapier, base2, arm2) = arm_world(1);
@@ -139,7 +141,7 @@ fn reactions_see_the_large_step_joints() {
         .restitution(0.3)
         .build()
         .unwrap();
-    world.insert_large_step(base, upper, pin);
+    world.insert_large_step(base, upper, pin).unwrap();
     world.step_to(5.0).unwrap();
     let joints = [IdealJoint::Revolute(IdealRevolute {
         body1: upper,
@@ -168,4 +170,155 @@ fn step_to_refuses_an_unreachable_time() {
     }
     assert_eq!(world.step_to(0.01).unwrap(), 10);
     assert_eq!(world.step_to(0.005).unwrap(), 0);
+}
+
+/// A joint on a body the world does not have (removed, `RigidBodyHandle::invalid()`) or on one
+/// body twice is refused at insertion, naming `body1` or `body2`, and nothing is added: the world
+/// still steps. (Unchecked, Rapier panicked at the step on a removed body and tried to allocate
+/// 34 GB for the invalid handle.)
+#[test]
+fn joints_on_missing_or_same_bodies_are_refused_naming_the_body() {
+    let (rapier, base, arm) = arm_world(1);
+    let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.0075));
+    let r = &mut world.rapier;
+    let gone = r.bodies.insert(RigidBodyBuilder::dynamic());
+    r.bodies.remove(
+        gone,
+        &mut r.islands,
+        &mut r.colliders,
+        &mut r.impulse_joints,
+        &mut r.multibody_joints,
+        &mut r.soft_bodies,
+        true,
+    );
+    let invalid = RigidBodyHandle::invalid();
+    for (b1, b2, field, says) in [
+        (base, gone, "body2", "not in the world"),
+        (gone, arm, "body1", "not in the world"),
+        (base, invalid, "body2", "not in the world"),
+        (invalid, arm, "body1", "not in the world"),
+        (arm, arm, "body2", "same body as body1"),
+    ] {
+        for e in [
+            world.insert_clearance(b1, b2, compliant_pin()).unwrap_err(),
+            world
+                .insert_large_step(b1, b2, large_step_pin())
+                .unwrap_err(),
+        ] {
+            let e = e.to_string();
+            assert!(
+                e.contains(&format!("`{field}`")) && e.contains(says),
+                "{field}: {e}"
+            );
+        }
+    }
+    assert!(world.clearance.is_empty() && world.large_step.is_empty());
+    assert_eq!(world.rapier.impulse_joints.len(), 0);
+    world.step_to(0.01).unwrap();
+}
+
+/// Times the clock cannot reach are refused, naming `until`, and nothing moves: an infinite one,
+/// and ones so large that a step of the control's largest size does not change the time there
+/// (before, `step(f64::MAX)` and `step(1e307)` returned `Ok` after a 0 s step). A step to a
+/// large time the clock can count is still taken.
+#[test]
+fn times_the_clock_cannot_reach_are_refused_naming_until() {
+    let (rapier, base, arm) = arm_world(1);
+    let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.0075));
+    world.insert_clearance(base, arm, compliant_pin()).unwrap();
+    let start = world.rapier.bodies[arm].translation();
+    for until in [f64::MAX, 1e307, 1e30, f64::INFINITY] {
+        let e = world.step(until).unwrap_err().to_string();
+        assert!(e.contains("`until`"), "step({until}): {e}");
+        assert_eq!(world.time(), 0.0);
+        assert_eq!(world.rapier.bodies[arm].translation(), start);
+        let e = world.step_to(until).unwrap_err().to_string();
+        assert!(e.contains("`until`"), "step_to({until}): {e}");
+    }
+    let info = world.step(1e6).unwrap();
+    assert!(info.dt > 0.0 && world.time() > 0.0, "{info:?}");
+}
+
+/// `peek` takes a step of `dt` before the first step: one the step control would not take (not
+/// finite, not positive, longer than its largest step) is refused naming `dt`; before, `peek(1e300)`
+/// returned `Ok` with nothing moved.
+#[test]
+fn peek_refuses_a_step_the_control_would_not_take() {
+    let (rapier, base, arm) = arm_world(1);
+    let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.0075));
+    world.insert_clearance(base, arm, compliant_pin()).unwrap();
+    for dt in [1e300, 1.0, f64::INFINITY, f64::NAN, 0.0, -1e-4] {
+        let e = world.peek(dt, |_, _| ()).unwrap_err().to_string();
+        assert!(e.contains("`dt`"), "peek({dt}): {e}");
+        assert_eq!(world.time(), 0.0);
+    }
+    let moved = world
+        .peek(1e-4, |w, info| (info.dt, w.bodies[arm].linvel().length()))
+        .unwrap();
+    assert!(moved.0 == 1e-4 && moved.1 > 0.0, "{moved:?}");
+}
+
+/// Gravity that takes a free body past the speed guard (half Rapier's `max_linear_velocity`)
+/// within one of the control's largest steps is refused before the step, naming `gravity`;
+/// before, 1e300 m/s^2 gave `Ok`, clean guards and a motionless arm.
+#[test]
+fn gravity_beyond_the_speed_guard_in_one_step_is_refused() {
+    for g in [1e300, 1e10, 1e6, f64::INFINITY] {
+        let (mut rapier, base, arm) = arm_world(1);
+        rapier.gravity = Vector::new(0.0, -g, 0.0);
+        let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.0075));
+        world.insert_clearance(base, arm, compliant_pin()).unwrap();
+        let e = world.step(0.01).unwrap_err().to_string();
+        assert!(e.contains("`gravity`"), "gravity {g}: {e}");
+        assert_eq!(world.time(), 0.0);
+    }
+    // 100 g is honoured.
+    let (mut rapier, base, arm) = arm_world(1);
+    rapier.gravity = Vector::new(0.0, -981.0, 0.0);
+    let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.0075));
+    world.insert_clearance(base, arm, compliant_pin()).unwrap();
+    world.step_to(0.01).unwrap();
+}
+
+/// The sets' own `insert` does not see the bodies: a joint on a removed body or on
+/// `RigidBodyHandle::invalid()` is refused at the step, naming the body, before Rapier's step
+/// runs (it panicked on the removed body; the invalid handle made Rapier's insert try to allocate
+/// 34 GB).
+#[test]
+fn a_set_joint_on_a_missing_body_is_refused_at_the_step() {
+    for large in [true, false] {
+        for removed in [true, false] {
+            let (mut r, base, _) = arm_world(if large { 4 } else { 1 });
+            let gone = r.bodies.insert(RigidBodyBuilder::dynamic());
+            r.bodies.remove(
+                gone,
+                &mut r.islands,
+                &mut r.colliders,
+                &mut r.impulse_joints,
+                &mut r.multibody_joints,
+                &mut r.soft_bodies,
+                true,
+            );
+            let gone = if removed {
+                gone
+            } else {
+                RigidBodyHandle::invalid()
+            };
+            let (mut joints, mut play) = (ClearanceJointSet::new(), LargeStepJointSet::new());
+            if large {
+                play.insert(base, gone, large_step_pin(), &mut r.impulse_joints);
+            } else {
+                joints.insert(base, gone, compliant_pin(), &mut r.impulse_joints);
+            }
+            let mut stepper = Stepper::new(StepControl::fixed(1e-4));
+            let e = stepper
+                .step(&mut r, &mut [&mut joints, &mut play], 1e-3)
+                .unwrap_err()
+                .to_string();
+            assert!(
+                e.contains("`body2`") && e.contains("not in the world"),
+                "large {large}, removed {removed}: {e}"
+            );
+        }
+    }
 }

@@ -417,11 +417,17 @@ impl Physics {
                 let joint = named(c, entity)
                     .large_step_joint(a1, a2, x1, x2)
                     .map_err(context)?;
-                HingeJoint::LargeStep(w.insert_large_step(bodies.0, bodies.1, joint))
+                HingeJoint::LargeStep(
+                    w.insert_large_step(bodies.0, bodies.1, joint)
+                        .map_err(context)?,
+                )
             }
             Some(c) => {
                 let joint = named(c, entity).joint(a1, a2, x1, x2).map_err(context)?;
-                HingeJoint::Clearance(w.insert_clearance(bodies.0, bodies.1, joint))
+                HingeJoint::Clearance(
+                    w.insert_clearance(bodies.0, bodies.1, joint)
+                        .map_err(context)?,
+                )
             }
         };
         self.changed = true;

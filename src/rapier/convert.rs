@@ -120,7 +120,7 @@ use rapier3d_f64::prelude::{
 ///     .model(ClearanceModel::Spatial(SpatialModel::steel(0.3e-3, 0.010)))
 ///     .joint(Vector::ZERO, Vector::new(-0.2, 0.0, 0.0), Vector::Y, Vector::Y)?;
 /// let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.0075));
-/// let hinge = world.insert_clearance(post, arm, pin);
+/// let hinge = world.insert_clearance(post, arm, pin)?;
 /// let (mut tilt, mut edges) = (0.0_f64, [0.0_f64; 2]);
 /// while world.time() < 0.03 {
 ///     world.step(0.03)?;

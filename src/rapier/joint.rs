@@ -1036,7 +1036,11 @@ impl ClearanceJointSet {
             .local_anchor2(joint.local_anchor2)
             .contacts_enabled(false)
             .build();
-            joint.lock_handle = Some(impulse_joints.insert(body1, body2, lock, true));
+            // Rapier sizes a table by each body's index: for the invalid handle (index u32::MAX)
+            // that is 34 GB. Such a joint gets no lock; the step refuses it, naming the body.
+            if body1 != RigidBodyHandle::invalid() && body2 != RigidBodyHandle::invalid() {
+                joint.lock_handle = Some(impulse_joints.insert(body1, body2, lock, true));
+            }
         }
         ClearanceJointHandle(self.joints.insert(joint))
     }
@@ -1355,6 +1359,17 @@ impl crate::rapier::step_hooks::StepHooks for ClearanceJointSet {
                 names.push(format!("clearance joint `{}`", j.name()));
             }
         }
+    }
+    fn check_bodies(&self, bodies: &RigidBodySet) -> Result<()> {
+        for (_, j) in self.iter() {
+            crate::rapier::step_hooks::joint_bodies(
+                bodies,
+                || format!("clearance joint `{}`", j.name()),
+                j.body1(),
+                j.body2(),
+            )?;
+        }
+        Ok(())
     }
 }
 

@@ -8,7 +8,8 @@
 //! here: it overrides what it needs, the rest does nothing.
 //!
 //! One step of the stepper, in the order the hooks are called:
-//! 1. [`check_world`](StepHooks::check_world) once before the first step (the solver settings a
+//! 1. [`check_bodies`](StepHooks::check_bodies) before every step;
+//!    [`check_world`](StepHooks::check_world) once before the first step (the solver settings a
 //!    participant needs), then [`set_last_step`](StepHooks::set_last_step) and
 //!    [`evaluate`](StepHooks::evaluate) at the state before the step.
 //! 2. The step's length: the smallest [`step_limit`](StepHooks::step_limit) (adaptive), or a
@@ -112,4 +113,35 @@ pub trait StepHooks {
     /// Names (in words) this participant's joints that join `body`, for a divergence's message.
     /// Default: none.
     fn joints_of(&self, _body: RigidBodyHandle, _names: &mut Vec<String>) {}
+
+    /// Checks that this participant's joints join bodies of `bodies` (before every step; an error
+    /// names `body1` or `body2`, as [`joint_bodies`] words it). Default: nothing to check.
+    fn check_bodies(&self, _bodies: &RigidBodySet) -> Result<()> {
+        Ok(())
+    }
+}
+
+/// `Ok` when `body1` and `body2` are both in `bodies`; else an error naming the one missing
+/// (`body1` or `body2`), with `joint()` (in words, formed only then) the joint that holds it.
+pub fn joint_bodies(
+    bodies: &RigidBodySet,
+    joint: impl FnOnce() -> String,
+    body1: RigidBodyHandle,
+    body2: RigidBodyHandle,
+) -> Result<()> {
+    for (field, body) in [("body1", body1), ("body2", body2)] {
+        if !bodies.contains(body) {
+            let (index, generation) = body.into_raw_parts();
+            let joint = joint();
+            return Err(crate::Error::invalid(
+                field,
+                format!(
+                    "{joint} joins a body (index {index}, generation {generation}) that is not in \
+                     the world's bodies (removed, invalid or of another world): insert joints \
+                     between bodies of this world, and remove a joint before its body"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }

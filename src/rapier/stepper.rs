@@ -401,7 +401,11 @@ impl Stepper {
     /// being taken whole when the remainder is within 1e-6 of it; an infinite `until` is no
     /// target), with `sources` evaluated at the state before it (done by the previous call, or by
     /// [`prepare`](Self::prepare) on the first) and again at the state after it. Returns what the
-    /// step did. `until` at or before the current time is refused. An error after the step (a
+    /// step did. `until` at or before the current time is refused, and so is a finite `until`
+    /// beyond what the clock can reach, where a step of `max_dt` does not change the time in f64;
+    /// the world's gravity must be finite and within what one step of `max_dt` can take without
+    /// passing the speed guard (`|g| max_dt` at most half Rapier's `max_linear_velocity`), else
+    /// it is refused naming `gravity`. An error after the step (a
     /// fixed step beyond a contact's stability limit, a guard under `strict`, a diverged body)
     /// leaves the world and the clock at the state the step reached.
     ///
@@ -421,7 +425,8 @@ impl Stepper {
     ) -> Result<StepInfo> {
         // Cheap, and `set_control` may have changed it since the last step.
         self.control.validate()?;
-        check_gravity(world)?;
+        check_gravity(world, self.control.max_dt)?;
+        check_joint_bodies(world, sources)?;
         self.prepare(world, sources)?;
         let left = until - self.t;
         if !(left > 0.0) {
@@ -430,6 +435,18 @@ impl Stepper {
                 format!(
                     "must be after the current time {} s (got {until} s)",
                     self.t
+                ),
+            ));
+        }
+        if until.is_finite() && until + self.control.max_dt == until {
+            return Err(Error::invalid(
+                "until",
+                format!(
+                    "is beyond what the clock can reach (got {until} s): there a step of the \
+                     largest size, max_dt = {} s, does not change the time in f64; give a time \
+                     below 2^52 times max_dt ({} s)",
+                    crate::error::sig4(self.control.max_dt),
+                    crate::error::sig4(self.control.max_dt * 2f64.powi(52))
                 ),
             ));
         }
@@ -587,7 +604,8 @@ impl Stepper {
 
     /// Takes a step of the last step's size (or `dt` if none), lets `read` look at the world and
     /// the step, then restores the state before it exactly: e.g. an ideal joint's reaction at
-    /// the final time, which only the step after it determines.
+    /// the final time, which only the step after it determines. `dt` must be > 0 and at most
+    /// the control's `max_dt`, else it is refused naming `dt`.
     pub fn peek<R>(
         &mut self,
         world: &mut PhysicsWorld,
@@ -595,6 +613,17 @@ impl Stepper {
         dt: f64,
         read: impl FnOnce(&PhysicsWorld, &StepInfo) -> R,
     ) -> Result<R> {
+        if !(dt > 0.0 && dt <= self.control.max_dt) {
+            return Err(Error::invalid(
+                "dt",
+                format!(
+                    "the peek's step must be > 0 and at most the control's largest step, \
+                     max_dt = {} s (got {} s)",
+                    crate::error::sig4(self.control.max_dt),
+                    crate::error::sig4(dt)
+                ),
+            ));
+        }
         self.prepare(world, sources)?;
         let (t, last, steps, guards, control, correction) = (
             self.t,
@@ -772,14 +801,49 @@ fn exact_kinematic_poses(world: &mut PhysicsWorld, saved: &[BodySnapshot], dt: f
 }
 
 /// The world's gravity must be finite (a NaN one would only show as a body leaving the
-/// physical range).
-fn check_gravity(world: &PhysicsWorld) -> Result<()> {
+/// physical range), and within what the speed guard lets a step take: a free body falling for
+/// one step of `max_dt` must stay below the guard, half Rapier's `max_linear_velocity` (beyond
+/// it the first step leaves the physical range, or Rapier's clamps leave the bodies still).
+fn check_gravity(world: &PhysicsWorld, max_dt: f64) -> Result<()> {
     let g = world.gravity;
     if !g.is_finite() {
         return Err(Error::invalid(
             "gravity",
             format!("the world's gravity must be finite (got {g:?})"),
         ));
+    }
+    let guard = 0.5 * world.integration_parameters.max_linear_velocity();
+    let bound = guard / max_dt;
+    if g.length() > bound {
+        return Err(Error::invalid(
+            "gravity",
+            format!(
+                "{} m/s^2 would take a free body past the speed guard ({} m/s, half \
+                 `integration_parameters.max_linear_velocity()`) within one step of max_dt = {} \
+                 s: give a gravity of at most {} m/s^2 (or a shorter max_dt)",
+                crate::error::sig4(g.length()),
+                crate::error::sig4(guard),
+                crate::error::sig4(max_dt),
+                crate::error::sig4(bound)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Every impulse joint (Rapier's own, a clearance joint's lock, a large-step joint's) and every
+/// participant's joint joins bodies of the world: Rapier's step panics on one whose body is gone.
+fn check_joint_bodies(world: &PhysicsWorld, sources: &[&mut dyn StepHooks]) -> Result<()> {
+    for (handle, joint) in world.impulse_joints.iter() {
+        crate::rapier::step_hooks::joint_bodies(
+            &world.bodies,
+            || format!("impulse joint {:?}", handle.into_raw_parts()),
+            joint.body1(),
+            joint.body2(),
+        )?;
+    }
+    for s in sources {
+        s.check_bodies(&world.bodies)?;
     }
     Ok(())
 }

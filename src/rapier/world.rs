@@ -27,7 +27,7 @@
 //!     Vector::Z,
 //!     Vector::Z,
 //! )?;
-//! let pin = world.insert_clearance(base, arm, pin);
+//! let pin = world.insert_clearance(base, arm, pin)?;
 //! let mut peak: f64 = 0.0;
 //! while world.time() < 0.2 {
 //!     world.step(0.2)?; // one accepted step, landing on 0.2 s at the end
@@ -57,7 +57,7 @@ use crate::rapier::reaction::{IdealJoint, KinematicState, ReactionSolver};
 use crate::rapier::step_hooks::StepHooks;
 use crate::rapier::stepper::{GuardReport, StepControl, StepInfo, Stepper};
 use rapier3d_f64::math::Vector;
-use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle};
+use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle, RigidBodySet};
 
 /// A Rapier world with clearance joints, drives and prescribed motions, stepped by one
 /// [`Stepper`]. The sets are public fields, as in Rapier's `PhysicsWorld`: read them freely;
@@ -104,16 +104,19 @@ impl ClearanceWorld {
     // ----- Joints, drives, motions -----
 
     /// Adds a compliant clearance joint between `body1` (bearing) and `body2` (journal), with its
-    /// Rapier lock.
+    /// Rapier lock. Refused, naming `body1` or `body2`, unless both are bodies of
+    /// `self.rapier.bodies` and not the same body; nothing is added then.
     pub fn insert_clearance(
         &mut self,
         body1: RigidBodyHandle,
         body2: RigidBodyHandle,
         joint: ClearanceJoint,
-    ) -> ClearanceJointHandle {
+    ) -> Result<ClearanceJointHandle> {
+        check_joint_bodies(&self.rapier.bodies, body1, body2)?;
         self.stepper.invalidate(false);
-        self.clearance
-            .insert(body1, body2, joint, &mut self.rapier.impulse_joints)
+        Ok(self
+            .clearance
+            .insert(body1, body2, joint, &mut self.rapier.impulse_joints))
     }
 
     /// Removes a compliant clearance joint (and its Rapier lock); `None` for a handle of no joint.
@@ -125,16 +128,19 @@ impl ClearanceWorld {
     }
 
     /// Adds a large-step clearance joint between `body1` (bearing) and `body2` (journal), with
-    /// its Rapier joint.
+    /// its Rapier joint. Refused, naming `body1` or `body2`, unless both are bodies of
+    /// `self.rapier.bodies` and not the same body; nothing is added then.
     pub fn insert_large_step(
         &mut self,
         body1: RigidBodyHandle,
         body2: RigidBodyHandle,
         joint: LargeStepJoint,
-    ) -> LargeStepJointHandle {
+    ) -> Result<LargeStepJointHandle> {
+        check_joint_bodies(&self.rapier.bodies, body1, body2)?;
         // No force to evaluate: its hooks run inside each step.
-        self.large_step
-            .insert(body1, body2, joint, &mut self.rapier.impulse_joints)
+        Ok(self
+            .large_step
+            .insert(body1, body2, joint, &mut self.rapier.impulse_joints))
     }
 
     /// Removes a large-step clearance joint (and its Rapier joint); `None` for a handle of no
@@ -169,7 +175,15 @@ impl ClearanceWorld {
     /// Takes one accepted step towards `until` (s), landing on it exactly
     /// ([`Stepper::step`]: the step control, acceptance, guards; the joints', drives' and
     /// motions' hooks in their order). Call it in place of Rapier's `PhysicsWorld::step`.
+    /// `until` must be finite, after the current time and within what the clock can reach (a
+    /// step of `max_dt` must change the time there); else it is refused, naming `until`.
     pub fn step(&mut self, until: f64) -> Result<StepInfo> {
+        if !until.is_finite() {
+            return Err(crate::Error::invalid(
+                "until",
+                format!("must be a finite time in seconds (got {until})"),
+            ));
+        }
         self.follow_changes();
         let (stepper, physics, mut hooks) = self.parts();
         stepper.step(physics, &mut hooks, until)
@@ -200,8 +214,8 @@ impl ClearanceWorld {
         stepper.prepare(physics, &mut hooks)
     }
 
-    /// [`Stepper::peek`]: a step of the last step's size (or `dt`), read by `read`, then undone
-    /// exactly.
+    /// [`Stepper::peek`]: a step of the last step's size (or `dt`: > 0 and at most the
+    /// control's `max_dt`, else refused naming `dt`), read by `read`, then undone exactly.
     pub fn peek<R>(
         &mut self,
         dt: f64,
@@ -325,4 +339,24 @@ impl ClearanceWorld {
             self.counts = counts;
         }
     }
+}
+
+/// A joint's two bodies: both in `bodies`, and two. Named as the insert methods name them.
+fn check_joint_bodies(
+    bodies: &RigidBodySet,
+    body1: RigidBodyHandle,
+    body2: RigidBodyHandle,
+) -> Result<()> {
+    crate::rapier::step_hooks::joint_bodies(bodies, || "the joint".to_string(), body1, body2)?;
+    if body1 == body2 {
+        let (index, generation) = body1.into_raw_parts();
+        return Err(crate::Error::invalid(
+            "body2",
+            format!(
+                "is the same body as body1 (index {index}, generation {generation}): a joint \
+                 joins two bodies; pass the journal's body as body2 and the bearing's as body1"
+            ),
+        ));
+    }
+    Ok(())
 }

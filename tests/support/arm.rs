@@ -33,6 +33,6 @@ pub fn arm(
             Vector::Z,
         )
         .expect("the arm's pin is a valid joint");
-    let pin = world.insert_clearance(base, arm, joint);
+    let pin = world.insert_clearance(base, arm, joint).unwrap();
     (world, arm, pin)
 }

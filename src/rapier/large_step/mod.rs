@@ -679,7 +679,11 @@ impl LargeStepJointSet {
         joint.body2 = body2;
         joint.state = JointState::default();
         joint.report = LargeStepReport::default();
-        joint.handle = Some(impulse_joints.insert(body1, body2, joint.rapier_joint(), true));
+        // Rapier sizes a table by each body's index: for the invalid handle (index u32::MAX) that
+        // is 34 GB. Such a joint gets no Rapier joint; the step refuses it, naming the body.
+        if body1 != RigidBodyHandle::invalid() && body2 != RigidBodyHandle::invalid() {
+            joint.handle = Some(impulse_joints.insert(body1, body2, joint.rapier_joint(), true));
+        }
         self.groups_valid = false;
         LargeStepJointHandle(self.joints.insert(joint))
     }
@@ -969,5 +973,16 @@ impl crate::rapier::step_hooks::StepHooks for LargeStepJointSet {
                 names.push(format!("large-step clearance joint `{}`", j.name()));
             }
         }
+    }
+    fn check_bodies(&self, bodies: &rapier3d_f64::prelude::RigidBodySet) -> crate::Result<()> {
+        for (_, j) in self.iter() {
+            crate::rapier::step_hooks::joint_bodies(
+                bodies,
+                || format!("large-step clearance joint `{}`", j.name()),
+                j.body1(),
+                j.body2(),
+            )?;
+        }
+        Ok(())
     }
 }

@@ -172,15 +172,8 @@ fn step_to_refuses_an_unreachable_time() {
     assert_eq!(world.step_to(0.005).unwrap(), 0);
 }
 
-/// A joint on a body the world does not have (removed, `RigidBodyHandle::invalid()`) or on one
-/// body twice is refused at insertion, naming `body1` or `body2`, and nothing is added: the world
-/// still steps. (Unchecked, Rapier panicked at the step on a removed body and tried to allocate
-/// 34 GB for the invalid handle.)
-#[test]
-fn joints_on_missing_or_same_bodies_are_refused_naming_the_body() {
-    let (rapier, base, arm) = arm_world(1);
-    let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.0075));
-    let r = &mut world.rapier;
+/// The handle of a body inserted into `r` and removed again: one the world no longer has.
+fn removed_body(r: &mut PhysicsWorld) -> RigidBodyHandle {
     let gone = r.bodies.insert(RigidBodyBuilder::dynamic());
     r.bodies.remove(
         gone,
@@ -191,6 +184,18 @@ fn joints_on_missing_or_same_bodies_are_refused_naming_the_body() {
         &mut r.soft_bodies,
         true,
     );
+    gone
+}
+
+/// A joint on a body the world does not have (removed, `RigidBodyHandle::invalid()`) or on one
+/// body twice is refused at insertion, naming `body1` or `body2`, and nothing is added: the world
+/// still steps. (Unchecked, Rapier panicked at the step on a removed body and tried to allocate
+/// 34 GB for the invalid handle.)
+#[test]
+fn joints_on_missing_or_same_bodies_are_refused_naming_the_body() {
+    let (rapier, base, arm) = arm_world(1);
+    let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.0075));
+    let gone = removed_body(&mut world.rapier);
     let invalid = RigidBodyHandle::invalid();
     for (b1, b2, field, says) in [
         (base, gone, "body2", "not in the world"),
@@ -289,16 +294,7 @@ fn a_set_joint_on_a_missing_body_is_refused_at_the_step() {
     for large in [true, false] {
         for removed in [true, false] {
             let (mut r, base, _) = arm_world(if large { 4 } else { 1 });
-            let gone = r.bodies.insert(RigidBodyBuilder::dynamic());
-            r.bodies.remove(
-                gone,
-                &mut r.islands,
-                &mut r.colliders,
-                &mut r.impulse_joints,
-                &mut r.multibody_joints,
-                &mut r.soft_bodies,
-                true,
-            );
+            let gone = removed_body(&mut r);
             let gone = if removed {
                 gone
             } else {

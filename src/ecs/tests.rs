@@ -294,7 +294,7 @@ fn errors_are_values_and_stop_the_systems() {
         Error::StepTooLarge { field, t, .. } => {
             assert_eq!(field, "Physics::world.rapier.integration_parameters.dt");
             assert!(t.is_some_and(|t| t.is_finite() && t > 0.0));
-            // Issue 18: the ECS's names, never the app's options or the scene's paths.
+            // The ECS's names, never the app's options or the scene's paths.
             let msg = e.to_string();
             assert!(
                 msg.contains("`Physics::world.rapier.integration_parameters.dt` =")

@@ -64,7 +64,7 @@ mod tests {
         }
     }
 
-    /// Issue 17, item 9 and issue 18: the step-limit message in a scene names the scene's field
+    /// The step-limit message in a scene names the scene's field
     /// that sets the stiffness (or the damping), the step field and the scene's switch to
     /// adaptive steps, and no option of the app.
     #[test]

@@ -9,6 +9,7 @@
 //! - [`progress`]: progress of a long run on a terminal.
 //! - [`replay`]: the self-contained `replay.html` of a run (3D, journal insets, timeline).
 //! - [`resultset`]: a result set (data, figures, report, replay) written as one unit.
+//! - [`summary`]: `summary.json` with the effective scene (the scene after overrides).
 //! - [`advice`]: the library's errors phrased for the command line (its options added).
 //!
 //! The binary (`src/main.rs`) parses arguments, calls these, prints and sets the exit code. The
@@ -25,3 +26,4 @@ pub mod progress;
 pub mod replay;
 pub mod resultset;
 pub mod study;
+pub mod summary;

@@ -357,7 +357,7 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     };
     // The whole set (tables, summary, figures, replay) goes to the staging folder, then into
     // place.
-    let summary = result.write_checked(job.set.dir(), &verdict)?;
+    let summary = clearance_joint_app::summary::write_run(&result, job.set.dir(), &verdict)?;
     let mut drawn = Vec::new();
     if figures {
         // A figure that cannot be written fails the command; the old set stays whole.

@@ -25,8 +25,10 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Version of the manifest and table formats.
-pub const FORMAT_VERSION: u32 = 1;
+/// Version of the point folders' files (the manifest, `summary.json` with its effective scene)
+/// and of the table format: a point written under another version is not finished (it runs
+/// again), and tables of another version do not merge.
+pub const FORMAT_VERSION: u32 = 2;
 /// Name of a point's manifest, written last.
 pub const MANIFEST: &str = "point.json";
 
@@ -473,7 +475,7 @@ impl Job {
         };
         let mut metrics = RunMetrics::of(&result)?;
         metrics.convergence = convergence.clone();
-        result.write_checked(&self.dir, &convergence)?;
+        crate::summary::write_run(&result, &self.dir, &convergence)?;
         match &recording {
             Some(recording) => {
                 crate::replay::write_run_replay(&self.scene, &result, recording, &self.dir)?;

@@ -12,10 +12,10 @@
 //!
 //! Each twin is a `ClearanceWorld` on the default adaptive steps.
 //!
-//! A closed form checks the spatial twin once the swing has died down: the weight's moment
-//! `m g x` is held by the couple of the two edge forces, `F_edge L`, plus the moment of the face
-//! force `W` at the shoulder's contact ring, `W r_f` (the ring's radius `r_f =
-//! sqrt((R_j^2 + R_o^2)/2)`, see `clearance_joint::model::spatial`).
+//! A static balance checks the spatial twin once the swing has died down: the weight's moment
+//! `m g x` is held by the moments of the bore's and the faces' contact forces about the
+//! bearing's centre (each quadrature point's normal and friction force at its point,
+//! `ClearanceJoint::spatial_points`).
 //!
 //! `cargo run --release --example door_hinge`
 
@@ -24,6 +24,7 @@ use clearance_joint::model::angle::twist_angle;
 use clearance_joint::model::laws::{Bai, FrictionModel};
 use clearance_joint::model::spatial::SpatialModel;
 use clearance_joint::prelude::*;
+use clearance_joint::rapier::joint::{ClearanceJoint, Region};
 use rapier3d_f64::prelude::*;
 use std::process::ExitCode;
 
@@ -55,6 +56,9 @@ pub struct Outcome {
     pub late_edge_force: [f64; 2],
     /// Force on both faces averaged over the last 0.2 s, N.
     pub late_face_force: f64,
+    /// Moments about the bearing's centre, averaged over the last 0.2 s, N m: of the edge
+    /// regions' resultants (their arms along the axis), of the faces' (their arms from it).
+    pub late_moments: [f64; 2],
     /// Face knocks: contacts of a shoulder with a face that began after a free flight.
     pub face_knocks: u32,
     /// Largest force on the faces, N.
@@ -76,12 +80,29 @@ pub fn spatial_model() -> SpatialModel {
 }
 
 /// The moments that hold the weight's moment `m g x` once the swing has died down (last 0.2 s):
-/// `[F_edge L, W r_f]`, N m (edge couple, with the two edges' mean force; face force at the
-/// shoulder's contact ring).
-pub fn holding_moments(o: &Outcome) -> Result<[f64; 2]> {
-    let ring = spatial_model().geometry.face_ring_radius(&pin()?.geometry);
-    let edge = 0.5 * (o.late_edge_force[0] + o.late_edge_force[1]);
-    Ok([edge * WIDTH, o.late_face_force * ring])
+/// `[edges, face]`, N m.
+pub fn holding_moments(o: &Outcome) -> [f64; 2] {
+    o.late_moments
+}
+
+/// The moments about the bearing's centre (the origin) of the joint's contact forces on the
+/// panel, N m: `[bore, faces]`, about the horizontal axis the weight's moment turns when the
+/// panel's centre of mass is at `com` (square to it: the axis turns with the swing).
+fn moments(joint: &ClearanceJoint, com: Vector) -> [f64; 2] {
+    let across = Vector::new(-com.z, 0.0, com.x).normalize();
+    let mut m = [0.0; 2];
+    for p in joint.spatial_points() {
+        let normal = -p.normal_force * p.contact.gradient.normalize();
+        let speed = p.slip.length();
+        let friction = if speed > 0.0 {
+            -p.friction_force / speed * p.slip
+        } else {
+            Vector::ZERO
+        };
+        let k = usize::from(matches!(p.region, Region::Face(_)));
+        m[k] += p.contact.point.cross(normal + friction).dot(across);
+    }
+    m
 }
 
 fn panel_world(spatial: bool) -> Result<(ClearanceWorld, RigidBodyHandle, ClearanceJointHandle)> {
@@ -121,6 +142,7 @@ pub fn run_twin(spatial: bool) -> Result<Outcome> {
     let mut o = Outcome::default();
     let mut was_on_face = false;
     let (mut late_sum, mut late_face, mut late_time) = ([0.0; 2], 0.0, 0.0);
+    let mut late_moments = [0.0; 2];
     while world.time() < END {
         let t0 = world.time();
         world.step(END)?;
@@ -133,6 +155,9 @@ pub fn run_twin(spatial: bool) -> Result<Outcome> {
             if world.time() > END - 0.2 {
                 late_sum = [0, 1].map(|e| late_sum[e] + s.edge_force[e] * dt);
                 late_face += (s.face_force[0] + s.face_force[1]) * dt;
+                let com = world.rapier.bodies[panel].center_of_mass();
+                let m = moments(world.clearance.get(hinge).expect("inserted"), com);
+                late_moments = [0, 1].map(|k| late_moments[k] + m[k] * dt);
                 late_time += dt;
             }
             let on_face = s.face_force[0] + s.face_force[1] > 0.0;
@@ -152,6 +177,7 @@ pub fn run_twin(spatial: bool) -> Result<Outcome> {
     if late_time > 0.0 {
         o.late_edge_force = late_sum.map(|f| f / late_time);
         o.late_face_force = late_face / late_time;
+        o.late_moments = late_moments.map(|m| m / late_time);
     }
     o.steps = world.steps();
     o.clean = world.guards().is_clean();
@@ -189,9 +215,9 @@ pub fn report(runs: &(Outcome, Outcome)) -> Result<String> {
             if o.clean { "clean" } else { "flagged" }
         );
     }
-    let [edges, face] = holding_moments(&runs.1)?;
+    let [edges, face] = holding_moments(&runs.1);
     s += &format!(
-        "spatial, last 0.2 s: edge couple F L = {edges:.3} N m + face W r_f = {face:.3} N m \
+        "spatial, last 0.2 s: bore {edges:.3} N m + face {face:.3} N m \
          (W = {:.2} N) = {:.3} N m against m g x = {moment:.3} N m ({:+.2} %)\n",
         runs.1.late_face_force,
         edges + face,

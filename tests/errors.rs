@@ -187,7 +187,7 @@ fn invalid_clearance_parameters_name_the_api_parameter() {
 /// naming the API's field.
 #[test]
 fn invalid_spatial_values_name_the_spatial_field() {
-    use clearance_joint::model::spatial::{FaceLaw, MAX_SLICES, SpatialModel};
+    use clearance_joint::model::spatial::{FaceLaw, SpatialModel};
     let joint = |model: SpatialModel| {
         steel()
             .model(ClearanceModel::Spatial(model))
@@ -196,7 +196,6 @@ fn invalid_spatial_values_name_the_spatial_field() {
     };
     let good = SpatialModel::steel(0.3e-3, 0.015);
     let cases = [
-        (joint(good.slices(0)), "spatial.slices"),
         (
             joint(SpatialModel::steel(0.3e-3, 0.009)),
             "spatial.collar_radius",
@@ -212,7 +211,6 @@ fn invalid_spatial_values_name_the_spatial_field() {
             })),
             "spatial.face.restitution",
         ),
-        (joint(good.slices(MAX_SLICES + 1)), "spatial.slices"),
         // The journal radius is 10 mm - 0.2 mm: a collar of that radius is no ring.
         (
             joint(SpatialModel::steel(0.3e-3, 0.0098)),

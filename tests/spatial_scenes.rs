@@ -4,7 +4,7 @@
 //! Runs optimised (`[profile.test] opt-level = 3`).
 
 use clearance_joint::model::laws::{Material, effective_modulus};
-use clearance_joint::model::spatial::{DEFAULT_SLICES, FaceLaw, SpatialModel};
+use clearance_joint::model::spatial::{FaceLaw, SpatialModel};
 use clearance_joint::rapier::convert::ClearanceModel;
 use clearance_joint::rapier::metrics::SpatialMetrics;
 use clearance_joint::scene::Scene;
@@ -54,15 +54,13 @@ fn rel(a: f64, b: f64) -> f64 {
     (a - b).abs() / a.abs().max(b.abs()).max(1e-300)
 }
 
-/// Issue 19, item 2: the spatial joint's aligned limit is the planar joint. On the paper's
-/// scene (5 s) the two runs take the same steps to one (20,570 and 20,571: the stations carry
-/// their rates to the state with their summed forces, which round differently from the planar
-/// joint's one force, and a step in contact follows the contact's energy) and count the same
-/// impacts, the first at the same instant to the bit. The rest is that rounding, grown over the
-/// rattle's 281 impacts and read at states a rounding apart (measured): the peaks agree to 1.9e-6,
-/// the deepest penetration to 4.9e-5, the final angles to 4.6e-8, the RMS force and restitution to
-/// 5.4e-5, the steps in contact to 2 of 12,910. (With the contact step at one tolerance of a period
-/// the peaks agreed to the last bit.)
+/// The spatial joint's aligned limit is the planar joint. On the paper's scene (5 s) the two
+/// runs take the same steps to one (20,570 and 20,571: the two edge regions carry their rates
+/// to the state together, which rounds differently from the planar joint's one force, and a step
+/// in contact follows the contact's energy) and count the same impacts, the first at the same
+/// instant to rounding. The rest is that rounding, grown over the rattle's 281 impacts and read
+/// at states a rounding apart (measured): the first peak agrees to 1.8e-6, the final angles to
+/// 1.1e-7, the steps in contact to 2 of 12,910.
 #[test]
 fn spatial_joint_aligned_is_the_planar_joint_on_the_paper_scene() {
     let planar = Scene::solar_panel();
@@ -73,6 +71,7 @@ fn spatial_joint_aligned_is_the_planar_joint_on_the_paper_scene() {
     );
     assert!(p.is_complete() && s.is_complete());
     assert!(p.guards.is_clean() && s.guards.is_clean(), "{:?}", s.guards);
+    println!("steps {} vs {}", p.steps, s.steps);
     assert!(
         p.steps.abs_diff(s.steps) <= 2,
         "step count {} vs {}",
@@ -88,7 +87,8 @@ fn spatial_joint_aligned_is_the_planar_joint_on_the_paper_scene() {
         "the paper's scene rattles: {}",
         hp.impacts
     );
-    assert_eq!(hp.first_impact_t_s, hs.first_impact_t_s, "first impact");
+    let (tp, ts) = (hp.first_impact_t_s.unwrap(), hs.first_impact_t_s.unwrap());
+    assert!(rel(tp, ts) < 1e-12, "first impact at {tp} vs {ts} s");
     for (name, a, b, bound) in [
         ("peak force", hp.peak_force_n, hs.peak_force_n, 1e-5),
         (
@@ -106,14 +106,17 @@ fn spatial_joint_aligned_is_the_planar_joint_on_the_paper_scene() {
         ("RMS force", hp.rms_force_n, hs.rms_force_n, 2e-4),
         ("restitution", hp.max_restitution, hs.max_restitution, 2e-4),
     ] {
+        println!("{name}: {a} vs {b}, {:.2e}", rel(a, b));
         assert!(rel(a, b) < bound, "{name}: {a} vs {b}");
     }
     for (body, a) in &p.final_angles_deg {
         let b = s.final_angles_deg[body];
+        println!("final angle of {body}: {a} vs {b}, {:.2e}", rel(*a, b));
         assert!(rel(*a, b) < 2e-7, "final angle of {body}: {a} vs {b}");
     }
+    println!("contact steps {} vs {}", hp.contact_steps, hs.contact_steps);
     assert!(hp.contact_steps.abs_diff(hs.contact_steps) <= 10);
-    // Nothing tilted, nothing slid, no face touched; the edges carried their share.
+    // Nothing tilted, nothing slid, no face touched; each end's region carried half the bore.
     let m = spatial(&s);
     assert!(
         m.max_tilt_deg < 1e-12 && m.max_axial_offset_mm < 1e-12,
@@ -121,12 +124,7 @@ fn spatial_joint_aligned_is_the_planar_joint_on_the_paper_scene() {
     );
     assert_eq!(m.face_contacts, [0, 0]);
     assert_eq!(m.edge_loaded_fraction, 0.0);
-    assert!(
-        rel(
-            m.peak_edge_force_n[0],
-            hp.peak_force_n / (2.0 * DEFAULT_SLICES as f64)
-        ) < 0.01
-    );
+    assert!(rel(m.peak_edge_force_n[0], hp.peak_force_n / 2.0) < 0.01);
     assert!(
         p.hinges["hinge"].spatial.is_none(),
         "a planar hinge has none"
@@ -210,12 +208,11 @@ fn door_model(scene: &Scene) -> SpatialModel {
 #[test]
 fn spatial_model_reads_in_full_and_with_defaults() {
     let full = door_with(
-        "model: Spatial((geometry: (axial_play: 0.3e-3, collar_radius: 0.010, slices: 12), \
+        "model: Spatial((geometry: (axial_play: 0.3e-3, collar_radius: 0.010), \
          face: (stiffness: 1e9, restitution: 0.8))),",
     )
     .unwrap();
     let m = door_model(&full);
-    assert_eq!(m.geometry.slices, 12);
     assert_eq!(
         m.face,
         FaceLaw {
@@ -224,7 +221,7 @@ fn spatial_model_reads_in_full_and_with_defaults() {
         }
     );
     assert_eq!(m.geometry.axial_play, 0.3e-3);
-    // Left out: DEFAULT_SLICES and a flat steel punch of the collar's radius, restitution 0.9.
+    // Left out: a flat steel punch of the collar's radius, restitution 0.9.
     let m = door_model(&asset("door_hinge.ron"));
     let steel = effective_modulus(&Material::STEEL, &Material::STEEL);
     assert_eq!(m, SpatialModel::steel(0.3e-3, 0.010));
@@ -262,11 +259,6 @@ fn spatial_model_errors_name_the_field_and_the_reason() {
             "model: Spatial((geometry: (axial_play: 0.3e-3, collar_radius: 10.0))),",
             format!("{p}.geometry.collar_radius"),
             "metres",
-        ),
-        (
-            "model: Spatial((geometry: (axial_play: 0.3e-3, collar_radius: 0.010, slices: 0))),",
-            format!("{p}.geometry.slices"),
-            "1 to",
         ),
         (
             "model: Spatial((geometry: (axial_play: 0.3e-3, collar_radius: 0.010), \
@@ -325,12 +317,9 @@ fn spatial_model_errors_name_the_field_and_the_reason() {
 #[test]
 fn spatial_settings_take_overrides() {
     let door = asset("door_hinge.ron");
-    let o = door
-        .with_overrides(&["hinge.axial_play=0.5e-3", "hinge.slices=4"])
-        .unwrap();
+    let o = door.with_overrides(&["hinge.axial_play=0.5e-3"]).unwrap();
     let m = door_model(&o);
     assert_eq!(m.geometry.axial_play, 0.5e-3);
-    assert_eq!(m.geometry.slices, 4);
     assert_eq!(
         door.override_field("hinge.collar_radius").unwrap(),
         "hinges[hinge].clearance.model.Spatial.geometry.collar_radius"

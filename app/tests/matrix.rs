@@ -31,6 +31,7 @@ fn shortened() -> Vec<(Case, f64, f64)> {
             n if n.starts_with("solar panel") => (0.1, 4e-6),
             "deployable array" => (0.03, 1e-5),
             "double pendulum" => (0.03, 4e-6),
+            n if n.starts_with("cantilever") => (0.03, 1.25e-7),
             other => panic!("no shortened form for {other}"),
         };
         out.push((case, end, dt));

@@ -27,8 +27,8 @@ use rapier3d_f64::prelude::{
     GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, IntegrationParameters, JointAxesMask,
     RigidBody, RigidBodyHandle, RigidBodySet,
 };
+pub use spatial::{Region, SpatialPoint, SpatialReport};
 use spatial::{SpatialMemory, SpatialParts};
-pub use spatial::{SpatialReport, SpatialStation, StationPlace};
 
 /// What holds the degrees of freedom the contact law does not (axial translation and the two tilts).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -184,12 +184,7 @@ impl ClearanceJointBuilder {
                 .validate(&j.geometry)
                 .map_err(|e| e.within("spatial"))?;
             j.lock = OutOfPlaneLock::None;
-            j.spatial = Some(SpatialParts::new(
-                model,
-                face_law,
-                j.local_axis1,
-                j.geometry.length(),
-            ));
+            j.spatial = Some(SpatialParts::new(model, face_law, j.local_axis1));
         }
         Ok(self.joint)
     }

@@ -177,9 +177,9 @@ pub struct SpatialMetrics {
     pub max_tilt_deg: f64,
     /// Largest axial offset of the journal from the bearing's centre (either way), mm.
     pub max_axial_offset_mm: f64,
-    /// Largest force of the bore's inner stations (the width between the edges), N.
+    /// Largest normal force of the whole bore, N.
     pub peak_bore_force_n: f64,
-    /// Largest force at the bore's lower and upper edges, N.
+    /// Largest resultant of the bore's regions at its lower and upper ends, N.
     pub peak_edge_force_n: [f64; 2],
     /// Largest force of the shoulders on the lower and upper faces, N.
     pub peak_face_force_n: [f64; 2],
@@ -187,8 +187,8 @@ pub struct SpatialMetrics {
     pub face_contacts: [u64; 2],
     /// Fraction of the recorded time a face carried load.
     pub face_contact_fraction: f64,
-    /// Fraction of the recorded time an edge carried more than the bore's inner stations
-    /// together: the journal bears on the bearing's ends (tilted, or loaded by a moment).
+    /// Fraction of the recorded time the bore was loaded over part of its width only: the
+    /// journal bears on the bearing's edges (tilted, or loaded by a moment).
     pub edge_loaded_fraction: f64,
 }
 
@@ -333,7 +333,7 @@ impl ImpactRecorder {
         if report.face_force.iter().any(|&f| f > 0.0) {
             self.face_time += dt;
         }
-        if report.edge_force.iter().any(|&f| f > report.bore_force) {
+        if report.bore_force > 0.0 && report.bore_contact_width < 1.0 {
             self.edge_time += dt;
         }
     }

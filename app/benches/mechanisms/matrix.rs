@@ -132,9 +132,34 @@ fn flores(name: &'static str, set: &[&str], omega: f64) -> Case {
     }
 }
 
+/// A shaft cantilevered from one spatial hinge (`assets/cantilever.ron`) with its centre of mass
+/// `offset` (m) out along the axis and the inertia `across` (kg m^2) about both transverse axes
+/// (half that about its own).
+fn cantilever(name: &'static str, offset: f64, across: f64) -> Case {
+    Case {
+        name,
+        file: "cantilever.ron",
+        set: vec![
+            format!("shaft.center_of_mass_m=[0,0,{offset}]"),
+            format!("shaft.inertia_kg_m2=[{across},{across},{}]", 0.5 * across),
+        ],
+        hinge: "hinge",
+        probe: "shaft",
+        end_s: 0.2,
+        quick_end_s: 0.05,
+        window_start_s: 0.1,
+        quick_window_start_s: 0.025,
+        unit: Unit::Second,
+        fixed_dt: [5e-7, 2.5e-7, 1.25e-7],
+        output_interval_s: 1e-4,
+        closed_form: None,
+    }
+}
+
 /// The matrix: the slider-crank (c = 0.5 and 0.1 mm, the bearing on the rod, 2000 rpm), the
 /// four-bar (the improved law, and Flores et al.'s), the paper's solar panel at T, 3T and 5T, the
-/// deployable array and the double pendulum.
+/// deployable array, the double pendulum and four cantilevers on a spatial hinge (offsets 0.05 to
+/// 0.4 m, inertias 2e-4 to 0.2 kg m^2).
 pub fn cases() -> Vec<Case> {
     let panel = |name: &'static str, scale: &str| Case {
         name,
@@ -240,6 +265,10 @@ pub fn cases() -> Vec<Case> {
             output_interval_s: 1e-4,
             closed_form: None,
         },
+        cantilever("cantilever 0.2 m, 2e-3", 0.2, 0.002),
+        cantilever("cantilever 0.05 m, 2e-4", 0.05, 2e-4),
+        cantilever("cantilever 0.1 m, 2e-2", 0.1, 0.02),
+        cantilever("cantilever 0.4 m, 0.2", 0.4, 0.2),
     ]
 }
 

@@ -139,6 +139,21 @@ impl Mechanism {
         held.max(0.0)
     }
 
+    /// What the ideal joints hold between two loads on the pair, `a^T C b` over its 12
+    /// coordinates (`C = g^T (G M^-1 G^T)^-1 g` as [`held_inverse_mass`](Self::held_inverse_mass)
+    /// for one row; `a`, `b` contact rows or sums of them). Zero without rows on the pair.
+    pub(crate) fn held_between(&self, a: &[f64; 12], b: &[f64; 12]) -> f64 {
+        if self.correction.is_empty() {
+            return 0.0;
+        }
+        let mut held = 0.0;
+        for (p, ap) in a.iter().enumerate() {
+            let row = &self.correction[p * 12..p * 12 + 12];
+            held += ap * row.iter().zip(b).map(|(c, bq)| c * bq).sum::<f64>();
+        }
+        held
+    }
+
     /// The pair's inverse mass along `n` at `point` given the free bodies' `free` (kg^-1), less
     /// what the ideal joints hold, floored at [`MIN_MOBILITY`] of the free one.
     pub(crate) fn inverse_mass(&self, free: f64, point: Vector, n: Vector) -> f64 {

@@ -7,7 +7,7 @@ use crate::model::laws::{
     FrictionModel, GonthierEtAl, Hertz, HuntCrossley, ImprovedLiu, KelvinVoigt, LankaraniNikravesh,
     LiuEtAl, Material, MaxDamping, NormalModel, Threlfall, effective_modulus,
 };
-use crate::model::spatial::{DEFAULT_SLICES, FaceLaw, SpatialGeometry, SpatialModel};
+use crate::model::spatial::{FaceLaw, SpatialGeometry, SpatialModel};
 use crate::rapier::convert::{Clearance, ClearanceModel};
 use crate::rapier::joint::OutOfPlaneLock;
 use serde::{Deserialize, Serialize};
@@ -82,7 +82,7 @@ pub enum ModelSpec {
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SpatialSpec {
-    /// Axial play, shoulders and slices.
+    /// Axial play and shoulders.
     pub geometry: SpatialGeometrySpec,
     /// The shoulders' law against the bearing's faces; default (left out): a flat punch of the
     /// collar's radius on the hinge's materials ([`FaceLaw::flat_punch`], restitution
@@ -105,9 +105,6 @@ pub struct SpatialGeometrySpec {
     /// Outer radius of the journal's shoulders (collars), m (above the journal radius, at most
     /// ten bearing radii).
     pub collar_radius: f64,
-    /// Slices across the bearing's width (1 to [`MAX_SLICES`](crate::model::spatial::MAX_SLICES); default [`DEFAULT_SLICES`]).
-    #[serde(default = "default_slices")]
-    pub slices: u32,
 }
 
 /// The face law ([`FaceLaw`]): a linear spring with Flores et al.'s hysteresis damping.
@@ -118,10 +115,6 @@ pub struct FaceSpec {
     pub stiffness: f64,
     /// Coefficient of restitution of a face knock, in (0, 1].
     pub restitution: f64,
-}
-
-fn default_slices() -> u32 {
-    DEFAULT_SLICES
 }
 
 /// An optional field written as its value (`face: (..)`, not `face: Some((..))`).
@@ -145,7 +138,6 @@ impl SpatialSpec {
         let geometry = SpatialGeometry {
             axial_play: g.axial_play,
             collar_radius: g.collar_radius,
-            slices: g.slices,
         };
         geometry.validate(radial).map_err_within("model.geometry")?;
         // Metres, not the spec's millimetres: a value in mm is caught by these bounds.

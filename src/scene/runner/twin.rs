@@ -10,7 +10,6 @@ use crate::model::laws::NormalForceLaw;
 use crate::rapier::drive::DriveHandle;
 use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle, SpatialReport};
 use crate::rapier::large_step::{LargeStepJoint, LargeStepJointHandle};
-use crate::rapier::ledger::Wrench;
 use crate::rapier::metrics::{ContactObservation, ImpactRecorder};
 use crate::rapier::reaction::{IdealJoint, ReactionSolver};
 use crate::rapier::replay::ReplayRecorder;
@@ -100,8 +99,6 @@ pub(super) struct HingeTrack {
 #[derive(Clone, Copy, Debug)]
 struct SpatialSample {
     report: SpatialReport,
-    wrenches: Option<[Wrench; 2]>,
-    elastic_energy: f64,
 }
 
 impl HingeTrack {
@@ -178,8 +175,9 @@ fn large_step_sample(j: &LargeStepJoint) -> ContactSample {
 }
 
 /// The columns a spatial hinge adds to its rows (after `contact`): the journal's tilt about the
-/// `ecc_u`/`ecc_v` axes, its axial offset, and the normal force of each contact kind.
-pub(super) const SPATIAL_COLUMNS: [&str; 8] = [
+/// `ecc_u`/`ecc_v` axes, its axial offset, the normal force of each contact kind, and where each
+/// edge region's resultant acts along the axis.
+pub(super) const SPATIAL_COLUMNS: [&str; 10] = [
     "tilt_u_deg",
     "tilt_v_deg",
     "axial_mm",
@@ -188,38 +186,9 @@ pub(super) const SPATIAL_COLUMNS: [&str; 8] = [
     "edge_upper_force_n",
     "face_lower_force_n",
     "face_upper_force_n",
+    "edge_lower_at_mm",
+    "edge_upper_at_mm",
 ];
-
-/// The work a spatial joint's damping and friction dissipated over a step, J: minus the work
-/// of its wrenches over the bodies' motion in the step (force times the centre of mass's
-/// displacement, torque times the rotation vector, the wrenches averaged over the step's two
-/// ends: exact for the elastic part of a linear law, whose work is then minus the change of
-/// its elastic energy) minus the change of its elastic energy. The planar joint's damping and
-/// friction work is taken from its one contact; a spatial joint's stations are summed this way.
-fn spatial_dissipation(
-    before: &SpatialSample,
-    after: &ClearanceJoint,
-    bodies: [&BodyTrack; 2],
-    set: &RigidBodySet,
-) -> f64 {
-    let (Some(w0), Some(w1)) = (before.wrenches, after.last_wrenches()) else {
-        return 0.0;
-    };
-    let work: f64 = (0..2)
-        .filter(|&k| !bodies[k].fixed)
-        .map(|k| {
-            let (b, rb) = (bodies[k], &set[bodies[k].handle]);
-            let moved = crate::rapier::ledger::world_center_of_mass(rb) - b.com_before;
-            let turned = (*rb.rotation() * b.rotation_before.inverse()).to_scaled_axis();
-            let (force, torque) = (
-                0.5 * (w0[k].force + w1[k].force),
-                0.5 * (w0[k].torque + w1[k].torque),
-            );
-            force.dot(moved) + torque.dot(turned)
-        })
-        .sum();
-    -work - (after.elastic_energy() - before.elastic_energy)
-}
 
 /// What a clearance hinge's hook saw at one state (read before the step it drives).
 #[derive(Clone, Copy, Debug, Default)]
@@ -306,11 +275,7 @@ impl Twin {
                     let j = world.clearance.get(c).expect("handle of this twin");
                     h.force = j.report().force.on_journal.length();
                     h.sample = compliant_sample(j);
-                    h.spatial_sample = j.report().spatial.map(|report| SpatialSample {
-                        report,
-                        wrenches: j.last_wrenches(),
-                        elastic_energy: j.elastic_energy(),
-                    });
+                    h.spatial_sample = j.report().spatial.map(|report| SpatialSample { report });
                 }
                 HingeJoint::LargeStep(k) => {
                     let j = world.large_step.get(k).expect("handle of this twin");
@@ -373,12 +338,9 @@ impl Twin {
             if let HingeJoint::Clearance(c) = h.joint {
                 let j = world.clearance.get(c).expect("handle of this twin");
                 if let Some(s) = &h.spatial_sample {
-                    self.invariants.dissipated_j += spatial_dissipation(
-                        s,
-                        j,
-                        [&self.bodies[h.bearing], &self.bodies[h.journal]],
-                        bodies,
-                    );
+                    // The power of every contact point's damping and friction at the state
+                    // before the step, as the planar joint's force at that state.
+                    self.invariants.dissipated_j += s.report.dissipation_power * info.dt;
                     continue;
                 }
                 let r = j.report();
@@ -554,6 +516,12 @@ impl Twin {
                             s.face_force[0],
                             s.face_force[1],
                         ]);
+                        // Where each edge region's resultant acts, from the bearing's centre
+                        // along the axis (0 while it carries nothing).
+                        v.extend(
+                            s.edge_point
+                                .map(|at| (at - p.bearing_center).dot(p.bearing_axis) * 1e3),
+                        );
                     }
                 }
                 HingeJoint::LargeStep(k) => {

@@ -455,9 +455,10 @@ impl Stepper {
         if adaptive {
             // Divide what is left into equal steps no larger than dt: no sliver step before the
             // target (a 1e-8 s step after a 1e-4 s one would break the growth bound). An
-            // infinite `until` is no target.
+            // infinite `until` is no target. A count within 1e-9 of a whole number is that
+            // number: rounding in dt must not add a step (200 steps of 5e-6 s to 1 ms, not 201).
             if left.is_finite() {
-                dt = left / (left / dt).ceil();
+                dt = left / (left / dt - 1e-9).ceil().max(1.0);
             }
         } else {
             // The last step lands on `until`: a full step when `left` is one step up to rounding

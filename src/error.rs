@@ -423,9 +423,8 @@ pub fn sig4(x: f64) -> String {
     }
 }
 
-/// The smallest step a run takes, s: the adaptive steps' default floor (`min_dt` of
-/// [`StepControl`](crate::rapier::stepper::StepControl)).
-const SMALLEST_STEP: f64 = 1e-10;
+/// The smallest step a run takes, s: the adaptive steps' default floor.
+const SMALLEST_STEP: f64 = crate::rapier::stepper::StepControl::SMALLEST_STEP;
 
 /// What to do about a step beyond a contact's stability limit, fitting the step mode, in the
 /// caller's names (`names`) or the plain API's.

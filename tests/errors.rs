@@ -221,6 +221,20 @@ fn invalid_spatial_values_name_the_spatial_field() {
             "spatial.collar_radius",
         ),
         (joint(SpatialModel::steel(0.0, 0.015)), "spatial.axial_play"),
+        // The given field, not the face stiffness a huge collar makes.
+        (
+            joint(SpatialModel::steel(1e-4, 1e300)),
+            "spatial.collar_radius",
+        ),
+        // A play lost in the rounding of the journal's position, one wider than the bearing.
+        (
+            joint(SpatialModel::steel(1e-300, 0.015)),
+            "spatial.axial_play",
+        ),
+        (
+            joint(SpatialModel::steel(0.017, 0.015)),
+            "spatial.axial_play",
+        ),
         (
             joint(SpatialModel::steel(f64::NAN, 0.015)),
             "spatial.axial_play",
@@ -269,6 +283,31 @@ fn invalid_spatial_values_name_the_spatial_field() {
         );
         assert_plain(&m);
     }
+}
+
+/// A restitution set on the compliant or spatial model, which take theirs from the normal law, is
+/// refused naming `restitution` (unchecked, `joint()` ignored it); the large-step model takes it.
+#[test]
+fn a_restitution_the_model_ignores_is_refused() {
+    use clearance_joint::model::spatial::SpatialModel;
+    let spatial = ClearanceModel::Spatial(SpatialModel::steel(0.3e-3, 0.015));
+    for model in [ClearanceModel::Compliant, spatial] {
+        let e = steel()
+            .model(model)
+            .restitution(0.5)
+            .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
+            .unwrap_err();
+        let m = e.to_string();
+        assert!(
+            matches!(&e, Error::Invalid { field, .. } if field == "restitution"),
+            "{m}"
+        );
+        assert!(m.contains("LargeStep"), "{m}");
+        assert_plain(&m);
+    }
+    let large = steel().model(ClearanceModel::LargeStep).restitution(0.5);
+    let j = large.large_step_joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z);
+    assert!(j.is_ok());
 }
 
 #[test]
@@ -378,4 +417,150 @@ fn the_scene_layer_names_the_scene_fields() {
         assert!(m.contains(part), "{part:?} not in {m}");
     }
     assert!(!m.contains("--"), "{m}");
+}
+
+/// A face law whose restitution is tiny stalls at the door's first face knock: its hysteresis
+/// damping, growing with the penetration, stiffens the contact 10^6 times past its spring. The
+/// stall names the face and its restitution, not the stiffness (unchecked, it read "too stiff
+/// ... check the law's stiffness").
+#[test]
+fn a_face_restitution_that_stalls_is_named() {
+    for restitution in ["1e-6", "1e-300"] {
+        let face = format!(
+            r#"hinge.model={{"Spatial":{{"geometry":{{"axial_play":3e-4,"collar_radius":0.010}},"face":{{"stiffness":3e9,"restitution":{restitution}}}}}}}"#
+        );
+        let scene = Scene::load(std::path::Path::new("assets/door_hinge.ron"))
+            .unwrap()
+            .with_overrides(&["run.end_s=0.02", face.as_str()])
+            .unwrap();
+        let e = Simulation::new(&scene, RunOptions::default())
+            .unwrap()
+            .run()
+            .unwrap_err();
+        let m = e.to_string();
+        assert!(matches!(e, Error::Stalled { .. }), "{m}");
+        for part in [
+            "a shoulder on a bearing face",
+            "lower the face law's damping",
+            "`spatial.face.restitution`",
+        ] {
+            assert!(m.contains(part), "{restitution}: {part:?} not in {m}");
+        }
+        assert!(!m.contains("stiffness"), "{m}");
+    }
+}
+
+/// Steps, tolerances and drive torques the solver cannot take are refused naming the plain API's
+/// field, before anything moves; a body whose state is not finite before a step is refused
+/// naming the state (unchecked, each left the physical range as "speed 0 m/s").
+#[test]
+fn steps_torques_and_states_the_solver_cannot_take_are_named() {
+    let (mut world, mut set) = pendulum(steel(), 1);
+    for (control, field) in [
+        (StepControl::fixed(1e-300), "dt"),
+        (StepControl::adaptive(1e-300, 0.0075), "max_dt"),
+        (StepControl::adaptive(1e-3, 1e-300), "tolerance"),
+    ] {
+        let e = Stepper::new(control)
+            .step(&mut world, &mut [&mut set], 0.1)
+            .unwrap_err();
+        let m = e.to_string();
+        assert!(
+            matches!(&e, Error::Invalid { field: f, .. } if f == field),
+            "{field}: {m}"
+        );
+        assert_plain(&m);
+    }
+    let arm = RigidBodyHandle::from_raw_parts(1, 0);
+    let spring = |t0: f64, k: f64| {
+        TorsionSpring::new(RigidBodyHandle::from_raw_parts(0, 0), arm, Vector::Z, t0, k)
+    };
+    for (e, field) in [
+        (spring(1e300, 0.0), "torque0"),
+        (spring(0.1, 1e300), "stiffness"),
+    ] {
+        let e = e.unwrap_err();
+        assert!(
+            matches!(&e, Error::Invalid { field: f, .. } if f == field),
+            "{e}"
+        );
+    }
+    for (field, set_bad) in [
+        (
+            "linvel",
+            (|rb: &mut RigidBody| rb.set_linvel(Vector::new(f64::NAN, 0.0, 0.0), true))
+                as fn(&mut RigidBody),
+        ),
+        ("angvel", |rb| {
+            rb.set_angvel(Vector::new(0.0, 0.0, f64::INFINITY), true)
+        }),
+        ("position", |rb| {
+            rb.set_translation(Vector::new(f64::NAN, 0.0, 0.0), true)
+        }),
+    ] {
+        let (mut world, mut set) = pendulum(steel(), 1);
+        set_bad(&mut world.bodies[arm]);
+        let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.0075));
+        let e = stepper.step(&mut world, &mut [&mut set], 0.1).unwrap_err();
+        let m = e.to_string();
+        assert!(
+            matches!(&e, Error::Invalid { field: f, .. } if f == field) && m.contains("non-finite"),
+            "{field}: {m}"
+        );
+        assert_eq!(stepper.time(), 0.0);
+    }
+}
+
+/// `model: Spatial` without its settings, in a scene file or an override, says how the spatial
+/// model is written (unchecked: "invalid type: unit variant, expected newtype variant").
+#[test]
+fn a_spatial_model_without_its_settings_says_how_it_is_written() {
+    let text = std::fs::read_to_string("assets/solar_panel_spatial.ron").unwrap();
+    let start = text.find("model: Spatial(").unwrap();
+    let end = start + text[start..].find("\n").unwrap();
+    let bare = format!("{}model: Spatial,{}", &text[..start], &text[end..]);
+    let e = Scene::from_ron(&bare, "bare.ron").unwrap_err().to_string();
+    assert!(
+        e.contains("`Spatial` is written Spatial((geometry: (axial_play"),
+        "{e}"
+    );
+    let e = Scene::solar_panel()
+        .with_overrides(&["hinge.model=Spatial"])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("`Spatial` is written Spatial((geometry:") && e.contains("as JSON"),
+        "{e}"
+    );
+}
+
+/// A stall that the turn bound causes (a body spinning so fast that `tolerance/8` rad a step needs
+/// steps at the floor) says so and names `tolerance`, not "a body moved by hand".
+#[test]
+fn a_stall_of_the_turn_bound_names_the_tolerance() {
+    let mut world = PhysicsWorld::new();
+    world.bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .angvel(Vector::new(0.0, 0.0, 2e4))
+            .additional_mass_properties(MassProperties::new(
+                Vector::ZERO,
+                1.0,
+                Vector::splat(0.01),
+            )),
+    );
+    let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 1e-6));
+    let e = loop {
+        match stepper.step(&mut world, &mut [], 1.0) {
+            Ok(_) => assert!(stepper.steps() < 1_000_000, "no stall"),
+            Err(e) => break e,
+        }
+    };
+    let m = e.to_string();
+    assert!(matches!(e, Error::Stalled { .. }), "{m}");
+    assert!(
+        m.contains("the turn bound") && m.contains("raise `tolerance`"),
+        "{m}"
+    );
+    assert!(!m.contains("moved by hand"), "{m}");
+    assert_plain(&m);
 }

@@ -190,7 +190,8 @@ pub struct Clearance {
     pub model: ClearanceModel,
     /// Coefficient of restitution of the large-step model's impacts; `None` (the default): the
     /// normal law's own restitution at each impact ([`crate::rapier::large_step::Restitution::Law`]).
-    /// The compliant and spatial models take their restitution from their laws and ignore this.
+    /// The compliant and spatial models take their restitution from their laws:
+    /// [`joint`](Self::joint) refuses a set one, naming `restitution`.
     pub restitution: Option<f64>,
 }
 
@@ -307,7 +308,8 @@ impl Clearance {
         self
     }
 
-    /// Sets the large-step model's coefficient of restitution (in [0, 1]).
+    /// Sets the large-step model's coefficient of restitution (in [0, 1]). The compliant and
+    /// spatial models take theirs from the normal law: [`joint`](Self::joint) refuses a set one.
     pub fn restitution(mut self, coefficient: f64) -> Self {
         self.restitution = Some(coefficient);
         self
@@ -328,6 +330,18 @@ impl Clearance {
                 "is LargeStep, but a compliant clearance joint was asked for: insert it into a \
                  LargeStepJointSet (or use `Clearance::large_step_joint`), or choose \
                  ClearanceModel::Compliant",
+            ));
+        }
+        if let Some(e) = self.restitution {
+            return Err(Error::invalid(
+                "restitution",
+                format!(
+                    "is set ({}), but the compliant and spatial models take their restitution from \
+                     the normal law (its damping): leave `restitution` unset, choose a law with the \
+                     restitution you want (e.g. a hysteresis law's `restitution`), or choose \
+                     ClearanceModel::LargeStep, which uses it",
+                    crate::error::sig4(e)
+                ),
             ));
         }
         let mut b = ClearanceJointBuilder::new(local_axis1, self.geometry, self.normal)

@@ -1,6 +1,6 @@
 //! Torsion-spring drive between two bodies (MODEL.md §4, eq. 20): `T = T0 - k theta`.
 
-use crate::error::{Result, finite, non_negative, unit_vector};
+use crate::error::{Result, in_range, unit_vector};
 use crate::model::angle::HingeAngle;
 use crate::rapier::arena::OrderedArena;
 use crate::rapier::ledger::{ForceLedger, Wrench};
@@ -24,7 +24,16 @@ pub struct TorsionSpring {
 }
 
 impl TorsionSpring {
-    /// Preload `torque0` (N m) and stiffness (N m/rad), about `local_axis1` (body 1's frame).
+    /// The largest preload, N m: a torque beyond it drives any body of a mechanism past the
+    /// speed guard within a step (1e300 N m left the physical range with nothing said).
+    pub const MAX_TORQUE: f64 = 1e9;
+
+    /// The largest stiffness, N m/rad.
+    pub const MAX_STIFFNESS: f64 = 1e12;
+
+    /// Preload `torque0` (N m, at most [`MAX_TORQUE`](Self::MAX_TORQUE) either way) and
+    /// `stiffness` (N m/rad, from 0 to [`MAX_STIFFNESS`](Self::MAX_STIFFNESS)), about
+    /// `local_axis1` (body 1's frame); errors name `torque0`, `stiffness` or `axis`.
     pub fn new(
         body1: RigidBodyHandle,
         body2: RigidBodyHandle,
@@ -32,8 +41,14 @@ impl TorsionSpring {
         torque0: f64,
         stiffness: f64,
     ) -> Result<Self> {
-        finite("torque0_nm", torque0)?;
-        non_negative("stiffness_nm_per_deg", stiffness)?;
+        in_range(
+            "torque0",
+            torque0,
+            -Self::MAX_TORQUE,
+            Self::MAX_TORQUE,
+            "N m",
+        )?;
+        in_range("stiffness", stiffness, 0.0, Self::MAX_STIFFNESS, "N m/rad")?;
         Ok(TorsionSpring {
             body1,
             body2,

@@ -11,7 +11,19 @@
 use crate::error::{Error, Result};
 use crate::rapier::step_hooks::StepHooks;
 use rapier3d_f64::math::{Pose, Rotation, Vector};
-use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle};
+use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle, RigidBodySet, RigidBodyType};
+
+/// `v` normalised; an error naming `field` when it has no direction (zero or not finite).
+fn unit(field: &str, v: Vector) -> Result<Vector> {
+    let n = v.length();
+    if !(n.is_finite() && n > 0.0) {
+        return Err(Error::invalid(
+            field,
+            format!("must be a non-zero, finite vector (got {v:?}): give the axis's direction"),
+        ));
+    }
+    Ok(v / n)
+}
 
 /// A value against time, interpolated by cubic Hermite segments with slopes from the neighbours
 /// (`(v[i+1] - v[i-1]) / (t[i+1] - t[i-1])`, one-sided at the ends): the value and its rate are
@@ -173,6 +185,76 @@ pub struct PrescribedMotion {
 }
 
 impl PrescribedMotion {
+    /// `body` turned by `table`'s angle (rad) about `axis` (world, normalised here) through its
+    /// frame origin, from `start`; refuses a zero or non-finite axis, naming `axis`.
+    pub fn angle(body: RigidBodyHandle, start: Pose, axis: Vector, table: Table) -> Result<Self> {
+        let axis = unit("axis", axis)?;
+        let path = PrescribedPath::Angle { axis };
+        Ok(PrescribedMotion {
+            body,
+            start,
+            path,
+            table,
+        })
+    }
+
+    /// `body` moved by `table`'s position (m) along `direction` (world, normalised here) from
+    /// `start`; refuses a zero or non-finite direction, naming `direction`.
+    pub fn position(
+        body: RigidBodyHandle,
+        start: Pose,
+        direction: Vector,
+        table: Table,
+    ) -> Result<Self> {
+        let direction = unit("direction", direction)?;
+        let path = PrescribedPath::Position { direction };
+        Ok(PrescribedMotion {
+            body,
+            start,
+            path,
+            table,
+        })
+    }
+
+    /// Whether this motion can be honoured in `bodies`: its body is there and kinematic
+    /// position-based (Rapier moves no other kind to a pose), its axis or direction a unit vector
+    /// (else the pose's rotation is not one). Errors name `motions[index]` and the field.
+    pub fn check(&self, index: usize, bodies: &RigidBodySet) -> Result<()> {
+        let at = |field: &str| format!("motions[{index}].{field}");
+        let Some(rb) = bodies.get(self.body) else {
+            return Err(Error::invalid(
+                at("body"),
+                "is not in the world's bodies (removed, invalid or of another world): prescribe \
+                 the motion of a body of this world",
+            ));
+        };
+        if rb.body_type() != RigidBodyType::KinematicPositionBased {
+            return Err(Error::invalid(
+                at("body"),
+                format!(
+                    "is a {:?} body, which Rapier does not move to a prescribed pose: build it \
+                     with `RigidBodyBuilder::kinematic_position_based()`",
+                    rb.body_type()
+                ),
+            ));
+        }
+        let (field, v) = match self.path {
+            PrescribedPath::Angle { axis } => ("path.axis", axis),
+            PrescribedPath::Position { direction } => ("path.direction", direction),
+        };
+        if !v.is_finite() || (v.length() - 1.0).abs() > 1e-9 {
+            return Err(Error::invalid(
+                at(field),
+                format!(
+                    "must be a unit vector (got length {}): give a unit vector, or build the \
+                     motion with `PrescribedMotion::angle` or `::position`, which normalise it",
+                    crate::error::sig4(v.length())
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// The body's pose at `t`.
     pub fn pose(&self, t: f64) -> Pose {
         let (x, _, _) = self.table.eval(t);
@@ -213,6 +295,13 @@ pub struct PrescribedSet {
 /// The tabulated motions take part in the stepper's steps: each Rapier step (a retried one
 /// included) gets the bodies' poses at its end time ([`crate::rapier::step_hooks`]).
 impl StepHooks for PrescribedSet {
+    fn check_bodies(&self, bodies: &RigidBodySet) -> Result<()> {
+        for (i, m) in self.motions.iter().enumerate() {
+            m.check(i, bodies)?;
+        }
+        Ok(())
+    }
+
     fn before_rapier_step(&mut self, world: &mut PhysicsWorld, t0: f64, dt: f64) {
         for m in &self.motions {
             if let Some(rb) = world.bodies.get_mut(m.body) {

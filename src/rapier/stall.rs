@@ -50,8 +50,15 @@ pub struct StalledContact {
     pub min_impact_speed: f64,
     /// Linearised damping ratio.
     pub zeta: f64,
-    /// Linearised natural frequency, rad/s.
+    /// Linearised natural frequency, rad/s: from `dF/d delta`, the spring's tangent stiffness
+    /// plus the slope of a hysteresis law's damping times the rate.
     pub omega: f64,
+    /// The spring's own tangent stiffness at the penetration, N/m (the law without its
+    /// damping): against `omega^2 m` it tells a stiff spring from a steep damping.
+    pub elastic_stiffness: f64,
+    /// Whether the contact is a shoulder on a bearing face (the spatial joint's face law), not
+    /// the journal on the bore.
+    pub face: bool,
     /// Damped stability limit of the step, s.
     pub stable_dt: f64,
     /// Friction's step limit, s.
@@ -137,6 +144,8 @@ impl StalledContact {
             min_impact_speed: joint.min_impact_speed_floor(),
             zeta: r.zeta,
             omega: r.omega,
+            elastic_stiffness: law.tangent_stiffness(s.penetration),
+            face: r.spatial.is_some_and(|sp| sp.governed_by_face),
             stable_dt: r.max_stable_dt,
             friction_dt: r.friction_stable_dt,
             normal_force: r.force.normal_force,
@@ -150,8 +159,13 @@ impl StalledContact {
 
     /// The contact state in words.
     pub fn state(&self) -> String {
+        let place = if self.face {
+            ", a shoulder on a bearing face"
+        } else {
+            ""
+        };
         format!(
-            "joint `{}` (handle {}): penetration {} um, rate {} m/s, delta_dot0 {} m/s, damping ratio \
+            "joint `{}` (handle {}){place}: penetration {} um, rate {} m/s, delta_dot0 {} m/s, damping ratio \
              {}, stable step {} s (friction's {} s), effective mass {} kg",
             self.joint,
             self.handle,
@@ -200,14 +214,7 @@ pub fn diagnose(c: &StalledContact, min_dt: f64) -> StallCause {
     // friction, whose limit then falls with it.
     let damped = c.zeta > 1.0;
     if damped && (c.stable_dt < min_dt || c.friction_dt >= c.stable_dt) {
-        let hysteresis = matches!(
-            c.law,
-            LawKind::HuntCrossley
-                | LawKind::LankaraniNikravesh
-                | LawKind::FloresEtAl
-                | LawKind::GonthierEtAl
-        );
-        if hysteresis && c.impact_rate <= 1.01 * c.min_impact_speed {
+        if is_hysteresis(c.law) && c.impact_rate <= 1.01 * c.min_impact_speed {
             return StallCause::SlowRecontact;
         }
         return StallCause::Damping;
@@ -215,7 +222,31 @@ pub fn diagnose(c: &StalledContact, min_dt: f64) -> StallCause {
     if c.friction_dt < c.stable_dt {
         return StallCause::Friction;
     }
+    if damping_stiffens(c) {
+        return StallCause::Damping;
+    }
     StallCause::Stiffness
+}
+
+/// Whether a hysteresis law's damping, not its spring, sets the contact's frequency: the damping
+/// grows with the penetration (`D = chi K delta^n`), so its slope times the rate adds to the
+/// stiffness; a tiny restitution makes that term dominate while the damping ratio stays small.
+/// Only a factor of 100 counts: a spatial joint's frequency sums its regions' over their own
+/// masses, which can reach a few times the law's spring without any damping.
+fn damping_stiffens(c: &StalledContact) -> bool {
+    is_hysteresis(c.law) && c.omega * c.omega * c.effective_mass > 100.0 * c.elastic_stiffness
+}
+
+/// The laws whose damping is `chi K delta^n delta_dot` (it grows with the penetration and is
+/// divided by the approach speed `delta_dot0`).
+fn is_hysteresis(law: LawKind) -> bool {
+    matches!(
+        law,
+        LawKind::HuntCrossley
+            | LawKind::LankaraniNikravesh
+            | LawKind::FloresEtAl
+            | LawKind::GonthierEtAl
+    )
 }
 
 /// The stall message: what was seen (`seen`), the contact state, the cause and what to change.
@@ -267,15 +298,27 @@ pub fn explain(seen: &str, contact: Option<&StalledContact>, min_dt: f64) -> Str
             sig4(c.zeta),
             sig4(c.stable_dt)
         ),
+        StallCause::Damping if c.zeta <= 1.0 => format!(
+            "the law's damping: it grows with the penetration, and its slope stiffens the contact \
+             to {} N/m against the spring's {} N/m (natural frequency {} rad/s), so it is stable \
+             only below {} s; lower the {} damping ({})",
+            sig4(c.omega * c.omega * c.effective_mass),
+            sig4(c.elastic_stiffness),
+            sig4(c.omega),
+            sig4(c.stable_dt),
+            law_name(c.face),
+            damping_field(c.law, c.face)
+        ),
         StallCause::Damping => format!(
             "the contact is over-damped: damping ratio {} (the damping is {} times the critical \
              damping 2 sqrt(K m) of the effective mass {} kg), so it is stable only below {} s; \
-             lower the law's damping ({})",
+             lower the {} damping ({})",
             sig4(c.zeta),
             sig4(c.zeta),
             sig4(c.effective_mass),
             sig4(c.stable_dt),
-            damping_field(c.law)
+            law_name(c.face),
+            damping_field(c.law, c.face)
         ),
         StallCause::Friction => format!(
             "friction: under a normal force of {} N its law is so steep near zero slip that a step \
@@ -285,10 +328,15 @@ pub fn explain(seen: &str, contact: Option<&StalledContact>, min_dt: f64) -> Str
         ),
         StallCause::Stiffness => format!(
             "the contact is too stiff for the effective mass {} kg: natural frequency {} rad/s, \
-             stable only below {} s; check the law's stiffness (or the materials' Young's moduli)",
+             stable only below {} s; check the {}",
             sig4(c.effective_mass),
             sig4(c.omega),
-            sig4(c.stable_dt)
+            sig4(c.stable_dt),
+            if c.face {
+                "face law's `stiffness` (`spatial.face`)"
+            } else {
+                "law's stiffness (or the materials' Young's moduli)"
+            }
         ),
     };
     format!(
@@ -298,8 +346,16 @@ pub fn explain(seen: &str, contact: Option<&StalledContact>, min_dt: f64) -> Str
     )
 }
 
-/// The parameter that sets a law's damping, in words.
-fn damping_field(law: LawKind) -> &'static str {
+/// Which law, in words: the face law of a spatial joint's shoulders, or the joint's own.
+fn law_name(face: bool) -> &'static str {
+    if face { "face law's" } else { "law's" }
+}
+
+/// The parameter that sets a law's damping, in words (`face`: the face law's restitution).
+fn damping_field(law: LawKind, face: bool) -> &'static str {
+    if face {
+        return "`spatial.face.restitution`: a higher restitution damps less";
+    }
     match law {
         LawKind::KelvinVoigt => "`damping`, N s/m",
         LawKind::ImprovedLiu => "`eta_s`, or `d_max_n_s_per_m`",
@@ -343,6 +399,8 @@ mod tests {
             min_impact_speed: 1e-4,
             zeta: 0.1,
             omega: 1e6,
+            elastic_stiffness: 1e11,
+            face: false,
             stable_dt: 2e-10 * 0.5,
             friction_dt: f64::INFINITY,
             normal_force: 10.0,
@@ -465,5 +523,39 @@ mod tests {
             assert!(m.contains(part), "{part:?} not in {m}");
         }
         assert!(!m.contains("out of its physical range"), "{m}");
+    }
+
+    /// A face law with a restitution of 1e-6: its damping's slope makes the contact 10^6 times
+    /// stiffer than its spring while the damping ratio stays small. The cause is the damping, and
+    /// the message names the face law's restitution, not a stiffness.
+    #[test]
+    fn a_steep_hysteresis_damping_on_a_face_names_the_face_restitution() {
+        let c = StalledContact {
+            law: LawKind::FloresEtAl,
+            zeta: 0.0037,
+            omega: 8.4e7,
+            elastic_stiffness: 3e9,
+            effective_mass: 0.68,
+            face: true,
+            ..contact()
+        };
+        assert_eq!(diagnose(&c, 1e-10), StallCause::Damping);
+        let m = explain("no step resolves the contact", Some(&c), 1e-10);
+        for part in [
+            "a shoulder on a bearing face",
+            "its slope stiffens the contact",
+            "lower the face law's damping",
+            "`spatial.face.restitution`",
+        ] {
+            assert!(m.contains(part), "{part:?} not in {m}");
+        }
+        assert!(!m.contains("check the law's stiffness"), "{m}");
+        // The same numbers on the bore's own law name that law's damping.
+        let bore = StalledContact { face: false, ..c };
+        let m = explain("no step resolves the contact", Some(&bore), 1e-10);
+        assert!(
+            m.contains("lower the law's damping (a higher `restitution`"),
+            "{m}"
+        );
     }
 }

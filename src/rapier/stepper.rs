@@ -137,6 +137,16 @@ pub struct StepControl {
 }
 
 impl StepControl {
+    /// The shortest step, s (fixed, or an adaptive control's largest; also the default floor
+    /// `min_dt`): Rapier's solver divides by the step, and a step of 1e-300 s ended in
+    /// non-finite states.
+    pub const SMALLEST_STEP: f64 = 1e-10;
+
+    /// The smallest adaptive tolerance: a step covers twice it of a contact period and a body
+    /// turns at most an eighth of it in rad, so below it a body turning at 1,000 rad/s needs
+    /// steps under the default floor `min_dt` (1e-10 s).
+    pub const SMALLEST_TOLERANCE: f64 = 1e-6;
+
     /// Constant steps of `dt` seconds.
     pub fn fixed(dt: f64) -> Self {
         StepControl {
@@ -154,7 +164,7 @@ impl StepControl {
             mode: StepMode::Adaptive,
             max_dt,
             tolerance,
-            min_dt: 1e-10,
+            min_dt: Self::SMALLEST_STEP,
             max_growth: 2.0,
             strict: false,
             joint_correction: true,
@@ -197,22 +207,30 @@ impl StepControl {
     /// Checks the fields: positive finite steps, a tolerance in (0, 1], growth above 1.
     pub fn validate(&self) -> Result<()> {
         let ok = |v: f64| v.is_finite() && v > 0.0;
-        if !ok(self.max_dt) {
+        let step = match self.mode {
+            StepMode::Fixed => "dt",
+            StepMode::Adaptive => "max_dt",
+        };
+        if !(ok(self.max_dt) && self.max_dt >= Self::SMALLEST_STEP) {
             return Err(Error::invalid(
-                "dt_s",
+                step,
                 format!(
-                    "must be a positive finite step in seconds (got {})",
+                    "must be a finite step of at least {} s (got {} s): Rapier's solver divides by \
+                     the step, and shorter ones end in non-finite states",
+                    Self::SMALLEST_STEP,
                     self.max_dt
                 ),
             ));
         }
         if self.mode == StepMode::Adaptive {
-            if !(ok(self.tolerance) && self.tolerance <= 1.0) {
+            if !(self.tolerance >= Self::SMALLEST_TOLERANCE && self.tolerance <= 1.0) {
                 return Err(Error::invalid(
                     "tolerance",
                     format!(
-                        "must be in (0, 1]: a step covers twice it of a contact's period and \
-                         turns a body by an eighth of it in rad (got {})",
+                        "must be in [{}, 1]: a step covers twice it of a contact's period and \
+                         turns a body by an eighth of it in rad, so a smaller one asks a fast \
+                         body for steps below the floor `min_dt` (got {})",
+                        Self::SMALLEST_TOLERANCE,
                         self.tolerance
                     ),
                 ));
@@ -427,6 +445,7 @@ impl Stepper {
         self.control.validate()?;
         check_gravity(world, self.control.max_dt)?;
         check_joint_bodies(world, sources)?;
+        check_body_states(world)?;
         self.prepare(world, sources)?;
         let left = until - self.t;
         if !(left > 0.0) {
@@ -697,6 +716,12 @@ impl Stepper {
         sources: &[&mut dyn StepHooks],
         seen: &str,
     ) -> String {
+        if let Some(turn) = self.turn_stall(world) {
+            return format!(
+                "{seen} (the floor `min_dt` is {} s); {turn}",
+                crate::error::sig4(self.control.min_dt)
+            );
+        }
         // The contact whose step limit is the shortest stops the step control.
         let limit = |c: &crate::rapier::stall::StalledContact| c.stable_dt.min(c.friction_dt);
         let contact = sources
@@ -704,6 +729,32 @@ impl Stepper {
             .filter_map(|s| s.stalled_contact(&world.bodies))
             .min_by(|a, b| limit(a).total_cmp(&limit(b)));
         crate::rapier::stall::explain(seen, contact.as_ref(), self.control.min_dt)
+    }
+
+    /// The turn bound in words when it alone asks for steps at the floor: the fastest-turning
+    /// movable body may turn `tolerance/8` rad a step.
+    fn turn_stall(&self, world: &PhysicsWorld) -> Option<String> {
+        let per_step = crate::rapier::motion_step::TURN_PER_TOLERANCE * self.control.tolerance;
+        let (handle, rb) = world
+            .bodies
+            .iter()
+            .filter(|(_, rb)| !rb.is_fixed())
+            .max_by(|a, b| a.1.angvel().length().total_cmp(&b.1.angvel().length()))?;
+        let w = rb.angvel().length();
+        let step = crate::rapier::motion_step::turn_step(per_step, w);
+        (step <= 2.0 * self.control.min_dt).then(|| {
+            let sig4 = crate::error::sig4;
+            format!(
+                "cause: the turn bound, not a contact: body {:?} turns at {} rad/s and may turn \
+                 at most tolerance/8 = {} rad a step, which needs steps of {} s; raise \
+                 `tolerance`, or check what spins the body so fast (a motor, a drive, a \
+                 prescribed motion, an initial velocity)",
+                handle.into_raw_parts(),
+                sig4(w),
+                sig4(per_step),
+                sig4(step)
+            )
+        })
     }
 
     fn count_floor(
@@ -832,6 +883,37 @@ fn check_gravity(world: &PhysicsWorld, max_dt: f64) -> Result<()> {
     Ok(())
 }
 
+/// Every body's pose and velocities are finite before a step: a NaN set by hand would otherwise
+/// show only as a body leaving the physical range after it, with nothing to say why.
+fn check_body_states(world: &PhysicsWorld) -> Result<()> {
+    for (handle, rb) in world.bodies.iter() {
+        let bad = [
+            (
+                "position",
+                rb.translation().is_finite() && rb.rotation().is_finite(),
+            ),
+            ("linvel", rb.linvel().is_finite()),
+            ("angvel", rb.angvel().is_finite()),
+        ]
+        .into_iter()
+        .find(|(_, ok)| !ok);
+        if let Some((field, _)) = bad {
+            return Err(Error::invalid(
+                field,
+                format!(
+                    "body {:?} has a non-finite {field} before the step (position {:?}, linvel \
+                     {:?}, angvel {:?}): set finite values",
+                    handle.into_raw_parts(),
+                    rb.translation(),
+                    rb.linvel(),
+                    rb.angvel()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// Every impulse joint (Rapier's own, a clearance joint's lock, a large-step joint's) and every
 /// participant's joint joins bodies of the world: Rapier's step panics on one whose body is gone.
 fn check_joint_bodies(world: &PhysicsWorld, sources: &[&mut dyn StepHooks]) -> Result<()> {
@@ -873,11 +955,7 @@ fn diverged_body(
     } else {
         format!(", joined by {}", joined.join(", "))
     };
-    let speed = if speed.is_finite() {
-        format!("speed {} m/s", crate::error::sig4(speed))
-    } else {
-        "its state is not finite".into()
-    };
+    let speed = state_in_words(world.bodies.get(body), speed);
     let correction = if jointed && !joint_correction {
         "; with the joint correction off (`StepControl::joint_correction`), also Rapier's joint \
          drift correction under changing steps, which makes a chain of slender bodies tilt out of \
@@ -892,6 +970,27 @@ fn diverged_body(
         body.into_raw_parts(),
         crate::error::sig4(0.5 * world.integration_parameters.max_linear_velocity())
     )
+}
+
+/// What is out of range in a diverged body's state: its pose, its velocities, Rapier's quarantine,
+/// or its `speed` (m/s).
+fn state_in_words(rb: Option<&rapier3d_f64::prelude::RigidBody>, speed: f64) -> String {
+    let Some(rb) = rb else {
+        return "it is no longer in the world".into();
+    };
+    if !(rb.translation().is_finite() && rb.rotation().is_finite()) {
+        format!("its position is not finite: {:?}", rb.translation())
+    } else if !(rb.linvel().is_finite() && rb.angvel().is_finite()) {
+        format!(
+            "its velocity is not finite: linvel {:?}, angvel {:?}",
+            rb.linvel(),
+            rb.angvel()
+        )
+    } else if !rb.is_enabled() {
+        "Rapier disabled it".into()
+    } else {
+        format!("speed {} m/s", crate::error::sig4(speed))
+    }
 }
 
 /// `Some(speed)` when `rb` has left the physical range: disabled by Rapier's quarantine,

@@ -105,7 +105,9 @@ impl ClearanceWorld {
 
     /// Adds a compliant clearance joint between `body1` (bearing) and `body2` (journal), with its
     /// Rapier lock. Refused, naming `body1` or `body2`, unless both are bodies of
-    /// `self.rapier.bodies` and not the same body; nothing is added then.
+    /// `self.rapier.bodies` and not the same body, and naming `local_axis2` when a spatial
+    /// joint's journal does not lie in its bore ([`ClearanceJoint::check_start`]); nothing is
+    /// added then.
     pub fn insert_clearance(
         &mut self,
         body1: RigidBodyHandle,
@@ -113,6 +115,8 @@ impl ClearanceWorld {
         joint: ClearanceJoint,
     ) -> Result<ClearanceJointHandle> {
         check_joint_bodies(&self.rapier.bodies, body1, body2)?;
+        let bodies = &self.rapier.bodies;
+        joint.check_start(&bodies[body1], &bodies[body2])?;
         self.stepper.invalidate(false);
         Ok(self
             .clearance
@@ -163,11 +167,14 @@ impl ClearanceWorld {
         self.drives.remove(handle)
     }
 
-    /// Adds a prescribed motion (its body must be a position-based kinematic body); returns its
-    /// index in [`PrescribedSet::motions`].
-    pub fn insert_prescribed(&mut self, motion: PrescribedMotion) -> usize {
+    /// Adds a prescribed motion; returns its index in [`PrescribedSet::motions`]. Refused, naming
+    /// `motions[i].body` or its path's field, unless its body is a position-based kinematic body
+    /// of this world and its axis or direction a unit vector; nothing is added then.
+    pub fn insert_prescribed(&mut self, motion: PrescribedMotion) -> Result<usize> {
+        let index = self.prescribed.motions.len();
+        motion.check(index, &self.rapier.bodies)?;
         self.prescribed.motions.push(motion);
-        self.prescribed.motions.len() - 1
+        Ok(index)
     }
 
     // ----- The step -----

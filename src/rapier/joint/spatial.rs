@@ -258,6 +258,36 @@ impl ClearanceJoint {
         }
     }
 
+    /// Whether a spatial joint can start from the bodies' poses: its journal's axis must lie in
+    /// its bore (a tilt whose edges alone would press past the law's validity is refused, naming
+    /// `local_axis2`). Planar joints pass: their lock aligns the axes.
+    pub fn check_start(&self, rb1: &RigidBody, rb2: &RigidBody) -> crate::error::Result<()> {
+        if self.spatial.is_none() {
+            return Ok(());
+        }
+        let pose = self.spatial_pose(rb1, rb2, Vector::X);
+        let sin = pose.bearing_axis.cross(pose.journal_axis).length();
+        let g = &self.geometry;
+        let edge = 0.5 * g.length() * sin - g.clearance();
+        if edge <= self.max_valid_penetration() {
+            return Ok(());
+        }
+        let sig4 = crate::error::sig4;
+        Err(crate::error::Error::invalid(
+            "local_axis2",
+            format!(
+                "puts the journal's axis {} deg from the bore's at the bodies' poses; the bore \
+                 lets it tilt {} deg (2c/L), so its edges would start {} um deep, past the law's \
+                 validity {} um: give axes that match at the poses (`local_axis1` in body 1's \
+                 frame, `local_axis2` in body 2's)",
+                sig4(sin.asin().to_degrees()),
+                sig4((2.0 * g.clearance() / g.length()).atan().to_degrees()),
+                sig4(edge * 1e6),
+                sig4(self.max_valid_penetration() * 1e6)
+            ),
+        ))
+    }
+
     /// A spatial joint's quadrature points in contact at its last application, region by
     /// region ([`Region::ALL`]'s order); empty for a planar joint or out of contact.
     pub fn spatial_points(&self) -> &[SpatialPoint] {

@@ -140,32 +140,6 @@ impl SpatialSpec {
             collar_radius: g.collar_radius,
         };
         geometry.validate(radial).map_err_within("model.geometry")?;
-        // Metres, not the spec's millimetres: a value in mm is caught by these bounds.
-        let in_m = |field: &str, value: f64, hi: f64, what: &str| -> Result<()> {
-            if value > hi {
-                return Err(Error::invalid(
-                    format!("model.geometry.{field}"),
-                    format!(
-                        "must be at most {what}, {} m (got {} m; this field is in metres, not mm)",
-                        sig4(hi),
-                        sig4(value)
-                    ),
-                ));
-            }
-            Ok(())
-        };
-        in_m(
-            "axial_play",
-            g.axial_play,
-            radial.length(),
-            "the bearing's width",
-        )?;
-        in_m(
-            "collar_radius",
-            g.collar_radius,
-            10.0 * radial.bearing_radius(),
-            "ten bearing radii",
-        )?;
         let face = match self.face {
             Some(f) => FaceLaw {
                 stiffness: f.stiffness,

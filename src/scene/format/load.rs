@@ -51,9 +51,10 @@ impl Scene {
     }
 }
 
-/// The enum variants of a scene (contact and friction laws) and how each is written, for hints
-/// when a variant is written in the wrong form (`LiuEtAl()`, a bare `ImprovedLiu`).
-const VARIANT_FORMS: [(&str, &str); 16] = [
+/// The enum variants of a scene (contact and friction laws, hinge models) and how each is
+/// written, for hints when a variant is written in the wrong form (`LiuEtAl()`, a bare
+/// `ImprovedLiu`, `Spatial` without its settings).
+const VARIANT_FORMS: [(&str, &str); 19] = [
     (
         "Hertz",
         "Hertz(stiffness: Some(K), exponent: n), or Hertz() for n = 1.5 and the geometric stiffness",
@@ -94,6 +95,19 @@ const VARIANT_FORMS: [(&str, &str); 16] = [
         "Lubricated, with no parameters and no parentheses",
     ),
     ("Some", "Some(value), or None"),
+    (
+        "Spatial",
+        "Spatial((geometry: (axial_play: a, collar_radius: r))), lengths in m, optionally with \
+         face: (stiffness: K, restitution: cr) after the geometry",
+    ),
+    (
+        "Compliant",
+        "Compliant, with no parameters and no parentheses",
+    ),
+    (
+        "LargeStep",
+        "LargeStep, with no parameters and no parentheses",
+    ),
 ];
 
 /// When a RON error comes right after the name of a law, how that law is written.
@@ -115,6 +129,11 @@ fn variant_hint(text: &str, at: &ron::error::Position) -> Option<String> {
         .rfind(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
         .map_or(0, |i| i + 1);
     let word = &before[start..];
+    variant_form(word)
+}
+
+/// How the scene's variant `word` is written, in words; `None` for a word that is no variant.
+pub(super) fn variant_form(word: &str) -> Option<String> {
     VARIANT_FORMS
         .iter()
         .find(|(name, _)| *name == word)

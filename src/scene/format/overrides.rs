@@ -62,7 +62,10 @@ impl Scene {
                 *slot = new;
             }
             if let Err(e) = serde_json::from_value::<Scene>(value.clone()) {
-                return Error::parse(format!("override `{o}`"), e.to_string());
+                let hint = super::load::variant_form(raw.trim()).map_or(String::new(), |h| {
+                    format!(" ({h}; in an override, as JSON)")
+                });
+                return Error::parse(format!("override `{o}`"), format!("{e}{hint}"));
             }
         }
         Error::parse("overrides", all.to_string())

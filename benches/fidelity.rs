@@ -121,7 +121,14 @@ fn joint(
             let j = c.joint(a1, a2, axis, axis).expect("valid clearance");
             built
                 .compliant
-                .insert(b1, b2, j, &mut built.world.impulse_joints);
+                .insert(
+                    b1,
+                    b2,
+                    j,
+                    &built.world.bodies,
+                    &mut built.world.impulse_joints,
+                )
+                .unwrap();
         }
         Model::LargeStep => {
             let j = c
@@ -129,7 +136,14 @@ fn joint(
                 .expect("valid clearance");
             built
                 .play
-                .insert(b1, b2, j, &mut built.world.impulse_joints);
+                .insert(
+                    b1,
+                    b2,
+                    j,
+                    &built.world.bodies,
+                    &mut built.world.impulse_joints,
+                )
+                .unwrap();
         }
         Model::Ideal => {
             built.world.impulse_joints.insert(
@@ -422,7 +436,8 @@ fn resolution(clearance: f64, cap: Option<usize>) -> (f64, f64, u64) {
         .max_substeps(cap)
         .build()
         .expect("valid joint");
-        play.insert(base, rod, joint, &mut w.impulse_joints)
+        play.insert(base, rod, joint, &w.bodies, &mut w.impulse_joints)
+            .unwrap()
     });
     if pin.is_none() {
         w.impulse_joints.insert(

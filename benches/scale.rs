@@ -127,11 +127,26 @@ fn chain(model: Model, dt: f64, start: Start) -> Chain {
                     .max_substeps(cap)
                     .build()
                     .unwrap();
-                play.insert(previous, link, joint, &mut world.impulse_joints);
+                play.insert(
+                    previous,
+                    link,
+                    joint,
+                    &world.bodies,
+                    &mut world.impulse_joints,
+                )
+                .unwrap();
             }
             Model::Compliant => {
                 let joint = c.joint(a1, a2, Vector::Z, Vector::Z).unwrap();
-                compliant.insert(previous, link, joint, &mut world.impulse_joints);
+                compliant
+                    .insert(
+                        previous,
+                        link,
+                        joint,
+                        &world.bodies,
+                        &mut world.impulse_joints,
+                    )
+                    .unwrap();
             }
         }
         pins.push((previous, link, a1, a2));

@@ -209,7 +209,9 @@ fn api_pendulum() -> (
         )
         .unwrap();
     let mut joints = clearance_joint::rapier::joint::ClearanceJointSet::new();
-    joints.insert(ground, arm, joint, &mut world.impulse_joints);
+    joints
+        .insert(ground, arm, joint, &world.bodies, &mut world.impulse_joints)
+        .unwrap();
     (world, joints, arm)
 }
 

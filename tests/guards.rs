@@ -31,7 +31,9 @@ fn arm(clearance: Clearance) -> (PhysicsWorld, ClearanceJointSet, ClearanceJoint
             Vector::Z,
         )
         .unwrap();
-    let pin = joints.insert(base, arm, pin, &mut world.impulse_joints);
+    let pin = joints
+        .insert(base, arm, pin, &world.bodies, &mut world.impulse_joints)
+        .unwrap();
     (world, joints, pin)
 }
 

@@ -44,7 +44,8 @@ fn clearance_handles_survive_removals_and_stale_ones_find_nothing() {
         let joint = clearance(name)
             .joint(anchor1, ANCHOR2, Vector::Z, Vector::Z)
             .unwrap();
-        set.insert(base, arms[i], joint, &mut w.impulse_joints)
+        set.insert(base, arms[i], joint, &w.bodies, &mut w.impulse_joints)
+            .unwrap()
     };
     let a = insert(&mut set, &mut w, 0, "a");
     let b = insert(&mut set, &mut w, 1, "b");
@@ -86,7 +87,8 @@ fn large_step_handles_survive_removals_and_stale_ones_find_nothing() {
         let joint = clearance(name)
             .large_step_joint(anchor1, ANCHOR2, Vector::Z, Vector::Z)
             .unwrap();
-        set.insert(base, arms[i], joint, &mut w.impulse_joints)
+        set.insert(base, arms[i], joint, &w.bodies, &mut w.impulse_joints)
+            .unwrap()
     };
     let a = insert(&mut set, &mut w, 0, "a");
     let b = insert(&mut set, &mut w, 1, "b");

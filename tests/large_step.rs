@@ -65,7 +65,9 @@ impl Pendulum {
         .build()
         .unwrap();
         let mut play = LargeStepJointSet::new();
-        let hinge = play.insert(base, arm, built, &mut world.impulse_joints);
+        let hinge = play
+            .insert(base, arm, built, &world.bodies, &mut world.impulse_joints)
+            .unwrap();
         Pendulum {
             world,
             play,
@@ -185,12 +187,15 @@ fn shot(
             .can_sleep(false),
     );
     let mut play = LargeStepJointSet::new();
-    let h = play.insert(
-        base,
-        body,
-        joint.build().unwrap(),
-        &mut world.impulse_joints,
-    );
+    let h = play
+        .insert(
+            base,
+            body,
+            joint.build().unwrap(),
+            &world.bodies,
+            &mut world.impulse_joints,
+        )
+        .unwrap();
     (world, play, h, body)
 }
 
@@ -349,18 +354,24 @@ fn the_force_readout_is_the_static_load() {
         .build()
         .unwrap()
     };
-    let top = play.insert(
-        base,
-        a,
-        joint(Vector::ZERO, Vector::new(0.0, 0.2, 0.0)),
-        &mut world.impulse_joints,
-    );
-    let low = play.insert(
-        a,
-        b,
-        joint(Vector::new(0.0, -0.2, 0.0), Vector::new(0.0, 0.2, 0.0)),
-        &mut world.impulse_joints,
-    );
+    let top = play
+        .insert(
+            base,
+            a,
+            joint(Vector::ZERO, Vector::new(0.0, 0.2, 0.0)),
+            &world.bodies,
+            &mut world.impulse_joints,
+        )
+        .unwrap();
+    let low = play
+        .insert(
+            a,
+            b,
+            joint(Vector::new(0.0, -0.2, 0.0), Vector::new(0.0, 0.2, 0.0)),
+            &world.bodies,
+            &mut world.impulse_joints,
+        )
+        .unwrap();
     for _ in 0..120 {
         step(&mut world, &mut play);
     }

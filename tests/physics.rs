@@ -236,7 +236,15 @@ fn ln_impact(dt: f64) -> (PhysicsWorld, ClearanceJointSet, ClearanceJointHandle)
         .build()
         .unwrap();
     let mut set = ClearanceJointSet::new();
-    let pin = set.insert(bearing, journal, joint, &mut world.impulse_joints);
+    let pin = set
+        .insert(
+            bearing,
+            journal,
+            joint,
+            &world.bodies,
+            &mut world.impulse_joints,
+        )
+        .unwrap();
     (world, set, pin)
 }
 

@@ -52,7 +52,15 @@ fn double_pendulum() -> (PhysicsWorld, ClearanceJointSet, RigidBodyHandle) {
         )
         .unwrap();
     let mut joints = ClearanceJointSet::new();
-    joints.insert(link1, link2, elbow, &mut world.impulse_joints);
+    joints
+        .insert(
+            link1,
+            link2,
+            elbow,
+            &world.bodies,
+            &mut world.impulse_joints,
+        )
+        .unwrap();
     (world, joints, link2)
 }
 

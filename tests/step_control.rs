@@ -102,7 +102,9 @@ fn journal_in_bearing(
         .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
         .unwrap();
     let mut joints = ClearanceJointSet::new();
-    let pin = joints.insert(base, journal, pin, &mut world.impulse_joints);
+    let pin = joints
+        .insert(base, journal, pin, &world.bodies, &mut world.impulse_joints)
+        .unwrap();
     (world, joints, pin)
 }
 

@@ -264,7 +264,9 @@ fn crank_mechanism(clearance: Clearance) -> (PhysicsWorld, ClearanceJointSet, Ri
             Vector::Z,
         )
         .unwrap();
-    joints.insert(slider, rod, joint, &mut world.impulse_joints);
+    joints
+        .insert(slider, rod, joint, &world.bodies, &mut world.impulse_joints)
+        .unwrap();
     (world, joints, slider)
 }
 

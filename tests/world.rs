@@ -85,7 +85,15 @@ fn the_world_steps_like_the_stepper_with_the_same_sets() {
 
     let (mut rapier, base2, arm2) = arm_world(1);
     let mut joints = ClearanceJointSet::new();
-    joints.insert(base2, arm2, compliant_pin(), &mut rapier.impulse_joints);
+    joints
+        .insert(
+            base2,
+            arm2,
+            compliant_pin(),
+            &rapier.bodies,
+            &mut rapier.impulse_joints,
+        )
+        .unwrap();
     let mut stepper = Stepper::new(control);
     while stepper.time() < 0.05 {
         stepper.step(&mut rapier, &mut [&mut joints], 0.05).unwrap();
@@ -107,7 +115,14 @@ fn a_joint_added_through_the_field_is_noticed() {
     world.step(1e-4).unwrap();
     let w = &mut world;
     w.clearance
-        .insert(base, arm, compliant_pin(), &mut w.rapier.impulse_joints);
+        .insert(
+            base,
+            arm,
+            compliant_pin(),
+            &w.rapier.bodies,
+            &mut w.rapier.impulse_joints,
+        )
+        .unwrap();
     let e = world.step(2e-4).unwrap_err().to_string();
     assert!(e.contains("num_solver_iterations"), "{e}");
 }
@@ -285,37 +300,89 @@ fn gravity_beyond_the_speed_guard_in_one_step_is_refused() {
     world.step_to(0.01).unwrap();
 }
 
-/// The sets' own `insert` does not see the bodies: a joint on a removed body or on
-/// `RigidBodyHandle::invalid()` is refused at the step, naming the body, before Rapier's step
-/// runs (it panicked on the removed body; the invalid handle made Rapier's insert try to allocate
-/// 34 GB).
+/// The sets' own `insert` takes the body set: a joint on a removed body, on
+/// `RigidBodyHandle::invalid()` or on a made-up handle with a huge index is refused there,
+/// naming the body, and adds nothing to Rapier's joints (Rapier's insert sizes a table by the
+/// body's index: 34 GB for the invalid handle). A joint whose body is removed afterwards is
+/// refused at the step, before Rapier's step runs (which panicked on it).
 #[test]
-fn a_set_joint_on_a_missing_body_is_refused_at_the_step() {
+fn a_set_joint_on_a_missing_body_is_refused() {
+    let made_up = RigidBodyHandle::from_raw_parts(1 << 30, 0);
     for large in [true, false] {
-        for removed in [true, false] {
+        for which in 0..3 {
             let (mut r, base, _) = arm_world(if large { 4 } else { 1 });
-            let gone = removed_body(&mut r);
-            let gone = if removed {
-                gone
-            } else {
-                RigidBodyHandle::invalid()
-            };
+            let gone = [removed_body(&mut r), RigidBodyHandle::invalid(), made_up][which];
             let (mut joints, mut play) = (ClearanceJointSet::new(), LargeStepJointSet::new());
-            if large {
-                play.insert(base, gone, large_step_pin(), &mut r.impulse_joints);
+            let e = if large {
+                play.insert(
+                    base,
+                    gone,
+                    large_step_pin(),
+                    &r.bodies,
+                    &mut r.impulse_joints,
+                )
+                .map(|_| ())
             } else {
-                joints.insert(base, gone, compliant_pin(), &mut r.impulse_joints);
-            }
-            let mut stepper = Stepper::new(StepControl::fixed(1e-4));
-            let e = stepper
-                .step(&mut r, &mut [&mut joints, &mut play], 1e-3)
-                .unwrap_err()
-                .to_string();
+                joints
+                    .insert(
+                        base,
+                        gone,
+                        compliant_pin(),
+                        &r.bodies,
+                        &mut r.impulse_joints,
+                    )
+                    .map(|_| ())
+            };
+            let e = e.unwrap_err().to_string();
             assert!(
                 e.contains("`body2`") && e.contains("not in the world"),
-                "large {large}, removed {removed}: {e}"
+                "large {large}, case {which}: {e}"
             );
+            assert!(joints.is_empty() && play.is_empty());
+            assert_eq!(r.impulse_joints.len(), 0);
         }
+        // Removed after insertion: refused at the step.
+        let (mut r, base, _) = arm_world(if large { 4 } else { 1 });
+        let later = r.bodies.insert(RigidBodyBuilder::dynamic());
+        let (mut joints, mut play) = (ClearanceJointSet::new(), LargeStepJointSet::new());
+        if large {
+            play.insert(
+                base,
+                later,
+                large_step_pin(),
+                &r.bodies,
+                &mut r.impulse_joints,
+            )
+            .unwrap();
+        } else {
+            joints
+                .insert(
+                    base,
+                    later,
+                    compliant_pin(),
+                    &r.bodies,
+                    &mut r.impulse_joints,
+                )
+                .unwrap();
+        }
+        r.bodies.remove(
+            later,
+            &mut r.islands,
+            &mut r.colliders,
+            &mut r.impulse_joints,
+            &mut r.multibody_joints,
+            &mut r.soft_bodies,
+            true,
+        );
+        let mut stepper = Stepper::new(StepControl::fixed(1e-4));
+        let e = stepper
+            .step(&mut r, &mut [&mut joints, &mut play], 1e-3)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("`body2`") && e.contains("not in the world"),
+            "large {large}, removed later: {e}"
+        );
     }
 }
 

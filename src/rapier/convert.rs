@@ -554,7 +554,7 @@ pub fn revolute_to_clearance(
         ),
     };
     impulse_joints.remove(revolute, true);
-    Ok(set.insert(body1, body2, joint, impulse_joints))
+    Ok(set.insert_unchecked(body1, body2, joint, impulse_joints))
 }
 
 /// Replaces the clearance joint `handle` of `set` by an ideal revolute joint in
@@ -606,7 +606,7 @@ pub fn revolute_to_large_step(
     let (body1, body2) = (ij.body1(), ij.body2());
     let joint = large_step_joint_from_revolute(&ij.data, &clearance)?;
     impulse_joints.remove(revolute, true);
-    Ok(set.insert(body1, body2, joint, impulse_joints))
+    Ok(set.insert_unchecked(body1, body2, joint, impulse_joints))
 }
 
 /// Replaces the large-step joint `handle` of `set` by an ideal revolute joint with the same

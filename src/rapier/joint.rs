@@ -1009,10 +1009,27 @@ impl ClearanceJointSet {
         Self::default()
     }
 
-    /// Adds `joint` between `body1` (bearing) and `body2` (journal). With
+    /// Adds `joint` between `body1` (bearing) and `body2` (journal) of `bodies`. With
     /// [`OutOfPlaneLock::Joint`] it also inserts into `impulse_joints` the Rapier joint that locks
-    /// the axial translation and the two tilts.
+    /// the axial translation and the two tilts. Refused, naming `body1` or `body2`, unless both
+    /// are in `bodies` and not the same body, and naming `local_axis2` when a spatial joint's
+    /// journal does not lie in its bore ([`ClearanceJoint::check_start`]); nothing is added then.
     pub fn insert(
+        &mut self,
+        body1: RigidBodyHandle,
+        body2: RigidBodyHandle,
+        joint: ClearanceJoint,
+        bodies: &RigidBodySet,
+        impulse_joints: &mut ImpulseJointSet,
+    ) -> Result<ClearanceJointHandle> {
+        crate::rapier::step_hooks::joint_pair(bodies, body1, body2)?;
+        joint.check_start(&bodies[body1], &bodies[body2])?;
+        Ok(self.insert_unchecked(body1, body2, joint, impulse_joints))
+    }
+
+    /// [`insert`](Self::insert) between bodies known to be in the world and two (a Rapier
+    /// joint's, which Rapier removes with its bodies).
+    pub(crate) fn insert_unchecked(
         &mut self,
         body1: RigidBodyHandle,
         body2: RigidBodyHandle,
@@ -1031,11 +1048,7 @@ impl ClearanceJointSet {
             .local_anchor2(joint.local_anchor2)
             .contacts_enabled(false)
             .build();
-            // Rapier sizes a table by each body's index: for the invalid handle (index u32::MAX)
-            // that is 34 GB. Such a joint gets no lock; the step refuses it, naming the body.
-            if body1 != RigidBodyHandle::invalid() && body2 != RigidBodyHandle::invalid() {
-                joint.lock_handle = Some(impulse_joints.insert(body1, body2, lock, true));
-            }
+            joint.lock_handle = Some(impulse_joints.insert(body1, body2, lock, true));
         }
         ClearanceJointHandle(self.joints.insert(joint))
     }

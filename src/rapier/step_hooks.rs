@@ -145,3 +145,24 @@ pub fn joint_bodies(
     }
     Ok(())
 }
+
+/// A new joint's two bodies: both in `bodies` ([`joint_bodies`]) and not the same body, naming
+/// `body1` or `body2` as the sets' `insert` methods name them.
+pub fn joint_pair(
+    bodies: &RigidBodySet,
+    body1: RigidBodyHandle,
+    body2: RigidBodyHandle,
+) -> Result<()> {
+    joint_bodies(bodies, || "the joint".to_string(), body1, body2)?;
+    if body1 == body2 {
+        let (index, generation) = body1.into_raw_parts();
+        return Err(crate::Error::invalid(
+            "body2",
+            format!(
+                "is the same body as body1 (index {index}, generation {generation}): a joint \
+                 joins two bodies; pass the journal's body as body2 and the bearing's as body1"
+            ),
+        ));
+    }
+    Ok(())
+}

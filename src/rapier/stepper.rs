@@ -62,7 +62,7 @@
 //!     Vector::Z,
 //!     Vector::Z,
 //! )?;
-//! let pin = joints.insert(base, arm, pin, &mut world.impulse_joints);
+//! let pin = joints.insert(base, arm, pin, &world.bodies, &mut world.impulse_joints)?;
 //! let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.02));
 //! let mut peak: f64 = 0.0;
 //! while stepper.time() < 0.2 {

@@ -114,13 +114,12 @@ impl ClearanceWorld {
         body2: RigidBodyHandle,
         joint: ClearanceJoint,
     ) -> Result<ClearanceJointHandle> {
-        check_joint_bodies(&self.rapier.bodies, body1, body2)?;
-        let bodies = &self.rapier.bodies;
-        joint.check_start(&bodies[body1], &bodies[body2])?;
+        let w = &mut self.rapier;
+        let handle =
+            self.clearance
+                .insert(body1, body2, joint, &w.bodies, &mut w.impulse_joints)?;
         self.stepper.invalidate(false);
-        Ok(self
-            .clearance
-            .insert(body1, body2, joint, &mut self.rapier.impulse_joints))
+        Ok(handle)
     }
 
     /// Removes a compliant clearance joint (and its Rapier lock); `None` for a handle of no joint.
@@ -140,11 +139,10 @@ impl ClearanceWorld {
         body2: RigidBodyHandle,
         joint: LargeStepJoint,
     ) -> Result<LargeStepJointHandle> {
-        check_joint_bodies(&self.rapier.bodies, body1, body2)?;
         // No force to evaluate: its hooks run inside each step.
-        Ok(self
-            .large_step
-            .insert(body1, body2, joint, &mut self.rapier.impulse_joints))
+        let w = &mut self.rapier;
+        self.large_step
+            .insert(body1, body2, joint, &w.bodies, &mut w.impulse_joints)
     }
 
     /// Removes a large-step clearance joint (and its Rapier joint); `None` for a handle of no
@@ -346,24 +344,4 @@ impl ClearanceWorld {
             self.counts = counts;
         }
     }
-}
-
-/// A joint's two bodies: both in `bodies`, and two. Named as the insert methods name them.
-fn check_joint_bodies(
-    bodies: &RigidBodySet,
-    body1: RigidBodyHandle,
-    body2: RigidBodyHandle,
-) -> Result<()> {
-    crate::rapier::step_hooks::joint_bodies(bodies, || "the joint".to_string(), body1, body2)?;
-    if body1 == body2 {
-        let (index, generation) = body1.into_raw_parts();
-        return Err(crate::Error::invalid(
-            "body2",
-            format!(
-                "is the same body as body1 (index {index}, generation {generation}): a joint \
-                 joins two bodies; pass the journal's body as body2 and the bearing's as body1"
-            ),
-        ));
-    }
-    Ok(())
 }

@@ -58,7 +58,7 @@
 //!     .friction(0.2)
 //!     .build()?;
 //! let mut play = LargeStepJointSet::new();
-//! let hinge = play.insert(base, arm, joint, &mut world.impulse_joints);
+//! let hinge = play.insert(base, arm, joint, &world.bodies, &mut world.impulse_joints)?;
 //! for _ in 0..120 {
 //!     play.before_step(&mut world.bodies, &mut world.impulse_joints, &world.integration_parameters);
 //!     world.step();
@@ -666,9 +666,24 @@ impl LargeStepJointSet {
         Self::default()
     }
 
-    /// Adds `joint` between `body1` (bearing) and `body2` (journal), and its Rapier joint to
-    /// `impulse_joints`.
+    /// Adds `joint` between `body1` (bearing) and `body2` (journal) of `bodies`, and its Rapier
+    /// joint to `impulse_joints`. Refused, naming `body1` or `body2`, unless both are in `bodies`
+    /// and not the same body; nothing is added then.
     pub fn insert(
+        &mut self,
+        body1: RigidBodyHandle,
+        body2: RigidBodyHandle,
+        joint: LargeStepJoint,
+        bodies: &RigidBodySet,
+        impulse_joints: &mut ImpulseJointSet,
+    ) -> Result<LargeStepJointHandle> {
+        crate::rapier::step_hooks::joint_pair(bodies, body1, body2)?;
+        Ok(self.insert_unchecked(body1, body2, joint, impulse_joints))
+    }
+
+    /// [`insert`](Self::insert) between bodies known to be in the world and two (a Rapier
+    /// joint's, which Rapier removes with its bodies).
+    pub(crate) fn insert_unchecked(
         &mut self,
         body1: RigidBodyHandle,
         body2: RigidBodyHandle,
@@ -679,11 +694,7 @@ impl LargeStepJointSet {
         joint.body2 = body2;
         joint.state = JointState::default();
         joint.report = LargeStepReport::default();
-        // Rapier sizes a table by each body's index: for the invalid handle (index u32::MAX) that
-        // is 34 GB. Such a joint gets no Rapier joint; the step refuses it, naming the body.
-        if body1 != RigidBodyHandle::invalid() && body2 != RigidBodyHandle::invalid() {
-            joint.handle = Some(impulse_joints.insert(body1, body2, joint.rapier_joint(), true));
-        }
+        joint.handle = Some(impulse_joints.insert(body1, body2, joint.rapier_joint(), true));
         self.groups_valid = false;
         LargeStepJointHandle(self.joints.insert(joint))
     }

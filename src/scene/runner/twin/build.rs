@@ -215,17 +215,16 @@ fn build_hinges(
         let (b1, b2) = (bodies[ib].handle, bodies[ij].handle);
         let joint = match (scene.clearance(i), kind) {
             (Some(settings), TwinKind::Clearance) => {
-                let rapier = &mut world.rapier.impulse_joints;
                 // The journal's centre starts off the bearing's by the hinge's offset.
                 let a2 = a2 + Vector::from(h.journal_offset_mm) * 1e-3;
                 match settings.model {
                     ClearanceModel::Compliant | ClearanceModel::Spatial(_) => {
                         let j = settings.joint(a1, a2, axis, axis)?;
-                        HingeJoint::Clearance(world.clearance.insert(b1, b2, j, rapier))
+                        HingeJoint::Clearance(world.insert_clearance(b1, b2, j)?)
                     }
                     ClearanceModel::LargeStep => {
                         let j = settings.large_step_joint(a1, a2, axis, axis)?;
-                        HingeJoint::LargeStep(world.large_step.insert(b1, b2, j, rapier))
+                        HingeJoint::LargeStep(world.insert_large_step(b1, b2, j)?)
                     }
                 }
             }

@@ -9,26 +9,36 @@
 //! every pixel column ([`minmax_decimate`]), so impact peaks survive; trajectories drop points
 //! closer than a fraction of a pixel to the last kept one ([`decimate_path`]). PNG text is drawn
 //! with DejaVu Sans embedded in the binary (`assets/fonts/`), so nothing depends on the fonts of
-//! the machine.
+//! the machine, and laid out by [`text`] (plotters' own PNG text misplaces glyphs).
 //!
 //! - [`series`]: the time series of one case, read from a run's tables or a point's CSV files.
 //! - [`run`]: the figures of one scene run (`run`, the default job).
+//! - [`text`]: the figures' text layout and rasterisation.
+//! - [`ticks`]: the axes' tick labels.
 
 pub mod run;
 pub mod series;
+pub mod text;
+pub mod ticks;
 
+use ab_glyph::FontRef;
 use clearance_joint::error::{Error, Result};
 use clearance_joint::scene::output::write_atomic;
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use series::CaseSeries;
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
+use text::{Target, Typeset};
+use ticks::{TICKS, TickFormat};
 
 type DrawResult = std::result::Result<(), Box<dyn std::error::Error>>;
 
 /// DejaVu Sans (Bitstream Vera licence, `assets/fonts/LICENSE-DejaVu.txt`).
 static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+/// The family the text styles name; plotters still measures legends with the font registered
+/// under it, [`text::Typeset`] draws every text in [`FONT`] whatever the family.
 const FAMILY: &str = "sans-serif";
 
 /// Case colours (Okabe-Ito, readable by colour-blind readers).
@@ -41,18 +51,18 @@ pub const PALETTE: [RGBColor; 6] = [
     RGBColor(86, 180, 233),
 ];
 
-/// Registers the embedded font with plotters once per process.
-fn fonts() -> Result<()> {
+/// The embedded font, registered with plotters once per process (its legends measure text
+/// with it).
+fn font() -> Result<FontRef<'static>> {
     static OK: OnceLock<bool> = OnceLock::new();
     let ok =
         *OK.get_or_init(|| plotters::style::register_font(FAMILY, FontStyle::Normal, FONT).is_ok());
-    if ok {
-        Ok(())
-    } else {
-        Err(Error::invalid(
+    match FontRef::try_from_slice(FONT) {
+        Ok(font) if ok => Ok(font),
+        _ => Err(Error::invalid(
             "assets/fonts/DejaVuSans.ttf",
             "is not a usable TrueType font",
-        ))
+        )),
     }
 }
 
@@ -81,6 +91,16 @@ impl FigureKind {
             FigureKind::AnglesRates => "angles_rates",
             FigureKind::Force => "joint_force",
             FigureKind::Trajectory => "trajectory",
+        }
+    }
+
+    /// What the figure shows, for a title: "body angles and angular rates", "joint force",
+    /// "journal-centre trajectory".
+    pub fn subject(self) -> &'static str {
+        match self {
+            FigureKind::AnglesRates => "body angles and angular rates",
+            FigureKind::Force => "joint force",
+            FigureKind::Trajectory => "journal-centre trajectory",
         }
     }
 }
@@ -174,11 +194,12 @@ impl Drawable for Figure<'_> {
 }
 
 fn render_png(f: &impl Drawable) -> Result<Vec<u8>> {
-    fonts()?;
+    let font = font()?;
     let (w, h) = f.pixels();
     let mut rgb = vec![0u8; w as usize * h as usize * 3];
     {
-        let root = BitMapBackend::with_buffer(&mut rgb, (w, h)).into_drawing_area();
+        let bitmap = BitMapBackend::with_buffer(&mut rgb, (w, h));
+        let root = Typeset::new(bitmap, font, Target::Raster).into_drawing_area();
         f.draw_on(&root).map_err(|e| f.fail("PNG", e))?;
         root.present()
             .map_err(|e| f.fail("PNG", e.to_string().into()))?;
@@ -198,10 +219,11 @@ fn render_png(f: &impl Drawable) -> Result<Vec<u8>> {
 }
 
 fn render_svg(f: &impl Drawable) -> Result<String> {
-    fonts()?;
+    let font = font()?;
     let mut text = String::new();
     {
-        let root = SVGBackend::with_string(&mut text, f.pixels()).into_drawing_area();
+        let svg = SVGBackend::with_string(&mut text, f.pixels());
+        let root = Typeset::new(svg, font, Target::Vector).into_drawing_area();
         f.draw_on(&root).map_err(|e| f.fail("SVG", e))?;
         root.present()
             .map_err(|e| f.fail("SVG", e.to_string().into()))?;
@@ -262,14 +284,7 @@ impl Drawable for XyFigure<'_> {
             .x_label_area_size(45)
             .y_label_area_size(90)
             .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))?;
-        chart
-            .configure_mesh()
-            .x_desc(self.x_label)
-            .y_desc(self.y_label)
-            .label_style((FAMILY, 15))
-            .axis_desc_style((FAMILY, 17))
-            .light_line_style(RGBColor(246, 246, 246))
-            .draw()?;
+        draw_mesh(&mut chart, (self.x_label, self.y_label), (15, 17))?;
         for (i, (label, points)) in self.curves.iter().enumerate() {
             let color = if i == 0 { BLACK } else { case_color(i - 1) };
             chart
@@ -295,6 +310,37 @@ impl Drawable for XyFigure<'_> {
             format!("cannot be drawn: {e}"),
         )
     }
+}
+
+/// A chart of `f64` against `f64`.
+type Chart<'a, DB> = ChartContext<'a, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>;
+
+/// Draws `chart`'s axes, grid and tick labels (labels of `sizes.0`, descriptions of `sizes.1`),
+/// every axis's labels with one number of decimals ([`TickFormat`]).
+fn draw_mesh<DB: DrawingBackend>(
+    chart: &mut Chart<'_, DB>,
+    (x_desc, y_desc): (&str, &str),
+    sizes: (u32, u32),
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    let (x, y) = (chart.x_range(), chart.y_range());
+    let xf = TickFormat::for_axis(x.start, x.end, TICKS);
+    let yf = TickFormat::for_axis(y.start, y.end, TICKS);
+    chart
+        .configure_mesh()
+        .x_labels(TICKS)
+        .y_labels(TICKS)
+        .x_label_formatter(&|v| xf.format(*v))
+        .y_label_formatter(&|v| yf.format(*v))
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .label_style((FAMILY, sizes.0))
+        .axis_desc_style((FAMILY, sizes.1))
+        .light_line_style(RGBColor(246, 246, 246))
+        .draw()?;
+    Ok(())
 }
 
 /// Keeps, for each of `bins` equal time columns over `[t0, t1]`, the minimum and the maximum of
@@ -517,14 +563,8 @@ where
                 .x_label_area_size(50)
                 .y_label_area_size(80)
                 .build_cartesian_2d(t0..t1, y0..y1)?;
-            chart
-                .configure_mesh()
-                .x_desc("time (s)")
-                .y_desc(format!("{what} ({unit})"))
-                .label_style((FAMILY, 16))
-                .axis_desc_style((FAMILY, 18))
-                .light_line_style(RGBColor(246, 246, 246))
-                .draw()?;
+            let y_desc = format!("{what} ({unit})");
+            draw_mesh(&mut chart, ("time (s)", &y_desc), (16, 18))?;
             for (label, color, dashed, points) in curves {
                 let style = color.stroke_width(if dashed { 2 } else { 1 });
                 if dashed {
@@ -555,6 +595,16 @@ where
     Ok(())
 }
 
+/// A force panel's caption: the joint, after the case's label when there are several cases (a
+/// single case is named by the figure's title and legends).
+fn force_caption(cases: usize, label: &str, joint: &str) -> String {
+    if cases > 1 {
+        format!("{label}: {joint}")
+    } else {
+        joint.to_string()
+    }
+}
+
 fn draw_force<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, cases: &[CaseSeries]) -> DrawResult
 where
     DB::ErrorType: 'static,
@@ -582,25 +632,18 @@ where
         {
             let panel = &panels[i * 2 + col];
             let mut chart = ChartBuilder::on(panel)
-                .caption(format!("{}: {name}", case.label), (FAMILY, 20))
+                .caption(force_caption(cases.len(), &case.label, name), (FAMILY, 20))
                 .margin(10)
                 .x_label_area_size(45)
                 .y_label_area_size(80)
                 .build_cartesian_2d(t0..t1, 0.0..y1)?;
-            chart
-                .configure_mesh()
-                .x_desc("time (s)")
-                .y_desc("joint force (N)")
-                .label_style((FAMILY, 15))
-                .axis_desc_style((FAMILY, 17))
-                .light_line_style(RGBColor(246, 246, 246))
-                .draw()?;
+            draw_mesh(&mut chart, ("time (s)", "joint force (N)"), (15, 17))?;
             let points = minmax_decimate(&case.t_s, series, t0, t1, DECIMATE_BINS);
             let peak = series.iter().copied().fold(0.0, f64::max);
             let corner = emptiest_corner(points.iter().copied(), (t0, t1), (0.0, y1), (0.45, 0.2));
             chart
                 .draw_series(LineSeries::new(points, color.stroke_width(1)))?
-                .label(format!("{name}, highest row {peak:.4} N"))
+                .label(format!("{name}, peak {peak:.4} N"))
                 .legend(legend_line(color));
             chart
                 .configure_series_labels()
@@ -636,7 +679,7 @@ where
         let panel = panels[i].margin(pad_y, pad_y, pad_x, pad_x);
         let mut chart = ChartBuilder::on(&panel)
             .caption(
-                if case.label.starts_with("c =") {
+                if case.label.contains("c = ") {
                     case.label.clone()
                 } else {
                     format!("{} (c = {:.2} mm)", case.label, case.clearance_mm)
@@ -647,14 +690,11 @@ where
             .x_label_area_size(50)
             .y_label_area_size(70)
             .build_cartesian_2d(-lim..lim, -lim..lim)?;
-        chart
-            .configure_mesh()
-            .x_desc("eccentricity u (mm)")
-            .y_desc("eccentricity v (mm)")
-            .label_style((FAMILY, 15))
-            .axis_desc_style((FAMILY, 17))
-            .light_line_style(RGBColor(246, 246, 246))
-            .draw()?;
+        draw_mesh(
+            &mut chart,
+            ("eccentricity u (mm)", "eccentricity v (mm)"),
+            (15, 17),
+        )?;
         let circle: Vec<(f64, f64)> = (0..=720)
             .map(|k| {
                 let a = k as f64 * std::f64::consts::PI / 360.0;

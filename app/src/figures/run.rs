@@ -39,7 +39,7 @@ pub fn draw_run_figures(
     };
     can_draw(scene)?;
     let series = [CaseSeries::from_tables(
-        scene.name.clone(),
+        case_label(scene),
         scene,
         &ideal.table,
         &clear.table,
@@ -111,7 +111,7 @@ pub fn draw_run_figures(
         }
     }
     for kind in FigureKind::ALL {
-        let title = format!("{}: {}", scene.name, kind.stem().replace('_', " "));
+        let title = format!("{}: {}", scene.name, kind.subject());
         let paths = Figure {
             kind,
             title: &title,
@@ -123,4 +123,24 @@ pub fn draw_run_figures(
         }
     }
     Ok(())
+}
+
+/// The legend label of a run's clearance curves: "clearance joint" and its clearance, with the
+/// hinge's name when the scene has several clearance hinges (the figures draw the first). The
+/// ideal curves are "ideal joint"; the scene's name is in the title.
+fn case_label(scene: &Scene) -> String {
+    let hinges: Vec<_> = scene
+        .hinges
+        .iter()
+        .filter(|h| h.clearance.is_some())
+        .collect();
+    let Some(h) = hinges.first() else {
+        return "clearance joint".to_string();
+    };
+    let c = h.clearance.as_ref().map_or(0.0, |c| c.clearance_mm);
+    if hinges.len() > 1 {
+        format!("clearance joint {} (c = {c:.2} mm)", h.name)
+    } else {
+        format!("clearance joint (c = {c:.2} mm)")
+    }
 }

@@ -57,7 +57,7 @@ use crate::rapier::reaction::{IdealJoint, KinematicState, ReactionSolver};
 use crate::rapier::step_hooks::StepHooks;
 use crate::rapier::stepper::{GuardReport, StepControl, StepInfo, Stepper};
 use rapier3d_f64::math::Vector;
-use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle, RigidBodySet};
+use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle};
 
 /// A Rapier world with clearance joints, drives and prescribed motions, stepped by one
 /// [`Stepper`]. The sets are public fields, as in Rapier's `PhysicsWorld`: read them freely;

@@ -204,7 +204,8 @@ impl StepControl {
         self
     }
 
-    /// Checks the fields: positive finite steps, a tolerance in (0, 1], growth above 1.
+    /// Checks the fields: finite steps of at least [`SMALLEST_STEP`](Self::SMALLEST_STEP), a
+    /// tolerance from [`SMALLEST_TOLERANCE`](Self::SMALLEST_TOLERANCE) to 1, growth above 1.
     pub fn validate(&self) -> Result<()> {
         let ok = |v: f64| v.is_finite() && v > 0.0;
         let step = match self.mode {

@@ -8,7 +8,7 @@ use crate::model::kinematics::{
 };
 use crate::model::laws::{
     BearingGeometry, FrictionLaw, FrictionModel, NormalContact, NormalForceLaw, NormalModel,
-    crossing_fraction, loaded_impact_rate, speed_at_crossing,
+    crossing_fraction, loaded_impact_rate, penetration_for_energy, speed_at_crossing,
 };
 use crate::rapier::arena::OrderedArena;
 use crate::rapier::guards::{GuardKind, GuardReport, Violation};
@@ -540,6 +540,33 @@ impl ClearanceJoint {
     pub fn last_wrenches(&self) -> Option<[Wrench; 2]> {
         self.last_wrenches
     }
+    /// At an onset, the impact the step met as a step short enough would resolve it: its
+    /// deepest penetration (the approach's kinetic energy at the crossing, `delta_dot0`, stored
+    /// in the law's spring at the effective mass, at most the depth reached), and the stable
+    /// step, natural frequency and damping ratio there; `None` when no contact began or when
+    /// that impact would take a step of `dt` (s). A refused fixed step's advice then comes from
+    /// the state before it, not from the depth a step too long pressed to (the paper's scene at
+    /// 1 ms pressed to 5.6 um where a resolved impact reaches 1.6 um, and suggested a step five
+    /// times shorter than the impact needs).
+    fn impact_met(&self, dt: f64) -> Option<(f64, f64, f64, f64)> {
+        let r = &self.report;
+        if !r.onset {
+            return None;
+        }
+        let law = self.governing_law();
+        let m = r.effective_mass;
+        let energy = 0.5 * m * r.impact_rate * r.impact_rate;
+        let depth = penetration_for_energy(law, energy, 1e-6).min(r.state.penetration);
+        let c = NormalContact {
+            penetration: depth,
+            penetration_rate: 0.0,
+            impact_rate: r.impact_rate,
+        };
+        let (dt_max, omega, zeta) =
+            stable_step(law.tangent_stiffness(depth), law.damping_coefficient(&c), m);
+        (dt_max < dt).then_some((dt_max, depth, omega, zeta))
+    }
+
     /// The deepest penetration at which the contact law is trusted, m
     /// ([`ClearanceJointBuilder::max_valid_penetration`]; default
     /// [`default_max_valid_penetration`]).
@@ -1233,16 +1260,20 @@ impl ClearanceJointSet {
             }
             let r = &j.report;
             if dt > r.max_stable_dt {
+                let (dt_max, depth, omega, zeta) = match j.impact_met(dt) {
+                    Some(impact) => impact,
+                    None => (r.max_stable_dt, r.state.penetration, r.omega, r.zeta),
+                };
                 return Err(Error::StepTooLarge {
                     field: "dt".into(),
                     joint: j.name.clone(),
                     dt,
-                    dt_max: r.max_stable_dt,
+                    dt_max,
                     t: None,
-                    penetration_um: r.state.penetration * 1e6,
-                    omega: r.omega,
-                    zeta: r.zeta,
-                    parameter: j.normal_law.kind().stiff_parameter(r.zeta),
+                    penetration_um: depth * 1e6,
+                    omega,
+                    zeta,
+                    parameter: j.normal_law.kind().stiff_parameter(zeta),
                     adaptive: None,
                     names: None,
                 });

@@ -51,6 +51,13 @@ fn pendulum(clearance: Clearance, iterations: usize) -> (PhysicsWorld, Clearance
     (world, set)
 }
 
+/// Runs `scene` through the scene runner with the default options.
+fn run_scene(
+    scene: &Scene,
+) -> clearance_joint::error::Result<clearance_joint::scene::runner::RunResult> {
+    Simulation::new(scene, RunOptions::default())?.run()
+}
+
 fn steel() -> Clearance {
     Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016).unwrap()
 }
@@ -400,10 +407,7 @@ fn the_scene_layer_names_the_scene_fields() {
     let scene = Scene::solar_panel()
         .with_overrides(&["run.step=Fixed", "run.dt_s=1e-3", "run.end_s=0.2"])
         .unwrap();
-    let e = Simulation::new(&scene, RunOptions::default())
-        .unwrap()
-        .run()
-        .unwrap_err();
+    let e = run_scene(&scene).unwrap_err();
     let m = e.to_string();
     assert!(
         matches!(&e, Error::StepTooLarge { field, .. } if field == "run.dt_s"),
@@ -436,10 +440,7 @@ fn a_face_restitution_that_stalls_is_named() {
             .unwrap()
             .with_overrides(&["run.end_s=0.02", face.as_str()])
             .unwrap();
-        let e = Simulation::new(&scene, RunOptions::default())
-            .unwrap()
-            .run()
-            .unwrap_err();
+        let e = run_scene(&scene).unwrap_err();
         let m = e.to_string();
         assert!(matches!(e, Error::Stalled { .. }), "{m}");
         for part in [
@@ -583,9 +584,7 @@ fn a_refused_fixed_step_suggests_the_step_the_impact_needs() {
                 "run.end_s=0.2".to_string(),
             ])
             .unwrap();
-        Simulation::new(&scene, RunOptions::default())
-            .unwrap()
-            .run()
+        run_scene(&scene)
     };
     let e = run(1e-3).unwrap_err();
     let suggested = e.suggested_step().expect("a fixed step to suggest");

@@ -190,8 +190,14 @@ fn step_to_refuses_an_unreachable_time() {
 /// The handle of a body inserted into `r` and removed again: one the world no longer has.
 fn removed_body(r: &mut PhysicsWorld) -> RigidBodyHandle {
     let gone = r.bodies.insert(RigidBodyBuilder::dynamic());
+    remove_body(r, gone);
+    gone
+}
+
+/// Removes `body` from `r` (with its Rapier joints).
+fn remove_body(r: &mut PhysicsWorld, body: RigidBodyHandle) {
     r.bodies.remove(
-        gone,
+        body,
         &mut r.islands,
         &mut r.colliders,
         &mut r.impulse_joints,
@@ -199,7 +205,6 @@ fn removed_body(r: &mut PhysicsWorld) -> RigidBodyHandle {
         &mut r.soft_bodies,
         true,
     );
-    gone
 }
 
 /// A joint on a body the world does not have (removed, `RigidBodyHandle::invalid()`) or on one
@@ -365,15 +370,7 @@ fn a_set_joint_on_a_missing_body_is_refused() {
                 )
                 .unwrap();
         }
-        r.bodies.remove(
-            later,
-            &mut r.islands,
-            &mut r.colliders,
-            &mut r.impulse_joints,
-            &mut r.multibody_joints,
-            &mut r.soft_bodies,
-            true,
-        );
+        remove_body(&mut r, later);
         let mut stepper = Stepper::new(StepControl::fixed(1e-4));
         let e = stepper
             .step(&mut r, &mut [&mut joints, &mut play], 1e-3)

@@ -25,7 +25,7 @@ pub struct TorsionSpring {
 
 impl TorsionSpring {
     /// The largest preload, N m: a torque beyond it drives any body of a mechanism past the
-    /// speed guard within a step (1e300 N m left the physical range with nothing said).
+    /// speed guard within a step.
     pub const MAX_TORQUE: f64 = 1e9;
 
     /// The largest stiffness, N m/rad.

@@ -545,9 +545,9 @@ impl ClearanceJoint {
     /// in the law's spring at the effective mass, at most the depth reached), and the stable
     /// step, natural frequency and damping ratio there; `None` when no contact began or when
     /// that impact would take a step of `dt` (s). A refused fixed step's advice then comes from
-    /// the state before it, not from the depth a step too long pressed to (the paper's scene at
-    /// 1 ms pressed to 5.6 um where a resolved impact reaches 1.6 um, and suggested a step five
-    /// times shorter than the impact needs).
+    /// the state before it, not from the depth a step too long pressed to (at 1 ms the paper's
+    /// scene presses to 5.6 um where a resolved impact reaches 1.6 um: advice from that depth
+    /// would ask for a step five times shorter than the impact needs).
     fn impact_met(&self, dt: f64) -> Option<(f64, f64, f64, f64)> {
         let r = &self.report;
         if !r.onset {

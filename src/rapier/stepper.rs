@@ -138,7 +138,7 @@ pub struct StepControl {
 
 impl StepControl {
     /// The shortest step, s (fixed, or an adaptive control's largest; also the default floor
-    /// `min_dt`): Rapier's solver divides by the step, and a step of 1e-300 s ended in
+    /// `min_dt`): Rapier's solver divides by the step, and a step of 1e-300 s ends in
     /// non-finite states.
     pub const SMALLEST_STEP: f64 = 1e-10;
 

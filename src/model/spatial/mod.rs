@@ -55,7 +55,8 @@ pub struct SpatialGeometry {
 impl SpatialGeometry {
     /// The smallest axial play, m: the radial clearance's floor in scenes (1 nm). Below it the
     /// shoulders press both faces at once and the play is lost in the rounding of the journal's
-    /// position (a play of 1e-12 m ran 100 times slower than one of 1e-9 m; 1e-300 m stalled).
+    /// position (measured on the spatial panel: a play of 1e-12 m runs 100 times slower than one
+    /// of 1e-9 m, and 1e-300 m stalls).
     pub const MIN_AXIAL_PLAY: f64 = 1e-9;
 
     /// The largest collar radius, in bearing radii: a shoulder wider than that is a plate, not a

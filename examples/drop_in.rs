@@ -115,8 +115,8 @@ pub struct Run {
     /// Largest contact force of the elbow's clearance joint, N (clearance only; the same force
     /// as the momentum balance sees, from the joint's own report).
     pub peak_contact_force_n: f64,
-    /// Contact onsets in the elbow (clearance only).
-    pub impacts: u64,
+    /// Contact onsets in the elbow, chatter included (clearance only).
+    pub onsets: u64,
     /// Largest penetration in the elbow, um (clearance only).
     pub max_penetration_um: f64,
 }
@@ -135,7 +135,7 @@ fn simulate(mut world: ClearanceWorld, arm: &Arm) -> Result<Run> {
         // The joint's contact over the coming step (evaluated at its start).
         for (_, j) in world.clearance.iter() {
             let r = j.report();
-            run.impacts += u64::from(r.onset);
+            run.onsets += u64::from(r.onset);
             run.peak_contact_force_n = run.peak_contact_force_n.max(r.force.on_journal.length());
             run.max_penetration_um = run.max_penetration_um.max(r.state.penetration * 1e6);
         }
@@ -221,9 +221,9 @@ pub fn report((ideal, clear): &(Run, Run)) -> String {
         format!("{:.3}", clear.rms_elbow_force_n),
     );
     row(
-        "elbow impacts",
-        ideal.impacts.to_string(),
-        clear.impacts.to_string(),
+        "elbow onsets",
+        ideal.onsets.to_string(),
+        clear.onsets.to_string(),
     );
     row(
         "max penetration (um)",

@@ -151,6 +151,7 @@ pub fn report(runs: &[Run; 3]) -> String {
     row("peak elbow force (N) *", &|r| {
         format!("{:.3}", r.elbow.peak_force)
     });
+    row("elbow onsets", &|r| r.elbow.onsets.to_string());
     row("elbow impacts", &|r| r.elbow.impacts.to_string());
     s.push_str("* ideal: the exact reaction of the ideal joint; clearance: the contact force\n");
     s

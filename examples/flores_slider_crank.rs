@@ -272,7 +272,7 @@ fn main() -> Result<()> {
     let wall = std::time::Instant::now();
     let run = simulate(Some(pin_clearance(c)?), control, end)?;
     let wall = wall.elapsed().as_secs_f64();
-    let first = run.recorder.impacts().first().copied().unwrap_or_default();
+    let first = run.recorder.contacts().first().copied().unwrap_or_default();
     println!(
         "clearance c = {} mm: {} steps ({} rejected), {:.3} s wall; crank {:+.3e} deg behind",
         c * 1e3,
@@ -291,16 +291,16 @@ fn main() -> Result<()> {
     );
     let m = run.recorder.metrics();
     println!(
-        "  turns 2-3: largest force {:.0} N, deepest {:.2} um; onsets {} ({} separated), contact {:.1} %",
+        "  turns 2-3: largest force {:.0} N, deepest {:.2} um; onsets {} ({} impacts), contact {:.1} %",
         run.late_peak_n,
         run.late_penetration_um,
+        m.onsets,
         m.impacts,
-        m.separated_impacts,
         100.0 * m.contact_fraction
     );
     {
         println!("  the first impacts: onset, approach speed, peak, penetration, duration");
-        for i in run.recorder.impacts().iter().take(6) {
+        for i in run.recorder.contacts().iter().take(6) {
             println!(
                 "  {:.3} us {:.1} mm/s {:.0} N {:.2} um {:.2} us",
                 i.onset_t_s * 1e6,

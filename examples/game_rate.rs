@@ -60,9 +60,9 @@ pub struct Run {
     /// Largest `|e|/c` at the end of a step (play only).
     pub max_eccentricity_ratio: f64,
     /// Impacts of the pin in its play while the cart rolls (play only).
-    pub impacts_rolling: u64,
+    pub bounces_rolling: u64,
     /// Impacts after the cart stopped (play only).
-    pub impacts_stopped: u64,
+    pub bounces_stopped: u64,
     /// Largest impact impulse, N s (play only).
     pub max_impact_impulse: f64,
     /// Normal force on the pin at the end, N (play only; the sign's weight at rest).
@@ -208,11 +208,11 @@ pub fn simulate(with_play: bool, max_substeps: usize) -> Result<Run> {
             let r = world.large_step.get(pin).expect("inserted").report();
             run.max_eccentricity_ratio = run.max_eccentricity_ratio.max(r.eccentricity_ratio);
             run.max_impact_impulse = run.max_impact_impulse.max(r.impact_impulse);
-            if r.impact {
+            if r.bounce {
                 if t < STOP {
-                    run.impacts_rolling += 1;
+                    run.bounces_rolling += 1;
                 } else {
-                    run.impacts_stopped += 1;
+                    run.bounces_stopped += 1;
                 }
             }
             run.max_substeps = run.max_substeps.max(r.substeps);
@@ -283,9 +283,9 @@ pub fn report(runs: &Runs) -> String {
     row("swing, last 5 s (deg)", a, b, c);
     let (_, b, c) = pair(|r| r.max_eccentricity_ratio, 4);
     row("largest |e|/c", "-".into(), b, c);
-    let impacts = |r: &Run| format!("{} / {}", r.impacts_rolling, r.impacts_stopped);
+    let impacts = |r: &Run| format!("{} / {}", r.bounces_rolling, r.bounces_stopped);
     row(
-        "pin impacts: rolling / stopped",
+        "pin bounces: rolling / stopped",
         "0 / 0".into(),
         impacts(play),
         impacts(capped),

@@ -215,8 +215,8 @@ pub struct Outcome {
     pub play_effect_mm: (f64, f64),
     /// RMS difference of the encoder angles between the two arms (shoulder, elbow), deg.
     pub angle_effect_deg: [f64; 2],
-    /// Pin impacts (shoulder, elbow).
-    pub impacts: [u64; 2],
+    /// Pin bounces (shoulder, elbow): onsets faster than the pins' `min_impact_speed`.
+    pub bounces: [u64; 2],
     /// Largest `|e|/c` (shoulder, elbow) at the end of a step.
     pub max_eccentricity_ratio: [f64; 2],
     /// Largest normal force in each pin, N.
@@ -281,7 +281,7 @@ pub fn run_at(dt: f64, end: f64) -> Result<Outcome> {
     o.play_effect_mm.0 = rms(sq[2]);
     for (k, pin) in play.pins.iter().enumerate() {
         o.angle_effect_deg[k] = (angle_sq[k] / n).sqrt().to_degrees();
-        o.impacts[k] = play.world.large_step.get(*pin).expect("inserted").impacts();
+        o.bounces[k] = play.world.large_step.get(*pin).expect("inserted").bounces();
     }
     o.us_per_step = (wall[0] / n * 1e6, wall[1] / n * 1e6);
     Ok(o)
@@ -316,9 +316,9 @@ pub fn report(o: &Outcome) -> String {
         both(o.angle_effect_deg, 5),
     );
     row(
-        "pin impacts, shoulder / elbow",
+        "pin bounces, shoulder / elbow",
         "0 / 0".into(),
-        format!("{} / {}", o.impacts[0], o.impacts[1]),
+        format!("{} / {}", o.bounces[0], o.bounces[1]),
     );
     row(
         "largest |e|/c, shoulder / elbow",

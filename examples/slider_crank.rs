@@ -327,9 +327,9 @@ fn main() -> Result<()> {
         mi.peak_force_n, mi.rms_force_n, mc.peak_force_n, mc.rms_force_n
     );
     println!(
-        "clearance pin: {} contacts ({} impacts after a real separation), in contact {:.1} % of the time, first impact at {:.6} s, peak {:.1} N",
+        "clearance pin: {} onsets ({} impacts after a separation), in contact {:.1} % of the time, first impact at {:.6} s, peak {:.1} N",
+        mc.onsets,
         mc.impacts,
-        mc.separated_impacts,
         100.0 * mc.contact_fraction,
         mc.first_impact_t_s.unwrap_or(f64::NAN),
         mc.first_impact_peak_n.unwrap_or(f64::NAN)
@@ -348,7 +348,7 @@ fn main() -> Result<()> {
         println!(
             "  dt = {dt:.2e} s: onset {:.7} s, approach {:.1} mm/s, peak {peak:.2} N{change}",
             m.first_impact_t_s.unwrap_or(f64::NAN),
-            r.recorder.impacts()[0].approach_speed_m_s * 1e3
+            r.recorder.contacts()[0].approach_speed_m_s * 1e3
         );
         prev = Some(peak);
     }

@@ -58,8 +58,8 @@ pub struct Outcome {
     /// Largest hinge force, N (ideal: the exact reaction of the ideal joint; clearance: the
     /// contact force).
     pub peak_force_n: f64,
-    /// Contact onsets.
-    pub impacts: u64,
+    /// Contact onsets, chatter included.
+    pub onsets: u64,
     /// Time of the first contact onset, s.
     pub first_impact_s: Option<f64>,
     /// Largest penetration, um.
@@ -195,7 +195,7 @@ pub fn run() -> Result<(Outcome, Outcome)> {
                 Some(c) => {
                     let r = world.clearance.get(c).expect("inserted").report();
                     if r.onset {
-                        o.impacts += 1;
+                        o.onsets += 1;
                         o.first_impact_s.get_or_insert(t);
                     }
                     o.max_penetration_um = o.max_penetration_um.max(r.state.penetration * 1e6);
@@ -255,7 +255,7 @@ pub fn report((ideal, clear): &(Outcome, Outcome)) -> String {
     row("peak hinge force (N)", &|o| {
         format!("{:.4}", o.peak_force_n)
     });
-    row("impacts", &|o| o.impacts.to_string());
+    row("onsets", &|o| o.onsets.to_string());
     row("first impact (s)", &|o| {
         o.first_impact_s.map_or("-".into(), |t| format!("{t:.4}"))
     });

@@ -92,6 +92,7 @@ fn the_papers_scene_through_the_ecs_is_the_runners() {
         let angle = twin.final_angles_deg()["hinge"];
         assert_eq!(s.angle.to_degrees(), angle, "{:?}", twin.kind);
         let m = &twin.hinge_metrics()["hinge"];
+        assert_eq!(s.onsets, m.onsets, "{:?}", twin.kind);
         assert_eq!(s.impacts, m.impacts, "{:?}", twin.kind);
         if s.mode == HingeMode::Clearance {
             assert_eq!(s.peak_force, m.peak_force_n);

@@ -30,9 +30,9 @@ mod solar_panel;
 fn drop_in_converts_the_elbow_and_the_arm_rattles() {
     let runs = drop_in::run().unwrap();
     let (ideal, clear) = &runs;
-    assert_eq!(ideal.impacts, 0);
+    assert_eq!(ideal.onsets, 0);
     assert_eq!(ideal.max_penetration_um, 0.0);
-    assert!(clear.impacts > 10, "{} impacts", clear.impacts);
+    assert!(clear.onsets > 10, "{} onsets", clear.onsets);
     // The swing barely changes; the joint force becomes impulsive.
     assert!(
         (ideal.shoulder_deg - clear.shoulder_deg).abs() < 1.0,
@@ -62,12 +62,7 @@ fn drop_in_converts_the_elbow_and_the_arm_rattles() {
     );
     assert_eq!(ideal.peak_contact_force_n, 0.0);
     let text = drop_in::report(&runs);
-    for needle in [
-        "ideal",
-        "clearance",
-        "peak elbow force (N)",
-        "elbow impacts",
-    ] {
+    for needle in ["ideal", "clearance", "peak elbow force (N)", "elbow onsets"] {
         assert!(text.contains(needle), "{text}");
     }
 }
@@ -85,13 +80,14 @@ fn ecs_swap_is_the_plain_api_run() {
     assert_eq!(clear.elbow.mode, HingeMode::Clearance);
     assert_eq!(swapped.elbow.mode, HingeMode::Clearance);
     assert_eq!(ideal.shoulder.mode, HingeMode::Ideal);
-    assert_eq!(ideal.elbow.impacts, 0);
-    assert_eq!(clear.elbow.impacts, plain.impacts);
+    assert_eq!(ideal.elbow.onsets, 0);
+    assert_eq!(clear.elbow.onsets, plain.onsets);
+    assert!(clear.elbow.impacts > 0 && clear.elbow.impacts <= clear.elbow.onsets);
     assert_eq!(clear.elbow.peak_force, plain.peak_contact_force_n);
     assert!((clear.shoulder.angle.to_degrees() - plain.shoulder_deg).abs() < 1e-9);
     assert!((clear.elbow.angle.to_degrees() - plain.elbow_deg).abs() < 1e-9);
     // Swapped while running: ideal until half time, then rattling.
-    assert!(swapped.elbow.impacts > 0);
+    assert!(swapped.elbow.onsets > 0);
     let text = ecs::report(&runs);
     assert!(
         text.contains("swapped@0.5s") && text.contains("Clearance"),
@@ -131,12 +127,12 @@ fn solar_panel_in_code_is_the_scene_file() {
         close(o.panel_deg, angles["panel"], "panel angle");
         close(o.satellite_deg, angles["satellite"], "satellite angle");
         close(o.peak_force_n, m.peak_force_n, "peak force");
-        assert_eq!(o.impacts, m.impacts, "{kind:?} impacts");
+        assert_eq!(o.onsets, m.onsets, "{kind:?} onsets");
     }
     // The paper's conclusion 1: angles barely change, the joint force becomes impulsive.
     assert!((ideal.deployment_deg - clear.deployment_deg).abs() < 0.5);
     assert!(clear.peak_force_n > 100.0 * ideal.peak_force_n);
-    assert!(clear.impacts > 100);
+    assert!(clear.onsets > 100);
     assert!(clear.linear_momentum_drift < 1e-9 && clear.angular_momentum_drift < 1e-9);
     let text = solar_panel::report(&outcomes);
     assert!(text.contains("final deployment angle (deg)"), "{text}");
@@ -160,8 +156,8 @@ fn game_rate_sign_rattles_within_its_play_at_60_hz() {
         play.max_eccentricity_ratio
     );
     // It rattles on the cobbles and rests once the cart stops, carrying the sign's weight.
-    assert!(play.impacts_rolling > 10, "{}", play.impacts_rolling);
-    assert_eq!(play.impacts_stopped, 0);
+    assert!(play.bounces_rolling > 10, "{}", play.bounces_rolling);
+    assert_eq!(play.bounces_stopped, 0);
     assert!(
         (play.final_force_n - 2.0 * 9.81).abs() < 1e-6,
         "{}",
@@ -191,7 +187,7 @@ fn game_rate_sign_rattles_within_its_play_at_60_hz() {
 fn robot_backlash_shows_the_tracking_error_of_the_play() {
     let o = robot_backlash::run().unwrap();
     // The pins rattle at every load turn-over and stay in their play.
-    assert!(o.impacts[0] > 5 && o.impacts[1] > 5, "{:?}", o.impacts);
+    assert!(o.bounces[0] > 5 && o.bounces[1] > 5, "{:?}", o.bounces);
     for r in o.max_eccentricity_ratio {
         assert!(r > 0.99 && r < 1.1, "{r}");
     }
@@ -328,7 +324,7 @@ fn example_binaries_run_headless_and_print_the_comparison() {
     );
     for (name, needles) in [
         ("door_hinge", &["planar", "spatial", "M/L", "bore"][..]),
-        ("drop_in", &["ideal", "clearance", "elbow impacts"][..]),
+        ("drop_in", &["ideal", "clearance", "elbow onsets"][..]),
         ("ecs", &["ideal", "clearance", "swapped@0.5s"][..]),
         (
             "solar_panel",

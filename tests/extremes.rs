@@ -32,7 +32,7 @@ fn run(overrides: &[&str]) -> Result<TwinSummary, Error> {
 }
 
 fn assert_healthy(case: &str, s: &TwinSummary) {
-    assert!(s.impacts > 0, "{case}: no impact, nothing tested");
+    assert!(s.onsets > 0, "{case}: no contact, nothing tested");
     assert!(
         s.peak_joint_force_n.is_finite() && s.final_angles_deg.values().all(|a| a.is_finite()),
         "{case}: non-finite"
@@ -174,7 +174,7 @@ fn a_stability_limit_below_the_smallest_step_is_out_of_reach() {
                 "{msg}"
             );
         }
-        other => panic!("expected StepTooLarge, got {:?}", other.map(|s| s.impacts)),
+        other => panic!("expected StepTooLarge, got {:?}", other.map(|s| s.onsets)),
     }
 }
 

@@ -159,7 +159,7 @@ fn no_energy_gain_over_a_minute_with_bounces_and_friction() {
             highest = highest.max(kinetic(&world));
             worst = worst.max(play.get(h).unwrap().report().eccentricity_ratio);
         }
-        let impacts = play.get(h).unwrap().impacts();
+        let impacts = play.get(h).unwrap().bounces();
         assert!(highest <= k0 * (1.0 + 1e-9), "e {e}: {highest} > {k0}");
         assert!(impacts > least, "e {e}: {impacts} impacts");
         assert!(worst < 1.1, "e {e}: |e|/c {worst}");
@@ -215,7 +215,7 @@ fn a_single_impact_rebounds_with_the_coefficient() {
         for _ in 0..3 {
             step(&mut world, &mut play);
             let r = *play.get(h).unwrap().report();
-            if r.impact {
+            if r.bounce {
                 impacts.push(r);
             }
         }
@@ -253,7 +253,7 @@ fn restitution_from_a_compliant_law_is_the_laws_own() {
         "{v} vs {}",
         -expected * 0.02
     );
-    assert_eq!(play.get(h).unwrap().impacts(), 1);
+    assert_eq!(play.get(h).unwrap().bounces(), 1);
 }
 
 #[test]
@@ -424,7 +424,7 @@ fn deterministic_and_substeps_handed_back() {
         .unwrap();
     assert_eq!(p.world.bodies[p.arm].additional_solver_iterations(), 2);
     assert_eq!(p.world.impulse_joints.len(), 0);
-    assert!(joint.impacts() == 0 && p.play.is_empty());
+    assert!(joint.bounces() == 0 && p.play.is_empty());
 }
 
 #[test]

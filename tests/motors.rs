@@ -671,7 +671,7 @@ fn a_velocity_motor_that_misses_its_speed_is_flagged() {
 fn four_bar_first_onset(overrides: &[&str]) -> f64 {
     let result = run_four_bar(0.0015, overrides, Twins::ClearanceOnly, true);
     let twin = result.twin(TwinKind::Clearance).unwrap();
-    twin.hinge_recorders()["rocker_pin"].impacts()[0].onset_t_s
+    twin.hinge_recorders()["rocker_pin"].contacts()[0].onset_t_s
 }
 
 #[test]

@@ -263,7 +263,7 @@ proptest! {
         rec.record(t, dt, &ContactObservation { onset: true, impact: true, penetration: force.abs(), ..obs });
         rec.finish(t, &obs);
         rec.set_final_angle_deg(force);
-        let _ = (rec.metrics(), rec.contact_time(), rec.impacts_table());
+        let _ = (rec.metrics(), rec.contact_time(), rec.contacts_table());
     }
 
     #[test]

@@ -204,7 +204,7 @@ fn record(world: &mut ClearanceWorld, pin: ClearanceJointHandle, end: f64) -> Ve
         let obs = ContactObservation::of(world.clearance.get(pin).expect("the pin"));
         if world.time() >= end {
             recorder.finish(world.time(), &obs);
-            return recorder.impacts().to_vec();
+            return recorder.contacts().to_vec();
         }
         let info = world.step(end).expect("the library's step");
         recorder.record(info.t0, info.dt, &obs);
@@ -556,7 +556,7 @@ fn scene_impacts(
         .twin(TwinKind::Clearance)
         .expect("the clearance twin")
         .hinge_recorders()[hinge]
-        .impacts()
+        .contacts()
         .to_vec()
 }
 

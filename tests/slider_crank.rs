@@ -50,7 +50,7 @@ fn ideal_slider_acceleration_matches_the_closed_form() {
         "peak {peak} N against {}",
         SLIDER_MASS * c_lo.abs()
     );
-    assert!(run.recorder.impacts().is_empty());
+    assert!(run.recorder.contacts().is_empty());
 }
 
 #[test]
@@ -69,7 +69,7 @@ fn clearance_pin_impacts_and_its_first_impact_converges() {
     assert!(d2.abs() < d1.abs(), "{peaks:?}");
     assert!((d2 / peaks[2]).abs() < 0.02, "{peaks:?}");
     // Onset and approach speed are resolved to 1e-3 relative.
-    let first: Vec<_> = runs.iter().map(|r| r.recorder.impacts()[0]).collect();
+    let first: Vec<_> = runs.iter().map(|r| r.recorder.contacts()[0]).collect();
     for w in first.windows(2) {
         assert!((w[1].onset_t_s / w[0].onset_t_s - 1.0).abs() < 1e-3);
         assert!((w[1].approach_speed_m_s / w[0].approach_speed_m_s - 1.0).abs() < 1e-3);
@@ -98,8 +98,8 @@ fn the_scene_run_is_the_plain_api_run_bit_for_bit() {
     let ideal = simulate(None, scene.run.dt_s, end).unwrap();
     let recorders = twin(TwinKind::Clearance).hinge_recorders();
     let scene_pin = recorders["slider_pin"];
-    assert!(!clear.recorder.impacts().is_empty());
-    assert_eq!(scene_pin.impacts(), clear.recorder.impacts());
+    assert!(!clear.recorder.contacts().is_empty());
+    assert_eq!(scene_pin.contacts(), clear.recorder.contacts());
     let (a, b) = (scene_pin.metrics(), clear.metrics());
     assert_eq!(
         (
@@ -321,7 +321,7 @@ fn per_turn_statistics_add_up() {
     let turn = TAU / OMEGA;
     assert!((rows[1][1] - turn).abs() < 1e-15);
     let m = &summary.twins["clearance"].hinges["slider_pin"];
-    assert_eq!(rows.iter().map(|r| r[2]).sum::<f64>() as u64, m.impacts);
+    assert_eq!(rows.iter().map(|r| r[2]).sum::<f64>() as u64, m.onsets);
     assert_eq!(
         rows.iter().map(|r| r[4]).fold(0.0, f64::max),
         m.peak_force_n

@@ -43,7 +43,7 @@ fn first_impact_at_the_defaults_matches_converged_fixed_steps() {
     )
     .unwrap();
     let run = simulate(Some(pin_clearance(0.5e-3).unwrap()), defaults(), end).unwrap();
-    let (f, a) = (fine.recorder.impacts()[0], run.recorder.impacts()[0]);
+    let (f, a) = (fine.recorder.contacts()[0], run.recorder.contacts()[0]);
     assert!((a.onset_t_s - f.onset_t_s).abs() < 1e-6, "{a:?} {f:?}");
     assert!((a.approach_speed_m_s / f.approach_speed_m_s - 1.0).abs() < 0.01);
     assert!(
@@ -152,7 +152,7 @@ fn onset_interpolated_on_a_constant_velocity_approach() {
         let info = stepper.step(&mut world, &mut [&mut joints], end).unwrap();
         recorder.record(info.t0, info.dt, &before);
     }
-    let first = recorder.impacts()[0];
+    let first = recorder.contacts()[0];
     let onset = gap / v;
     assert!(
         (first.onset_t_s - onset).abs() < 1e-9,

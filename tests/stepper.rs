@@ -27,7 +27,7 @@ fn metrics(r: &RunResult) -> (f64, f64, f64, f64, f64) {
     let m = &twin.hinge_metrics()["hinge"];
     (
         m.first_impact_peak_n.unwrap(),
-        m.impacts as f64,
+        m.onsets as f64,
         m.contact_fraction,
         m.rms_force_n,
         twin.final_angles_deg()["hinge"],
@@ -96,6 +96,7 @@ fn the_output_interval_never_changes_the_physics() {
         assert_eq!(ta.final_angles_deg(), tb.final_angles_deg());
         assert_eq!(ta.final_angles_deg(), tc.final_angles_deg());
         let (ma, mb) = (&ta.hinge_metrics()["hinge"], &tb.hinge_metrics()["hinge"]);
+        assert_eq!(ma.onsets, mb.onsets);
         assert_eq!(ma.impacts, mb.impacts);
         assert_eq!(ma.peak_force_n, mb.peak_force_n);
         assert_eq!(ma.contact_fraction, mb.contact_fraction);

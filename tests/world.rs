@@ -70,7 +70,7 @@ fn large_step_hooks_run_inside_the_world_step() {
         "the readout is zero or low: {}",
         r.normal_force
     );
-    assert!(world.large_step.get(pin).unwrap().impacts() > 0);
+    assert!(world.large_step.get(pin).unwrap().bounces() > 0);
     assert!(world.guards().is_clean(), "{:?}", world.guards());
 }
 

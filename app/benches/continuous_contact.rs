@@ -118,7 +118,7 @@ fn measure(v: &Variant) -> String {
     let twin = r.twin(TwinKind::Clearance).unwrap();
     let rec = twin.hinge_recorders()["slider_pin"];
     let late: Vec<_> = rec
-        .impacts()
+        .contacts()
         .iter()
         .filter(|i| i.onset_t_s >= TURN)
         .collect();
@@ -131,7 +131,7 @@ fn measure(v: &Variant) -> String {
     );
     // The widest gap and longest flight before each late onset (rows at every step).
     let (mut widest, mut longest) = (0.0f64, 0.0f64);
-    let list = rec.impacts();
+    let list = rec.contacts();
     for (k, i) in list.iter().enumerate().filter(|(_, i)| i.onset_t_s >= TURN) {
         let from = k
             .checked_sub(1)

@@ -513,8 +513,9 @@ fn study(args: &StudyArgs) -> clearance_joint::Result<()> {
         for c in &o.cases {
             if let Some(h) = c.metrics.hinges.get(&o.study.hinge) {
                 println!(
-                    "  {:<22} impacts {:>5}  peak force {:>9.3} N  RMS force {:>7.3} N  final hinge angle {:>8.3} deg (ideal {:>8.3}){}",
+                    "  {:<22} onsets {:>5}  impacts {:>5}  peak force {:>9.3} N  RMS force {:>7.3} N  final hinge angle {:>8.3} deg (ideal {:>8.3}){}",
                     c.label,
+                    h.onsets,
                     h.impacts,
                     h.peak_force_n,
                     h.rms_force_n,

@@ -75,7 +75,7 @@ fn a_run_records_its_effective_scene_and_reruns_the_same() {
         scene["hinges"][0]["journal_offset_mm"],
         serde_json::json!([0.0, 0.0, 0.0])
     );
-    assert!(first["twins"]["clearance"]["impacts"].as_u64().unwrap() > 0);
+    assert!(first["twins"]["clearance"]["onsets"].as_u64().unwrap() > 0);
 
     let text = std::fs::read_to_string(dir.join("set/summary.json")).unwrap();
     let recorded = recorded_scene(&text, "summary.json").unwrap();

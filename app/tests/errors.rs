@@ -340,7 +340,7 @@ fn cli_writes_the_specified_files() {
         "wall_s",
         "final_angles_deg",
         "peak_joint_force_n",
-        "impacts",
+        "onsets",
         "first_impact_t_s",
         "first_impact_peak_n",
         "max_penetration_um",

@@ -229,7 +229,11 @@ fn sharded_sweep_merges_into_the_unsharded_table() {
     let lines: Vec<&str> = csv.lines().collect();
     assert_eq!(lines.len(), 4);
     assert!(lines[0].starts_with("index,dir,hinge.clearance_mm,dt_s,"));
-    assert!(lines[0].contains("hinge_impacts") && lines[0].contains("panel_rate_dev_rms_deg_s"));
+    assert!(
+        lines[0].contains("hinge_onsets")
+            && lines[0].contains("hinge_separated_impacts")
+            && lines[0].contains("panel_rate_dev_rms_deg_s")
+    );
     assert!(!csv.contains("NaN") && !csv.contains("inf"));
     let _ = std::fs::remove_dir_all(&out);
 }
@@ -461,7 +465,7 @@ fn clearance_study_shows_more_impacts_and_higher_peaks_as_c_grows() {
         .collect();
     let cs: Vec<f64> = h.iter().map(|m| m.clearance_mm).collect();
     assert_eq!(cs, [0.1, 0.25, 0.5]);
-    let impacts: Vec<u64> = h.iter().map(|m| m.impacts).collect();
+    let impacts: Vec<u64> = h.iter().map(|m| m.onsets).collect();
     let peaks: Vec<f64> = h.iter().map(|m| m.peak_force_n).collect();
     assert!(
         impacts.windows(2).all(|w| w[1] > w[0]),

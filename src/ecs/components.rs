@@ -191,7 +191,10 @@ pub enum HingeMode {
     LargeStep,
 }
 
-/// What a hinge did over the last step.
+/// What a hinge did over the last step, and over the last frame (`frame_*`). `force` is a
+/// sample at the state the step reached: in a rattle it jumps between 0 and the contact's peak
+/// from one step to the next, and [`frame_mean_force`](Self::frame_mean_force) is the load the
+/// frame carried.
 #[derive(Component, Clone, Copy, Debug, Default, PartialEq)]
 pub struct HingeState {
     /// What the hinge is realised as.
@@ -209,8 +212,27 @@ pub struct HingeState {
     pub force: f64,
     /// Largest `force` so far, N.
     pub peak_force: f64,
-    /// Contact onsets so far (clearance; large step: impacts, onsets above the joint's
-    /// `min_impact_speed`).
+    /// The joint force averaged over the last frame, N: its impulse over the frame's steps over
+    /// the frame's time, each state's force held over the step that followed it (as
+    /// [`HingeMetrics::rms_force_n`](crate::rapier::metrics::HingeMetrics::rms_force_n) weighs
+    /// it). A frame is one [`run_step`](super::run_step), the steps of one
+    /// [`run_frame`](super::run_frame), or the steps since [`Physics::begin_frame`](super::Physics::begin_frame).
+    /// Large step: the normal force times each step plus the bounces' impulses
+    /// ([`impulse`](Self::impulse)); ideal: the reaction at each step's start as the last step
+    /// computed it.
+    pub frame_mean_force: f64,
+    /// The largest joint force at the last frame's states, N: the state it began at and every
+    /// state it reached (at least every `force` read after its steps).
+    pub frame_peak_force: f64,
+    /// [Onsets](crate::rapier::metrics#onsets-impacts-and-chatter) so far: every contact that
+    /// began, chatter included (clearance and large step; 0 for ideal hinges). Equals
+    /// [`HingeMetrics::onsets`](crate::rapier::metrics::HingeMetrics::onsets) of the same states.
+    pub onsets: u64,
+    /// [Impacts](crate::rapier::metrics#onsets-impacts-and-chatter) so far: onsets after a free
+    /// flight that opened at least the joint's `min_separation` (large step: its bounces, onsets
+    /// faster than its `min_impact_speed`); `onsets - impacts` is the chatter. Equals
+    /// [`HingeMetrics::impacts`](crate::rapier::metrics::HingeMetrics::impacts) of the same
+    /// states. 0 for ideal hinges.
     pub impacts: u64,
     /// Penetration (clearance; negative: free gap), m.
     pub penetration: f64,
@@ -223,9 +245,9 @@ pub struct HingeState {
     pub eccentricity_ratio: f64,
     /// Motion mode (clearance).
     pub contact: ContactMode,
-    /// Normal impulse of an impact in the last step, N s (large step: `m_n (1 + e) v_approach`,
+    /// Normal impulse of a bounce in the last step, N s (large step: `m_n (1 + e) v_approach`,
     /// see [`LargeStepReport::impact_impulse`](crate::rapier::large_step::LargeStepReport::impact_impulse));
-    /// 0 without an impact, and always 0 for the compliant model, whose impacts are resolved
+    /// 0 without a bounce, and always 0 for the compliant model, whose contacts are resolved
     /// as force histories in `force`, and for ideal hinges.
     pub impulse: f64,
     /// Rapier substeps the hinge's bodies took in the last step (large step; it chooses them,
@@ -244,4 +266,24 @@ pub struct HingeState {
     pub spatial: Option<crate::rapier::joint::SpatialReport>,
     /// The unwrapped relative angle, referenced where the hinge was first realised.
     pub(super) angle_tracker: HingeAngle,
+    /// The impulse of the last frame's steps so far, N s.
+    pub(super) frame_impulse: f64,
+    /// The time of the last frame's steps so far, s.
+    pub(super) frame_time: f64,
+}
+
+impl HingeState {
+    /// Adds a step of `h` (s) to the frame: `impulse` (N s) over it, between states of force
+    /// `start` and `end` (N); `new_frame` empties the frame first.
+    pub(super) fn add_step(&mut self, new_frame: bool, h: f64, impulse: f64, start: f64, end: f64) {
+        if new_frame {
+            (self.frame_impulse, self.frame_time, self.frame_peak_force) = (0.0, 0.0, 0.0);
+        }
+        self.frame_impulse += impulse;
+        self.frame_time += h;
+        self.frame_peak_force = self.frame_peak_force.max(start).max(end);
+        if self.frame_time > 0.0 {
+            self.frame_mean_force = self.frame_impulse / self.frame_time;
+        }
+    }
 }

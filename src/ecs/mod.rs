@@ -15,8 +15,10 @@
 //!   friction laws). A hinge with neither joins nothing. When both are present, the clearance wins.
 //! - [`Drive`]: a torsion spring `T = T0 - k theta` on a hinge (on the hinge's entity).
 //! - [`HingeState`] and [`BodyState`] (added automatically): what the last step did (a hinge's
-//!   force, eccentricity and `|e|/c`, contact, impacts and impulse, the substeps of a
-//!   large-step hinge).
+//!   force, eccentricity and `|e|/c`, contact, impulse, the substeps of a large-step hinge;
+//!   the counts of onsets and impacts, see the
+//!   [definitions](crate::rapier::metrics#onsets-impacts-and-chatter); the force averaged over
+//!   the last frame and its peak: [`run_frame`] runs one frame of a game loop).
 //!
 //! A `ClearanceHinge` builds the compliant model unless its
 //! [`Clearance::model`](crate::rapier::convert::Clearance::model) is
@@ -155,5 +157,5 @@ pub use components::{
     Body, BodyState, ClearanceHinge, Drive, Hinge, HingeMode, HingeState, IdealHinge,
 };
 pub use physics::{HingeJoint, Physics};
-pub use schedule::{PhysicsSet, add_physics_systems, physics_schedule, run_step};
+pub use schedule::{PhysicsSet, add_physics_systems, physics_schedule, run_frame, run_step};
 pub use systems::{apply_forces, record, step_physics, sync_bodies, sync_hinges};

@@ -70,6 +70,16 @@ pub struct Physics {
     pub(super) hinge_passes: u64,
     reactions: ReactionSolver,
     ideal_joints: Vec<IdealJoint>,
+    /// Set by [`begin_frame`](Self::begin_frame): the next recorded step empties the hinges'
+    /// frame figures first.
+    new_frame: bool,
+    /// The end of the frame [`run_frame`](super::run_frame) is running, s: its last step lands
+    /// there.
+    frame_end: Option<f64>,
+    /// Each hinge's force at the start of the step just taken, N: the force that step held.
+    start_forces: BTreeMap<Entity, f64>,
+    /// The ideal hinges' reactions at the state the last record saw, with the step count then.
+    ideal_cache: (u64, BTreeMap<Entity, f64>),
 }
 
 impl Physics {
@@ -103,14 +113,19 @@ impl Physics {
             hinge_passes: 0,
             reactions: ReactionSolver::default(),
             ideal_joints: Vec::new(),
+            new_frame: true,
+            frame_end: None,
+            start_forces: BTreeMap::new(),
+            ideal_cache: (u64::MAX, BTreeMap::new()),
         }
     }
 
     /// The step control: fixed steps of `world.rapier.integration_parameters.dt` by default (changing
     /// `dt` between steps is followed). With [`StepControl::adaptive`] each run of the schedule
     /// takes ONE accepted step of the stepper's choice, at most up to `time() + dt`: inside
-    /// contacts that step is far shorter than a frame, so a game loop must run the schedule until
-    /// `time()` reaches the frame's time (each run records its state and impacts).
+    /// contacts that step is far shorter than a frame, so a game loop runs the schedule until
+    /// `time()` reaches the frame's time ([`run_frame`](super::run_frame); each run records its
+    /// state and counts, and adds to the frame's mean and peak force).
     pub fn set_step_control(&mut self, control: StepControl) {
         self.world.set_step_control(control);
     }
@@ -140,6 +155,16 @@ impl Physics {
             HingeJoint::LargeStep(h) => self.world.large_step.get(h),
             _ => None,
         }
+    }
+
+    /// Begins a frame: the hinges' frame figures
+    /// ([`HingeState::frame_mean_force`](super::HingeState::frame_mean_force),
+    /// [`frame_peak_force`](super::HingeState::frame_peak_force)) cover the steps from the next
+    /// one until the next call. [`run_step`](super::run_step) and
+    /// [`run_frame`](super::run_frame) call it; a schedule run by hand calls it at the start of
+    /// each frame (without it, the frame is every step since the world's first).
+    pub fn begin_frame(&mut self) {
+        self.new_frame = true;
     }
 
     /// Simulated time, s.
@@ -494,11 +519,15 @@ impl Physics {
         self.world.prepare()
     }
 
-    /// One accepted step of the world's step control, at most `integration_parameters.dt` long.
+    /// One accepted step of the world's step control, at most `integration_parameters.dt` long
+    /// (and ending at most at the frame's end under [`run_frame`](super::run_frame)).
     pub(super) fn step(&mut self) -> Result<()> {
         let dt = self.world.rapier.integration_parameters.dt;
         follow_dt(&mut self.world);
-        let until = self.world.time() + dt;
+        // The forces the step holds are those at its start (evaluated by `apply_forces`): read
+        // them before it.
+        self.start_forces = self.hinge_forces_now()?;
+        let until = (self.world.time() + dt).min(self.frame_end.unwrap_or(f64::INFINITY));
         let result = self.world.step(until);
         // Rapier's `dt` as the user set it (the stepper sets it per step).
         self.world.rapier.integration_parameters.dt = dt;
@@ -513,9 +542,45 @@ impl Physics {
         })
     }
 
+    /// Whether a step begins a new frame (and clears it).
+    pub(super) fn take_new_frame(&mut self) -> bool {
+        std::mem::take(&mut self.new_frame)
+    }
+
+    /// Sets the end of the frame being run (`None`: no end).
+    pub(super) fn set_frame_end(&mut self, end: Option<f64>) {
+        self.frame_end = end;
+    }
+
+    /// The force each hinge held over the step just taken (its force at the step's start), N.
+    pub(super) fn start_force(&self, entity: Entity) -> f64 {
+        self.start_forces.get(&entity).copied().unwrap_or(0.0)
+    }
+
+    /// Each compliant and ideal hinge's force at the current state, N (a large-step hinge's
+    /// readout is its step's own). The ideal reactions are the last record's when it saw this
+    /// state; solved here otherwise.
+    fn hinge_forces_now(&mut self) -> Result<BTreeMap<Entity, f64>> {
+        let ideal_missing = self.hinges.iter().any(|(e, r)| {
+            matches!(r.joint, HingeJoint::Ideal(_)) && !self.ideal_cache.1.contains_key(e)
+        });
+        if self.ideal_cache.0 != self.world.steps() || ideal_missing {
+            self.ideal_forces()?;
+        }
+        let mut forces = self.ideal_cache.1.clone();
+        for (e, r) in &self.hinges {
+            if let HingeJoint::Clearance(h) = r.joint
+                && let Some(j) = self.world.clearance.get(h)
+            {
+                forces.insert(*e, j.report().force.on_journal.length());
+            }
+        }
+        Ok(forces)
+    }
+
     /// The ideal hinges' reaction magnitudes, N, by entity, at the current state
-    /// ([`ClearanceWorld::solve_reactions`], the runner's piece). A solve that fails (a
-    /// non-finite state or mass) is an error, never a zero force.
+    /// ([`ClearanceWorld::solve_reactions`], the runner's piece), kept for the next step's
+    /// start. A solve that fails (a non-finite state or mass) is an error, never a zero force.
     pub(super) fn ideal_forces(&mut self) -> Result<BTreeMap<Entity, f64>> {
         self.ideal_joints.clear();
         let mut ideal_entities = Vec::new();
@@ -532,7 +597,8 @@ impl Physics {
             }
         }
         let t = self.world.time();
-        self.world
+        let forces: BTreeMap<Entity, f64> = self
+            .world
             .solve_reactions(&mut self.reactions, &self.ideal_joints)
             .map(|f| {
                 ideal_entities
@@ -546,7 +612,9 @@ impl Physics {
                 reason: "the ideal hinges' reactions cannot be solved: the state or a body's \
                          mass is not finite"
                     .into(),
-            })
+            })?;
+        self.ideal_cache = (self.world.steps(), forces.clone());
+        Ok(forces)
     }
 }
 

@@ -45,16 +45,57 @@ pub fn physics_schedule() -> Schedule {
     schedule
 }
 
-/// Runs `schedule` (one physics step) and returns the error it met, if any (taken out of
-/// [`Physics`]).
+/// Runs `schedule` (one physics step, a frame of its own: see
+/// [`HingeState::frame_mean_force`](super::HingeState::frame_mean_force)) and returns the error
+/// it met, if any (taken out of [`Physics`]).
 pub fn run_step(world: &mut World, schedule: &mut Schedule) -> Result<()> {
-    if !world.contains_resource::<Physics>() {
+    physics_of(world)?.begin_frame();
+    run_once(world, schedule)
+}
+
+/// Runs `schedule` until [`Physics::time`] reaches `duration` (s) later: one frame of a game
+/// loop, whatever steps the step control takes (the last lands on the frame's end). The hinges'
+/// frame figures ([`HingeState::frame_mean_force`](super::HingeState::frame_mean_force),
+/// [`frame_peak_force`](super::HingeState::frame_peak_force)) cover its steps. Returns the
+/// steps taken, or the first error (taken out of [`Physics`]; the frame stops there).
+pub fn run_frame(world: &mut World, schedule: &mut Schedule, duration: f64) -> Result<u64> {
+    if !(duration > 0.0 && duration.is_finite()) {
         return Err(Error::invalid(
+            "duration",
+            format!("must be a positive, finite time in seconds (got {duration})"),
+        ));
+    }
+    let mut physics = physics_of(world)?;
+    physics.begin_frame();
+    let end = physics.time() + duration;
+    physics.set_frame_end(Some(end));
+    let mut taken = 0;
+    let result = loop {
+        if world.resource::<Physics>().time() >= end {
+            break Ok(taken);
+        }
+        if let Err(e) = run_once(world, schedule) {
+            break Err(e);
+        }
+        taken += 1;
+    };
+    world.resource_mut::<Physics>().set_frame_end(None);
+    result
+}
+
+/// The [`Physics`] resource of `world`, or the error that names it missing.
+fn physics_of(world: &mut World) -> Result<Mut<'_, Physics>> {
+    world.get_resource_mut::<Physics>().ok_or_else(|| {
+        Error::invalid(
             "Physics",
             "no such resource in the world: insert one with `world.insert_resource(Physics::new(dt, gravity))` \
              (or `Physics::from_world(your_rapier_world)`)",
-        ));
-    }
+        )
+    })
+}
+
+/// Runs `schedule` once and takes its error out of [`Physics`].
+fn run_once(world: &mut World, schedule: &mut Schedule) -> Result<()> {
     schedule.run(world);
     world.clear_trackers();
     match world.resource_mut::<Physics>().take_error() {

@@ -162,7 +162,8 @@ pub fn step_physics(mut physics: ResMut<Physics>) {
     }
 }
 
-/// Copies the state of the step into [`HingeState`] and [`BodyState`].
+/// Copies the state of the step into [`HingeState`] and [`BodyState`], and adds the step to
+/// each hinge's frame figures.
 pub fn record(
     mut physics: ResMut<Physics>,
     mut hinges: Query<(Entity, &Hinge, &mut HingeState)>,
@@ -178,7 +179,9 @@ pub fn record(
             return;
         }
     };
+    let new_frame = physics.take_new_frame();
     let physics = &*physics;
+    let h = physics.world.last_dt();
     let w = &physics.world.rapier;
     for (body, mut state) in bodies.iter_mut() {
         if let Some(rb) = body.handle.and_then(|h| w.bodies.get(h)) {
@@ -202,6 +205,8 @@ pub fn record(
             .angle_tracker
             .update(rb1.rotation(), rb2.rotation(), axis1);
         state.rate = (rb2.angvel() - rb1.angvel()).dot(*rb1.rotation() * axis1);
+        // The impulse the step carried beyond its force times `h` (a large-step bounce's).
+        let mut extra_impulse = 0.0;
         match joint {
             HingeJoint::Ideal(_) => {
                 state.force = ideal_forces.get(&entity).copied().unwrap_or(0.0);
@@ -223,9 +228,8 @@ pub fn record(
                     state.contact = rep.mode;
                     state.spatial = rep.spatial;
                     (state.impulse, state.substeps, state.under_resolved) = (0.0, 0, false);
-                    if rep.onset {
-                        state.impacts += 1;
-                    }
+                    state.onsets += u64::from(rep.onset);
+                    state.impacts += u64::from(rep.impact);
                 }
             }
             HingeJoint::LargeStep(k) => {
@@ -244,12 +248,20 @@ pub fn record(
                         (true, true) => ContactMode::Impact,
                         (true, false) => ContactMode::Continuous,
                     };
-                    if rep.impact {
-                        state.impacts += 1;
-                    }
+                    state.onsets += u64::from(rep.onset);
+                    state.impacts += u64::from(rep.bounce);
+                    extra_impulse = rep.impact_impulse;
                 }
             }
         }
         state.peak_force = state.peak_force.max(state.force);
+        // The force the step held: the state's at its start; a large-step hinge's readout is
+        // its step's own.
+        let start = match joint {
+            HingeJoint::LargeStep(_) => state.force,
+            _ => physics.start_force(entity),
+        };
+        let force = state.force;
+        state.add_step(new_frame, h, start * h + extra_impulse, start, force);
     }
 }

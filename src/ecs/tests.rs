@@ -6,6 +6,8 @@ use crate::error::{Error, Result};
 use crate::model::kinematics::ContactMode;
 use crate::model::laws::{Bai, FrictionModel};
 use crate::rapier::convert::{Clearance, ClearanceModel};
+use crate::rapier::metrics::{ContactObservation, ImpactRecorder};
+use crate::rapier::stepper::StepControl;
 use bevy_ecs::prelude::*;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{MassProperties, PhysicsWorld, RigidBodyBuilder};
@@ -92,7 +94,7 @@ fn swapping_the_mode_converts_the_rapier_joint_both_ways() {
     assert_eq!(p.world.rapier.impulse_joints.len(), 1, "only the lock");
     let s = world.get::<HingeState>(hinge).unwrap();
     assert_eq!(s.mode, HingeMode::Clearance);
-    assert!(s.impacts > 0);
+    assert!(s.onsets > 0);
     assert!((s.force - 19.62).abs() < 0.02, "{}", s.force);
     assert!(s.penetration > 0.0);
 
@@ -346,13 +348,13 @@ fn errors_are_values_and_stop_the_systems() {
 #[test]
 fn an_unnamed_clearance_hinge_is_realised_once() {
     // The joint is named after its entity; the component is not. Comparing the two rebuilt
-    // the joint (and reset its contact history) at every step: 17,659 "impacts" in 20,000
+    // the joint (and reset its contact history) at every step: 17,659 onsets in 20,000
     // steps instead of the pendulum's 18.
     let (mut world, mut schedule, _, hinge) = pendulum(1e-5);
     world.entity_mut(hinge).insert(ClearanceHinge(clearance()));
     steps(&mut world, &mut schedule, 20_000).unwrap();
     let s = world.get::<HingeState>(hinge).unwrap();
-    assert!(s.impacts > 0 && s.impacts < 100, "{} impacts", s.impacts);
+    assert!(s.onsets > 0 && s.onsets < 100, "{} onsets", s.onsets);
     let p = world.resource::<Physics>();
     assert_eq!(
         p.clearance_joint(hinge).unwrap().name(),
@@ -571,6 +573,11 @@ fn hinge_state_carries_the_readouts() {
         if s.impulse > 0.0 {
             impulses.push(s.impulse);
         }
+        // A one-step frame: the step's normal force plus its bounce's impulse over the step.
+        let mean = r.normal_force + r.impact_impulse * 60.0;
+        assert!((s.frame_mean_force - mean).abs() <= 1e-12 * mean.max(1.0));
+        let j = world.resource::<Physics>().large_step_joint(hinge).unwrap();
+        assert_eq!((s.onsets, s.impacts), (j.onsets(), j.bounces()));
     }
     assert!(!impulses.is_empty(), "the journal hit the wall");
 }
@@ -809,4 +816,117 @@ fn a_game_worlds_stack_stands_because_its_iterations_are_left_alone() {
     // One iteration, as the compliant model needs, for the whole world: the stack falls.
     let top = stack_beside_a_sign(1);
     assert!(top.y < 1.0, "{top:?}");
+}
+
+/// A 2 kg arm released horizontal on a clearance hinge (0.2 mm of play, dry friction), stepped
+/// adaptively (at most 1 ms a run): its journal rattles in the bearing as it swings.
+fn rattling_pendulum() -> (World, Schedule, Entity) {
+    let (mut world, base) = compliant_world(1e-3);
+    world
+        .resource_mut::<Physics>()
+        .set_step_control(StepControl::adaptive(1e-3, 0.02));
+    let arm = world
+        .spawn(arm_with_centre(Vector::new(0.3, 0.0, 0.0)))
+        .id();
+    let hinge = world
+        .spawn((
+            Hinge::new(base, arm, Vector::Z).local_anchor2(Vector::new(-0.3, 0.0, 0.0)),
+            ClearanceHinge(clearance()),
+        ))
+        .id();
+    (world, physics_schedule(), hinge)
+}
+
+/// One run of `schedule` inside the current frame (`run_step` would begin a new one).
+fn step_in_frame(world: &mut World, schedule: &mut Schedule) {
+    schedule.run(world);
+    world.clear_trackers();
+    assert!(world.resource::<Physics>().error().is_none());
+}
+
+#[test]
+fn the_frame_mean_is_the_step_weighted_force_and_the_peak_bounds_every_sample() {
+    let (mut world, mut schedule, hinge) = rattling_pendulum();
+    run_frame(&mut world, &mut schedule, 0.1).unwrap();
+    let time = |w: &World| w.resource::<Physics>().time();
+    // One 1/60 s frame by hand: each state's force held over the step that followed it.
+    let mut samples = vec![world.get::<HingeState>(hinge).unwrap().force];
+    let (mut impulse, t0) = (0.0, time(&world));
+    world.resource_mut::<Physics>().begin_frame();
+    while time(&world) < t0 + 1.0 / 60.0 {
+        let t = time(&world);
+        step_in_frame(&mut world, &mut schedule);
+        impulse += samples.last().unwrap() * (time(&world) - t);
+        samples.push(world.get::<HingeState>(hinge).unwrap().force);
+    }
+    let s = *world.get::<HingeState>(hinge).unwrap();
+    let mean = impulse / (time(&world) - t0);
+    let (min, max) = samples
+        .iter()
+        .fold((f64::INFINITY, 0.0_f64), |(a, b), f| (a.min(*f), b.max(*f)));
+    eprintln!(
+        "frame of {} steps: samples {min:.3}..{max:.3} N, last {:.3} N, mean {:.3} N, peak {:.3} N",
+        samples.len() - 1,
+        s.force,
+        s.frame_mean_force,
+        s.frame_peak_force
+    );
+    // A rattle: the samples jump between free flight and contact.
+    assert!(min < 0.5 * mean && max > 2.0 * mean, "{samples:?}");
+    assert!((s.frame_mean_force - mean).abs() <= 1e-12 * mean);
+    assert!(min <= s.frame_mean_force && s.frame_mean_force <= max);
+    assert_eq!(s.frame_peak_force, max);
+}
+
+#[test]
+fn run_frame_lands_on_the_frames_end_and_covers_its_steps() {
+    let (mut world, mut schedule, hinge) = rattling_pendulum();
+    run_frame(&mut world, &mut schedule, 0.1).unwrap();
+    let t0 = world.resource::<Physics>().time();
+    let steps = run_frame(&mut world, &mut schedule, 1.0 / 60.0).unwrap();
+    let t1 = world.resource::<Physics>().time();
+    assert!((t1 - t0 - 1.0 / 60.0).abs() < 1e-12, "{t0} -> {t1}");
+    assert!(steps > 1, "{steps} steps");
+    let s = *world.get::<HingeState>(hinge).unwrap();
+    assert!(s.frame_mean_force > 0.0 && s.frame_mean_force <= s.frame_peak_force);
+    assert!(s.frame_peak_force <= s.peak_force && s.force <= s.frame_peak_force);
+    // A step is a frame of its own: its mean is the force its start state held.
+    let start = s.force;
+    run_step(&mut world, &mut schedule).unwrap();
+    let s = *world.get::<HingeState>(hinge).unwrap();
+    assert_eq!(s.frame_mean_force, start);
+    assert_eq!(s.frame_peak_force, start.max(s.force));
+    let e = run_frame(&mut world, &mut schedule, 0.0).unwrap_err();
+    assert!(e.to_string().contains("duration"), "{e}");
+}
+
+#[test]
+fn onsets_and_impacts_are_the_metrics_of_the_same_states() {
+    // 2 s of the rattling pendulum, every state also recorded by the library's recorder.
+    let (mut world, mut schedule, hinge) = rattling_pendulum();
+    let mut recorder = ImpactRecorder::new();
+    let observe =
+        |w: &World| ContactObservation::of(w.resource::<Physics>().clearance_joint(hinge).unwrap());
+    while world.resource::<Physics>().time() < 2.0 {
+        let t = world.resource::<Physics>().time();
+        let before = if t > 0.0 {
+            observe(&world)
+        } else {
+            ContactObservation::default()
+        };
+        run_step(&mut world, &mut schedule).unwrap();
+        recorder.record(t, world.resource::<Physics>().time() - t, &before);
+    }
+    recorder.finish(world.resource::<Physics>().time(), &observe(&world));
+    let s = world.get::<HingeState>(hinge).unwrap();
+    let m = recorder.metrics();
+    eprintln!(
+        "2 s: {} onsets, {} impacts, {} chatter",
+        s.onsets,
+        s.impacts,
+        s.onsets - s.impacts
+    );
+    assert_eq!((s.onsets, s.impacts), (m.onsets, m.impacts));
+    // Chatter: one counter could not be both.
+    assert!(s.impacts > 0 && s.onsets > s.impacts);
 }

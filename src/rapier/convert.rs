@@ -175,7 +175,9 @@ pub struct Clearance {
     pub friction: FrictionModel,
     /// Floor on the impact velocity of the hysteresis laws, m/s (default 1e-4).
     pub min_impact_speed: f64,
-    /// Gap a free flight must open for the next contact to count as an impact, m (default 0.1 um).
+    /// Gap a free flight must open for the next onset to count as an
+    /// [impact](crate::rapier::metrics#onsets-impacts-and-chatter), m (default 0.1 um; the
+    /// large-step model does not count impacts and ignores it).
     pub min_separation: f64,
     /// The deepest penetration at which the contact law is trusted, m; deeper contacts are guard
     /// violations ([`ClearanceJointBuilder::max_valid_penetration`]). `None` (the default): 1 % of
@@ -188,8 +190,8 @@ pub struct Clearance {
     pub name: Option<String>,
     /// Which model to build (default [`ClearanceModel::Compliant`]).
     pub model: ClearanceModel,
-    /// Coefficient of restitution of the large-step model's impacts; `None` (the default): the
-    /// normal law's own restitution at each impact ([`crate::rapier::large_step::Restitution::Law`]).
+    /// Coefficient of restitution of the large-step model's bounces; `None` (the default): the
+    /// normal law's own restitution at each bounce ([`crate::rapier::large_step::Restitution::Law`]).
     /// The compliant and spatial models take their restitution from their laws:
     /// [`joint`](Self::joint) refuses a set one, naming `restitution`.
     pub restitution: Option<f64>,
@@ -274,8 +276,9 @@ impl Clearance {
         self
     }
 
-    /// Sets the gap a free flight must open for the next contact to count as an impact, m
-    /// (checked when the joint is built: not negative).
+    /// Sets the gap a free flight must open for the next onset to count as an
+    /// [impact](crate::rapier::metrics#onsets-impacts-and-chatter), m (checked when the joint is
+    /// built: not negative).
     pub fn min_separation(mut self, gap: f64) -> Self {
         self.min_separation = gap;
         self

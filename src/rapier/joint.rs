@@ -123,8 +123,9 @@ impl ClearanceJointBuilder {
         self.joint.min_impact_speed = speed;
         self
     }
-    /// The gap a free flight must open for the next contact to count as a new impact, m
-    /// (default 0.1 um, about 8 times the resting penetration of the paper's hinge load): smaller
+    /// The gap a free flight must open for the next onset to count as an
+    /// [impact](crate::rapier::metrics#onsets-impacts-and-chatter), m (default 0.1 um, about 8
+    /// times the resting penetration of the paper's hinge load): onsets after smaller
     /// separations are the chatter of a journal following the wall.
     pub fn min_separation(mut self, gap: f64) -> Self {
         self.joint.min_separation = gap;
@@ -290,11 +291,13 @@ pub struct ClearanceReport {
     pub state: JournalState,
     /// Motion mode.
     pub mode: ContactMode,
-    /// Whether a contact began at this application (any onset, chatter included).
+    /// Whether a contact began at this application: an
+    /// [onset](crate::rapier::metrics#onsets-impacts-and-chatter), chatter included.
     pub onset: bool,
-    /// Whether this onset is an impact: the first contact, or one after a free flight that opened
-    /// a gap of at least the joint's `min_separation`. Re-contacts after smaller separations are
-    /// chatter of a journal following the wall, not new impacts.
+    /// Whether this onset is an [impact](crate::rapier::metrics#onsets-impacts-and-chatter): the
+    /// first contact, or one after a free flight that opened a gap of at least the joint's
+    /// `min_separation`. Re-contacts after smaller separations are chatter of a journal
+    /// following the wall, not impacts.
     pub impact: bool,
     /// `delta_dot0` the normal law used at this application (0 in free flight), m/s: the
     /// approach speed at the crossing of delta = 0, floored by the joint's `min_impact_speed`

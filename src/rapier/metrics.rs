@@ -1,6 +1,33 @@
-//! Joint metrics a loop of your own can record: the impact list of a clearance joint (onset,
+//! Joint metrics a loop of your own can record: the contact list of a clearance joint (onset,
 //! approach speed, peak force, deepest penetration, duration of every contact), the fraction of
 //! time in contact, peak, RMS and first-impact figures.
+//!
+//! # Onsets, impacts and chatter
+//!
+//! Every layer (the joints' reports, these metrics, the scene runner, the bevy_ecs layer's
+//! [`HingeState`](crate::ecs::HingeState), the app's summaries and studies) counts contacts
+//! with these words:
+//!
+//! - **Onset**: the penetration crosses 0 into contact: the first state in contact after a
+//!   state out of it ([`ClearanceReport::onset`](crate::rapier::joint::ClearanceReport::onset)).
+//!   Every contact begins with one.
+//! - **Impact**: an onset after a free flight that opened a gap of at least the joint's
+//!   `min_separation` ([`ClearanceJointBuilder::min_separation`](crate::rapier::joint::ClearanceJointBuilder::min_separation),
+//!   [`DEFAULT_MIN_SEPARATION`](crate::rapier::joint::DEFAULT_MIN_SEPARATION) = 0.1 um); the
+//!   first contact of a joint is always one
+//!   ([`ClearanceReport::impact`](crate::rapier::joint::ClearanceReport::impact)).
+//! - **Chatter**: the onsets that are not impacts: a journal following the wall that lifts off
+//!   by less than `min_separation` and touches again. Chatter = onsets - impacts.
+//! - **Bounce**: an onset of the [large-step model](crate::rapier::large_step) whose approach
+//!   speed exceeds the joint's `min_impact_speed`, which Newton's impact law gives a rebound
+//!   ([`LargeStepJoint::bounces`](crate::rapier::large_step::LargeStepJoint::bounces)). That
+//!   model resolves the journal's position to a few percent of the clearance, too coarse for a
+//!   separation of `min_separation`: its bounces are its impacts (in these metrics, the scene
+//!   runner's and the bevy_ecs layer's), and its chatter the onsets that approach slower.
+//!
+//! [`HingeMetrics::onsets`] and [`HingeMetrics::impacts`] count the first two over a run; the
+//! contact list ([`ImpactRecorder::contacts`]) holds every onset, [`Impact::separated`] marking
+//! the impacts.
 //!
 //! The scene runner records its hinges with the same [`ImpactRecorder`], so a plain-Rapier loop
 //! that records the same states gets the same numbers. A state is recorded with the step that
@@ -37,9 +64,10 @@
 //! }
 //! recorder.finish(stepper.time(), &ContactObservation::of(clearance.get(pivot).unwrap()));
 //! // The journal drops through the 0.2 mm gap and bounces on the bearing's floor.
-//! let first = &recorder.impacts()[0];
+//! let first = &recorder.contacts()[0];
 //! assert!(first.approach_speed_m_s > 0.01 && first.peak_force_n > 100.0);
-//! assert_eq!(recorder.metrics().impacts as usize, recorder.impacts().len());
+//! assert_eq!(recorder.metrics().onsets as usize, recorder.contacts().len());
+//! assert!(recorder.metrics().impacts <= recorder.metrics().onsets);
 //! # Ok::<(), clearance_joint::Error>(())
 //! ```
 
@@ -59,10 +87,12 @@ pub struct ContactObservation {
     /// Joint force magnitude, N (the contact and friction force on the journal; for an ideal
     /// joint, its reaction).
     pub force: f64,
-    /// Whether a contact began at this state (any onset, chatter included).
+    /// Whether a contact began at this state: an [onset](crate::rapier::metrics#onsets-impacts-and-chatter),
+    /// chatter included.
     pub onset: bool,
-    /// Whether this onset is an impact after a real separation (see
-    /// [`ClearanceReport::impact`](crate::rapier::joint::ClearanceReport::impact)).
+    /// Whether this onset is an [impact](crate::rapier::metrics#onsets-impacts-and-chatter), after a separation
+    /// of at least the joint's `min_separation`
+    /// ([`ClearanceReport::impact`](crate::rapier::joint::ClearanceReport::impact)).
     pub impact: bool,
     /// Penetration, m (negative: the gap).
     pub penetration: f64,
@@ -108,7 +138,8 @@ impl ContactObservation {
     }
 }
 
-/// One contact of a clearance joint, from its onset to the first state out of contact.
+/// One contact of a clearance joint, from its onset to the first state out of contact: an
+/// impact or chatter ([`separated`](Self::separated); see the [definitions](crate::rapier::metrics#onsets-impacts-and-chatter)).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Impact {
     /// Time of the crossing of delta = 0, s: interpolated inside the step that led to the first
@@ -125,8 +156,8 @@ pub struct Impact {
     /// inside the step that led to the first state out of contact as the onset is (up to the end
     /// of the run for a contact still closed there).
     pub duration_s: f64,
-    /// Whether the onset came after a free flight that opened at least the joint's
-    /// `min_separation` (an impact; otherwise chatter of a journal following the wall).
+    /// Whether the onset is an [impact](crate::rapier::metrics#onsets-impacts-and-chatter): it came after a free
+    /// flight that opened at least the joint's `min_separation` (otherwise it is chatter).
     pub separated: bool,
 }
 
@@ -135,11 +166,14 @@ pub struct Impact {
 pub struct HingeMetrics {
     /// Largest joint force, N.
     pub peak_force_n: f64,
-    /// Number of contact onsets, chatter of a journal following the wall included.
+    /// [Onsets](crate::rapier::metrics#onsets-impacts-and-chatter): every contact that began, chatter included.
+    /// JSON key `onsets`.
+    pub onsets: u64,
+    /// [Impacts](crate::rapier::metrics#onsets-impacts-and-chatter): onsets after a free flight that opened at
+    /// least the joint's `min_separation` (the first contact always counts); `onsets - impacts`
+    /// is the chatter. JSON key `separated_impacts`.
+    #[serde(rename = "separated_impacts")]
     pub impacts: u64,
-    /// Contact onsets after a free flight that opened at least the joint's `min_separation`
-    /// (0.1 um by default; the first contact always counts): impacts without the chatter.
-    pub separated_impacts: u64,
     /// Time of the first contact onset, s.
     pub first_impact_t_s: Option<f64>,
     /// Largest force during the first contact, N.
@@ -232,7 +266,7 @@ impl ImpactRecorder {
         // The last state was in contact and this one is not.
         let lift_off = self.last_penetration > 0.0 && !in_contact;
         if obs.impact {
-            m.separated_impacts += 1;
+            m.impacts += 1;
         }
         // The crossing of delta = 0 inside the step that led here.
         let (onset_t, approach) = if obs.onset && obs.onset_fraction > 0.0 {
@@ -269,7 +303,7 @@ impl ImpactRecorder {
         if obs.onset {
             // In contact from the crossing on.
             self.contact_time += t - onset_t;
-            m.impacts += 1;
+            m.onsets += 1;
             if m.first_impact_t_s.is_none() {
                 m.first_impact_t_s = Some(onset_t);
                 m.first_impact_peak_n = Some(0.0);
@@ -366,8 +400,9 @@ impl ImpactRecorder {
         self.metrics.final_angle_deg = angle;
     }
 
-    /// Every contact so far, in order of onset.
-    pub fn impacts(&self) -> &[Impact] {
+    /// Every contact so far, in order of onset: one per onset, chatter included
+    /// ([`Impact::separated`] marks the impacts).
+    pub fn contacts(&self) -> &[Impact] {
         &self.impacts
     }
 
@@ -376,9 +411,9 @@ impl ImpactRecorder {
         self.contact_time
     }
 
-    /// The impact list as a table: `onset_t_s, approach_speed_mm_s, peak_force_n,
-    /// max_penetration_um, duration_s, separated` (1 or 0).
-    pub fn impacts_table(&self) -> Table {
+    /// The contact list as a table: `onset_t_s, approach_speed_mm_s, peak_force_n,
+    /// max_penetration_um, duration_s, separated` (1 for an impact, 0 for chatter).
+    pub fn contacts_table(&self) -> Table {
         let mut t = Table::new(
             [
                 "onset_t_s",
@@ -412,18 +447,21 @@ pub struct PeriodStats {
     pub start_s: f64,
     /// Its length, s (the last period may be cut short by the end of the run).
     pub length_s: f64,
-    /// Contacts that began in it.
+    /// [Onsets](crate::rapier::metrics#onsets-impacts-and-chatter) in it: contacts that began in it, chatter
+    /// included.
+    pub onsets: u64,
+    /// [Impacts](crate::rapier::metrics#onsets-impacts-and-chatter) in it: its onsets after a
+    /// separation. JSON key `separated_impacts`.
+    #[serde(rename = "separated_impacts")]
     pub impacts: u64,
-    /// Contacts that began in it after a real separation.
-    pub separated_impacts: u64,
     /// Largest peak force of the contacts that began in it, N (0 without one).
     pub peak_force_n: f64,
     /// Time in contact within it, s (contacts are split at the period's bounds).
     pub contact_s: f64,
 }
 
-/// Per-period statistics of an impact list over `[0, end)` in periods of `period` (s): impacts,
-/// peak force and time in contact per crank turn. A contact's duration is the contiguous span
+/// Per-period statistics of a contact list over `[0, end)` in periods of `period` (s): onsets,
+/// impacts, peak force and time in contact per crank turn. A contact's duration is the contiguous span
 /// from its onset, so the time in contact is split exactly at the bounds; its peak counts in the
 /// period of its onset. Empty for a period or end that is not positive (or NaN); an error when
 /// `end / period` is more than [`MAX_PERIODS`] (or infinite): the table would not fit in
@@ -458,8 +496,8 @@ pub fn per_period(impacts: &[Impact], period: f64, end: f64) -> Result<Vec<Perio
     for i in impacts {
         let k = ((i.onset_t_s / period) as usize).min(n - 1);
         let p = &mut out[k];
-        p.impacts += 1;
-        p.separated_impacts += u64::from(i.separated);
+        p.onsets += 1;
+        p.impacts += u64::from(i.separated);
         p.peak_force_n = p.peak_force_n.max(i.peak_force_n);
         let (a, b) = (i.onset_t_s, i.onset_t_s + i.duration_s);
         for p in out.iter_mut().skip(k) {
@@ -476,14 +514,14 @@ pub fn per_period(impacts: &[Impact], period: f64, end: f64) -> Result<Vec<Perio
 /// Most periods [`per_period`] tabulates (a table of about 50 MB).
 pub const MAX_PERIODS: usize = 1_000_000;
 
-/// The per-period statistics as a table: `turn, start_s, impacts, separated_impacts,
-/// peak_force_n, contact_fraction`.
+/// The per-period statistics as a table: `turn, start_s, onsets, separated_impacts,
+/// peak_force_n, contact_fraction` (`separated_impacts`: the [impacts](crate::rapier::metrics#onsets-impacts-and-chatter)).
 pub fn per_period_table(periods: &[PeriodStats]) -> Table {
     let mut t = Table::new(
         [
             "turn",
             "start_s",
-            "impacts",
+            "onsets",
             "separated_impacts",
             "peak_force_n",
             "contact_fraction",
@@ -495,8 +533,8 @@ pub fn per_period_table(periods: &[PeriodStats]) -> Table {
         t.values.extend_from_slice(&[
             k as f64,
             p.start_s,
+            p.onsets as f64,
             p.impacts as f64,
-            p.separated_impacts as f64,
             p.peak_force_n,
             if p.length_s > 0.0 {
                 p.contact_s / p.length_s
@@ -539,7 +577,7 @@ mod tests {
             r.record(*t, *dt, o);
         }
         r.finish(1.0, &obs(6.0, 1.5, 0.0, false));
-        let i = r.impacts();
+        let i = r.contacts();
         assert_eq!(i.len(), 2);
         assert_eq!(i[0].onset_t_s, 0.1);
         assert_eq!(i[0].approach_speed_m_s, 0.02);
@@ -551,7 +589,7 @@ mod tests {
         assert_eq!(i[1].peak_force_n, 6.0);
         assert_eq!(i[1].duration_s, 0.5);
         let m = r.metrics();
-        assert_eq!((m.impacts, m.separated_impacts), (2, 2));
+        assert_eq!((m.onsets, m.impacts), (2, 2));
         assert_eq!(m.first_impact_t_s, Some(0.1));
         assert_eq!(m.first_impact_peak_n, Some(30.0));
         assert_eq!(m.peak_force_n, 30.0);
@@ -560,7 +598,7 @@ mod tests {
         assert!((m.rms_force_n - 112.5f64.sqrt()).abs() < 1e-12);
         // Restitution: left at 0.01 m/s after approaching at 0.02.
         assert!((m.max_restitution - 0.5).abs() < 1e-15);
-        assert_eq!(r.impacts_table().rows(), 2);
+        assert_eq!(r.contacts_table().rows(), 2);
     }
 
     #[test]
@@ -568,7 +606,7 @@ mod tests {
         let mut r = ImpactRecorder::new();
         r.record(0.0, 0.5, &ContactObservation::ideal(2.0));
         r.finish(0.5, &ContactObservation::ideal(4.0));
-        assert!(r.impacts().is_empty());
+        assert!(r.contacts().is_empty());
         assert_eq!(r.metrics().peak_force_n, 4.0);
         assert_eq!(r.metrics().contact_fraction, 0.0);
         assert_eq!(r.metrics().rms_force_n, 2.0);
@@ -587,7 +625,7 @@ mod tests {
         let list = [imp(0.2, 0.1, 5.0), imp(0.5, 0.75, 9.0), imp(2.1, 0.2, 3.0)];
         let p = per_period(&list, 1.0, 2.5).unwrap();
         assert_eq!(p.len(), 3);
-        assert_eq!((p[0].impacts, p[1].impacts, p[2].impacts), (2, 0, 1));
+        assert_eq!((p[0].onsets, p[1].onsets, p[2].onsets), (2, 0, 1));
         assert_eq!((p[0].peak_force_n, p[1].peak_force_n), (9.0, 0.0));
         assert!((p[0].contact_s - 0.6).abs() < 1e-12);
         assert!((p[1].contact_s - 0.25).abs() < 1e-12);

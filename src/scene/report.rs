@@ -53,8 +53,9 @@ pub struct TwinSummary {
     pub final_angles_deg: BTreeMap<String, f64>,
     /// Largest joint force over all hinges, N.
     pub peak_joint_force_n: f64,
-    /// Contact onsets over all hinges.
-    pub impacts: u64,
+    /// [Onsets](crate::rapier::metrics#onsets-impacts-and-chatter) over all hinges, chatter
+    /// included.
+    pub onsets: u64,
     /// Earliest contact onset, s (null without contact).
     pub first_impact_t_s: Option<f64>,
     /// Peak force of that first contact, N.
@@ -85,7 +86,7 @@ impl TwinSummary {
             wall_s,
             final_angles_deg: twin.final_angles_deg(),
             peak_joint_force_n: hinges.values().map(|m| m.peak_force_n).fold(0.0, f64::max),
-            impacts: hinges.values().map(|m| m.impacts).sum(),
+            onsets: hinges.values().map(|m| m.onsets).sum(),
             first_impact_t_s: first.map(|f| f.0),
             first_impact_peak_n: first.map(|f| f.1),
             max_penetration_um: hinges
@@ -136,7 +137,7 @@ impl RunResult {
     }
 
     /// Writes `<twin>.csv` for each twin, `<twin>_<joint>_impacts.csv` for each clearance joint
-    /// (its impact list, [`ImpactRecorder::impacts_table`](crate::rapier::metrics::ImpactRecorder::impacts_table)),
+    /// (its contact list, every onset, [`ImpactRecorder::contacts_table`](crate::rapier::metrics::ImpactRecorder::contacts_table)),
     /// `<twin>_<joint>_turns.csv` when a body spins (per-turn statistics,
     /// [`per_period`](crate::rapier::metrics::per_period))
     /// and `summary.json` into `dir` as one set
@@ -156,7 +157,7 @@ impl RunResult {
         let mut summary = self.summary();
         summary.convergence = convergence.clone();
         let json = summary_json(&summary)?;
-        // One impact list per clearance joint, `<twin>_<joint>_impacts.csv`.
+        // One contact list per clearance joint, `<twin>_<joint>_impacts.csv`.
         let mut impact_tables: Vec<(std::path::PathBuf, crate::table::Table)> = Vec::new();
         for t in &self.twins {
             let recorders = t.hinge_recorders();
@@ -166,11 +167,11 @@ impl RunResult {
             for h in t.clearance_hinges() {
                 impact_tables.push((
                     dir.join(format!("{}_{h}_impacts.csv", t.kind.name())),
-                    recorders[h].impacts_table(),
+                    recorders[h].contacts_table(),
                 ));
                 // Per crank turn when a body spins.
                 if let Some(p) = period {
-                    let turns = crate::rapier::metrics::per_period(recorders[h].impacts(), p, end)
+                    let turns = crate::rapier::metrics::per_period(recorders[h].contacts(), p, end)
                         .map_err(|e| e.within("run.end_s"))?;
                     impact_tables.push((
                         dir.join(format!("{}_{h}_turns.csv", t.kind.name())),
@@ -338,8 +339,8 @@ pub fn comparison_table(summary: &Summary) -> String {
             .collect(),
     ));
     rows.push((
-        "impacts".into(),
-        twins.iter().map(|(_, t)| t.impacts.to_string()).collect(),
+        "onsets".into(),
+        twins.iter().map(|(_, t)| t.onsets.to_string()).collect(),
     ));
     rows.push((
         "first impact (s)".into(),

@@ -426,7 +426,7 @@ pub fn run(
         r.twin(TwinKind::Clearance).unwrap(),
     );
     let rec = clear.hinge_recorders()[case.hinge];
-    out.impacts = rec.impacts().to_vec();
+    out.impacts = rec.contacts().to_vec();
     out.peak_force_n = rec.metrics().peak_force_n;
     out.max_penetration_um = rec.metrics().max_penetration_um;
     let t = ideal.table.column("t_s").unwrap();

@@ -1,4 +1,4 @@
-//! Per-run metrics of a sweep point: the runner's every-step metrics (impacts, peak and RMS
+//! Per-run metrics of a sweep point: the runner's every-step metrics (onsets and impacts, peak and RMS
 //! force, settling, rate deviation, contact fraction) plus a few computed here from the output
 //! rows (angle deviation, force decay time, journal path length, contact arc), as pure functions
 //! of series so they can be tested on hand-made data.
@@ -68,12 +68,16 @@ pub struct BodyRunMetrics {
 pub struct HingeRunMetrics {
     /// Radial clearance of the clearance twin, mm (0 for an ideal hinge).
     pub clearance_mm: f64,
-    /// Contact onsets (every step).
+    /// Contact [onsets](clearance_joint::rapier::metrics#onsets-impacts-and-chatter), chatter
+    /// included (every step). JSON key `onsets`; a point written with the key `impacts` reads
+    /// back here.
+    #[serde(alias = "impacts")]
+    pub onsets: u64,
+    /// [Impacts](clearance_joint::rapier::metrics#onsets-impacts-and-chatter): onsets after a
+    /// free flight that opened at least the joint's minimum separation (0.1 um by default), the
+    /// onsets without the chatter of a journal following the wall. JSON key `separated_impacts`.
+    #[serde(default, rename = "separated_impacts")]
     pub impacts: u64,
-    /// Contact onsets after a free flight that opened at least the joint's minimum separation
-    /// (0.1 um by default): impacts without the chatter of a journal following the wall.
-    #[serde(default)]
-    pub separated_impacts: u64,
     /// Peak joint force, clearance twin (every step), N.
     pub peak_force_n: f64,
     /// Peak joint force, ideal twin (every step), N.
@@ -197,8 +201,8 @@ impl RunMetrics {
                 name.clone(),
                 HingeRunMetrics {
                     clearance_mm: h.clearance.as_ref().map_or(0.0, |s| s.clearance_mm),
+                    onsets: hc.onsets,
                     impacts: hc.impacts,
-                    separated_impacts: hc.separated_impacts,
                     peak_force_n: hc.peak_force_n,
                     peak_force_ideal_n: hi.peak_force_n,
                     rms_force_n: hc.rms_force_n,
@@ -263,8 +267,8 @@ impl RunMetrics {
         for (name, h) in &self.hinges {
             for (k, v) in [
                 ("clearance_mm", Some(h.clearance_mm)),
-                ("impacts", Some(h.impacts as f64)),
-                ("separated_impacts", Some(h.separated_impacts as f64)),
+                ("onsets", Some(h.onsets as f64)),
+                ("separated_impacts", Some(h.impacts as f64)),
                 ("peak_force_n", Some(h.peak_force_n)),
                 ("peak_force_ideal_n", Some(h.peak_force_ideal_n)),
                 ("rms_force_n", Some(h.rms_force_n)),

@@ -11,7 +11,7 @@
 //!   two radial axes are coupled with a limit `[0, c]` on their norm (Rapier's
 //!   `limit_linear_coupled`, the way `RopeJoint` works): the journal centre stays within the
 //!   clearance circle `|e| <= c`, solved with every other constraint of the world.
-//! - **Restitution.** Rapier's limits are inelastic. At an impact (a contact that begins, with an
+//! - **Restitution.** Rapier's limits are inelastic. At a bounce (a contact that begins, with an
 //!   approach speed above [`LargeStepJointBuilder::min_impact_speed`]) the hook gives the journal the
 //!   normal separation speed `e v_approach` by an impulse pair after the step (Newton's law,
 //!   `v_n+ = -e v_n-`). `v_approach` is the normal relative velocity the bodies had before the
@@ -33,8 +33,13 @@
 //!   usually enough; a small clearance under a heavy, fast load at 1/60 s asks for more. The
 //!   report says how many were used and whether the cap left the step under-resolved.
 //! - **Readout, every step**: the normal force (the limit's impulse over the substep), the
-//!   friction torque, the eccentricity (the journal orbit), the contact flag, impacts with their
-//!   approach and rebound speeds.
+//!   friction torque, the eccentricity (the journal orbit), the contact flag, onsets and bounces
+//!   with their approach and rebound speeds.
+//! - **Counts**: [onsets](LargeStepJoint::onsets) (every contact that began) and
+//!   [bounces](LargeStepJoint::bounces) (onsets faster than `min_impact_speed`, the ones
+//!   Newton's law gives a rebound); see the [definitions](crate::rapier::metrics#onsets-impacts-and-chatter).
+//!   The model resolves the journal's position to a few percent of `c`, too coarse for the
+//!   compliant model's `min_separation`: its bounces stand for its impacts in the metrics.
 //!
 //! ```
 //! use clearance_joint::rapier::large_step::{LargeStepJointBuilder, LargeStepJointSet};
@@ -189,7 +194,7 @@ impl LargeStepJointBuilder {
         self.joint.local_axis2 = axis;
         self
     }
-    /// A fixed coefficient of restitution in [0, 1] (default 0: impacts do not bounce).
+    /// A fixed coefficient of restitution in [0, 1] (default 0: onsets do not rebound).
     pub fn restitution(mut self, coefficient: f64) -> Self {
         self.joint.restitution = Restitution::Coefficient(coefficient);
         self
@@ -273,17 +278,19 @@ pub struct LargeStepReport {
     /// ([`eccentricity_ratio`](Self::eccentricity_ratio)): 0.984 on the arm of
     /// `examples/robot_backlash.rs` at 1 kHz.
     pub contact: bool,
-    /// Whether a contact began in this step.
+    /// Whether a contact began in this step: an
+    /// [onset](crate::rapier::metrics#onsets-impacts-and-chatter).
     pub onset: bool,
-    /// Whether that onset was an impact: approach speed above the joint's `min_impact_speed`.
-    pub impact: bool,
-    /// Normal approach speed of this step's impact, m/s (0 without one).
+    /// Whether that onset was a [bounce](crate::rapier::metrics#onsets-impacts-and-chatter): its
+    /// approach speed exceeded the joint's `min_impact_speed`, so Newton's law gave it a rebound.
+    pub bounce: bool,
+    /// Normal approach speed of this step's bounce, m/s (0 without one).
     pub approach_speed: f64,
-    /// Normal separation speed the impact was given, `e v_approach`, m/s.
+    /// Normal separation speed the bounce was given, `e v_approach`, m/s.
     pub rebound_speed: f64,
-    /// The coefficient of restitution used at this impact.
+    /// The coefficient of restitution used at this bounce.
     pub restitution: f64,
-    /// The impact's normal impulse by Newton's law, `m_n (1 + e) v_approach`, N s (`m_n` the
+    /// The bounce's normal impulse by Newton's law, `m_n (1 + e) v_approach`, N s (`m_n` the
     /// effective mass of the two bodies along the normal): an impact in a large step is an
     /// impulse, not a force history.
     pub impact_impulse: f64,
@@ -334,7 +341,8 @@ struct JointState {
     /// Substeps asked for, and for how many steps fewer would have done.
     substeps: usize,
     low_steps: u32,
-    impacts: u64,
+    onsets: u64,
+    bounces: u64,
     pre: Option<PreStep>,
     /// In-plane relative velocity before the last step.
     last_relative_velocity: Option<Vector>,
@@ -383,7 +391,7 @@ impl LargeStepJoint {
     pub fn clearance(&self) -> f64 {
         self.geometry.clearance()
     }
-    /// Restitution of impacts.
+    /// Restitution of bounces.
     pub fn restitution(&self) -> &Restitution {
         &self.restitution
     }
@@ -423,9 +431,16 @@ impl LargeStepJoint {
     pub fn report(&self) -> &LargeStepReport {
         &self.report
     }
-    /// Impacts so far (contact onsets that bounced or would have with a non-zero restitution).
-    pub fn impacts(&self) -> u64 {
-        self.state.impacts
+    /// [Onsets](crate::rapier::metrics#onsets-impacts-and-chatter) so far: every contact that
+    /// began.
+    pub fn onsets(&self) -> u64 {
+        self.state.onsets
+    }
+    /// [Bounces](crate::rapier::metrics#onsets-impacts-and-chatter) so far: onsets whose
+    /// approach speed exceeded `min_impact_speed` (they bounced, or would have with a non-zero
+    /// restitution).
+    pub fn bounces(&self) -> u64 {
+        self.state.bounces
     }
 
     /// The Rapier joint of this clearance: axial translation and both tilts locked, the two
@@ -576,6 +591,7 @@ impl LargeStepJoint {
             ..LargeStepReport::default()
         };
         if onset {
+            self.state.onsets += 1;
             // Before the step, with that step's geometry (the lever arms turn during the step), along
             // the wall's normal after it.
             let approach = pre.relative_velocity.dot(normal);
@@ -595,12 +611,12 @@ impl LargeStepJoint {
                         rb.apply_impulse_at_point(p * normal, p2, true);
                     }
                 }
-                report.impact = true;
+                report.bounce = true;
                 report.approach_speed = approach;
                 report.rebound_speed = e_coef * approach;
                 report.restitution = e_coef;
                 report.impact_impulse = m_n * (1.0 + e_coef) * approach;
-                self.state.impacts += 1;
+                self.state.bounces += 1;
             }
         }
         self.state.in_contact = contact;

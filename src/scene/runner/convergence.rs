@@ -493,16 +493,16 @@ impl ConvergenceCheck {
                 );
                 push(
                     "onsets",
-                    x.impacts as f64,
-                    y.impacts as f64,
+                    x.onsets as f64,
+                    y.onsets as f64,
                     ONSET_COUNT_BOUND,
                     true,
                     true,
                 );
                 push(
                     "impacts after a separation",
-                    x.separated_impacts as f64,
-                    y.separated_impacts as f64,
+                    x.impacts as f64,
+                    y.impacts as f64,
                     ONSET_COUNT_BOUND,
                     true,
                     true,

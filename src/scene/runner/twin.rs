@@ -160,7 +160,8 @@ fn large_step_sample(j: &LargeStepJoint) -> ContactSample {
     let excursion = r.eccentricity.length() - j.clearance();
     ContactSample {
         onset: r.onset,
-        impact: r.impact,
+        // The model's impacts are its bounces (see the metrics' definitions).
+        impact: r.bounce,
         penetration: if r.contact {
             excursion.max(f64::MIN_POSITIVE)
         } else {

@@ -125,7 +125,7 @@ pub fn study_report(
     }
     let _ = writeln!(
         s,
-        "- Metrics (table `metrics.csv` / `metrics.json`): impacts, peak and RMS force, first impact, settling time, contact \
+        "- Metrics (table `metrics.csv` / `metrics.json`): onsets and impacts (after a separation; the chatter is the difference), peak and RMS force, first impact, settling time, contact \
          fraction, penetration and rate deviations come from every internal step; angle deviation, force decay time, journal \
          path and contact arc from the output rows. **Settling time** (runner): the last time the clearance joint force exceeds \
          the ideal joint force by more than a band equal to the ideal twin's peak joint force. **Force decay**: the last time \

@@ -140,7 +140,7 @@ pub fn conclusions(
 
     // 2. Clearance: impacts, settling.
     if kind == StudyKind::Clearance {
-        let impacts = trend_of(cases, |c| hm(c).impacts as f64);
+        let impacts = trend_of(cases, |c| hm(c).onsets as f64);
         let peak = trend_of(cases, |c| hm(c).peak_force_n);
         let settle = trend_of(cases, |c| hm(c).settling_time_s);
         let decay = trend_of(cases, |c| hm(c).force_decay_time_s);
@@ -148,9 +148,9 @@ pub fn conclusions(
             .iter()
             .all(|c| hm(c).settling_time_s >= 0.99 * end - 1e-12);
         let mut more = format!(
-            "Impacts over the {} s run: {} ({}). The peak joint force {} with c: {}.",
+            "Onsets (contacts, chatter included) over the {} s run: {} ({}). The peak joint force {} with c: {}.",
             num(end),
-            list(cases, |c| hm(c).impacts.to_string()),
+            list(cases, |c| hm(c).onsets.to_string()),
             impacts.verb(),
             peak.verb(),
             list(cases, |c| format!("{} N", num(hm(c).peak_force_n))),
@@ -177,7 +177,7 @@ pub fn conclusions(
                 None => {
                     let _ = write!(
                         more,
-                        ", and more impacts with larger c holds at every window end."
+                        ", and more onsets with larger c holds at every window end."
                     );
                 }
                 Some(k) if k + 1 < ordered.len() => {
@@ -258,7 +258,7 @@ pub fn conclusions(
         };
         let osc_rel = trend_of(cases, rel);
         let force = trend_of(cases, |c| hm(c).peak_force_n);
-        let impacts = trend_of(cases, |c| hm(c).impacts as f64);
+        let impacts = trend_of(cases, |c| hm(c).onsets as f64);
         let path = trend_of(cases, |c| hm(c).journal_path_mm);
         let arc = trend_of(cases, |c| hm(c).contact_arc_deg);
         let irregular = path == Trend::Increasing && arc == Trend::Increasing;
@@ -299,14 +299,14 @@ pub fn conclusions(
                 "more irregular trajectory",
                 irregular,
                 format!(
-                    "Journal path length: {} ({}); arc of the bearing touched: {} ({}). Impacts: {} ({}), with time in \
+                    "Journal path length: {} ({}); arc of the bearing touched: {} ({}). Onsets: {} ({}), with time in \
                      contact {}: at high torque the journal rides along the bearing wall (following mode) for most of the run, \
                      so separate impacts are not a measure of irregularity there.",
                     list(cases, |c| format!("{} mm", num(hm(c).journal_path_mm))),
                     path.verb(),
                     list(cases, |c| format!("{} deg", num(hm(c).contact_arc_deg))),
                     arc.verb(),
-                    list(cases, |c| hm(c).impacts.to_string()),
+                    list(cases, |c| hm(c).onsets.to_string()),
                     impacts.verb(),
                     list(cases, |c| format!(
                         "{} %",
@@ -336,7 +336,7 @@ pub fn conclusions(
         let (bd, bl) = (bm(dry), bm(lub));
         let smaller_force = clearly_less(hd.peak_force_n, hl.peak_force_n)
             && clearly_less(hd.rms_force_n, hl.rms_force_n);
-        let fewer = hd.impacts < hl.impacts;
+        let fewer = hd.onsets < hl.onsets;
         let faster = clearly_less(hd.force_decay_time_s, hl.force_decay_time_s)
             || clearly_less(hd.settling_time_s, hl.settling_time_s);
         let calmer = clearly_less(bd.rate_dev_rms_deg_s, bl.rate_dev_rms_deg_s);
@@ -374,13 +374,13 @@ pub fn conclusions(
                 fewer,
                 format!(
                     "{} vs {} contact onsets; time in contact {} % vs {} %. Without the chatter of a journal \
-                     following the wall (onsets after a free flight of at least 0.1 um): {} vs {}.",
-                    hd.impacts,
-                    hl.impacts,
+                     following the wall (impacts: onsets after a free flight of at least 0.1 um): {} vs {}.",
+                    hd.onsets,
+                    hl.onsets,
                     num(100.0 * hd.contact_fraction),
                     num(100.0 * hl.contact_fraction),
-                    hd.separated_impacts,
-                    hl.separated_impacts
+                    hd.impacts,
+                    hl.impacts
                 ),
             ),
             part(
@@ -423,15 +423,15 @@ pub fn conclusions(
     } else {
         out.push(elsewhere(4, StudyKind::Friction));
     }
-    let impacts: Vec<u64> = cases.iter().map(|c| hm(c).impacts).collect();
-    if impacts.iter().any(|&n| n < MIN_IMPACTS) {
+    let onsets: Vec<u64> = cases.iter().map(|c| hm(c).onsets).collect();
+    if onsets.iter().any(|&n| n < MIN_IMPACTS) {
         for c in out.iter_mut().filter(|c| c.verdict != Verdict::NotTested) {
             c.verdict = Verdict::TooLittleData;
             c.finding = format!(
-                "**Too little data to judge.** The cases hold {} impacts in {} s; a verdict needs at least \
+                "**Too little data to judge.** The cases hold {} onsets in {} s; a verdict needs at least \
                  {MIN_IMPACTS} in every case (run longer: the studies' default is 5 s). The numbers, for \
                  what they are worth: {}",
-                list(cases, |c| hm(c).impacts.to_string()),
+                list(cases, |c| hm(c).onsets.to_string()),
                 num(end),
                 c.finding
             );

@@ -47,7 +47,7 @@ pub fn key_tables(cases: &[StudyCase], setup: &Setup) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "| case | impacts | peak force, N (ideal) | RMS force, N (ideal) | first impact, s / peak, N | settling time, s (band, N) | force decay to 10 % of peak, s | time in contact | max penetration, um | wall, s |"
+        "| case | onsets | peak force, N (ideal) | RMS force, N (ideal) | first impact, s / peak, N | settling time, s (band, N) | force decay to 10 % of peak, s | time in contact | max penetration, um | wall, s |"
     );
     let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|");
     for c in cases {
@@ -60,7 +60,7 @@ pub fn key_tables(cases: &[StudyCase], setup: &Setup) -> String {
             s,
             "| {} | {} | {} ({}) | {} ({}) | {} | {} ({}) | {} | {:.2} % | {} | {:.2} |",
             c.label,
-            m.impacts,
+            m.onsets,
             num(m.peak_force_n),
             num(m.peak_force_ideal_n),
             num(m.rms_force_n),

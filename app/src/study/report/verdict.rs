@@ -24,12 +24,13 @@ pub enum Verdict {
     NotShown,
     /// The study does not vary the parameter the conclusion is about.
     NotTested,
-    /// The runs hold too few impacts to judge (a run too short): see [`MIN_IMPACTS`].
+    /// The runs hold too few onsets to judge (a run too short): see [`MIN_IMPACTS`].
     TooLittleData,
 }
 
-/// Impacts (contact onsets) every case needs before a verdict is given: the conclusions are
-/// about impacts, impact forces and the rattle they cause, and a run without them shows none.
+/// [Onsets](clearance_joint::rapier::metrics#onsets-impacts-and-chatter) (contacts, chatter
+/// included) every case needs before a verdict is given: the conclusions are about impacts,
+/// impact forces and the rattle they cause, and a run without contacts shows none.
 pub const MIN_IMPACTS: u64 = 10;
 
 impl Verdict {

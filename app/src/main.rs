@@ -269,7 +269,10 @@ impl RunArgs {
     fn scene(&self) -> clearance_joint::Result<ValidatedScene> {
         let mut overrides = self.overrides.clone();
         overrides.extend(self.time.overrides());
-        cli::load_validated(self.scene.as_deref())?.with_overrides(&overrides)
+        let scene = cli::load_validated(self.scene.as_deref())?;
+        // Given together, an override a later one replaces whole would be lost unsaid.
+        scene.refuse_lost_overrides::<&str, _>(&[], &overrides)?;
+        scene.with_overrides(&overrides)
     }
 }
 
@@ -282,6 +285,10 @@ fn warn(scene: &Scene) {
 fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     let scene = args.scene()?;
     warn(&scene);
+    let (dt, max_dt) = (args.time.dt.is_some(), args.time.max_dt.is_some());
+    if let Some(note) = cli::unused_step_note(&scene.run, dt, max_dt) {
+        eprintln!("note: {note}");
+    }
     // Asked to confirm convergence strictly, a scene with nothing to check fails before any
     // run: it could only pass by checking nothing.
     if let (true, true, Some(reason)) = (
@@ -440,6 +447,10 @@ fn sweep(args: &SweepArgs) -> clearance_joint::Result<()> {
         args.shard.as_deref(),
         out,
     )?;
+    let (dt, max_dt) = (args.time.dt.is_some(), args.time.max_dt.is_some());
+    if let Some(note) = job.unused_step_note(dt, max_dt) {
+        eprintln!("note: {note}");
+    }
     eprintln!(
         "sweep of {} points{}: {} to run or reuse, into {}",
         job.sweep.grid.len(),
@@ -506,6 +517,10 @@ fn study(args: &StudyArgs) -> clearance_joint::Result<()> {
             .collect(),
         no_figures: args.no_figures,
     };
+    // The `--set`s replace the study's own settings freely, but not one another unsaid.
+    for s in &studies {
+        base.refuse_lost_overrides(&s.spec.set, &options.extra_overrides)?;
+    }
     let start = Instant::now();
     let outcomes = run_studies(&studies, &base, &root, &options)?;
     for o in &outcomes {

@@ -25,22 +25,11 @@ pub struct Merged {
 pub fn merge(inputs: &[PathBuf], out: Option<&Path>, incomplete: bool) -> Result<Merged> {
     let mut files = Vec::new();
     for input in inputs {
-        if input.is_dir() {
-            let found = sweep::shard_tables_in(input)?;
-            if found.is_empty() {
-                return Err(Error::invalid(
-                    format!("merge input `{}`", input.display()),
-                    "holds no shard table (metrics.shard-K-of-N.json)",
-                ));
-            }
-            files.extend(found);
-        } else {
-            files.push(input.clone());
-        }
+        files.extend(tables_of(input)?);
     }
     let tables = files
         .iter()
-        .map(|f| MetricsTable::load(f))
+        .map(|f| MetricsTable::load(f).map_err(not_a_table))
         .collect::<Result<Vec<_>>>()?;
     let merged = sweep::merge(&tables)?;
     if !merged.missing.is_empty() && !incomplete {
@@ -60,7 +49,7 @@ pub fn merge(inputs: &[PathBuf], out: Option<&Path>, incomplete: bool) -> Result
             if first.is_dir() {
                 first.clone()
             } else {
-                first.parent().unwrap_or(Path::new(".")).to_path_buf()
+                folder_of(first).to_path_buf()
             }
         }
     };
@@ -76,6 +65,60 @@ pub fn merge(inputs: &[PathBuf], out: Option<&Path>, incomplete: bool) -> Result
         out,
         stem,
     })
+}
+
+/// The table files an input names: a sweep folder's shard tables (`metrics.shard-*.json`), or
+/// the file itself. A CSV table is refused naming the JSON to pass instead: only the JSON
+/// describes the sweep (its axes and fixed settings), which merging checks.
+fn tables_of(input: &Path) -> Result<Vec<PathBuf>> {
+    let what = || format!("merge input `{}`", input.display());
+    if input.is_dir() {
+        let found = sweep::shard_tables_in(input)?;
+        if found.is_empty() {
+            return Err(Error::invalid(
+                what(),
+                "holds no shard table (metrics.shard-K-of-N.json)",
+            ));
+        }
+        return Ok(found);
+    }
+    let is_csv = input
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+    if is_csv {
+        return Err(Error::invalid(
+            what(),
+            format!(
+                "is a CSV table, and merge reads the JSON tables (only they describe the sweep, \
+                 which merging checks): pass `{}` instead, or the sweep folder `{}` to merge \
+                 all its metrics.shard-K-of-N.json",
+                input.with_extension("json").display(),
+                folder_of(input).display()
+            ),
+        ));
+    }
+    Ok(vec![input.to_path_buf()])
+}
+
+/// The folder holding `file` (`.` for a bare file name).
+fn folder_of(file: &Path) -> &Path {
+    file.parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."))
+}
+
+/// A file that does not read as a metrics table, said so with what merge takes.
+fn not_a_table(e: Error) -> Error {
+    match e {
+        Error::Parse { what, reason } => Error::Parse {
+            what,
+            reason: format!(
+                "{reason}: not a metrics table; merge takes sweep folders or their \
+                 metrics.shard-K-of-N.json files"
+            ),
+        },
+        other => other,
+    }
 }
 
 /// The error of a merged table with points missing (written as incomplete), or `Ok`.

@@ -12,8 +12,9 @@ pub mod run;
 pub mod sweep;
 
 use crate::study::sweep::{ExecOptions, Progress, thread_count};
+use clearance_joint::error::sig4;
 use clearance_joint::error::{Error, Result};
-use clearance_joint::scene::{SOLAR_PANEL_RON, Scene, ValidatedScene};
+use clearance_joint::scene::{RunSettings, SOLAR_PANEL_RON, Scene, StepMode, ValidatedScene};
 use std::path::Path;
 
 /// The scene file at `path`, or without one the paper's solar-panel scene.
@@ -84,4 +85,28 @@ pub fn exec_options(
         check: false,
     };
     Ok((options, note))
+}
+
+/// The note for a step flag the scene's step mode does not use, or `None`: `--dt` sets the fixed
+/// step (`run.dt_s`), which adaptive steps ignore, and `--max-dt` caps adaptive steps
+/// (`run.max_dt_s`), which a fixed step ignores. Said rather than refused: the flag is recorded
+/// in the scene and holds if the mode is switched, but the run must not look refined by it.
+pub fn unused_step_note(run: &RunSettings, dt: bool, max_dt: bool) -> Option<String> {
+    match run.step {
+        StepMode::Adaptive if dt => Some(format!(
+            "`--dt` sets the fixed step (`run.dt_s`), but this scene steps adaptively \
+             (`run.step: Adaptive`), so it is not used. For smaller adaptive steps give a smaller \
+             `--set run.tolerance=...` (now {}) or cap them with `--max-dt` (now {} s); for fixed \
+             steps of `--dt` add `--set run.step=Fixed`",
+            sig4(run.tolerance),
+            sig4(run.max_dt_s)
+        )),
+        StepMode::Fixed if max_dt => Some(format!(
+            "`--max-dt` caps adaptive steps (`run.max_dt_s`), but this scene steps at a fixed \
+             step (`run.step: Fixed`, {} s), so it is not used. Set the fixed step with `--dt`, \
+             or step adaptively with `--set run.step=Adaptive`",
+            sig4(run.dt_s)
+        )),
+        _ => None,
+    }
 }

@@ -61,6 +61,24 @@ impl SweepJob {
         self.shard.len(&self.sweep.grid)
     }
 
+    /// The note for a step flag no point uses ([`super::unused_step_note`]), or `None`: none
+    /// when an axis sets the step mode (each point uses what its mode uses).
+    pub fn unused_step_note(&self, dt: bool, max_dt: bool) -> Option<String> {
+        let base = self
+            .sweep
+            .base
+            .with_overrides(&self.sweep.base_overrides)
+            .ok()?;
+        let sets_mode = self.sweep.grid.axes.iter().any(|a| {
+            base.override_field(&a.path)
+                .is_ok_and(|f| f == "run" || f == "run.step")
+        });
+        if sets_mode {
+            return None;
+        }
+        super::unused_step_note(&base.run, dt, max_dt)
+    }
+
     /// Runs the points and writes the table.
     pub fn run(&self, exec: ExecOptions) -> Result<SweepOutcome> {
         self.sweep.run(&self.out, self.shard, exec)

@@ -17,7 +17,7 @@ use clearance_joint::scene::output::{
     DirLock, MemoryEstimate, bytes_text, write_all_atomic, write_atomic,
 };
 use clearance_joint::scene::runner::convergence::{self, ConvergenceVerdict};
-use clearance_joint::scene::{Scene, ValidatedScene};
+use clearance_joint::scene::{Scene, ValidatedScene, field_within};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -202,38 +202,83 @@ impl Sweep {
     }
 
     /// Checks the sweep before any point runs, and returns the base scene with the fixed
-    /// overrides applied: two axes naming one field by different paths are refused (the later
-    /// would silently win), and every value of every axis is applied once, the other axes at
-    /// their first value, so a bad value fails naming its point without building the whole grid.
+    /// overrides applied: two axes naming one field by different paths, or nested ones (one sets
+    /// a field inside the other's value), are refused (one would silently overwrite the other),
+    /// and every value of every axis is applied once, the other axes at their first value, so a
+    /// bad value fails naming its point without building the whole grid.
     pub fn check(&self) -> Result<ValidatedScene> {
         let base = self
             .base
             .with_overrides(&self.base_overrides)?
             .validated()?;
-        let first = self.grid.point(0);
-        let reference = base
-            .with_overrides(&first.overrides())
-            .unwrap_or(base.clone());
-        let mut fields: Vec<(String, &str)> = Vec::new();
-        for a in &self.grid.axes {
-            let field = reference
-                .override_field(&a.path)
-                .unwrap_or_else(|_| a.path.clone());
-            if let Some((_, other)) = fields.iter().find(|(f, _)| *f == field) {
-                return Err(Error::invalid(
-                    format!("sweep axis `{}`", a.path),
-                    format!(
-                        "names the same field as axis `{other}` ({field}): put all its values in one \
-                         `--set {field}=v1,v2,...`"
-                    ),
-                ));
-            }
-            fields.push((field, &a.path));
+        let points = self.axis_value_points();
+        for &index in &points {
+            self.check_axis_fields(&base, index)?;
+            self.check_fixed_fields(index)?;
         }
-        for index in self.axis_value_points() {
+        for index in points {
             self.job(&base, Path::new(""), self.grid.point(index))?;
         }
         Ok(base)
+    }
+
+    /// Refuses two axes that write one field, or nested fields, at point `index`: each axis's
+    /// field is found as the point's overrides apply (in axis order, each in the scene the
+    /// earlier left), so `hinge.exponent` after a `hinge.contact` axis is found inside the law
+    /// that axis sets. A point whose overrides do not apply is left to the point's own check.
+    fn check_axis_fields(&self, base: &ValidatedScene, index: usize) -> Result<()> {
+        let Ok(fields) = base.override_fields(&self.grid.point(index).overrides()) else {
+            return Ok(());
+        };
+        let axes = &self.grid.axes;
+        for (i, (a, fa)) in axes.iter().zip(&fields).enumerate() {
+            for (b, fb) in axes[i + 1..].iter().zip(&fields[i + 1..]) {
+                if fa == fb {
+                    return Err(Error::invalid(
+                        format!("sweep axis `{}`", b.path),
+                        format!(
+                            "names the same field as axis `{}` ({fa}): put all its values in one \
+                             `--set {fa}=v1,v2,...`",
+                            a.path
+                        ),
+                    ));
+                }
+                if field_within(fb, fa) {
+                    return Err(nested_axes(a, fa, b, fb));
+                }
+                if field_within(fa, fb) {
+                    return Err(nested_axes(b, fb, a, fa));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Refuses a fixed override the point's axes overwrite (an axis sets its field, or an object
+    /// holding it): it would be ignored at every point (`study torque --set
+    /// drive.torque_scale=2`). A field set inside a fixed override's value is well-defined.
+    fn check_fixed_fields(&self, index: usize) -> Result<()> {
+        let mut all = self.base_overrides.clone();
+        all.extend(self.grid.point(index).overrides());
+        let Ok(fields) = self.base.override_fields(&all) else {
+            return Ok(());
+        };
+        let (fixed, swept) = fields.split_at(self.base_overrides.len());
+        for (o, f) in self.base_overrides.iter().zip(fixed) {
+            let over = self.grid.axes.iter().zip(swept);
+            if let Some((a, af)) = over.clone().find(|(_, af)| *af == f || field_within(f, af)) {
+                return Err(Error::invalid(
+                    format!("setting `{o}`"),
+                    format!(
+                        "is overwritten at every point of `{}` by the swept `{}` (which sets \
+                         `{af}`), so it would be ignored: drop it, or put what it sets in the \
+                         swept values",
+                        self.name, a.path
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// Indices of the points that set each value of each axis once, the other axes at their
@@ -1000,6 +1045,22 @@ pub fn merge(tables: &[MetricsTable]) -> Result<MetricsTable> {
         failures: failures.into_values().collect(),
         missing,
     })
+}
+
+/// The refusal of two nested axes: `inner` (writing `inner_field`) sets a field inside the value
+/// of `outer` (writing `outer_field`), so whichever applies later overwrites the other at every
+/// point.
+fn nested_axes(outer: &Axis, outer_field: &str, inner: &Axis, inner_field: &str) -> Error {
+    Error::invalid(
+        "sweep",
+        format!(
+            "axes `{op}` and `{ip}` are nested: `{ip}` sets `{inner_field}`, a field inside `{op}`'s value \
+             (`{outer_field}`), so one would overwrite the other at every point. Sweep one of \
+             them, or give the field inside each value of `{op}`",
+            ip = inner.path,
+            op = outer.path,
+        ),
+    )
 }
 
 /// Two runs' metrics equal in everything but the wall times (the run's, and its check's).

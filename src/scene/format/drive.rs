@@ -58,6 +58,7 @@ impl Scene {
             )?;
             let s = TORQUE_SCALE_MAX;
             in_range(&format!("{p}.torque_scale"), d.torque_scale, -s, s, "")?;
+            check_scaled_spring(&p, d)?;
         }
         Ok(())
     }
@@ -109,6 +110,27 @@ impl Scene {
     }
 }
 
+/// Refuses a negative `torque_scale` on a spring with stiffness: the scale multiplies `k` too,
+/// and a negative stiffness pushes the hinge away from rest (the run's spring would refuse it,
+/// naming the stiffness the user never set). With no stiffness it only turns the preload round.
+fn check_scaled_spring(p: &str, d: &DriveSpec) -> Result<()> {
+    if d.torque_scale >= 0.0 || d.stiffness_nm_per_deg <= 0.0 {
+        return Ok(());
+    }
+    Err(Error::invalid(
+        format!("{p}.torque_scale"),
+        format!(
+            "must be 0 to {} for a spring with stiffness (got {}): it scales \
+             `stiffness_nm_per_deg` ({} N m/deg) as well as `torque0_nm`, and a negative \
+             stiffness would push the hinge away from rest. To turn the preload round, give \
+             `torque0_nm` a negative value and keep `torque_scale` positive",
+            sig4(TORQUE_SCALE_MAX),
+            sig4(d.torque_scale),
+            sig4(d.stiffness_nm_per_deg)
+        ),
+    ))
+}
+
 /// The moment of inertia of body `b` about the axis `axis` (unit) through `point`: its
 /// principal moments (along the world axes at t = 0) projected on the axis, plus its mass times
 /// the square of its centre of mass's distance from the axis.
@@ -119,4 +141,29 @@ fn inertia_about(b: &super::BodySpec, point: [f64; 3], axis: [f64; 3]) -> f64 {
     let along = (0..3).map(|i| r[i] * axis[i]).sum::<f64>();
     let d2 = (0..3).map(|i| r[i] * r[i]).sum::<f64>() - along * along;
     own + b.mass_kg * d2.max(0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A negative scale on a spring with stiffness is refused naming `torque_scale`, the field
+    /// given, with the range to use; without stiffness it only turns the preload round.
+    #[test]
+    fn a_negative_torque_scale_names_itself() {
+        let e = Scene::solar_panel()
+            .with_overrides(&["drive.torque_scale=-5"])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("drives[drive].torque_scale")
+                && e.contains("0 to 1000")
+                && e.contains("got -5")
+                && !e.contains("drives[drive].stiffness_nm_per_deg"),
+            "{e}"
+        );
+        Scene::solar_panel()
+            .with_overrides(&["drive.stiffness_nm_per_deg=0", "drive.torque_scale=-1"])
+            .unwrap();
+    }
 }

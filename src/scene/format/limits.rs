@@ -19,7 +19,7 @@ pub const POSITION_MAX: f64 = 1e4;
 pub const GRAVITY_MAX: f64 = 1e3;
 /// Largest drive preload, N m (and stiffness, N m/deg).
 pub const TORQUE_MAX: f64 = 1e6;
-/// Largest drive `torque_scale` (either sign).
+/// Largest drive `torque_scale` (either sign; negative only for a spring without stiffness).
 pub const TORQUE_SCALE_MAX: f64 = 1e3;
 /// Range of `run.dt_s`, s (also the smallest `run.output_interval_s`).
 pub const DT_RANGE: (f64, f64) = (1e-9, 1.0);

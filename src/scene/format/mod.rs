@@ -21,6 +21,7 @@ pub use hinge::HingeSpec;
 pub use joint::{JointKindSpec, JointSpec, MotorSpec};
 pub use limits::*;
 pub use load::SOLAR_PANEL_RON;
+pub use overrides::field_within;
 pub use run::{RunSettings, StepMode};
 pub use validated::ValidatedScene;
 

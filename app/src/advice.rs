@@ -62,6 +62,16 @@ pub fn memory_options(
         None if concurrent > 1 => "raise `--max-memory` or lower `--jobs`".into(),
         None => "raise `--max-memory`".into(),
     };
+    // The replay's share does not shrink with the rows (its frames are capped): say how to
+    // drop it first.
+    let options = if estimate.replay_bytes > 0 {
+        format!(
+            "`--no-replay` drops the replay (`replay.html`, about {}), or {options}",
+            clearance_joint::scene::output::bytes_text(estimate.replay_bytes)
+        )
+    } else {
+        options
+    };
     Error::Invalid {
         field,
         reason: format!("{reason}. On the command line: {options}"),

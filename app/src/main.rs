@@ -322,7 +322,7 @@ fn run(args: &RunArgs) -> clearance_joint::Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| PathBuf::from("out").join(&scene.name));
-    let job = SceneRun::prepare(scene, out, args.memory.budget()?)?;
+    let job = SceneRun::prepare(scene, out, args.memory.budget()?, !args.no_replay)?;
     let scene = &job.scene;
     eprintln!(
         "running `{}`: {}, {} s simulated, ideal and clearance twins",
@@ -583,7 +583,11 @@ fn main() -> ExitCode {
     if let Err(e) = ctrlc::set_handler(|| {
         clearance_joint::scene::output::remove_inflight();
         clearance_joint_app::resultset::abandon_all();
-        eprintln!("\ninterrupted: temporary files removed");
+        // Not `eprintln!`: it panics on a closed standard error, and the process would not exit.
+        let _ = std::io::Write::write_all(
+            &mut std::io::stderr(),
+            b"\ninterrupted: temporary files removed\n",
+        );
         std::process::exit(130);
     }) {
         eprintln!(

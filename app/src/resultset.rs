@@ -16,7 +16,8 @@
 //!   the carried entries go back into the target). [`abandon_all`] does the same on an interrupt.
 
 use clearance_joint::error::{Error, Result};
-use clearance_joint::scene::output::{DirLock, clean_stale_temps};
+use clearance_joint::scene::output::{DirLock, clean_stale_temps, process_alive};
+use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -103,6 +104,10 @@ impl ResultSet {
         }
         std::fs::create_dir_all(&parent).map_err(io("cannot create the output folder", target))?;
         let lock = DirLock::acquire_named(&parent, &format!(".{name}.lock"))?;
+        // Under the registry's lock from the first rename to the registration: an interrupt
+        // waits, then finds the staging folder registered and drops it (an unregistered one
+        // would stay behind, or hold the old set with the target gone).
+        let mut open = open_sets();
         clean_stale_temps(target);
         let stage = parent.join(format!(".{name}.new-{}", std::process::id()));
         let keep: Vec<String> = keep.iter().map(|k| k.to_string()).collect();
@@ -132,7 +137,8 @@ impl ResultSet {
                 }
             }
         }
-        open_sets().push((stage.clone(), target.to_path_buf(), !keep.is_empty()));
+        open.push((stage.clone(), target.to_path_buf(), !keep.is_empty()));
+        drop(open);
         Ok(ResultSet {
             target: target.to_path_buf(),
             stage,
@@ -191,10 +197,6 @@ impl ResultSet {
     }
 }
 
-fn forget(stage: &Path) {
-    open_sets().retain(|(s, _, _)| s != stage);
-}
-
 /// Drops a staging folder: removed, or with entries carried over, put back as the target
 /// (only the carried entries and the user's files) unless a target exists.
 fn abandon(stage: &Path, target: &Path, keeps: bool) {
@@ -214,7 +216,9 @@ fn abandon(stage: &Path, target: &Path, keeps: bool) {
 impl Drop for ResultSet {
     fn drop(&mut self) {
         if !self.committed {
-            forget(&self.stage);
+            // Under the registry's lock: an interrupt waits until the set is dropped whole.
+            let mut open = open_sets();
+            open.retain(|(s, _, _)| *s != self.stage);
             // A kept entry of the new set (a finished point) stays; the rest goes.
             let keeps = !self.keep.is_empty();
             abandon(&self.stage, &self.target, keeps);
@@ -227,10 +231,57 @@ impl Drop for ResultSet {
 pub fn abandon_all() -> usize {
     let mut open = open_sets();
     let n = open.len();
-    for (stage, target, keeps) in open.drain(..) {
+    // Newest first: a sweep point's set inside a study's staging folder goes before the study's
+    // is put back (else it would be carried along and stay).
+    for (stage, target, keeps) in open.drain(..).rev() {
         abandon(&stage, &target, keeps);
     }
     // Keep the registry locked: a set committing now waits until the process exits.
     std::mem::forget(open);
     n
+}
+
+/// Removes from `dir` the staging folders (`.<name>.new-<pid>`, `.<name>.old-<pid>`) of
+/// processes that no longer exist: what a SIGKILL left (an interrupt leaves none). Their
+/// targets hold the old set whole (or, killed inside a commit, nothing: the point runs again).
+/// Returns how many were removed.
+pub fn clean_stale(dir: &Path) -> usize {
+    entries(dir)
+        .into_iter()
+        .filter(|(n, _)| n.starts_with('.'))
+        .filter(|(n, _)| {
+            let pid = n.rsplit_once(".new-").or_else(|| n.rsplit_once(".old-"));
+            pid.and_then(|(_, p)| p.parse::<u32>().ok())
+                .is_some_and(|p| !process_alive(p))
+        })
+        .filter(|(_, path)| remove_any(path).is_ok())
+        .count()
+}
+
+/// Environment variable of [`pause_at`]: `STEP` or `STEP#K` (the K-th time, from 1).
+pub const PAUSE_ENV: &str = "CLEARANCE_JOINT_PAUSE_AT";
+
+/// A test hook between two writes of a result set: when [`PAUSE_ENV`] names `step` (and this
+/// is its K-th passage), prints `paused at STEP` on standard error and waits for ever, so a
+/// test can kill the process at that exact point. Does nothing otherwise.
+pub fn pause_at(step: &str) {
+    static PASSED: Mutex<Vec<String>> = Mutex::new(Vec::new());
+    let Ok(wanted) = std::env::var(PAUSE_ENV) else {
+        return;
+    };
+    let (name, k) = wanted
+        .split_once('#')
+        .map_or((wanted.as_str(), 1), |(n, k)| (n, k.parse().unwrap_or(1)));
+    if name != step {
+        return;
+    }
+    let mut passed = PASSED.lock().unwrap_or_else(|e| e.into_inner());
+    passed.push(step.to_string());
+    if passed.iter().filter(|s| *s == step).count() == k {
+        let _ = writeln!(std::io::stderr(), "paused at {step}");
+        drop(passed);
+        loop {
+            std::thread::sleep(std::time::Duration::from_secs(3600));
+        }
+    }
 }

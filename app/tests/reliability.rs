@@ -1220,3 +1220,70 @@ fn study_strict_fails_on_a_guard() {
     assert!(table.contains("guard violated (strict)"), "{table}");
     let _ = std::fs::remove_dir_all(&root);
 }
+
+/// Issue 33, item 6: the replay is in the memory estimate. A 20 s pendulum's rows fit 75 MB,
+/// but with its replay (bounded by the recorder's cap) the run is refused before it starts,
+/// the message naming the replay and `--no-replay`; `run` and `sweep --replay` alike.
+#[test]
+fn the_replay_is_in_the_memory_estimate() {
+    let mut scene = Scene::from_ron(PENDULUM_RON, "pendulum").unwrap();
+    scene.run.end_s = 20.0;
+    let rows = MemoryEstimate::of(&scene);
+    let replay = clearance_joint_app::replay::memory_bytes(&scene);
+    let with = clearance_joint_app::replay::estimate(&scene, true);
+    assert!(replay > 10_000_000, "{replay}");
+    assert_eq!(with.bytes, rows.bytes + replay);
+    assert_eq!(with.replay_bytes, replay);
+    assert_eq!(clearance_joint_app::replay::estimate(&scene, false), rows);
+    assert!(
+        rows.bytes < 75_000_000 && with.bytes > 75_000_000,
+        "{with:?}"
+    );
+    // The cap bounds it: a longer run's replay is no larger.
+    scene.run.end_s = 60.0;
+    assert_eq!(clearance_joint_app::replay::memory_bytes(&scene), replay);
+    let dir = scratch("replay-memory");
+    let pendulum = concat!(env!("CARGO_MANIFEST_DIR"), "/../assets/pendulum.ron");
+    let common = ["--end", "20", "--max-memory", "75M", "--out"];
+    for args in [
+        vec!["run", "--scene", pendulum, "--no-check"],
+        vec![
+            "sweep",
+            "--scene",
+            pendulum,
+            "--set",
+            "pivot.clearance_mm=0.2,0.3",
+        ],
+    ] {
+        let replay = if args[0] == "run" {
+            None
+        } else {
+            Some("--replay")
+        };
+        let start = Instant::now();
+        let o = bin()
+            .args(&args)
+            .args(replay)
+            .args(common)
+            .arg(&dir)
+            .output()
+            .unwrap();
+        let e = stderr(&o);
+        assert!(!o.status.success(), "{args:?}: accepted");
+        assert!(
+            e.contains("the replay (about") && e.contains("`--no-replay` drops the replay"),
+            "{e}"
+        );
+        assert!(e.contains("--max-memory"), "{e}");
+        assert!(
+            start.elapsed() < Duration::from_secs(5),
+            "refused only after running"
+        );
+        assert!(
+            files_in(&dir.join("points")).is_empty(),
+            "{:?}",
+            files_in(&dir)
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -215,6 +215,8 @@ pub struct ReplayRecorder {
     /// Time of the last contact onset.
     onset: f64,
     last_kept: f64,
+    /// Frames kept at most (see the module docs' cap).
+    max_frames: usize,
 }
 
 impl ReplayRecorder {
@@ -243,7 +245,15 @@ impl ReplayRecorder {
             in_contact: false,
             onset: f64::NEG_INFINITY,
             last_kept: f64::NEG_INFINITY,
+            max_frames: usize::MAX,
         })
+    }
+
+    /// The recorder keeping at most `max_frames` frames (at least 4), halving its frames and
+    /// doubling its intervals whenever it reaches them (see the module docs' cap).
+    pub fn with_max_frames(mut self, max_frames: usize) -> Self {
+        self.max_frames = max_frames.max(4);
+        self
     }
 
     /// Tracks a body (in group `group`), its shapes from its colliders or its mass properties
@@ -366,6 +376,30 @@ impl ReplayRecorder {
     fn push(&mut self, frame: ReplayFrame) {
         self.last_kept = frame.t;
         self.recording.frames.push(frame);
+        if self.recording.frames.len() > self.max_frames {
+            self.halve();
+        }
+    }
+
+    /// Halves the frames kept (see the module docs' cap): the first and last stay, each pair
+    /// between keeps its frame of larger force, with the other's impact flags.
+    fn halve(&mut self) {
+        let frames = std::mem::take(&mut self.recording.frames);
+        let n = frames.len();
+        let mut kept = Vec::with_capacity(n / 2 + 2);
+        let mut it = frames.into_iter();
+        kept.extend(it.next());
+        let last = it.next_back();
+        while let Some(a) = it.next() {
+            kept.push(match it.next() {
+                Some(b) => merge_pair(a, b),
+                None => a,
+            });
+        }
+        kept.extend(last);
+        self.recording.frames = kept;
+        self.recording.interval_s *= 2.0;
+        self.recording.contact_interval_s *= 2.0;
     }
 
     fn frame(&self, t: f64, bodies: &RigidBodySet, sets: &[&ClearanceJointSet]) -> ReplayFrame {
@@ -423,6 +457,17 @@ impl ReplayRecorder {
         }
         self.recording
     }
+}
+
+/// The frame of `a` and `b` with the larger contact force, carrying the other's impact flags
+/// (an impact's frame dropped still shows on the timeline).
+fn merge_pair(a: ReplayFrame, b: ReplayFrame) -> ReplayFrame {
+    let peak = |f: &ReplayFrame| f.journals.iter().map(|j| j.force_n).fold(0.0, f64::max);
+    let (mut keep, drop) = if peak(&b) > peak(&a) { (b, a) } else { (a, b) };
+    for (k, d) in keep.journals.iter_mut().zip(&drop.journals) {
+        k.impact |= d.impact;
+    }
+    keep
 }
 
 /// The in-plane `u` direction of a hinge: the axis of the frame least aligned with `axis`,
@@ -549,6 +594,20 @@ mod tests {
         assert_eq!(t[0], 0.0);
         assert!((t[1] - 0.1).abs() < 1e-12 && t[2] == 0.15, "{t:?}");
         assert!(ReplayRecorder::new(0.1, 0.2).is_err());
+    }
+
+    #[test]
+    fn the_cap_halves_frames_and_keeps_the_first_and_last() {
+        let mut r = ReplayRecorder::new(1e-3, 1e-3).unwrap().with_max_frames(10);
+        let bodies = RigidBodySet::new();
+        for k in 0..=100 {
+            r.record(k as f64 * 1e-3, &bodies, &[]);
+        }
+        let rec = r.finish();
+        assert!(rec.frames.len() <= 10, "{}", rec.frames.len());
+        assert_eq!(rec.frames[0].t, 0.0);
+        assert_eq!(rec.frames.last().unwrap().t, 0.1);
+        assert!(rec.interval_s > 1e-3 && rec.contact_interval_s > 1e-3);
         assert!(ReplayRecorder::new(f64::NAN, 0.1).is_err());
     }
 }

@@ -46,7 +46,7 @@ pub fn remove_inflight() -> usize {
 
 /// Whether process `pid` exists (Linux: `/proc/<pid>`; elsewhere assumed alive, so nothing of
 /// another process is ever removed by mistake).
-fn process_alive(pid: u32) -> bool {
+pub fn process_alive(pid: u32) -> bool {
     if pid == std::process::id() {
         return true;
     }
@@ -238,6 +238,23 @@ pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<()> {
     write_set(&renders)
 }
 
+/// Creates the folder of `path` and removes the stale temporaries there (once per folder).
+fn create_parent(path: &Path, cleaned: &mut Vec<PathBuf>) -> Result<()> {
+    let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) else {
+        return Ok(());
+    };
+    std::fs::create_dir_all(dir).map_err(|source| Error::Io {
+        action: "cannot create the folder of",
+        path: path.to_path_buf(),
+        source,
+    })?;
+    if !cleaned.iter().any(|d| d == dir) {
+        clean_stale_temps(dir);
+        cleaned.push(dir.to_path_buf());
+    }
+    Ok(())
+}
+
 /// Writes the content of one file into a writer (streamed: a large table is never held as text).
 pub type Render<'a> = Box<dyn Fn(&mut dyn Write) -> Result<()> + 'a>;
 
@@ -269,18 +286,28 @@ pub fn write_set(files: &[(&Path, Render)]) -> Result<()> {
     };
     let mut cleaned: Vec<PathBuf> = Vec::new();
     for (path, render) in files {
-        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-            std::fs::create_dir_all(dir).map_err(|e| io("cannot create the folder of", path, e))?;
-            if !cleaned.iter().any(|d| d == dir) {
-                clean_stale_temps(dir);
-                cleaned.push(dir.to_path_buf());
-            }
-        }
         let tmp = temp(path);
-        inflight().push(tmp.clone());
+        // Folder and temporary made under the in-flight lock: an interrupt either finds the
+        // temporary registered (and removes it) or stops us before we create anything, so no
+        // folder (a result set's staging folder) is made again after the interrupt removed it.
+        let created = {
+            let mut list = inflight();
+            let made = create_parent(path, &mut cleaned)
+                .and_then(|_| std::fs::File::create(&tmp).map_err(|e| io("cannot write", path, e)));
+            if made.is_ok() {
+                list.push(tmp.clone());
+            }
+            made
+        };
+        let f = match created {
+            Ok(f) => f,
+            Err(e) => {
+                discard(&staged);
+                return Err(e);
+            }
+        };
         staged.push(tmp.clone());
         let written = (|| -> Result<()> {
-            let f = std::fs::File::create(&tmp).map_err(|e| io("cannot write", path, e))?;
             let mut w = std::io::BufWriter::with_capacity(1 << 16, f);
             render(&mut w)?;
             let f = w
@@ -334,8 +361,12 @@ pub struct MemoryEstimate {
     /// Values per row, over both twins.
     pub values_per_row: u64,
     /// Bytes: the rows' values (8 bytes each) held twice, for a table's growth by doubling,
-    /// plus a fixed allowance for the world and the program.
+    /// plus a fixed allowance for the world and the program, plus [`replay_bytes`](Self::replay_bytes).
     pub bytes: u64,
+    /// Bytes of the run's replay, when one is recorded (0 otherwise): what its recorder and
+    /// page hold at their peak, as the application that builds them states
+    /// ([`with_replay`](Self::with_replay)).
+    pub replay_bytes: u64,
 }
 
 /// Fixed allowance of a run beyond its rows (program, Rapier world, buffers), bytes.
@@ -376,6 +407,20 @@ impl MemoryEstimate {
             rows,
             values_per_row,
             bytes,
+            replay_bytes: 0,
+        }
+    }
+
+    /// The estimate with a replay of `replay_bytes` recorded beside the rows (replacing any
+    /// replay counted before).
+    pub fn with_replay(self, replay_bytes: u64) -> MemoryEstimate {
+        MemoryEstimate {
+            bytes: self
+                .bytes
+                .saturating_sub(self.replay_bytes)
+                .saturating_add(replay_bytes),
+            replay_bytes,
+            ..self
         }
     }
 
@@ -395,7 +440,7 @@ impl MemoryEstimate {
             ),
             None => format!(
                 "that is less than the {} a run needs beyond its rows: raise the memory budget{}",
-                bytes_text(BASE_BYTES),
+                bytes_text(BASE_BYTES.saturating_add(self.replay_bytes)),
                 if concurrent > 1 {
                     " or run fewer in parallel"
                 } else {
@@ -406,9 +451,14 @@ impl MemoryEstimate {
         Err(Error::invalid(
             "run.output_interval_s",
             format!(
-                "{} rows of {} values{} would need about {} of memory, more than the {} available: {advice}",
+                "{} rows of {} values{}{} would need about {} of memory, more than the {} available: {advice}",
                 sig4(self.rows as f64),
                 self.values_per_row,
+                if self.replay_bytes > 0 {
+                    format!(" and the replay (about {})", bytes_text(self.replay_bytes))
+                } else {
+                    String::new()
+                },
                 if concurrent > 1 {
                     format!(" in each of {concurrent} parallel runs")
                 } else {
@@ -430,7 +480,8 @@ impl MemoryEstimate {
         budget: u64,
     ) -> Option<f64> {
         let per_run = budget / concurrent.max(1);
-        let fit_rows = per_run.saturating_sub(BASE_BYTES) / (16 * self.values_per_row.max(1));
+        let fixed = BASE_BYTES.saturating_add(self.replay_bytes);
+        let fit_rows = per_run.saturating_sub(fixed) / (16 * self.values_per_row.max(1));
         (fit_rows > 2).then(|| round_up_sig(scene.run.end_s / (fit_rows - 2) as f64))
     }
 }

@@ -3,7 +3,7 @@
 
 use crate::resultset::ResultSet;
 use clearance_joint::error::Result;
-use clearance_joint::scene::output::{MemoryEstimate, available_memory, write_atomic};
+use clearance_joint::scene::output::{available_memory, write_atomic};
 use clearance_joint::scene::runner::convergence::{self, Convergence, ConvergenceCheck};
 use clearance_joint::scene::runner::{Progress, RunOptions, RunResult, Simulation};
 use clearance_joint::scene::{StepMode, ValidatedScene};
@@ -22,15 +22,17 @@ pub struct SceneRun {
 }
 
 impl SceneRun {
-    /// Before any work: the run fits `max_memory` (default: what the system has available), and
-    /// the folder is ours alone until the set is in place, its staging folder writable.
+    /// Before any work: the run, with its replay when `replay`, fits `max_memory` (default:
+    /// what the system has available), and the folder is ours alone until the set is in place,
+    /// its staging folder writable.
     pub fn prepare(
         scene: ValidatedScene,
         out: PathBuf,
         max_memory: Option<u64>,
+        replay: bool,
     ) -> Result<SceneRun> {
         if let Some(budget) = max_memory.or_else(available_memory) {
-            let estimate = MemoryEstimate::of(&scene);
+            let estimate = crate::replay::estimate(&scene, replay);
             estimate
                 .check(&scene, 1, budget)
                 .map_err(|e| crate::advice::memory_options(e, &estimate, &scene, 1, budget))?;

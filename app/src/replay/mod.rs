@@ -19,7 +19,7 @@
 
 use clearance_joint::error::{Error, Result};
 use clearance_joint::rapier::replay::Recording;
-use clearance_joint::scene::output::write_atomic;
+use clearance_joint::scene::output::{MemoryEstimate, write_atomic};
 use clearance_joint::scene::runner::{Progress, RunOptions, RunResult, Simulation, TwinKind};
 use clearance_joint::scene::{Scene, ValidatedScene};
 use clearance_joint::table::Table;
@@ -34,6 +34,45 @@ pub const FRAMES: f64 = 2000.0;
 pub const CONTACT_FRAMES: f64 = 100_000.0;
 /// Time buckets of the plotted series (each keeps its smallest and largest value).
 pub const SERIES_BUCKETS: usize = 1500;
+/// Frames a replay keeps at most: beyond, the recorder halves them, keeping the largest force
+/// (its cap, [`clearance_joint::rapier::replay`]); so a replay's memory does not grow with the
+/// run's length or its impacts.
+pub const MAX_FRAMES: usize = 20_000;
+/// Characters per number in the page's JSON (7 significant digits, sign, exponent, comma).
+const JSON_CHARS: u64 = 14;
+
+/// The memory a replay of `scene` holds at its peak, bytes: [`MAX_FRAMES`] frames of the
+/// tracked bodies (both twins') and journals, as the recorder stores them (a pose of 7 numbers
+/// per body, 6 numbers and 2 flags per journal), the page's flattened copy of them, and its
+/// JSON text held three times while the page is built (the JSON, its escaped copy, the page),
+/// each string allowed twice its length for its growth by doubling.
+pub fn memory_bytes(scene: &Scene) -> u64 {
+    let bodies = 2 * scene.bodies.len() as u64;
+    let journals = scene
+        .hinges
+        .iter()
+        .filter(|h| h.clearance.is_some())
+        .count() as u64;
+    // A frame: time and two vectors' headers (8 + 48), their heap blocks (+ 32 of allocator).
+    let recorded = 88 + 56 * bodies + 56 * journals;
+    let flattened = 8 + 56 * bodies + 49 * journals;
+    let numbers = 1 + 7 * bodies + 7 * journals;
+    let text = 3 * 2 * JSON_CHARS * numbers;
+    // The frames' vector itself may be twice its length (growth by doubling).
+    let per_frame = recorded + 56 + 2 * flattened + text;
+    MAX_FRAMES as u64 * per_frame + TEMPLATE.len() as u64 * 3
+}
+
+/// The memory estimate of a run of `scene` ([`MemoryEstimate::of`]) with its replay when
+/// `replay` ([`memory_bytes`]).
+pub fn estimate(scene: &Scene, replay: bool) -> MemoryEstimate {
+    let rows = MemoryEstimate::of(scene);
+    if replay {
+        rows.with_replay(memory_bytes(scene))
+    } else {
+        rows
+    }
+}
 
 const TEMPLATE: &str = include_str!("../../assets/replay/replay.html");
 
@@ -49,7 +88,9 @@ pub fn run_recorded(
         return Ok((sim.run_keeping_partial(progress)?, None));
     }
     let end = scene.run.end_s;
-    let mut recorder = sim.replay_recorder(end / FRAMES, end / CONTACT_FRAMES)?;
+    let mut recorder = sim
+        .replay_recorder(end / FRAMES, end / CONTACT_FRAMES)?
+        .with_max_frames(MAX_FRAMES);
     let result = sim.run_observed(progress, |s| s.record_replay(&mut recorder))?;
     Ok((result, Some(recorder.finish())))
 }

@@ -12,10 +12,9 @@
 use super::grid::{Axis, Grid, Point, Shard};
 use super::metrics::RunMetrics;
 use crate::advice::memory_options;
+use crate::resultset::{ResultSet, pause_at};
 use clearance_joint::error::{Error, Result};
-use clearance_joint::scene::output::{
-    DirLock, MemoryEstimate, bytes_text, write_all_atomic, write_atomic,
-};
+use clearance_joint::scene::output::{bytes_text, write_all_atomic, write_atomic};
 use clearance_joint::scene::runner::convergence::{self, ConvergenceVerdict};
 use clearance_joint::scene::{Scene, ValidatedScene, field_within};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -303,6 +302,7 @@ impl Sweep {
         points: usize,
         threads: usize,
         budget: Option<u64>,
+        replay: bool,
     ) -> Result<Option<u64>> {
         let Some(budget) = budget.or_else(clearance_joint::scene::output::available_memory) else {
             return Ok(None);
@@ -328,7 +328,7 @@ impl Sweep {
             .into_iter()
             .map(|i| self.job(base, Path::new(""), self.grid.point(i)))
             .collect::<Result<Vec<_>>>()?;
-        check_memory(&samples, threads.min(points.max(1)), Some(left))?;
+        check_memory(&samples, threads.min(points.max(1)), Some(left), replay)?;
         Ok(Some(left))
     }
 
@@ -378,9 +378,11 @@ impl Sweep {
         let base = self.check()?;
         let (threads, _) = thread_count(options.threads)?;
         let count = shard.len(&self.grid);
-        let run_budget = self.check_memory(&base, count, threads, options.max_memory)?;
+        let run_budget =
+            self.check_memory(&base, count, threads, options.max_memory, options.replay)?;
         // The table of an earlier run must not pass for this one's while the points change.
         remove_tables(out, shard)?;
+        crate::resultset::clean_stale(&out.join("points"));
         let index = |k: usize| shard.index() + k * shard.count();
         let results = execute_with(
             count,
@@ -480,8 +482,8 @@ impl Job {
         Some(m)
     }
 
-    /// Runs the point and writes its files, the manifest last. An old manifest is removed
-    /// first, so an interrupted rerun never looks finished.
+    /// Runs the point and writes its files as one set, the manifest last (see
+    /// [`run_point`](Self::run_point)).
     pub fn run(&self) -> Result<Manifest> {
         self.run_replay(false)
     }
@@ -493,12 +495,12 @@ impl Job {
 
     /// As [`run_replay`](Self::run_replay), also checking the point's convergence when `check`
     /// ([`ExecOptions::check`]). A check whose own run fails does not fail the point: its
-    /// verdict says so.
+    /// verdict says so. The point's files (CSVs, summary, replay, manifest) are one result set
+    /// ([`ResultSet`]): written into `points/.<dir>.new-<pid>` and renamed into place whole, so
+    /// a kill leaves the old set or the new one, never a mix; its claim (`points/.<dir>.lock`)
+    /// refuses a second sweep running the same point.
     pub fn run_point(&self, replay: bool, check: bool) -> Result<Manifest> {
-        // One process per point folder: a second sweep running the same point is refused
-        // rather than mixing its files with ours.
-        let _lock = DirLock::acquire(&self.dir)?;
-        remove_if_present(&self.dir.join(MANIFEST))?;
+        let set = ResultSet::begin(&self.dir, &[])?;
         let adaptive = self.scene.run.step == clearance_joint::scene::StepMode::Adaptive;
         let (mut result, recording) = crate::replay::run_recorded(&self.scene, |_| {}, replay)
             .map_err(|e| e.with_step_mode(adaptive))?;
@@ -520,22 +522,37 @@ impl Job {
         };
         let mut metrics = RunMetrics::of(&result)?;
         metrics.convergence = convergence.clone();
-        crate::summary::write_run(&result, &self.dir, &convergence)?;
-        match &recording {
-            Some(recording) => {
-                crate::replay::write_run_replay(&self.scene, &result, recording, &self.dir)?;
-            }
-            None => crate::replay::remove_stale(&self.dir)?,
+        let dir = set.dir();
+        crate::summary::write_run(&result, dir, &convergence)?;
+        pause_at("point-summary");
+        if let Some(recording) = &recording {
+            crate::replay::write_run_replay(&self.scene, &result, recording, dir)?;
         }
-        let mut files = Vec::new();
-        for twin in &result.twins {
-            files.push(format!("{}.csv", twin.kind.name()));
-        }
-        files.push("summary.json".into());
-        let files = files
+        pause_at("point-replay");
+        let manifest = self.manifest(&result, dir, metrics)?;
+        write_atomic(&dir.join(MANIFEST), &json_bytes(&manifest, "manifest")?)?;
+        pause_at("point-manifest");
+        set.commit()?;
+        Ok(manifest)
+    }
+
+    /// The manifest of the point's files written into `dir`.
+    fn manifest(
+        &self,
+        result: &clearance_joint::scene::runner::RunResult,
+        dir: &Path,
+        metrics: RunMetrics,
+    ) -> Result<Manifest> {
+        let mut names: Vec<String> = result
+            .twins
+            .iter()
+            .map(|t| format!("{}.csv", t.kind.name()))
+            .collect();
+        names.push("summary.json".into());
+        let files = names
             .into_iter()
             .map(|name| {
-                let path = self.dir.join(&name);
+                let path = dir.join(&name);
                 let bytes = std::fs::metadata(&path)
                     .map_err(|source| Error::Io {
                         action: "cannot read the size of",
@@ -546,19 +563,14 @@ impl Job {
                 Ok(FileEntry { name, bytes })
             })
             .collect::<Result<Vec<_>>>()?;
-        let manifest = Manifest {
+        Ok(Manifest {
             format: FORMAT_VERSION,
             point: self.point.clone(),
             base_overrides: self.base_overrides.clone(),
             scene_ron: self.scene.to_ron(),
             files,
             metrics,
-        };
-        write_atomic(
-            &self.dir.join(MANIFEST),
-            &json_bytes(&manifest, "manifest")?,
-        )?;
-        Ok(manifest)
+        })
     }
 }
 
@@ -584,7 +596,12 @@ pub(crate) fn json_bytes<T: Serialize>(value: &T, what: &str) -> Result<Vec<u8>>
 /// each job has its own result.
 pub fn execute(jobs: &[Job], options: ExecOptions) -> Result<Vec<Result<PointOutcome>>> {
     let (threads, _) = thread_count(options.threads)?;
-    check_memory(jobs, threads, options.max_memory)?;
+    check_memory(jobs, threads, options.max_memory, options.replay)?;
+    let mut parents: Vec<&Path> = jobs.iter().filter_map(|j| j.dir.parent()).collect();
+    parents.dedup();
+    for p in parents {
+        crate::resultset::clean_stale(p);
+    }
     execute_with(jobs.len(), |k| Ok(jobs[k].clone()), options, None)
 }
 
@@ -602,7 +619,7 @@ fn execute_with(
     let progress = Reporter::new(count, options.progress);
     let run = |job: &Job| -> Result<PointOutcome> {
         if let Some(budget) = run_budget {
-            let estimate = MemoryEstimate::of(&job.scene);
+            let estimate = crate::replay::estimate(&job.scene, options.replay);
             estimate
                 .check(&job.scene, concurrent, budget)
                 .map_err(|e| memory_options(e, &estimate, &job.scene, concurrent, budget))
@@ -653,13 +670,13 @@ fn execute_with(
 /// Refuses, before any point runs, a batch whose parallel runs would hold more memory than
 /// `budget` (default: what the system has available): the largest point's estimate times the
 /// runs in flight at once.
-pub fn check_memory(jobs: &[Job], threads: usize, budget: Option<u64>) -> Result<()> {
+pub fn check_memory(jobs: &[Job], threads: usize, budget: Option<u64>, replay: bool) -> Result<()> {
     let Some(budget) = budget.or_else(clearance_joint::scene::output::available_memory) else {
         return Ok(());
     };
     let Some((job, estimate)) = jobs
         .iter()
-        .map(|j| (j, MemoryEstimate::of(&j.scene)))
+        .map(|j| (j, crate::replay::estimate(&j.scene, replay)))
         .max_by_key(|(_, e)| e.bytes)
     else {
         return Ok(());

@@ -89,6 +89,18 @@ fn assert_whole_points(points: &Path, rerun: SystemTime, what: &str) {
     }
 }
 
+/// The files of the first point folder (by name) under `points`.
+fn first_point(points: &Path) -> Vec<(String, SystemTime)> {
+    let mut dirs: Vec<PathBuf> = std::fs::read_dir(points)
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.is_dir() && !p.file_name().unwrap().to_string_lossy().starts_with('.'))
+        .collect();
+    dirs.sort();
+    members(&dirs[0])
+}
+
 /// Runs the rerun until it pauses at `step`, then sends `signal`.
 fn kill_at(out: &Path, end: &str, step: &str, signal: &str) {
     let mut child = sweep(out, end)
@@ -100,7 +112,8 @@ fn kill_at(out: &Path, end: &str, step: &str, signal: &str) {
     // Standard error stays open (read to its end) after the pause: the interrupt handler
     // writes to it.
     let mut lines = std::io::BufReader::new(child.stderr.take().unwrap()).lines();
-    let paused = lines.any(|l| l.unwrap_or_default().contains(&format!("paused at {step}")));
+    let name = step.split('#').next().unwrap_or(step);
+    let paused = lines.any(|l| l.unwrap_or_default().contains(&format!("paused at {name}")));
     let drain = std::thread::spawn(move || lines.for_each(drop));
     assert!(paused, "the rerun never reached `{step}`");
     let sent = Command::new("kill")
@@ -125,10 +138,18 @@ fn killed_replay_reruns_leave_whole_point_sets() {
             std::thread::sleep(Duration::from_millis(20));
             let rerun = SystemTime::now();
             std::thread::sleep(Duration::from_millis(20));
-            // Another end each time: the rerun's points differ from the folder's.
-            kill_at(&out, &format!("0.0{trial}1"), step, signal);
-            let what = format!("killed by SIG{signal} at {step}");
+            // Another end each time: the rerun's points differ from the folder's. Every other
+            // trial stops at the second point, after the first committed its new set.
+            let at = format!("{step}#{}", 1 + trial % 2);
+            kill_at(&out, &format!("0.0{trial}1"), &at, signal);
+            let what = format!("killed by SIG{signal} at {at}");
             assert_whole_points(&points, rerun, &what);
+            if at.ends_with("#2") {
+                assert!(
+                    first_point(&points).iter().all(|(_, t)| *t > rerun),
+                    "{what}: the first point's new set is not in place"
+                );
+            }
             if signal != "KILL" {
                 assert!(stages(&points).is_empty(), "{what}: {:?}", stages(&points));
             }

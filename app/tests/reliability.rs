@@ -488,7 +488,7 @@ fn bad_command_lines() {
         (vec!["--end", "1e-300"], "run.end_s", "between"),
         (vec!["--set", "run=5"], "`run`", "group of settings"),
         (
-            vec!["--max-memory", "80M"],
+            vec!["--max-memory", "80M", "--no-replay"],
             "run.output_interval_s",
             "--output-interval",
         ),

@@ -15,6 +15,12 @@
 //! sustained contact (a journal sliding along the wall) cost one frame per `interval`: at most
 //! `duration / interval + impacts x (DENSE_FRAMES + 2)` frames.
 //!
+//! **Cap.** A recorder built [`with_max_frames`](ReplayRecorder::with_max_frames) never holds
+//! more: on reaching the cap it halves its frames (the first and last stay; of each pair between,
+//! the frame of larger contact force, carrying the other's impact flags) and doubles both
+//! intervals, so a long or rattling run's recording stays bounded in memory and every kept
+//! stretch keeps its largest force.
+//!
 //! ```
 //! use clearance_joint::prelude::*;
 //! use clearance_joint::rapier::replay::{ReplayRecorder, ReplayShape};

@@ -41,11 +41,12 @@ pub const MAX_FRAMES: usize = 20_000;
 /// Characters per number in the page's JSON (7 significant digits, sign, exponent, comma).
 const JSON_CHARS: u64 = 14;
 
-/// The memory a replay of `scene` holds at its peak, bytes: [`MAX_FRAMES`] frames of the
-/// tracked bodies (both twins') and journals, as the recorder stores them (a pose of 7 numbers
-/// per body, 6 numbers and 2 flags per journal), the page's flattened copy of them, and its
-/// JSON text held three times while the page is built (the JSON, its escaped copy, the page),
-/// each string allowed twice its length for its growth by doubling.
+/// The memory a replay of `scene` holds at its peak, bytes, an upper bound: [`MAX_FRAMES`]
+/// frames of the tracked bodies (both twins') and journals, as the recorder stores them (a pose
+/// of 7 numbers per body, 6 numbers and 2 flags per journal), the page's flattened copy of them,
+/// and its JSON text held three times while the page is built (the JSON, its escaped copy, the
+/// page). Measured: the paper's scene at 5 times its torque keeps 9,844 frames and peaks 13.2 MB
+/// above its run without a replay, 1.35 kB a frame, against 2.5 kB a frame here.
 pub fn memory_bytes(scene: &Scene) -> u64 {
     let bodies = 2 * scene.bodies.len() as u64;
     let journals = scene
@@ -57,7 +58,7 @@ pub fn memory_bytes(scene: &Scene) -> u64 {
     let recorded = 88 + 56 * bodies + 56 * journals;
     let flattened = 8 + 56 * bodies + 49 * journals;
     let numbers = 1 + 7 * bodies + 7 * journals;
-    let text = 3 * 2 * JSON_CHARS * numbers;
+    let text = 3 * JSON_CHARS * numbers;
     // The frames' vector itself may be twice its length (growth by doubling).
     let per_frame = recorded + 56 + 2 * flattened + text;
     MAX_FRAMES as u64 * per_frame + TEMPLATE.len() as u64 * 3

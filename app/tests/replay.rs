@@ -182,6 +182,40 @@ fn replay_opens_in_chromium_at_an_impact_and_matches_the_csv() {
         );
     }
     assert_eq!(j["contact"], true, "{j}");
+    // The run's peak (every step) is the page's: the inset's largest force and the force
+    // plot's top, to the page's 7 digits; neither is the rows' lower maximum.
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    let peak = summary["twins"]["clearance"]["hinges"]["hinge"]["peak_force_n"]
+        .as_f64()
+        .unwrap();
+    let rows_max = rows
+        .iter()
+        .map(|r| r[col("hinge_force_n")])
+        .fold(0.0, f64::max);
+    assert!(rows_max < peak * (1.0 - 1e-4), "rows {rows_max} vs {peak}");
+    let largest = j["largest_force_n"].as_f64().unwrap();
+    assert!(
+        (largest / peak - 1.0).abs() < 1e-6,
+        "inset {largest} N vs summary {peak} N"
+    );
+    let plots = status["plots"].as_array().unwrap();
+    let force_plot = plots
+        .iter()
+        .find(|p| p["title"].as_str().unwrap().contains("joint force"))
+        .expect("a force plot");
+    let plotted = force_plot["lines"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|l| l["group"] == "clearance")
+        .unwrap()["max"]
+        .as_f64()
+        .unwrap();
+    assert!(
+        (plotted / peak - 1.0).abs() < 1e-6,
+        "plot {plotted} N vs summary {peak} N"
+    );
 
     // A screenshot that is not blank: many distinct colours and a real spread of brightness.
     let shot = dir.join("replay.png");

@@ -364,7 +364,7 @@ fn the_impact_list_is_written_and_matches_the_summary() {
     let mut lines = csv.lines();
     assert_eq!(
         lines.next().unwrap(),
-        "onset_t_s,approach_speed_mm_s,peak_force_n,max_penetration_um,duration_s,separated"
+        "onset_t_s,approach_speed_mm_s,peak_force_n,peak_t_s,max_penetration_um,duration_s,separated"
     );
     let rows: Vec<Vec<f64>> = lines
         .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
@@ -372,15 +372,19 @@ fn the_impact_list_is_written_and_matches_the_summary() {
     let m = &summary.twins["clearance"].hinges["pivot"];
     assert_eq!(rows.len() as u64, m.onsets);
     assert!(m.onsets > 1);
-    let separated = rows.iter().filter(|r| r[5] == 1.0).count();
+    let separated = rows.iter().filter(|r| r[6] == 1.0).count();
     assert_eq!(separated as u64, m.impacts);
     assert_eq!(Some(rows[0][0]), m.first_impact_t_s);
     assert_eq!(Some(rows[0][2]), m.first_impact_peak_n);
     let peak = rows.iter().map(|r| r[2]).fold(0.0, f64::max);
     assert_eq!(peak, m.peak_force_n);
-    let pen = rows.iter().map(|r| r[3]).fold(0.0, f64::max);
+    // Each peak inside its contact.
+    for r in &rows {
+        assert!(r[3] >= r[0] && r[3] <= r[0] + r[5] + 1e-12, "peak at {} s: {r:?}", r[3]);
+    }
+    let pen = rows.iter().map(|r| r[4]).fold(0.0, f64::max);
     assert_eq!(pen, m.max_penetration_um);
-    let contact: f64 = rows.iter().map(|r| r[4]).sum();
+    let contact: f64 = rows.iter().map(|r| r[5]).sum();
     assert!((contact / scene.run.end_s - m.contact_fraction).abs() < 1e-12);
     // Released centred, the journal falls freely through the clearance: it arrives at
     // sqrt(2 g c) = 62.6 mm/s for 0.2 mm.
@@ -574,6 +578,22 @@ fn the_scene_runs_from_the_command_line_with_figures() {
     ] {
         assert!(dir.join(f).is_file(), "no {f}");
     }
+    // The force figure shows the run's peak from every step, not the rows' lower maximum.
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap();
+    let peak = summary["twins"]["clearance"]["hinges"]["slider_pin"]["peak_force_n"]
+        .as_f64()
+        .unwrap();
+    let rows = clearance_joint_app::figures::series::read_csv(&dir.join("clearance.csv")).unwrap();
+    let rows_max = rows
+        .column("slider_pin_force_n")
+        .unwrap()
+        .into_iter()
+        .fold(0.0, f64::max);
+    assert!(rows_max < peak * (1.0 - 1e-3), "rows {rows_max} vs {peak}");
+    let svg = std::fs::read_to_string(dir.join("joint_force.svg")).unwrap();
+    let legend = format!("clearance joint, peak {peak:.4} N");
+    assert!(svg.contains(&legend), "no `{legend}` in joint_force.svg");
     let _ = std::fs::remove_dir_all(&dir);
 }
 

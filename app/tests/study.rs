@@ -382,6 +382,7 @@ fn synthetic_case(label: &str, c: f64, phase: f64) -> CaseSeries {
             .collect(),
         ecc_u_mm: u,
         ecc_v_mm: v,
+        peaks: Vec::new(),
     }
 }
 
@@ -965,4 +966,55 @@ fn a_study_checks_each_case_and_reports_which_metrics_converged() {
             .all(|r| r.metrics.convergence.is_checked())
     );
     let _ = std::fs::remove_dir_all(&root);
+}
+
+/// A study's force figure shows each case's peak from every step of its run (the contact
+/// list's `peak_t_s`, read back from the point), not the rows' lower maximum: each case's
+/// legend reads its metrics' `peak_force_n`.
+#[test]
+fn study_force_figures_show_each_case_peak() {
+    let out = scratch("study-peaks");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
+        .args([
+            "study",
+            "friction",
+            "--set",
+            "run.end_s=0.12",
+            "--progress",
+            "quiet",
+        ])
+        .arg("--out")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let dir = out.join("friction");
+    let table: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("metrics.json")).unwrap()).unwrap();
+    let svg = std::fs::read_to_string(dir.join("joint_force.svg")).unwrap();
+    let rows = table["rows"].as_array().unwrap();
+    assert_eq!(rows.len(), 2);
+    for row in rows {
+        let peak = row["metrics"]["hinges"]["hinge"]["peak_force_n"]
+            .as_f64()
+            .unwrap();
+        let legend = format!("clearance joint, peak {peak:.4} N");
+        assert!(
+            svg.contains(&legend),
+            "no `{legend}` in the study's joint_force.svg"
+        );
+        let point = out.join("friction").join(row["dir"].as_str().unwrap());
+        let rows = clearance_joint_app::figures::series::read_csv(&point.join("clearance.csv"))
+            .unwrap()
+            .column("hinge_force_n")
+            .unwrap()
+            .into_iter()
+            .fold(0.0, f64::max);
+        assert!(rows < peak * (1.0 - 1e-3), "rows {rows} vs {peak}");
+    }
+    let _ = std::fs::remove_dir_all(&out);
 }

@@ -150,6 +150,10 @@ pub struct Impact {
     pub approach_speed_m_s: f64,
     /// Largest joint force during the contact, N.
     pub peak_force_n: f64,
+    /// Time of the recorded state where the contact's force is largest, s: with
+    /// [`peak_force_n`](Self::peak_force_n), the point a plot of thinned rows must still pass
+    /// through.
+    pub peak_t_s: f64,
     /// Deepest penetration during the contact, um.
     pub max_penetration_um: f64,
     /// Time in contact, s, from the onset to the crossing of delta = 0 at lift-off, interpolated
@@ -315,6 +319,7 @@ impl ImpactRecorder {
                 separated: obs.impact,
                 // From the crossing: the part of the step before this state spent in contact.
                 duration_s: t - onset_t,
+                peak_t_s: t,
                 ..Impact::default()
             });
             self.open = true;
@@ -336,7 +341,10 @@ impl ImpactRecorder {
         if self.open
             && let Some(i) = self.impacts.last_mut()
         {
-            i.peak_force_n = i.peak_force_n.max(obs.force);
+            if obs.force > i.peak_force_n {
+                i.peak_force_n = obs.force;
+                i.peak_t_s = t;
+            }
             i.max_penetration_um = i.max_penetration_um.max(obs.penetration * 1e6);
             i.duration_s += dt;
         }
@@ -411,7 +419,7 @@ impl ImpactRecorder {
         self.contact_time
     }
 
-    /// The contact list as a table: `onset_t_s, approach_speed_mm_s, peak_force_n,
+    /// The contact list as a table: `onset_t_s, approach_speed_mm_s, peak_force_n, peak_t_s,
     /// max_penetration_um, duration_s, separated` (1 for an impact, 0 for chatter).
     pub fn contacts_table(&self) -> Table {
         let mut t = Table::new(
@@ -419,6 +427,7 @@ impl ImpactRecorder {
                 "onset_t_s",
                 "approach_speed_mm_s",
                 "peak_force_n",
+                "peak_t_s",
                 "max_penetration_um",
                 "duration_s",
                 "separated",
@@ -431,6 +440,7 @@ impl ImpactRecorder {
                 i.onset_t_s,
                 i.approach_speed_m_s * 1e3,
                 i.peak_force_n,
+                i.peak_t_s,
                 i.max_penetration_um,
                 i.duration_s,
                 if i.separated { 1.0 } else { 0.0 },
@@ -588,6 +598,8 @@ mod tests {
         assert!((i[0].duration_s - (lift_off - 0.1)).abs() < 1e-15);
         assert_eq!(i[1].peak_force_n, 6.0);
         assert_eq!(i[1].duration_s, 0.5);
+        // Each peak at its state's time: 30 N at 0.2 s, and 6 N at the final state, 1 s.
+        assert_eq!((i[0].peak_t_s, i[1].peak_t_s), (0.2, 1.0));
         let m = r.metrics();
         assert_eq!((m.onsets, m.impacts), (2, 2));
         assert_eq!(m.first_impact_t_s, Some(0.1));

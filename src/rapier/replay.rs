@@ -11,9 +11,12 @@
 //! state; during the first [`DENSE_FRAMES`] `contact_interval`s after a contact's onset (while
 //! in contact, and at the state where that contact ends), when at least `contact_interval` has
 //! passed; always at a contact's onset and at the state just before it, and the last state
-//! recorded. So every impact is kept at the contact's own resolution while free flight and
-//! sustained contact (a journal sliding along the wall) cost one frame per `interval`: at most
-//! `duration / interval + impacts x (DENSE_FRAMES + 2)` frames.
+//! recorded; and between two kept states, the skipped state of largest contact force when that
+//! force exceeds both of theirs, so the recording's largest force is the largest of every state
+//! recorded (a summary's peak), whatever the intervals. So every impact is kept at the contact's
+//! own resolution while free flight and sustained contact (a journal sliding along the wall)
+//! cost one frame per `interval`: at most `2 (duration / interval + impacts x (DENSE_FRAMES +
+//! 2))` frames.
 //!
 //! **Cap.** A recorder built [`with_max_frames`](ReplayRecorder::with_max_frames) never holds
 //! more: on reaching the cap it halves its frames (the first and last stay; of each pair between,
@@ -217,6 +220,9 @@ pub struct ReplayRecorder {
     joints: Vec<(usize, ClearanceJointHandle)>,
     /// The last state recorded, when not kept (kept if a contact starts next).
     pending: Option<ReplayFrame>,
+    /// The state of largest contact force since the last kept one, when not kept (kept before
+    /// the next kept state when its force exceeds both neighbours').
+    peak: Option<ReplayFrame>,
     in_contact: bool,
     /// Time of the last contact onset.
     onset: f64,
@@ -248,6 +254,7 @@ impl ReplayRecorder {
             handles: Vec::new(),
             joints: Vec::new(),
             pending: None,
+            peak: None,
             in_contact: false,
             onset: f64::NEG_INFINITY,
             last_kept: f64::NEG_INFINITY,
@@ -368,15 +375,31 @@ impl ReplayRecorder {
         };
         let keep = onset || t - self.last_kept >= spacing * (1.0 - 1e-9);
         if onset && let Some(before) = self.pending.take() {
-            self.push(before);
+            self.push_after_peak(before);
         }
         self.in_contact = contact;
         if keep {
             self.pending = None;
-            self.push(frame);
+            self.push_after_peak(frame);
         } else {
+            if self.peak.as_ref().is_none_or(|p| force(&frame) > force(p)) {
+                self.peak = Some(frame.clone());
+            }
             self.pending = Some(frame);
         }
+    }
+
+    /// Keeps `frame`, after the state of largest force skipped since the last kept one when
+    /// that force exceeds both neighbours' (a peak between kept states: so the recording's
+    /// largest force is the run's, whatever the thinning).
+    fn push_after_peak(&mut self, frame: ReplayFrame) {
+        if let Some(peak) = self.peak.take() {
+            let before = self.recording.frames.last().map_or(0.0, force);
+            if peak.t < frame.t && force(&peak) > before.max(force(&frame)) {
+                self.push(peak);
+            }
+        }
+        self.push(frame);
     }
 
     fn push(&mut self, frame: ReplayFrame) {
@@ -459,17 +482,25 @@ impl ReplayRecorder {
     /// The recording, with the last state recorded kept.
     pub fn finish(mut self) -> Recording {
         if let Some(last) = self.pending.take() {
-            self.push(last);
+            self.push_after_peak(last);
         }
         self.recording
     }
 }
 
+/// The largest contact force of a frame's journals, N.
+fn force(f: &ReplayFrame) -> f64 {
+    f.journals.iter().map(|j| j.force_n).fold(0.0, f64::max)
+}
+
 /// The frame of `a` and `b` with the larger contact force, carrying the other's impact flags
 /// (an impact's frame dropped still shows on the timeline).
 fn merge_pair(a: ReplayFrame, b: ReplayFrame) -> ReplayFrame {
-    let peak = |f: &ReplayFrame| f.journals.iter().map(|j| j.force_n).fold(0.0, f64::max);
-    let (mut keep, drop) = if peak(&b) > peak(&a) { (b, a) } else { (a, b) };
+    let (mut keep, drop) = if force(&b) > force(&a) {
+        (b, a)
+    } else {
+        (a, b)
+    };
     for (k, d) in keep.journals.iter_mut().zip(&drop.journals) {
         k.impact |= d.impact;
     }

@@ -605,10 +605,27 @@ fn force_caption(cases: usize, label: &str, joint: &str) -> String {
     }
 }
 
+/// What the force panels drew of the runs: the rows, thinned, and for the clearance joint
+/// each contact's peak from every step.
+fn force_footnote(cases: &[CaseSeries]) -> String {
+    let peaks: usize = cases.iter().map(|c| c.peaks.len()).sum();
+    format!(
+        "Curves: the output rows, each pixel column's smallest and largest value; the clearance \
+         joint's also passes through each contact's peak from every step ({peaks} contact peaks)."
+    )
+}
+
 fn draw_force<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, cases: &[CaseSeries]) -> DrawResult
 where
     DB::ErrorType: 'static,
 {
+    let (w, h) = area.dim_in_pixel();
+    let (area, foot) = area.split_vertically(h.saturating_sub(26));
+    foot.draw_text(
+        &force_footnote(cases),
+        &(FAMILY, 14).into_font().color(&RGBColor(80, 80, 80)),
+        (10.min(w as i32), 4),
+    )?;
     let panels = area.split_evenly((cases.len(), 2));
     let (t0, t1) = time_range(cases);
     let top = |f: fn(&CaseSeries) -> &Vec<f64>| {
@@ -620,12 +637,32 @@ where
             .fold(0.0, f64::max);
         if m > 0.0 { 1.05 * m } else { 1.0 }
     };
+    // The clearance joint's curve passes through each contact's peak from every step (the
+    // rows alone, one per output interval, miss most of an impact's top).
+    let clear: Vec<(Vec<f64>, Vec<f64>)> = cases.iter().map(|c| c.force_with_peaks()).collect();
     let ideal_top = top(|c| &c.force_ideal_n);
-    let clear_top = top(|c| &c.force_n);
+    let clear_top = {
+        let m = clear.iter().flat_map(|c| c.1.iter()).copied();
+        let m = m.filter(|v| v.is_finite()).fold(0.0, f64::max);
+        if m > 0.0 { 1.05 * m } else { 1.0 }
+    };
     for (i, case) in cases.iter().enumerate() {
-        for (col, (name, series, y1, color)) in [
-            ("ideal joint", &case.force_ideal_n, ideal_top, BLACK),
-            ("clearance joint", &case.force_n, clear_top, case_color(i)),
+        let (clear_t, clear_f) = &clear[i];
+        for (col, (name, times, series, y1, color)) in [
+            (
+                "ideal joint",
+                &case.t_s,
+                &case.force_ideal_n,
+                ideal_top,
+                BLACK,
+            ),
+            (
+                "clearance joint",
+                clear_t,
+                clear_f,
+                clear_top,
+                case_color(i),
+            ),
         ]
         .into_iter()
         .enumerate()
@@ -638,7 +675,7 @@ where
                 .y_label_area_size(80)
                 .build_cartesian_2d(t0..t1, 0.0..y1)?;
             draw_mesh(&mut chart, ("time (s)", "joint force (N)"), (15, 17))?;
-            let points = minmax_decimate(&case.t_s, series, t0, t1, DECIMATE_BINS);
+            let points = minmax_decimate(times, series, t0, t1, DECIMATE_BINS);
             let peak = series.iter().copied().fold(0.0, f64::max);
             let corner = emptiest_corner(points.iter().copied(), (t0, t1), (0.0, y1), (0.45, 0.2));
             chart

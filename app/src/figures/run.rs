@@ -38,12 +38,12 @@ pub fn draw_run_figures(
         return Err(Error::invalid("--figures", "needs both twins"));
     };
     can_draw(scene)?;
-    let series = [CaseSeries::from_tables(
-        case_label(scene),
-        scene,
-        &ideal.table,
-        &clear.table,
-    )?];
+    let case = CaseSeries::from_tables(case_label(scene), scene, &ideal.table, &clear.table)?;
+    let contacts = clear.hinge_recorders();
+    let series = [match contacts.get(&case.hinge) {
+        Some(r) => case.with_contacts(r.contacts()),
+        None => case,
+    }];
     // Driven mechanisms: each moving body's x acceleration against the driver's angle over
     // the last turn, ideal against clearance.
     if let (Some(period), true) = (scene.drive_period(), scene.run.body_motion) {

@@ -44,9 +44,35 @@ pub struct CaseSeries {
     pub ecc_v_mm: Vec<f64>,
     /// 1 in contact, 0 in free flight.
     pub contact: Vec<f64>,
+    /// Each contact's largest force, clearance twin, from every step of the run, not the rows:
+    /// `(time s, force N)` in time order ([`Impact::peak_t_s`]). The force plot passes through
+    /// them ([`force_with_peaks`](Self::force_with_peaks)), so it never shows less than the
+    /// run's peak. Empty when unknown (a point saved without its `peak_t_s` column).
+    ///
+    /// [`Impact::peak_t_s`]: clearance_joint::rapier::metrics::Impact::peak_t_s
+    pub peaks: Vec<(f64, f64)>,
 }
 
 impl CaseSeries {
+    /// The clearance twin's force against time, the rows with each contact's peak
+    /// ([`peaks`](Self::peaks)) merged in time order.
+    pub fn force_with_peaks(&self) -> (Vec<f64>, Vec<f64>) {
+        merge_points(&self.t_s, &self.force_n, &self.peaks)
+    }
+
+    /// The case with `peaks` set from a contact list ([`Impact::peak_t_s`],
+    /// [`Impact::peak_force_n`]).
+    ///
+    /// [`Impact::peak_t_s`]: clearance_joint::rapier::metrics::Impact::peak_t_s
+    /// [`Impact::peak_force_n`]: clearance_joint::rapier::metrics::Impact::peak_force_n
+    pub fn with_contacts(mut self, contacts: &[clearance_joint::rapier::metrics::Impact]) -> Self {
+        self.peaks = contacts
+            .iter()
+            .map(|i| (i.peak_t_s, i.peak_force_n))
+            .collect();
+        self
+    }
+
     /// Extracts the series of `scene`'s first clearance hinge from the two twins' tables.
     pub fn from_tables(
         label: impl Into<String>,
@@ -103,6 +129,7 @@ impl CaseSeries {
             ecc_u_mm: col(clear, &h("ecc_u_mm"))?,
             ecc_v_mm: col(clear, &h("ecc_v_mm"))?,
             contact: col(clear, &h("contact"))?,
+            peaks: Vec::new(),
         })
     }
 
@@ -252,11 +279,56 @@ impl CaseSeries {
                 ecc_u_mm,
                 ecc_v_mm,
                 contact: column(n - 1),
+                peaks: read_peaks(&dir.join(format!("clearance_{}_impacts.csv", spec.name)))?,
             },
             onsets_s: onsets,
             rows,
         })
     }
+}
+
+/// `(t, v)` with `points` (`(t, v)` pairs in time order) merged in time order: the series a
+/// plot draws so that it passes through values the rows skipped.
+pub fn merge_points(t: &[f64], v: &[f64], points: &[(f64, f64)]) -> (Vec<f64>, Vec<f64>) {
+    let n = t.len().min(v.len());
+    let (mut mt, mut mv) = (
+        Vec::with_capacity(n + points.len()),
+        Vec::with_capacity(n + points.len()),
+    );
+    let mut p = points.iter().peekable();
+    for i in 0..n {
+        while let Some(&&(pt, pv)) = p.peek().filter(|q| q.0 < t[i]) {
+            mt.push(pt);
+            mv.push(pv);
+            p.next();
+        }
+        mt.push(t[i]);
+        mv.push(v[i]);
+    }
+    for &(pt, pv) in p {
+        mt.push(pt);
+        mv.push(pv);
+    }
+    (mt, mv)
+}
+
+/// Each contact's peak `(peak_t_s, peak_force_n)` from a contact list written by the run
+/// (`<twin>_<hinge>_impacts.csv`), read row by row; empty when the file or its `peak_t_s`
+/// column is absent (a point written before the column existed draws its rows alone).
+fn read_peaks(path: &Path) -> Result<Vec<(f64, f64)>> {
+    if !path.is_file() {
+        return Ok(Vec::new());
+    }
+    let mut rows = CsvRows::open(path)?;
+    let (Ok(t), Ok(f)) = (rows.index("peak_t_s"), rows.index("peak_force_n")) else {
+        return Ok(Vec::new());
+    };
+    let mut peaks = Vec::new();
+    let mut row = Vec::new();
+    while rows.next_into(&mut row)? {
+        peaks.push((row[t], row[f]));
+    }
+    Ok(peaks)
 }
 
 /// Per time bin, the rows holding each column's minimum and maximum (plus the first and the

@@ -122,7 +122,21 @@ impl Line {
     /// Column `column` of `table` against its `t_s`, thinned to [`SERIES_BUCKETS`] buckets of
     /// time keeping each bucket's smallest and largest value (in time order).
     pub fn from_table(label: &str, group: &str, table: &Table, column: &str) -> Option<Line> {
+        Self::with_points(label, group, table, column, &[])
+    }
+
+    /// As [`from_table`](Self::from_table), with `points` (`(t, v)` in time order: each
+    /// contact's peak from every step) merged into the rows before thinning, so the line
+    /// passes through them.
+    pub fn with_points(
+        label: &str,
+        group: &str,
+        table: &Table,
+        column: &str,
+        points: &[(f64, f64)],
+    ) -> Option<Line> {
         let (t, v) = (table.column("t_s")?, table.column(column)?);
+        let (t, v) = crate::figures::series::merge_points(&t, &v, points);
         let (t, v) = min_max_thin(&t, &v, SERIES_BUCKETS);
         Some(Line {
             label: label.into(),
@@ -309,8 +323,19 @@ pub fn run_page<'a>(scene: &Scene, result: &RunResult, recording: &'a Recording)
         .twin(TwinKind::Clearance)
         .map(|t| t.clearance_hinges().iter().map(|h| h.to_string()).collect())
         .unwrap_or_default();
+    // Each contact's peak from every step, for the clearance twin's force line.
+    let recorders = result
+        .twin(TwinKind::Clearance)
+        .map(|t| t.hinge_recorders())
+        .unwrap_or_default();
     let mut series = Vec::new();
     for h in &hinges {
+        let peaks: Vec<(f64, f64)> = recorders.get(h).map_or(Vec::new(), |r| {
+            r.contacts()
+                .iter()
+                .map(|i| (i.peak_t_s, i.peak_force_n))
+                .collect()
+        });
         for (what, column) in [
             ("angle (deg)", "angle_deg"),
             ("relative rate (deg/s)", "rate_deg_s"),
@@ -319,7 +344,9 @@ pub fn run_page<'a>(scene: &Scene, result: &RunResult, recording: &'a Recording)
             let lines: Vec<Line> = twins
                 .iter()
                 .filter_map(|(name, table)| {
-                    Line::from_table(name, name, table, &format!("{h}_{column}"))
+                    let clear_force = column == "force_n" && *name == TwinKind::Clearance.name();
+                    let points = if clear_force { &peaks[..] } else { &[] };
+                    Line::with_points(name, name, table, &format!("{h}_{column}"), points)
                 })
                 .collect();
             if !lines.is_empty() {
@@ -340,9 +367,11 @@ pub fn run_page<'a>(scene: &Scene, result: &RunResult, recording: &'a Recording)
         ),
         notes: format!(
             "Frames: {} kept of the run's states: one per {} s, one per {} s over the first {} s of \
-             each contact, and every contact onset with the state before it; in between, \
-             positions and journal values are interpolated linearly. Plots: the CSV rows, thinned to \
-             {SERIES_BUCKETS} time buckets keeping each bucket's smallest and largest value. Bodies: \
+             each contact, every contact onset with the state before it, and between kept frames \
+             the state of largest force; in between, positions and journal values are interpolated \
+             linearly. Plots: the CSV rows (the clearance force also each contact's peak from every \
+             step), thinned to {SERIES_BUCKETS} time buckets keeping each bucket's smallest and \
+             largest value. Bodies: \
              their colliders, else the uniform box with their mass and inertia; grey: a fixed body, \
              drawn around its joint points. Open at a time with #t=SECONDS.",
             recording.frames.len(),

@@ -165,7 +165,7 @@ fn a_study_setting_its_swept_field_is_refused() {
         &o,
         &out,
         &[
-            "setting `drive.torque_scale=2`",
+            "invalid `drive.torque_scale=2`: this fixed setting",
             "overwritten at every point of `torque` by the swept `drive.torque_scale`",
         ],
     );

@@ -267,9 +267,9 @@ impl Sweep {
             let over = self.grid.axes.iter().zip(swept);
             if let Some((a, af)) = over.clone().find(|(_, af)| *af == f || field_within(f, af)) {
                 return Err(Error::invalid(
-                    format!("setting `{o}`"),
+                    o,
                     format!(
-                        "is overwritten at every point of `{}` by the swept `{}` (which sets \
+                        "this fixed setting is overwritten at every point of `{}` by the swept `{}` (which sets \
                          `{af}`), so it would be ignored: drop it, or put what it sets in the \
                          swept values",
                         self.name, a.path

@@ -7,6 +7,9 @@ use clearance_joint_app::figures::legend::segment_meets_rect;
 use clearance_joint_app::figures::series::{BodySeries, CaseSeries};
 use clearance_joint_app::figures::{Figure, FigureKind};
 
+/// A polyline's stroke colour, stroke width and points.
+type Polyline<'a> = (&'a String, &'a String, &'a Vec<(f64, f64)>);
+
 /// An element of the SVG, in document order.
 #[derive(Debug)]
 enum Element {
@@ -194,7 +197,7 @@ fn the_ideal_curve_is_dashed_and_drawn_over_the_clearance_one() {
     let cases = [busy_case("clearance joint (c = 0.50 mm)", 0.5, 0.0)];
     let svg = svg_of(FigureKind::AnglesRates, &cases);
     let elements = elements(&svg);
-    let lines: Vec<(&String, &String, &Vec<(f64, f64)>)> = elements
+    let lines: Vec<Polyline<'_>> = elements
         .iter()
         .filter_map(|e| match e {
             Element::Line(s, w, p) => Some((s, w, p)),

@@ -484,6 +484,22 @@ struct Panel<'a> {
     style: PanelStyle,
 }
 
+/// The width in pixels of the widest tick label of an axis over `range`, at font `size`.
+fn widest_tick<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    range: (f64, f64),
+    size: u32,
+) -> u32 {
+    let format = TickFormat::for_axis(range.0, range.1, TICKS);
+    let font = TextStyle::from((FAMILY, size).into_font());
+    let ticks = RangedCoordf64::from(range.0.min(range.1)..range.0.max(range.1)).key_points(TICKS);
+    let width = |t: f64| {
+        area.estimate_text_size(&format.format(t), &font)
+            .map_or(0, |s| s.0)
+    };
+    ticks.into_iter().map(width).max().unwrap_or(0)
+}
+
 /// `points` in pixels of a plotting area of `plot` pixels showing `x` by `y`.
 fn to_pixels(
     points: &[(f64, f64)],
@@ -549,19 +565,32 @@ impl Panel<'_> {
             area.titled(self.caption, (FAMILY, st.caption).into_font().color(&BLACK))?
         };
         // The plotting area ChartBuilder leaves, known before building so the y range can
-        // make room for the legend.
+        // make room for the legend; the y label area is as wide as the y range's tick labels
+        // need, which the legend's headroom may change, hence the second pass.
         let (w, h) = area.dim_in_pixel();
-        let plot = (
-            w as i32 - 2 * st.margin as i32 - st.label_areas.1 as i32,
-            h as i32 - 2 * st.margin as i32 - st.label_areas.0 as i32,
-        );
+        let right = st.margin.max(widest_tick(&area, self.x, st.mesh.0) / 2 + 4);
+        let y_area = |y: (f64, f64)| {
+            let need = widest_tick(&area, y, st.mesh.0) + st.mesh.1 + 30;
+            st.label_areas.1.max(need)
+        };
+        let plot = |y_area: u32| {
+            let used_w = st.margin + right + y_area;
+            let used_h = 2 * st.margin + st.label_areas.0;
+            (w as i32 - used_w as i32, h as i32 - used_h as i32)
+        };
         let legend = self.legend();
         let size = legend.size(&area);
-        let y = self.y_range(plot, size);
+        let mut y_width = y_area(self.y);
+        let mut y = self.y_range(plot(y_width), size);
+        if y_area(y) > y_width {
+            y_width = y_area(y);
+            y = self.y_range(plot(y_width), size);
+        }
         let mut chart = ChartBuilder::on(&area)
             .margin(st.margin)
+            .margin_right(right)
             .x_label_area_size(st.label_areas.0)
-            .y_label_area_size(st.label_areas.1)
+            .y_label_area_size(y_width)
             .build_cartesian_2d(self.x.0..self.x.1, y.0..y.1)?;
         draw_mesh(&mut chart, self.descs, st.mesh)?;
         for (_, color, dashed, points) in self.curves {

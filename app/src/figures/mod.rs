@@ -11,11 +11,13 @@
 //! with DejaVu Sans embedded in the binary (`assets/fonts/`), so nothing depends on the fonts of
 //! the machine, and laid out by [`text`] (plotters' own PNG text misplaces glyphs).
 //!
+//! - [`legend`]: the legends, placed where they cover no curve.
 //! - [`series`]: the time series of one case, read from a run's tables or a point's CSV files.
 //! - [`run`]: the figures of one scene run (`run`, the default job).
 //! - [`text`]: the figures' text layout and rasterisation.
 //! - [`ticks`]: the axes' tick labels.
 
+pub mod legend;
 pub mod run;
 pub mod series;
 pub mod text;
@@ -24,6 +26,7 @@ pub mod ticks;
 use ab_glyph::FontRef;
 use clearance_joint::error::{Error, Result};
 use clearance_joint::scene::output::write_atomic;
+use legend::{Entry, INSET, Legend, Mark};
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
@@ -279,30 +282,27 @@ impl Drawable for XyFigure<'_> {
             return Ok(());
         }
         let pad = 0.05 * (y1 - y0).max(1e-12);
-        let mut chart = ChartBuilder::on(&body)
-            .margin(15)
-            .x_label_area_size(45)
-            .y_label_area_size(90)
-            .build_cartesian_2d(x0..x1, (y0 - pad)..(y1 + pad))?;
-        draw_mesh(&mut chart, (self.x_label, self.y_label), (15, 17))?;
-        for (i, (label, points)) in self.curves.iter().enumerate() {
-            let color = if i == 0 { BLACK } else { case_color(i - 1) };
-            chart
-                .draw_series(LineSeries::new(
-                    points.iter().copied(),
-                    color.stroke_width(1),
-                ))?
-                .label(label.as_str())
-                .legend(legend_line(color));
+        let curves: Vec<Curve> = (self.curves.iter().enumerate())
+            .map(|(i, (label, points))| {
+                let color = if i == 0 { BLACK } else { case_color(i - 1) };
+                (label.clone(), color, false, points.clone())
+            })
+            .collect();
+        Panel {
+            caption: "",
+            descs: (self.x_label, self.y_label),
+            x: (x0, x1),
+            y: (y0 - pad, y1 + pad),
+            curves: &curves,
+            style: PanelStyle {
+                caption: 0,
+                margin: 15,
+                label_areas: (45, 90),
+                mesh: (15, 17),
+                legend: 15,
+            },
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font((FAMILY, 15))
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(160, 160, 160))
-            .draw()?;
-        Ok(())
+        .draw(&body)
     }
     fn fail(&self, format: &str, e: Box<dyn std::error::Error>) -> Error {
         Error::invalid(
@@ -405,39 +405,6 @@ pub fn decimate_path(u: &[f64], v: &[f64], min_step: f64) -> Vec<(f64, f64)> {
     out
 }
 
-/// The corner of the plotting area (`x` and `y` ranges) where a legend box of `(fw, fh)`
-/// (fractions of width and height) covers the fewest of `points`; upper corners win ties.
-fn emptiest_corner(
-    points: impl Iterator<Item = (f64, f64)>,
-    (x0, x1): (f64, f64),
-    (y0, y1): (f64, f64),
-    (fw, fh): (f64, f64),
-) -> SeriesLabelPosition {
-    let mut counts = [0usize; 4]; // upper left, upper right, lower left, lower right
-    let (w, h) = ((x1 - x0).max(1e-300), (y1 - y0).max(1e-300));
-    for (x, y) in points {
-        let (fx, fy) = ((x - x0) / w, (y - y0) / h);
-        let left = fx <= fw;
-        let right = fx >= 1.0 - fw;
-        let upper = fy >= 1.0 - fh;
-        let lower = fy <= fh;
-        for (k, hit) in [upper && left, upper && right, lower && left, lower && right]
-            .into_iter()
-            .enumerate()
-        {
-            if hit {
-                counts[k] += 1;
-            }
-        }
-    }
-    match (0..4).min_by_key(|&k| (counts[k], k)) {
-        Some(1) => SeriesLabelPosition::UpperRight,
-        Some(2) => SeriesLabelPosition::LowerLeft,
-        Some(3) => SeriesLabelPosition::LowerRight,
-        _ => SeriesLabelPosition::UpperLeft,
-    }
-}
-
 /// `[lo, hi]` of the values with 5 % padding (a unit span around a constant).
 fn range_of<'a>(values: impl IntoIterator<Item = &'a f64>) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -491,8 +458,155 @@ fn case_color(i: usize) -> RGBColor {
     PALETTE[i % PALETTE.len()]
 }
 
-fn legend_line(color: RGBColor) -> impl Fn((i32, i32)) -> PathElement<(i32, i32)> {
-    move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+/// Sizes of a panel's parts, px.
+#[derive(Clone, Copy, Debug)]
+struct PanelStyle {
+    /// Caption font.
+    caption: u32,
+    /// Chart margin on every side.
+    margin: u32,
+    /// Heights of the x label area and widths of the y label area.
+    label_areas: (u32, u32),
+    /// Tick label and axis description fonts.
+    mesh: (u32, u32),
+    /// Legend font.
+    legend: u32,
+}
+
+/// One panel of curves: caption, axes with their descriptions, the curves (in order, so a
+/// dashed curve listed last lies over the solid ones) and a legend that crosses no curve.
+struct Panel<'a> {
+    caption: &'a str,
+    descs: (&'a str, &'a str),
+    x: (f64, f64),
+    y: (f64, f64),
+    curves: &'a [Curve],
+    style: PanelStyle,
+}
+
+/// The width in pixels of the widest tick label of an axis over `range`, at font `size`.
+fn widest_tick<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    range: (f64, f64),
+    size: u32,
+) -> u32 {
+    let format = TickFormat::for_axis(range.0, range.1, TICKS);
+    let font = TextStyle::from((FAMILY, size).into_font());
+    let ticks = RangedCoordf64::from(range.0.min(range.1)..range.0.max(range.1)).key_points(TICKS);
+    let width = |t: f64| {
+        area.estimate_text_size(&format.format(t), &font)
+            .map_or(0, |s| s.0)
+    };
+    ticks.into_iter().map(width).max().unwrap_or(0)
+}
+
+/// `points` in pixels of a plotting area of `plot` pixels showing `x` by `y`.
+fn to_pixels(
+    points: &[(f64, f64)],
+    x: (f64, f64),
+    y: (f64, f64),
+    plot: (i32, i32),
+) -> Vec<(f64, f64)> {
+    let (w, h) = (f64::from(plot.0), f64::from(plot.1));
+    let (sx, sy) = ((x.1 - x.0).max(1e-300), (y.1 - y.0).max(1e-300));
+    points
+        .iter()
+        .map(|&(u, v)| ((u - x.0) / sx * w, (y.1 - v) / sy * h))
+        .collect()
+}
+
+impl Panel<'_> {
+    fn legend(&self) -> Legend {
+        let entries = self.curves.iter().map(|(label, color, dashed, _)| Entry {
+            label: label.clone(),
+            mark: if *dashed {
+                Mark::Dashed(*color)
+            } else {
+                Mark::Line(*color)
+            },
+        });
+        Legend {
+            entries: entries.collect(),
+            font_size: self.style.legend,
+            row: false,
+        }
+    }
+
+    fn pixel_paths(&self, y: (f64, f64), plot: (i32, i32)) -> Vec<Vec<(f64, f64)>> {
+        self.curves
+            .iter()
+            .map(|c| to_pixels(&c.3, self.x, y, plot))
+            .collect()
+    }
+
+    /// The y range to draw: the panel's, or raised so the legend fits above the data when no
+    /// corner of the plot is free of curves.
+    fn y_range(&self, plot: (i32, i32), legend: (i32, i32)) -> (f64, f64) {
+        if legend::free_corner(&self.pixel_paths(self.y, plot), plot, legend).is_some() {
+            return self.y;
+        }
+        let top = self.curves.iter().flat_map(|c| c.3.iter().map(|p| p.1));
+        let y_max = top.filter(|v| v.is_finite()).fold(self.y.0, f64::max);
+        let need = 2 * INSET + legend.1;
+        match legend::headroom(self.y.0, y_max, need, plot.1) {
+            Some(y1) => (self.y.0, y1.max(self.y.1)),
+            None => self.y,
+        }
+    }
+
+    fn draw<DB: DrawingBackend>(&self, area: &DrawingArea<DB, Shift>) -> DrawResult
+    where
+        DB::ErrorType: 'static,
+    {
+        let st = self.style;
+        let area = if self.caption.is_empty() {
+            area.clone()
+        } else {
+            area.titled(self.caption, (FAMILY, st.caption).into_font().color(&BLACK))?
+        };
+        // The plotting area ChartBuilder leaves, known before building so the y range can
+        // make room for the legend; the y label area is as wide as the y range's tick labels
+        // need, which the legend's headroom may change, hence the second pass.
+        let (w, h) = area.dim_in_pixel();
+        let right = st.margin.max(widest_tick(&area, self.x, st.mesh.0) / 2 + 4);
+        let y_area = |y: (f64, f64)| {
+            let need = widest_tick(&area, y, st.mesh.0) + st.mesh.1 + 30;
+            st.label_areas.1.max(need)
+        };
+        let plot = |y_area: u32| {
+            let used_w = st.margin + right + y_area;
+            let used_h = 2 * st.margin + st.label_areas.0;
+            (w as i32 - used_w as i32, h as i32 - used_h as i32)
+        };
+        let legend = self.legend();
+        let size = legend.size(&area);
+        let mut y_width = y_area(self.y);
+        let mut y = self.y_range(plot(y_width), size);
+        if y_area(y) > y_width {
+            y_width = y_area(y);
+            y = self.y_range(plot(y_width), size);
+        }
+        let mut chart = ChartBuilder::on(&area)
+            .margin(st.margin)
+            .margin_right(right)
+            .x_label_area_size(st.label_areas.0)
+            .y_label_area_size(y_width)
+            .build_cartesian_2d(self.x.0..self.x.1, y.0..y.1)?;
+        draw_mesh(&mut chart, self.descs, st.mesh)?;
+        for (_, color, dashed, points) in self.curves {
+            let style = color.stroke_width(if *dashed { 2 } else { 1 });
+            if *dashed {
+                chart.draw_series(DashedLineSeries::new(points.iter().copied(), 8, 5, style))?;
+            } else {
+                chart.draw_series(LineSeries::new(points.iter().copied(), style))?;
+            }
+        }
+        let plotting = chart.plotting_area().strip_coord_spec();
+        let (pw, ph) = plotting.dim_in_pixel();
+        let actual = (pw as i32, ph as i32);
+        let at = legend::free_corner(&self.pixel_paths(y, actual), actual, size);
+        legend.draw(&plotting, at.unwrap_or((INSET, INSET)))
+    }
 }
 
 fn draw_angles_rates<DB: DrawingBackend>(
@@ -509,7 +623,6 @@ where
     let single_ideal = own_ideal.iter().filter(|&&b| b).count() == 1;
     for (r, body) in cases[0].bodies.iter().enumerate() {
         for (c, is_rate) in [(0, false), (1, true)] {
-            let panel = &panels[r * 2 + c];
             let pick = |b: &series::BodySeries, ideal: bool| -> Vec<f64> {
                 match (is_rate, ideal) {
                     (false, false) => b.angle_deg.clone(),
@@ -519,6 +632,8 @@ where
                 }
             };
             let mut curves: Vec<Curve> = Vec::new();
+            // The clearance curves first, the ideal ones dashed over them: the two nearly
+            // coincide, and a dashed line on top leaves both visible.
             for (i, case) in cases.iter().enumerate() {
                 let Some(b) = case.bodies.iter().find(|b| b.name == body.name) else {
                     continue;
@@ -536,9 +651,9 @@ where
                 };
                 if own_ideal[i] {
                     let (label, color) = if single_ideal {
-                        ("ideal joint".to_string(), BLACK)
+                        ("ideal joint (dashed)".to_string(), BLACK)
                     } else {
-                        (format!("ideal, {}", case.label), case_color(i))
+                        (format!("ideal, {} (dashed)", case.label), case_color(i))
                     };
                     curves.push((
                         label,
@@ -548,48 +663,28 @@ where
                     ));
                 }
             }
-            let (y0, y1) = range_of(curves.iter().flat_map(|c| c.3.iter().map(|p| &p.1)));
-            let corner = emptiest_corner(
-                curves.iter().flat_map(|c| c.3.iter().copied()),
-                (t0, t1),
-                (y0, y1),
-                (0.3, 0.1 + 0.07 * curves.len() as f64),
-            );
-            let what = if is_rate { "angular rate" } else { "angle" };
-            let unit = if is_rate { "deg/s" } else { "deg" };
-            let mut chart = ChartBuilder::on(panel)
-                .caption(format!("{} {what}", body.name), (FAMILY, 22))
-                .margin(12)
-                .x_label_area_size(50)
-                .y_label_area_size(80)
-                .build_cartesian_2d(t0..t1, y0..y1)?;
-            let y_desc = format!("{what} ({unit})");
-            draw_mesh(&mut chart, ("time (s)", &y_desc), (16, 18))?;
-            for (label, color, dashed, points) in curves {
-                let style = color.stroke_width(if dashed { 2 } else { 1 });
-                if dashed {
-                    chart
-                        .draw_series(DashedLineSeries::new(points, 8, 5, style))?
-                        .label(label)
-                        .legend(move |(x, y)| {
-                            EmptyElement::at((x, y))
-                                + PathElement::new(vec![(0, 0), (8, 0)], color.stroke_width(2))
-                                + PathElement::new(vec![(12, 0), (20, 0)], color.stroke_width(2))
-                        });
-                } else {
-                    chart
-                        .draw_series(LineSeries::new(points, style))?
-                        .label(label)
-                        .legend(legend_line(color));
-                }
+            let (what, unit) = if is_rate {
+                ("angular rate", "deg/s")
+            } else {
+                ("angle", "deg")
+            };
+            let caption = format!("{} {what}", body.name);
+            let y_desc = format!("{caption} ({unit})");
+            Panel {
+                caption: &caption,
+                descs: ("time (s)", &y_desc),
+                x: (t0, t1),
+                y: range_of(curves.iter().flat_map(|c| c.3.iter().map(|p| &p.1))),
+                curves: &curves,
+                style: PanelStyle {
+                    caption: 22,
+                    margin: 12,
+                    label_areas: (50, 80),
+                    mesh: (16, 18),
+                    legend: 16,
+                },
             }
-            chart
-                .configure_series_labels()
-                .position(corner)
-                .label_font((FAMILY, 16))
-                .background_style(WHITE.mix(0.85))
-                .border_style(RGBColor(160, 160, 160))
-                .draw()?;
+            .draw(&panels[r * 2 + c])?;
         }
     }
     Ok(())
@@ -667,31 +762,63 @@ where
         .into_iter()
         .enumerate()
         {
-            let panel = &panels[i * 2 + col];
-            let mut chart = ChartBuilder::on(panel)
-                .caption(force_caption(cases.len(), &case.label, name), (FAMILY, 20))
-                .margin(10)
-                .x_label_area_size(45)
-                .y_label_area_size(80)
-                .build_cartesian_2d(t0..t1, 0.0..y1)?;
-            draw_mesh(&mut chart, ("time (s)", "joint force (N)"), (15, 17))?;
             let points = minmax_decimate(times, series, t0, t1, DECIMATE_BINS);
             let peak = series.iter().copied().fold(0.0, f64::max);
-            let corner = emptiest_corner(points.iter().copied(), (t0, t1), (0.0, y1), (0.45, 0.2));
-            chart
-                .draw_series(LineSeries::new(points, color.stroke_width(1)))?
-                .label(format!("{name}, peak {peak:.4} N"))
-                .legend(legend_line(color));
-            chart
-                .configure_series_labels()
-                .position(corner)
-                .label_font((FAMILY, 15))
-                .background_style(WHITE.mix(0.85))
-                .border_style(RGBColor(160, 160, 160))
-                .draw()?;
+            let curves = [(format!("{name}, peak {peak:.4} N"), color, false, points)];
+            Panel {
+                caption: &force_caption(cases.len(), &case.label, name),
+                descs: ("time (s)", "joint force (N)"),
+                x: (t0, t1),
+                y: (0.0, y1),
+                curves: &curves,
+                style: PanelStyle {
+                    caption: 20,
+                    margin: 10,
+                    label_areas: (45, 80),
+                    mesh: (15, 17),
+                    legend: 15,
+                },
+            }
+            .draw(&panels[i * 2 + col])?;
         }
     }
     Ok(())
+}
+
+/// The trajectory legend of case `i`: one row under the plot when it fits the panel's
+/// `width`, else a column.
+fn trajectory_legend<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, i: usize) -> Legend {
+    let entries = vec![
+        Entry {
+            label: "clearance circle |e| = c".into(),
+            mark: Mark::Line(BLACK),
+        },
+        Entry {
+            label: "journal centre".into(),
+            mark: Mark::Line(case_color(i)),
+        },
+        Entry {
+            label: "start".into(),
+            mark: Mark::Dot(BLACK),
+        },
+    ];
+    let mut legend = Legend {
+        entries,
+        font_size: 14,
+        row: true,
+    };
+    legend.row = legend.size(area).0 + 2 * INSET <= area.dim_in_pixel().0 as i32;
+    legend
+}
+
+/// The circle `|e| = c`, as a closed polyline.
+fn circle_points(c: f64) -> Vec<(f64, f64)> {
+    (0..=720)
+        .map(|k| {
+            let a = k as f64 * std::f64::consts::PI / 360.0;
+            (c * a.cos(), c * a.sin())
+        })
+        .collect()
 }
 
 fn draw_trajectory<DB: DrawingBackend>(
@@ -709,11 +836,17 @@ where
             1.0
         };
         let lim = 1.15 * c;
-        // A square plotting area keeps the circle round: same span on both axes.
+        // The legend goes in a strip under the plot: the orbit fills the circle, so no
+        // corner of the plot is ever free of data.
+        let legend = trajectory_legend(&panels[i], i);
+        let (lw, lh) = legend.size(&panels[i]);
         let (w, h) = panels[i].dim_in_pixel();
+        let (upper, strip) = panels[i].split_vertically(h as i32 - lh - 2 * INSET);
+        // A square plotting area keeps the circle round: same span on both axes.
+        let h = upper.dim_in_pixel().1;
         let side = w.min(h.saturating_sub(40));
-        let (pad_x, pad_y) = ((w - side) / 2, (h - side) / 2);
-        let panel = panels[i].margin(pad_y, pad_y, pad_x, pad_x);
+        let pad_x = (w - side) / 2;
+        let panel = upper.margin(h - side, 0, pad_x, pad_x);
         let mut chart = ChartBuilder::on(&panel)
             .caption(
                 if case.label.contains("c = ") {
@@ -732,36 +865,14 @@ where
             ("eccentricity u (mm)", "eccentricity v (mm)"),
             (15, 17),
         )?;
-        let circle: Vec<(f64, f64)> = (0..=720)
-            .map(|k| {
-                let a = k as f64 * std::f64::consts::PI / 360.0;
-                (c * a.cos(), c * a.sin())
-            })
-            .collect();
-        chart
-            .draw_series(LineSeries::new(circle, BLACK.stroke_width(2)))?
-            .label("clearance circle |e| = c")
-            .legend(legend_line(BLACK));
+        chart.draw_series(LineSeries::new(circle_points(c), BLACK.stroke_width(2)))?;
         // A pixel is about 2 lim / 400 here; keep steps of a quarter pixel.
         let path = decimate_path(&case.ecc_u_mm, &case.ecc_v_mm, lim / 800.0);
-        let color = case_color(i);
-        chart
-            .draw_series(LineSeries::new(path, color.stroke_width(1)))?
-            .label("journal centre")
-            .legend(legend_line(color));
+        chart.draw_series(LineSeries::new(path, case_color(i).stroke_width(1)))?;
         if let (Some(&u), Some(&v)) = (case.ecc_u_mm.first(), case.ecc_v_mm.first()) {
-            chart
-                .draw_series(std::iter::once(Circle::new((u, v), 4, BLACK.filled())))?
-                .label("start")
-                .legend(|(x, y)| Circle::new((x + 10, y), 4, BLACK.filled()));
+            chart.draw_series(std::iter::once(Circle::new((u, v), 4, BLACK.filled())))?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .label_font((FAMILY, 14))
-            .background_style(WHITE.mix(0.85))
-            .border_style(RGBColor(160, 160, 160))
-            .draw()?;
+        legend.draw(&strip, ((w as i32 - lw) / 2, INSET))?;
     }
     Ok(())
 }

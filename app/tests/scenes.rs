@@ -380,7 +380,11 @@ fn the_impact_list_is_written_and_matches_the_summary() {
     assert_eq!(peak, m.peak_force_n);
     // Each peak inside its contact.
     for r in &rows {
-        assert!(r[3] >= r[0] && r[3] <= r[0] + r[5] + 1e-12, "peak at {} s: {r:?}", r[3]);
+        assert!(
+            r[3] >= r[0] && r[3] <= r[0] + r[5] + 1e-12,
+            "peak at {} s: {r:?}",
+            r[3]
+        );
     }
     let pen = rows.iter().map(|r| r[4]).fold(0.0, f64::max);
     assert_eq!(pen, m.max_penetration_um);

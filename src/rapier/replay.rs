@@ -146,6 +146,10 @@ pub struct ReplayJournal {
     pub bearing_radius_m: f64,
     /// Bearing width, m.
     pub width_m: f64,
+    /// A spatial joint's axial play (its journal's free axial travel when centred), m; `None`
+    /// (and absent from the serialized journal) for a planar joint.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axial_play_m: Option<f64>,
 }
 
 /// An ideal hinge drawn as a pin (not sampled: its bodies' poses say all).
@@ -358,6 +362,7 @@ impl ReplayRecorder {
             clearance_m: g.clearance(),
             bearing_radius_m: g.bearing_radius(),
             width_m: g.length(),
+            axial_play_m: joint.spatial_model().map(|m| m.geometry.axial_play),
         });
         self.joints.push((set_index, handle));
         Ok(())

@@ -324,8 +324,7 @@ impl ReplayPage<'_> {
                 );
                 data.contact.push(j.contact as u8);
                 if data.spatial.iter().any(|&b| b) {
-                    data.sf
-                        .extend(spatial_numbers(j).map(|x| round_sig(x, 7)));
+                    data.sf.extend(spatial_numbers(j).map(|x| round_sig(x, 7)));
                 }
                 if j.impact {
                     data.impacts.push(Impact { t: f.t, journal: k });
@@ -370,9 +369,7 @@ fn spatial_journals(r: &Recording) -> Vec<bool> {
 
 /// A journal frame's spatial numbers in the page's order ([`SPATIAL_NUMBERS`]; zeros for a
 /// planar journal).
-fn spatial_numbers(
-    j: &clearance_joint::rapier::replay::JournalFrame,
-) -> [f64; SPATIAL_NUMBERS] {
+fn spatial_numbers(j: &clearance_joint::rapier::replay::JournalFrame) -> [f64; SPATIAL_NUMBERS] {
     let s = j.spatial.unwrap_or_default();
     let [e0, e1] = s.edge_at_m;
     let [f0, f1] = s.face_at_m;
@@ -491,6 +488,11 @@ fn spatial_series(h: &str, twins: &[(&str, &Table)]) -> Vec<Series> {
         format!("{h}_tilt_v_deg"),
         format!("{h}_axial_mm"),
     );
+    // The ideal twin's hinge has no play: its zeros would only hide the axis.
+    let twins: Vec<&(&str, &Table)> = twins
+        .iter()
+        .filter(|(name, _)| *name != TwinKind::Ideal.name())
+        .collect();
     let tilt: Vec<Line> = twins
         .iter()
         .filter_map(|(name, table)| {

@@ -104,6 +104,150 @@ fn status_of(dom: &str) -> serde_json::Value {
     serde_json::from_str(&text).unwrap_or_else(|e| panic!("status is JSON ({e}): {text}"))
 }
 
+/// No two label boxes of one canvas (the page's `labels`, CSS pixels) intersect.
+fn assert_labels_apart(status: &serde_json::Value) {
+    let canvases = status["labels"].as_object().expect("labels in the status");
+    assert!(
+        canvases.contains_key("scene3d") && canvases.contains_key("inset0"),
+        "{status}"
+    );
+    for (canvas, boxes) in canvases {
+        let boxes = boxes.as_array().unwrap();
+        let r = |b: &serde_json::Value, k: &str| b[k].as_f64().unwrap();
+        for (i, a) in boxes.iter().enumerate() {
+            for b in &boxes[i + 1..] {
+                let overlap_x = r(a, "x") + r(a, "w") - r(b, "x") > 0.01
+                    && r(b, "x") + r(b, "w") - r(a, "x") > 0.01;
+                let overlap_y = r(a, "y") + r(a, "h") - r(b, "y") > 0.01
+                    && r(b, "y") + r(b, "h") - r(a, "y") > 0.01;
+                assert!(
+                    !(overlap_x && overlap_y),
+                    "labels overlap in {canvas}: {a} and {b}"
+                );
+            }
+        }
+    }
+}
+
+/// Runs the app with `args` and `--out dir`; panics with its stderr on failure.
+fn run_app(args: &[&str], dir: &Path) {
+    let out = Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
+        .args(args)
+        .args(["--no-figures", "--no-check", "--progress", "quiet", "--out"])
+        .arg(dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+/// A spatial replay (the spatial panel's first impact): the page shows, at a CSV row's time in
+/// contact, the row's tilt, axial offset, edge forces and mid-plane eccentricity; it plots the
+/// tilt, and its labels do not overlap.
+#[test]
+fn spatial_replay_shows_the_csv_tilt_and_edge_forces() {
+    let Some(browser) = chromium() else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("cj-sreplay-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../assets/solar_panel_spatial.ron");
+    run_app(&["--scene", scene.to_str().unwrap(), "--end", "0.12"], &dir);
+    let page = dir.join("replay.html");
+    let (header, rows) = csv(&dir.join("clearance.csv"));
+    let col = |name: &str| {
+        header
+            .iter()
+            .position(|c| c == name)
+            .unwrap_or_else(|| panic!("no column {name} in {header:?}"))
+    };
+    let (tc, contact) = (col("t_s"), col("hinge_contact"));
+    let edges = [
+        col("hinge_edge_lower_force_n"),
+        col("hinge_edge_upper_force_n"),
+    ];
+    // A row in contact with an edge loaded.
+    let row = rows
+        .iter()
+        .find(|r| r[contact] == 1.0 && (r[edges[0]] > 1.0 || r[edges[1]] > 1.0))
+        .expect("a row in edge contact");
+    let t = row[tc];
+    let url = format!("file://{}#t={t}", page.display());
+    let (dom, log) = headless(&browser, &url, &["--dump-dom"], &dir.join("profile"));
+    let errors = console_errors(&log);
+    assert!(errors.is_empty(), "console errors: {errors:?}");
+    let status = status_of(&dom);
+    assert_eq!(
+        status["errors"].as_array().map(Vec::len),
+        Some(0),
+        "{status}"
+    );
+    assert!(
+        (status["t"].as_f64().unwrap() - t).abs() < 1e-12,
+        "{status}"
+    );
+    let j = &status["clearance.hinge"];
+    // The page's numbers carry 7 digits.
+    let close = |page: f64, csv: f64, what: &str, abs: f64| {
+        assert!(
+            (page - csv).abs() <= 1e-5 * csv.abs() + abs,
+            "{what}: page {page} vs CSV {csv} at t = {t}: {j}"
+        );
+    };
+    let num = |v: &serde_json::Value| v.as_f64().unwrap_or_else(|| panic!("{v} in {j}"));
+    close(
+        num(&j["tilt_u_deg"]),
+        row[col("hinge_tilt_u_deg")],
+        "tilt u",
+        1e-12,
+    );
+    close(
+        num(&j["tilt_v_deg"]),
+        row[col("hinge_tilt_v_deg")],
+        "tilt v",
+        1e-12,
+    );
+    close(
+        num(&j["axial_mm"]),
+        row[col("hinge_axial_mm")],
+        "axial offset",
+        1e-9,
+    );
+    for (k, c) in edges.iter().enumerate() {
+        close(num(&j["edge_force_n"][k]), row[*c], "edge force", 1e-6);
+    }
+    close(
+        num(&j["ecc_u_mm"]),
+        row[col("hinge_ecc_u_mm")],
+        "eccentricity u",
+        1e-9,
+    );
+    close(
+        num(&j["ecc_v_mm"]),
+        row[col("hinge_ecc_v_mm")],
+        "eccentricity v",
+        1e-9,
+    );
+    assert!(
+        status["labels"]["side0"]
+            .as_array()
+            .is_some_and(|l| !l.is_empty()),
+        "{status}"
+    );
+    let plots = status["plots"].as_array().unwrap();
+    assert!(
+        plots
+            .iter()
+            .any(|p| p["title"].as_str().unwrap().contains("tilt")),
+        "no tilt plot: {status}"
+    );
+    assert_labels_apart(&status);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn replay_opens_in_chromium_at_an_impact_and_matches_the_csv() {
     let Some(browser) = chromium() else {
@@ -182,6 +326,11 @@ fn replay_opens_in_chromium_at_an_impact_and_matches_the_csv() {
         );
     }
     assert_eq!(j["contact"], true, "{j}");
+    assert!(
+        j.get("tilt_u_deg").is_none(),
+        "a planar journal shows no tilt: {j}"
+    );
+    assert_labels_apart(&status);
     // The run's peak (every step) is the page's: the inset's largest force and the force
     // plot's top, to the page's 7 digits; neither is the rows' lower maximum.
     let summary: serde_json::Value =

@@ -64,7 +64,10 @@
 //! ```
 
 use crate::error::{Error, Result};
-use crate::rapier::joint::{ClearanceJointHandle, ClearanceJointSet};
+use crate::model::spatial::SpatialPose;
+use crate::rapier::joint::{
+    ClearanceJoint, ClearanceJointHandle, ClearanceJointSet, SpatialReport,
+};
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -143,6 +146,10 @@ pub struct ReplayJournal {
     pub bearing_radius_m: f64,
     /// Bearing width, m.
     pub width_m: f64,
+    /// A spatial joint's axial play (its journal's free axial travel when centred), m; `None`
+    /// (and absent from the serialized journal) for a planar joint.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axial_play_m: Option<f64>,
 }
 
 /// An ideal hinge drawn as a pin (not sampled: its bodies' poses say all).
@@ -181,6 +188,30 @@ pub struct JournalFrame {
     pub contact: bool,
     /// A contact began at this state with an impact (approach speed above the joint's floor).
     pub impact: bool,
+    /// A spatial joint's tilt, axial offset and edge and face forces (`None` for a planar
+    /// joint, and then absent from the serialized frame).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spatial: Option<SpatialFrame>,
+}
+
+/// A spatial journal at one state, in the bearing's frame: `u`, `v` (as [`JournalFrame`]'s
+/// eccentricity) and the axis `a`, from the bearing's centre.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct SpatialFrame {
+    /// The journal axis's tilt about `u` and about `v`, rad (the scene runner's
+    /// `tilt_u_deg`/`tilt_v_deg` columns, in rad).
+    pub tilt_rad: [f64; 2],
+    /// The journal's axial offset along `a`, m.
+    pub axial_m: f64,
+    /// Normal resultant of the bore at its lower (`-L/2`) and upper (`+L/2`) end, N.
+    pub edge_force_n: [f64; 2],
+    /// Where each edge resultant acts, `[u, v, a]` from the bearing's centre, m (the centre
+    /// while it carries nothing).
+    pub edge_at_m: [[f64; 3]; 2],
+    /// Normal resultant of the lower and upper shoulder face, N.
+    pub face_force_n: [f64; 2],
+    /// Where each face resultant acts, `[u, v, a]` from the bearing's centre, m.
+    pub face_at_m: [[f64; 3]; 2],
 }
 
 /// One kept state.
@@ -331,6 +362,7 @@ impl ReplayRecorder {
             clearance_m: g.clearance(),
             bearing_radius_m: g.bearing_radius(),
             width_m: g.length(),
+            axial_play_m: joint.spatial_model().map(|m| m.geometry.axial_play),
         });
         self.joints.push((set_index, handle));
         Ok(())
@@ -451,24 +483,7 @@ impl ReplayRecorder {
                 let Some(joint) = sets.get(set).and_then(|s| s.get(h)) else {
                     return JournalFrame::default();
                 };
-                let r = joint.report();
-                let rotation: Rotation = bodies
-                    .get(joint.body1())
-                    .map(|rb| *rb.rotation())
-                    .unwrap_or_default();
-                let u = rotation * Vector::from(track.u1);
-                let v = rotation * Vector::from(track.axis1).cross(Vector::from(track.u1));
-                let (e, f) = (r.state.eccentricity, r.force.on_journal);
-                JournalFrame {
-                    ecc_u_m: e.dot(u),
-                    ecc_v_m: e.dot(v),
-                    force_u_n: f.dot(u),
-                    force_v_n: f.dot(v),
-                    force_n: f.length(),
-                    penetration_m: r.state.penetration.max(0.0),
-                    contact: r.state.penetration > 0.0,
-                    impact: r.impact,
-                }
+                journal_frame(joint, bodies, track)
             })
             .collect();
         ReplayFrame { t, poses, journals }
@@ -485,6 +500,63 @@ impl ReplayRecorder {
             self.push_after_peak(last);
         }
         self.recording
+    }
+}
+
+/// One journal's state in its bearing's `u`/`v` directions (a spatial joint's eccentricity at
+/// the bearing's mid-plane, as the scene runner's CSV rows: its report's state is its deepest
+/// station's, which may be a face's).
+fn journal_frame(
+    joint: &ClearanceJoint,
+    bodies: &RigidBodySet,
+    track: &ReplayJournal,
+) -> JournalFrame {
+    let r = joint.report();
+    let (rb1, rb2) = (bodies.get(joint.body1()), bodies.get(joint.body2()));
+    let rotation: Rotation = rb1.map(|rb| *rb.rotation()).unwrap_or_default();
+    let u = rotation * Vector::from(track.u1);
+    let v = rotation * Vector::from(track.axis1).cross(Vector::from(track.u1));
+    let pose = match (r.spatial, rb1, rb2) {
+        (Some(_), Some(rb1), Some(rb2)) => Some(joint.spatial_pose(rb1, rb2, u)),
+        _ => None,
+    };
+    let e = match &pose {
+        Some(p) => {
+            let d = p.journal_center - p.bearing_center;
+            d - d.dot(p.bearing_axis) * p.bearing_axis
+        }
+        None => r.state.eccentricity,
+    };
+    let f = r.force.on_journal;
+    JournalFrame {
+        ecc_u_m: e.dot(u),
+        ecc_v_m: e.dot(v),
+        force_u_n: f.dot(u),
+        force_v_n: f.dot(v),
+        force_n: f.length(),
+        penetration_m: r.state.penetration.max(0.0),
+        contact: r.state.penetration > 0.0,
+        impact: r.impact,
+        spatial: pose
+            .zip(r.spatial)
+            .map(|(p, s)| spatial_frame(&p, &s, u, v)),
+    }
+}
+
+/// A spatial joint's frame values from its pose and report (`u`, `v`: the bearing's
+/// directions, world).
+fn spatial_frame(pose: &SpatialPose, s: &SpatialReport, u: Vector, v: Vector) -> SpatialFrame {
+    let local = |at: Vector| {
+        let d = at - pose.bearing_center;
+        [d.dot(u), d.dot(v), d.dot(pose.bearing_axis)]
+    };
+    SpatialFrame {
+        tilt_rad: pose.tilt(),
+        axial_m: pose.axial_offset(),
+        edge_force_n: s.edge_force,
+        edge_at_m: s.edge_point.map(local),
+        face_force_n: s.face_force,
+        face_at_m: s.face_point.map(local),
     }
 }
 
@@ -646,5 +718,75 @@ mod tests {
         assert_eq!(rec.frames.last().unwrap().t, 0.1);
         assert!(rec.interval_s > 1e-3 && rec.contact_interval_s > 1e-3);
         assert!(ReplayRecorder::new(f64::NAN, 0.1).is_err());
+    }
+
+    #[test]
+    fn a_spatial_frame_carries_the_joints_tilt_and_edge_forces() {
+        use crate::model::spatial::SpatialModel;
+        use crate::prelude::*;
+        // The library's spatial example: an arm 0.2 m out from a vertical pin tilts its journal
+        // onto both edges of the bore.
+        let mut rapier = PhysicsWorld::new();
+        rapier.gravity = Vector::new(0.0, -9.81, 0.0);
+        rapier.integration_parameters.num_solver_iterations = 1;
+        let post = rapier.bodies.insert(RigidBodyBuilder::fixed());
+        let arm = rapier.bodies.insert(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(0.2, 0.0, 0.0))
+                .additional_mass_properties(MassProperties::new(
+                    Vector::ZERO,
+                    2.0,
+                    Vector::splat(0.02),
+                )),
+        );
+        let pin = Clearance::steel_improved_liu(0.006, 0.1e-3, 0.020)
+            .unwrap()
+            .model(ClearanceModel::Spatial(SpatialModel::steel(0.3e-3, 0.010)))
+            .joint(
+                Vector::ZERO,
+                Vector::new(-0.2, 0.0, 0.0),
+                Vector::Y,
+                Vector::Y,
+            )
+            .unwrap();
+        let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.0075));
+        let hinge = world.insert_clearance(post, arm, pin).unwrap();
+        let mut r = ReplayRecorder::new(1e-3, 1e-5).unwrap();
+        let (b, c) = (&world.rapier.bodies, &world.rapier.colliders);
+        r.track_body("post", "clearance", post, b, c);
+        r.track_body("arm", "clearance", arm, b, c);
+        r.track_journal("pin", "clearance", 0, hinge, &world.clearance)
+            .unwrap();
+        let mut seen = false;
+        while world.time() < 0.03 {
+            world.step(0.03).unwrap();
+            r.record(world.time(), &world.rapier.bodies, &[&world.clearance]);
+            let joint = world.clearance.get(hinge).unwrap();
+            let s = joint.report().spatial.unwrap();
+            let last = r.frames().last().unwrap();
+            if last.t != world.time() || s.edge_force[0] <= 0.0 || s.edge_force[1] <= 0.0 {
+                continue;
+            }
+            // A kept frame in edge contact: its values are the joint's report's.
+            seen = true;
+            let f = last.journals[0].spatial.expect("a spatial frame");
+            assert_eq!(f.edge_force_n, s.edge_force);
+            assert_eq!(f.face_force_n, s.face_force);
+            // Tilt in the recorder's u/v is the report's (the joint's transverse axis is u).
+            assert!(
+                (f.tilt_rad[0].hypot(f.tilt_rad[1]) - s.tilt[0].hypot(s.tilt[1])).abs() < 1e-12
+            );
+            assert!((f.axial_m - s.axial_offset).abs() < 1e-12);
+            // Each edge acts at its end of the width, on the bore's wall.
+            let w = 0.020;
+            let [lo, hi] = f.edge_at_m;
+            assert!(lo[2] < 0.0 && lo[2] >= -0.5 * w - 1e-9, "{lo:?}");
+            assert!(hi[2] > 0.0 && hi[2] <= 0.5 * w + 1e-9, "{hi:?}");
+            assert!((lo[0].hypot(lo[1]) - 0.006).abs() < 0.2e-3, "{lo:?}");
+        }
+        assert!(seen, "no kept frame with both edges in contact");
+        // A planar joint's frame serializes without the spatial part.
+        let planar = serde_json::to_string(&JournalFrame::default()).unwrap();
+        assert!(!planar.contains("spatial"), "{planar}");
     }
 }

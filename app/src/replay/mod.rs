@@ -38,15 +38,20 @@ pub const SERIES_BUCKETS: usize = 1500;
 /// (its cap, [`clearance_joint::rapier::replay`]); so a replay's memory does not grow with the
 /// run's length or its impacts.
 pub const MAX_FRAMES: usize = 20_000;
+/// Numbers per journal and frame in the page's spatial array `sf`: tilt about `u` and `v`
+/// (rad), axial offset (m), the two edge forces (N), their points `[u, v, a]` (m), the two face
+/// forces (N) and their points.
+pub const SPATIAL_NUMBERS: usize = 19;
 /// Characters per number in the page's JSON (7 significant digits, sign, exponent, comma).
 const JSON_CHARS: u64 = 14;
 
 /// The memory a replay of `scene` holds at its peak, bytes, an upper bound: [`MAX_FRAMES`]
 /// frames of the tracked bodies (both twins') and journals, as the recorder stores them (a pose
-/// of 7 numbers per body, 6 numbers and 2 flags per journal), the page's flattened copy of them,
+/// of 7 numbers per body, 6 numbers, 2 flags and room for a spatial part per journal), the page's
+/// flattened copy of them,
 /// and its JSON text held three times while the page is built (the JSON, its escaped copy, the
 /// page). Measured: the paper's scene at 5 times its torque keeps 9,844 frames and peaks 13.2 MB
-/// above its run without a replay, 1.35 kB a frame, against 2.5 kB a frame here.
+/// above its run without a replay, 1.35 kB a frame, against 2.7 kB a frame here.
 pub fn memory_bytes(scene: &Scene) -> u64 {
     let bodies = 2 * scene.bodies.len() as u64;
     let journals = scene
@@ -54,10 +59,18 @@ pub fn memory_bytes(scene: &Scene) -> u64 {
         .iter()
         .filter(|h| h.clearance.is_some())
         .count() as u64;
-    // A frame: time and two vectors' headers (8 + 48), their heap blocks (+ 32 of allocator).
-    let recorded = 88 + 56 * bodies + 56 * journals;
-    let flattened = 8 + 56 * bodies + 49 * journals;
-    let numbers = 1 + 7 * bodies + 7 * journals;
+    // A spatial scene's page carries SPATIAL_NUMBERS more per journal (`sf`).
+    let spatial = if scene.hinges.iter().any(|h| h.is_spatial()) {
+        SPATIAL_NUMBERS as u64 * journals
+    } else {
+        0
+    };
+    // A frame: time and two vectors' headers (8 + 48), their heap blocks (+ 32 of allocator);
+    // a journal's frame holds room for the spatial part whether used or not.
+    let journal = std::mem::size_of::<clearance_joint::rapier::replay::JournalFrame>() as u64;
+    let recorded = 88 + 56 * bodies + journal * journals;
+    let flattened = 8 + 56 * bodies + 49 * journals + 8 * spatial;
+    let numbers = 1 + 7 * bodies + 7 * journals + spatial;
     let text = 3 * JSON_CHARS * numbers;
     // The frames' vector itself may be twice its length (growth by doubling).
     let per_frame = recorded + 56 + 2 * flattened + text;
@@ -137,6 +150,34 @@ impl Line {
     ) -> Option<Line> {
         let (t, v) = (table.column("t_s")?, table.column(column)?);
         let (t, v) = crate::figures::series::merge_points(&t, &v, points);
+        let (t, v) = min_max_thin(&t, &v, SERIES_BUCKETS);
+        Some(Line {
+            label: label.into(),
+            group: group.into(),
+            t,
+            v: v.into_iter().map(|x| round_sig(x, 7)).collect(),
+        })
+    }
+}
+
+impl Line {
+    /// `f` of columns `columns` of `table` per row against its `t_s`, thinned as
+    /// [`from_table`](Self::from_table) (`None` when a column is missing).
+    pub fn derived(
+        label: &str,
+        group: &str,
+        table: &Table,
+        columns: &[&str],
+        f: impl Fn(&[f64]) -> f64,
+    ) -> Option<Line> {
+        let t = table.column("t_s")?;
+        let cols = columns
+            .iter()
+            .map(|c| table.column(c))
+            .collect::<Option<Vec<_>>>()?;
+        let v: Vec<f64> = (0..t.len())
+            .map(|i| f(&cols.iter().map(|c| c[i]).collect::<Vec<_>>()))
+            .collect();
         let (t, v) = min_max_thin(&t, &v, SERIES_BUCKETS);
         Some(Line {
             label: label.into(),
@@ -229,6 +270,12 @@ struct PageData<'a> {
     poses: Vec<f64>,
     jf: Vec<f64>,
     contact: Vec<u8>,
+    /// Per journal: whether it is spatial (its frames carry `sf`).
+    spatial: Vec<bool>,
+    /// Per frame and journal, [`SPATIAL_NUMBERS`] numbers (zeros for a planar journal); empty
+    /// when no journal is spatial.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    sf: Vec<f64>,
     impacts: Vec<Impact>,
     series: &'a [Series],
     default_speed: f64,
@@ -252,6 +299,8 @@ impl ReplayPage<'_> {
             poses: Vec::new(),
             jf: Vec::new(),
             contact: Vec::new(),
+            spatial: spatial_journals(r),
+            sf: Vec::new(),
             impacts: Vec::new(),
             series: &self.series,
             default_speed: 0.0,
@@ -275,6 +324,9 @@ impl ReplayPage<'_> {
                     .map(|x| round_sig(x, 7)),
                 );
                 data.contact.push(j.contact as u8);
+                if data.spatial.iter().any(|&b| b) {
+                    data.sf.extend(spatial_numbers(j).map(|x| round_sig(x, 7)));
+                }
                 if j.impact {
                     data.impacts.push(Impact { t: f.t, journal: k });
                 }
@@ -303,6 +355,46 @@ impl ReplayPage<'_> {
         write_atomic(&path, self.html()?.as_bytes())?;
         Ok(path)
     }
+}
+
+/// Per journal of `r`: whether any frame carries its spatial part.
+fn spatial_journals(r: &Recording) -> Vec<bool> {
+    (0..r.journals.len())
+        .map(|k| {
+            r.frames
+                .iter()
+                .any(|f| f.journals.get(k).is_some_and(|j| j.spatial.is_some()))
+        })
+        .collect()
+}
+
+/// A journal frame's spatial numbers in the page's order ([`SPATIAL_NUMBERS`]; zeros for a
+/// planar journal).
+fn spatial_numbers(j: &clearance_joint::rapier::replay::JournalFrame) -> [f64; SPATIAL_NUMBERS] {
+    let s = j.spatial.unwrap_or_default();
+    let [e0, e1] = s.edge_at_m;
+    let [f0, f1] = s.face_at_m;
+    [
+        s.tilt_rad[0],
+        s.tilt_rad[1],
+        s.axial_m,
+        s.edge_force_n[0],
+        s.edge_force_n[1],
+        e0[0],
+        e0[1],
+        e0[2],
+        e1[0],
+        e1[1],
+        e1[2],
+        s.face_force_n[0],
+        s.face_force_n[1],
+        f0[0],
+        f0[1],
+        f0[2],
+        f1[0],
+        f1[1],
+        f1[2],
+    ]
 }
 
 fn escape_html(s: &str) -> String {
@@ -357,13 +449,16 @@ pub fn run_page<'a>(scene: &Scene, result: &RunResult, recording: &'a Recording)
             }
         }
     }
+    for h in &hinges {
+        series.extend(spatial_series(h, &twins));
+    }
     let run = &scene.run;
     ReplayPage {
         title: format!("{}: replay", scene.name),
         subtitle: format!(
-            "{} s simulated, {}; ideal and clearance twins",
+            "{} s simulated \u{b7} {} \u{b7} ideal and clearance twins",
             clearance_joint::error::sig4(run.end_s),
-            run.stepping()
+            stepping_short(run)
         ),
         notes: format!(
             "Frames: {} kept of the run's states: one per {} s, one per {} s over the first {} s of \
@@ -383,6 +478,62 @@ pub fn run_page<'a>(scene: &Scene, result: &RunResult, recording: &'a Recording)
         ),
         recording,
         series,
+    }
+}
+
+/// A spatial hinge's tilt magnitude (mrad) and axial offset (mm) panels, from the twins whose
+/// rows carry them (none for a planar hinge).
+fn spatial_series(h: &str, twins: &[(&str, &Table)]) -> Vec<Series> {
+    let (tu, tv, ax) = (
+        format!("{h}_tilt_u_deg"),
+        format!("{h}_tilt_v_deg"),
+        format!("{h}_axial_mm"),
+    );
+    // The ideal twin's hinge has no play: its zeros would only hide the axis.
+    let twins: Vec<&(&str, &Table)> = twins
+        .iter()
+        .filter(|(name, _)| *name != TwinKind::Ideal.name())
+        .collect();
+    let tilt: Vec<Line> = twins
+        .iter()
+        .filter_map(|(name, table)| {
+            Line::derived(name, name, table, &[&tu, &tv], |x| {
+                x[0].hypot(x[1]).to_radians() * 1e3
+            })
+        })
+        .collect();
+    let axial: Vec<Line> = twins
+        .iter()
+        .filter_map(|(name, table)| Line::from_table(name, name, table, &ax))
+        .collect();
+    [("tilt |tilt| (mrad)", tilt), ("axial offset (mm)", axial)]
+        .into_iter()
+        .filter(|(_, lines)| !lines.is_empty())
+        .map(|(what, lines)| Series {
+            title: format!("hinge `{h}`: {what}"),
+            lines,
+        })
+        .collect()
+}
+
+/// The header's short line on the stepping: `adaptive steps <= 1 ms, tolerance 0.0075` or
+/// `fixed step 10 us`.
+fn stepping_short(run: &clearance_joint::scene::RunSettings) -> String {
+    use clearance_joint::scene::StepMode;
+    let time = |s: f64| {
+        if s >= 1e-3 {
+            format!("{} ms", clearance_joint::error::sig4(s * 1e3))
+        } else {
+            format!("{} \u{b5}s", clearance_joint::error::sig4(s * 1e6))
+        }
+    };
+    match run.step {
+        StepMode::Fixed => format!("fixed step {}", time(run.dt_s)),
+        StepMode::Adaptive => format!(
+            "adaptive steps \u{2264} {}, tolerance {}",
+            time(run.max_dt_s),
+            run.tolerance
+        ),
     }
 }
 

@@ -234,7 +234,7 @@ damping ratio 0.2573). Use `run.dt_s` below 1.308e-4 s",
     );
     let memory = run(&["--max-memory", "80M"], &out);
     for quote in [
-        "50002 rows of 24 values and the replay (about 50.04 MB) would need about 136.4 MB",
+        "50002 rows of 24 values and the replay (about 53.29 MB) would need about 139.6 MB",
         "`--no-replay` drops the replay",
     ] {
         assert_same("docs/reliability.md", quote, &memory);

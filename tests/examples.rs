@@ -176,6 +176,16 @@ fn game_rate_sign_rattles_within_its_play_at_60_hz() {
     assert_eq!(capped.max_substeps, 4);
     assert!(capped.under_resolved > 0);
     assert!(play.mean_substeps > capped.mean_substeps);
+    // What the README quotes of this run.
+    readme_quotes(&format!(
+        "rattles ({} bounces while rolling)",
+        play.bounces_rolling
+    ));
+    readme_quotes(&format!(
+        "stays within {:.1} % of its clearance and carries {:.4} N once at rest",
+        100.0 * (play.max_eccentricity_ratio - 1.0),
+        play.final_force_n
+    ));
     let text = game_rate::report(&runs);
     assert!(
         text.contains("largest |e|/c") && text.contains("play@4"),
@@ -198,6 +208,10 @@ fn robot_backlash_shows_the_tracking_error_of_the_play() {
         "{:?}",
         o.play_effect_mm
     );
+    readme_quotes(&format!(
+        "the play moves the hand {:.3} mm RMS and {:.3} mm at most off the ideal arm's",
+        o.play_effect_mm.0, o.play_effect_mm.1
+    ));
     assert!(o.play_effect_mm.1 > 0.2, "{:?}", o.play_effect_mm);
     assert_eq!(o.under_resolved, 0);
     let text = robot_backlash::report(&o);
@@ -260,8 +274,32 @@ fn door_hinge_sags_edge_loads_and_knocks_only_in_space() {
         planar.swing_deg > 45.0 && spatial.swing_deg < 15.0,
         "{runs:?}"
     );
+    readme_quotes(&format!(
+        "swings on ({:.0}° in 1 s) on the planar joint; on the spatial one it tilts {:.1} mrad, \
+         sags {:.1} mm at its free edge, knocks the top face ({:.1} kN peak), and its edge \
+         friction stops the swing at {:.1}°; at rest the edges' couple ({:.0} and {:.0} N)",
+        planar.swing_deg,
+        1e3 * spatial.max_tilt,
+        spatial.sag_mm,
+        1e-3 * spatial.max_face_force,
+        spatial.swing_deg,
+        spatial.late_edge_force[0],
+        spatial.late_edge_force[1]
+    ));
     let text = door_hinge::report(&runs).unwrap();
     assert!(text.contains("M/L") && text.contains("m g x"), "{text}");
+}
+
+/// Asserts the README quotes `figure` (whitespace-insensitive: it wraps its lines), as the
+/// example computes it: a figure that moves fails here until the README is re-measured.
+fn readme_quotes(figure: &str) {
+    let readme =
+        std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md")).unwrap();
+    let flat = |t: &str| t.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert!(
+        flat(&readme).contains(&flat(figure)),
+        "the README does not quote `{figure}`, which the example now gives: re-measure it"
+    );
 }
 
 /// `target/<profile>/examples`, next to this test's `deps` folder.

@@ -314,7 +314,7 @@ pub fn merge_points(t: &[f64], v: &[f64], points: &[(f64, f64)]) -> (Vec<f64>, V
 
 /// Each contact's peak `(peak_t_s, peak_force_n)` from a contact list written by the run
 /// (`<twin>_<hinge>_impacts.csv`), read row by row; empty when the file or its `peak_t_s`
-/// column is absent (a point written before the column existed draws its rows alone).
+/// column is absent (a point saved without that column draws its rows alone).
 fn read_peaks(path: &Path) -> Result<Vec<(f64, f64)>> {
     if !path.is_file() {
         return Ok(Vec::new());

@@ -520,13 +520,7 @@ fn journal_frame(
         (Some(_), Some(rb1), Some(rb2)) => Some(joint.spatial_pose(rb1, rb2, u)),
         _ => None,
     };
-    let e = match &pose {
-        Some(p) => {
-            let d = p.journal_center - p.bearing_center;
-            d - d.dot(p.bearing_axis) * p.bearing_axis
-        }
-        None => r.state.eccentricity,
-    };
+    let e = pose.map_or(r.state.eccentricity, |p| p.mid_plane_eccentricity());
     let f = r.force.on_journal;
     JournalFrame {
         ecc_u_m: e.dot(u),

@@ -710,6 +710,17 @@ fn force_footnote(cases: &[CaseSeries]) -> String {
     )
 }
 
+/// The top of a force axis over `series`: 5 % above their largest finite value (1 N when none
+/// is positive).
+fn force_top<'a>(series: impl Iterator<Item = &'a [f64]>) -> f64 {
+    let m = series
+        .flatten()
+        .copied()
+        .filter(|v| v.is_finite())
+        .fold(0.0, f64::max);
+    if m > 0.0 { 1.05 * m } else { 1.0 }
+}
+
 fn draw_force<DB: DrawingBackend>(area: &DrawingArea<DB, Shift>, cases: &[CaseSeries]) -> DrawResult
 where
     DB::ErrorType: 'static,
@@ -723,24 +734,11 @@ where
     )?;
     let panels = area.split_evenly((cases.len(), 2));
     let (t0, t1) = time_range(cases);
-    let top = |f: fn(&CaseSeries) -> &Vec<f64>| {
-        let m = cases
-            .iter()
-            .flat_map(|c| f(c).iter())
-            .copied()
-            .filter(|v| v.is_finite())
-            .fold(0.0, f64::max);
-        if m > 0.0 { 1.05 * m } else { 1.0 }
-    };
     // The clearance joint's curve passes through each contact's peak from every step (the
     // rows alone, one per output interval, miss most of an impact's top).
     let clear: Vec<(Vec<f64>, Vec<f64>)> = cases.iter().map(|c| c.force_with_peaks()).collect();
-    let ideal_top = top(|c| &c.force_ideal_n);
-    let clear_top = {
-        let m = clear.iter().flat_map(|c| c.1.iter()).copied();
-        let m = m.filter(|v| v.is_finite()).fold(0.0, f64::max);
-        if m > 0.0 { 1.05 * m } else { 1.0 }
-    };
+    let ideal_top = force_top(cases.iter().map(|c| &c.force_ideal_n[..]));
+    let clear_top = force_top(clear.iter().map(|c| &c.1[..]));
     for (i, case) in cases.iter().enumerate() {
         let (clear_t, clear_f) = &clear[i];
         for (col, (name, times, series, y1, color)) in [

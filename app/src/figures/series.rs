@@ -66,10 +66,7 @@ impl CaseSeries {
     /// [`Impact::peak_t_s`]: clearance_joint::rapier::metrics::Impact::peak_t_s
     /// [`Impact::peak_force_n`]: clearance_joint::rapier::metrics::Impact::peak_force_n
     pub fn with_contacts(mut self, contacts: &[clearance_joint::rapier::metrics::Impact]) -> Self {
-        self.peaks = contacts
-            .iter()
-            .map(|i| (i.peak_t_s, i.peak_force_n))
-            .collect();
+        self.peaks = peaks_of(contacts);
         self
     }
 
@@ -285,6 +282,15 @@ impl CaseSeries {
             rows,
         })
     }
+}
+
+/// Each contact's peak `(peak_t_s, peak_force_n)` of a contact list, in time order: the points
+/// a force plot of thinned rows must pass through.
+pub fn peaks_of(contacts: &[clearance_joint::rapier::metrics::Impact]) -> Vec<(f64, f64)> {
+    contacts
+        .iter()
+        .map(|i| (i.peak_t_s, i.peak_force_n))
+        .collect()
 }
 
 /// `(t, v)` with `points` (`(t, v)` pairs in time order) merged in time order: the series a

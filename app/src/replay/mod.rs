@@ -422,11 +422,8 @@ pub fn run_page<'a>(scene: &Scene, result: &RunResult, recording: &'a Recording)
         .unwrap_or_default();
     let mut series = Vec::new();
     for h in &hinges {
-        let peaks: Vec<(f64, f64)> = recorders.get(h).map_or(Vec::new(), |r| {
-            r.contacts()
-                .iter()
-                .map(|i| (i.peak_t_s, i.peak_force_n))
-                .collect()
+        let peaks = recorders.get(h).map_or(Vec::new(), |r| {
+            crate::figures::series::peaks_of(r.contacts())
         });
         for (what, column) in [
             ("angle (deg)", "angle_deg"),

@@ -157,8 +157,7 @@ fn least_eccentricity(geometry: &BearingGeometry, pose: &SpatialPose) -> f64 {
     let (ai, aj) = (pose.bearing_axis, pose.journal_axis);
     let cos = ai.dot(aj);
     let e1 = (aj - cos * ai) / cos;
-    let d = pose.journal_center - pose.bearing_center;
-    let e0 = d - d.dot(ai) * ai - pose.axial_offset() * e1;
+    let e0 = pose.mid_plane_eccentricity() - pose.axial_offset() * e1;
     let slope2 = e1.length_squared();
     // Aligned to rounding: the eccentricity moves less than 1e-12 of the clearance over the width.
     let width = geometry.length();

@@ -218,6 +218,13 @@ impl SpatialPose {
         (self.journal_center - self.bearing_center).dot(self.bearing_axis)
     }
 
+    /// The journal centre's offset from the bore's axis, square to it, m: the eccentricity at
+    /// the bearing's mid-plane (`d - (d . a_i) a_i`, `d = P_j - P_i`).
+    pub fn mid_plane_eccentricity(&self) -> Vector {
+        let d = self.journal_center - self.bearing_center;
+        d - d.dot(self.bearing_axis) * self.bearing_axis
+    }
+
     /// The journal axis's tilt against the bore's, rad: its components along the bearing's
     /// transverse axes `t1 = bearing_transverse` and `t2 = a_i x t1` (the rotation about `t1`,
     /// then about `t2`, that carries `a_i` to `a_j`, small-angle components

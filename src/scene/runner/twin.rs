@@ -494,13 +494,7 @@ impl Twin {
                     let pose = r.spatial.map(|_| j.spatial_pose(r1, r2, u));
                     // A spatial joint's eccentricity at the bearing's mid-plane (its report's
                     // state is the deepest station's, which may be a face's).
-                    let e = match &pose {
-                        Some(p) => {
-                            let d = p.journal_center - p.bearing_center;
-                            d - d.dot(p.bearing_axis) * p.bearing_axis
-                        }
-                        None => r.state.eccentricity,
-                    };
+                    let e = pose.map_or(r.state.eccentricity, |p| p.mid_plane_eccentricity());
                     v.push(e.dot(u) * 1e3);
                     v.push(e.dot(v_axis) * 1e3);
                     v.push(r.state.penetration.max(0.0) * 1e6);

@@ -202,7 +202,7 @@ pub mod prelude {
     pub use crate::rapier::guards::GuardReport;
     pub use crate::rapier::joint::{
         ClearanceJoint, ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet,
-        OutOfPlaneLock,
+        ContactIntegration, OutOfPlaneLock,
     };
     pub use crate::rapier::large_step::{
         LargeStepJoint, LargeStepJointBuilder, LargeStepJointHandle, LargeStepJointSet, Restitution,

@@ -195,6 +195,9 @@ pub struct Clearance {
     /// The compliant and spatial models take their restitution from their laws:
     /// [`joint`](Self::joint) refuses a set one, naming `restitution`.
     pub restitution: Option<f64>,
+    /// How the compliant planar joint integrates its contact (default
+    /// [`ContactIntegration::Explicit`](crate::rapier::joint::ContactIntegration::Explicit)).
+    pub integration: crate::rapier::joint::ContactIntegration,
 }
 
 impl Clearance {
@@ -211,6 +214,7 @@ impl Clearance {
             name: None,
             model: ClearanceModel::Compliant,
             restitution: None,
+            integration: crate::rapier::joint::ContactIntegration::Explicit,
         }
     }
 
@@ -298,6 +302,13 @@ impl Clearance {
         self
     }
 
+    /// Sets how the compliant planar joint integrates its contact
+    /// ([`ContactIntegration`](crate::rapier::joint::ContactIntegration)).
+    pub fn integration(mut self, integration: crate::rapier::joint::ContactIntegration) -> Self {
+        self.integration = integration;
+        self
+    }
+
     /// Sets the name used in errors and reports.
     pub fn name(mut self, name: impl Into<String>) -> Self {
         self.name = Some(name.into());
@@ -354,7 +365,8 @@ impl Clearance {
             .friction(self.friction)
             .min_impact_speed(self.min_impact_speed)
             .min_separation(self.min_separation)
-            .lock(self.lock);
+            .lock(self.lock)
+            .integration(self.integration);
         if let Some(depth) = self.max_valid_penetration {
             b = b.max_valid_penetration(depth);
         }

@@ -21,6 +21,7 @@ use std::sync::OnceLock;
 
 mod effective_mass;
 mod spatial;
+mod subcycle;
 use effective_mass::Mechanism;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
@@ -29,6 +30,8 @@ use rapier3d_f64::prelude::{
 };
 pub use spatial::{Region, SpatialPoint, SpatialReport};
 use spatial::{SpatialMemory, SpatialParts};
+pub use subcycle::{ContactIntegration, SubStep};
+use subcycle::{PairStart, SubCycle};
 
 /// What holds the degrees of freedom the contact law does not (axial translation and the two tilts).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -93,6 +96,8 @@ impl ClearanceJointBuilder {
                 last_wrenches: None,
                 prepared: false,
                 spatial: None,
+                integration: ContactIntegration::default(),
+                cycle: CycleState::default(),
             },
             spatial: None,
         }
@@ -105,6 +110,12 @@ impl ClearanceJointBuilder {
     /// Journal centre in body 2's frame.
     pub fn local_anchor2(mut self, anchor: Vector) -> Self {
         self.joint.local_anchor2 = anchor;
+        self
+    }
+    /// How the contact is integrated over a step ([`ContactIntegration`]; default
+    /// [`ContactIntegration::Explicit`]).
+    pub fn integration(mut self, integration: ContactIntegration) -> Self {
+        self.joint.integration = integration;
         self
     }
     /// Hinge axis in body 2's frame (defaults to the axis given to [`new`](Self::new)).
@@ -186,6 +197,14 @@ impl ClearanceJointBuilder {
                 .map_err(|e| e.within("spatial"))?;
             j.lock = OutOfPlaneLock::None;
             j.spatial = Some(SpatialParts::new(model, face_law, j.local_axis1));
+            if j.integration == ContactIntegration::SubCycled {
+                return Err(Error::invalid(
+                    "integration",
+                    "is SubCycled, which the planar joint has and the spatial joint has not: \
+                     give the spatial joint ContactIntegration::Explicit, or drop its spatial \
+                     model",
+                ));
+            }
         }
         Ok(self.joint)
     }
@@ -374,6 +393,28 @@ pub struct ClearanceJoint {
     prepared: bool,
     /// The spatial model's stations (`None`: the planar joint).
     spatial: Option<SpatialParts>,
+    integration: ContactIntegration,
+    /// The sub-cycle's memory and buffers ([`ContactIntegration::SubCycled`]).
+    cycle: CycleState,
+}
+
+/// What a sub-cycled joint carries between and within steps.
+#[derive(Clone, Debug, Default)]
+struct CycleState {
+    /// The pair at the state before the next step (taken at each evaluation).
+    start: Option<PairStart>,
+    /// The impulse of the steps so far that Rapier's velocities do not hold yet, `H`.
+    held: [f64; 12],
+    /// The states inside the last step.
+    substeps: Vec<SubStep>,
+    /// The step's sub-cycle, and the impulse it leaves held, between Rapier's pass 0 and the
+    /// evaluation at the step's end.
+    run: SubCycle,
+    pending: Option<[f64; 12]>,
+    /// [`ClearanceJoint::start_velocity_correction`] of the last step.
+    start_correction: [f64; 12],
+    /// [`ClearanceJoint::step_dissipation`] of the last step, J.
+    dissipated: f64,
 }
 
 /// Default of [`ClearanceJointBuilder::min_impact_speed`], m/s.
@@ -466,6 +507,55 @@ fn stable_fraction(tolerance: f64) -> f64 {
     (STABLE_FRACTION_PER_TOLERANCE * tolerance).min(STABILITY_SAFETY)
 }
 
+/// A contact as the step control sees it ahead: the effective mass along its normal (kg), the
+/// approach speed (m/s) and depth (m) it starts from, the current contact's `delta_dot0` (m/s;
+/// `None` before it begins) and the joint's floor on it.
+#[derive(Clone, Copy, Debug)]
+struct ContactAhead {
+    mass: f64,
+    approach_speed: f64,
+    depth: f64,
+    impact_rate: Option<f64>,
+    min_impact_speed: f64,
+}
+
+impl ContactAhead {
+    /// The step that resolves this contact of `law` (elastic energy `elastic` J at its depth) to
+    /// `2 tolerance` of its natural period ([`CONTACT_PERIODS_PER_TOLERANCE`]), taken at the
+    /// deepest point its energy reaches, and to `stable` (a fraction, e.g. [`stable_fraction`])
+    /// of its damped stability limit there.
+    fn resolving_step(
+        &self,
+        law: &impl NormalForceLaw,
+        elastic: f64,
+        tolerance: f64,
+        stable_share: f64,
+    ) -> f64 {
+        let m = self.mass;
+        let v = self.approach_speed;
+        let energy = 0.5 * m * v * v + elastic;
+        let peak = penetration_for_energy(law, energy, 1e-6).max(self.depth);
+        let stiffness = law.tangent_stiffness(peak);
+        if !(stiffness > 0.0) {
+            return f64::INFINITY;
+        }
+        let mut impact_rate = self
+            .impact_rate
+            .unwrap_or_else(|| v.max(self.min_impact_speed));
+        if law.uses_impact_rate() {
+            impact_rate = impact_rate.max(loaded_impact_rate(energy, m));
+        }
+        let c = NormalContact {
+            penetration: peak,
+            penetration_rate: v,
+            impact_rate,
+        };
+        let (stable, omega, _) = stable_step(stiffness, law.damping_coefficient(&c), m);
+        let period = std::f64::consts::TAU / omega;
+        (CONTACT_PERIODS_PER_TOLERANCE * tolerance * period).min(stable_share * stable)
+    }
+}
+
 /// The dynamic state of a joint between steps (what a rejected step must restore).
 #[derive(Clone, Debug, Default)]
 struct JointDynamics {
@@ -477,6 +567,8 @@ struct JointDynamics {
     last_wrenches: Option<[Wrench; 2]>,
     prepared: bool,
     spatial: Option<SpatialMemory>,
+    held: [f64; 12],
+    substeps: Vec<SubStep>,
 }
 
 /// Slope `dmu/dv` of a friction law at slip speed `v` (one-sided difference at 0, where the
@@ -532,6 +624,21 @@ impl ClearanceJoint {
     /// The Rapier joint locking the out-of-plane motion, if any.
     pub fn lock_handle(&self) -> Option<ImpulseJointHandle> {
         self.lock_handle
+    }
+    /// How the contact is integrated ([`ContactIntegration`]).
+    pub fn integration(&self) -> ContactIntegration {
+        self.integration
+    }
+    /// A sub-cycled joint's states inside the last step, in time order, the step's end last
+    /// (empty for an explicit joint, and before the first step): its contacts resolved where
+    /// the step itself is too long to see them. A loop that records a sub-cycled joint's
+    /// contacts records these ([`ImpactRecorder::record_step`](crate::rapier::metrics::ImpactRecorder::record_step)).
+    pub fn substeps(&self) -> &[SubStep] {
+        &self.cycle.substeps
+    }
+    /// Whether the contact is sub-cycled (a planar joint with [`ContactIntegration::SubCycled`]).
+    fn sub_cycled(&self) -> bool {
+        self.integration == ContactIntegration::SubCycled && self.spatial.is_none()
     }
     /// What the hook computed at its last application.
     pub fn report(&self) -> &ClearanceReport {
@@ -632,6 +739,14 @@ impl ClearanceJoint {
         if !(m > 0.0 && m.is_finite()) {
             return f64::INFINITY;
         }
+        if self.sub_cycled() {
+            // The sub-steps resolve the contact: the journal's path alone bounds the step.
+            return flight_step(
+                tolerance,
+                self.geometry.clearance(),
+                r.state.eccentricity_rate.length(),
+            );
+        }
         let delta = r.state.penetration;
         let rate = r.state.penetration_rate;
         let contact_step =
@@ -721,30 +836,14 @@ impl ClearanceJoint {
         depth: f64,
         tolerance: f64,
     ) -> f64 {
-        let m = self.report.effective_mass;
-        let energy = 0.5 * m * approach_speed * approach_speed + elastic;
-        let peak = crate::model::laws::penetration_for_energy(law, energy, 1e-6).max(depth);
-        let stiffness = law.tangent_stiffness(peak);
-        if !(stiffness > 0.0) {
-            return f64::INFINITY;
-        }
-        let mut impact_rate = if self.contact.in_contact {
-            self.contact.impact_rate
-        } else {
-            approach_speed.max(self.min_impact_speed)
+        let contact = ContactAhead {
+            mass: self.report.effective_mass,
+            approach_speed,
+            depth,
+            impact_rate: self.contact.in_contact.then_some(self.contact.impact_rate),
+            min_impact_speed: self.min_impact_speed,
         };
-        if law.uses_impact_rate() {
-            impact_rate = impact_rate.max(loaded_impact_rate(energy, m));
-        }
-        let c = NormalContact {
-            penetration: peak,
-            penetration_rate: approach_speed,
-            impact_rate,
-        };
-        let (stable, omega, _) = stable_step(stiffness, law.damping_coefficient(&c), m);
-        let period = std::f64::consts::TAU / omega;
-        (CONTACT_PERIODS_PER_TOLERANCE * tolerance * period)
-            .min(stable_fraction(tolerance) * stable)
+        contact.resolving_step(law, elastic, tolerance, stable_fraction(tolerance))
     }
 
     /// Judges a step of `dt` that ended in the state of the last application, for a joint that
@@ -757,7 +856,7 @@ impl ClearanceJoint {
     pub fn judge_step(&self, dt: f64, tolerance: f64, was_in_contact: bool) -> Option<f64> {
         let r = &self.report;
         let delta = r.state.penetration;
-        if !(delta > 0.0) {
+        if !(delta > 0.0) || self.sub_cycled() {
             return None;
         }
         let limit = r.max_stable_dt.min(r.friction_stable_dt);
@@ -788,6 +887,8 @@ impl ClearanceJoint {
         d.last_step = self.last_step;
         d.last_wrenches = self.last_wrenches;
         d.prepared = self.prepared;
+        d.held = self.cycle.held;
+        d.substeps.clone_from(&self.cycle.substeps);
         match (&self.spatial, &mut d.spatial) {
             (Some(parts), Some(memory)) => parts.save_into(memory),
             (Some(parts), memory) => *memory = Some(parts.memory()),
@@ -803,6 +904,8 @@ impl ClearanceJoint {
         self.last_step = d.last_step;
         self.last_wrenches = d.last_wrenches;
         self.prepared = d.prepared;
+        self.cycle.held = d.held;
+        self.cycle.substeps.clone_from(&d.substeps);
         if let (Some(parts), Some(memory)) = (&mut self.spatial, &d.spatial) {
             parts.restore(memory);
         }
@@ -1024,9 +1127,17 @@ impl std::fmt::Display for ClearanceJointHandle {
 pub struct ClearanceJointSet {
     joints: OrderedArena<ClearanceJoint>,
     ledger: ForceLedger,
+    /// The forces at the state (every joint's).
     wrenches: Vec<Wrench>,
+    /// The forces the stepper applies over the next step: the explicit joints', and in the
+    /// step's pass 1 the sub-cycled joints' deliveries.
+    applied: Vec<Wrench>,
+    /// The sub-cycled joints' deliveries of the step being taken, and whether its pass 1 is on.
+    planned: Vec<Wrench>,
+    retaking: bool,
     saved: Vec<JointDynamics>,
     saved_wrenches: Vec<Wrench>,
+    saved_applied: Vec<Wrench>,
     /// The step that led to the bodies' state, for the next evaluation, s.
     last_step: f64,
     /// Scratch: the mechanism around the joint being evaluated.
@@ -1199,6 +1310,8 @@ impl ClearanceJointSet {
     /// set how hard a journal strikes its wall (the laws' damping, the step bounds).
     pub fn evaluate(&mut self, bodies: &mut RigidBodySet, impulse_joints: &ImpulseJointSet) {
         self.wrenches.clear();
+        self.applied.clear();
+        self.retaking = false;
         for joint in self.joints.values_mut() {
             if !joint.prepared {
                 ensure_mass_properties(bodies, None, joint.body1);
@@ -1207,9 +1320,17 @@ impl ClearanceJointSet {
             }
             self.mechanism
                 .rebuild(bodies, impulse_joints, joint.body1, joint.body2);
-            joint.last_wrenches = joint
-                .evaluate(bodies, self.last_step, &self.mechanism)
+            let finished = joint.finish_cycle(bodies);
+            if finished.is_none() {
+                // Explicit, or a sub-cycled joint's first evaluation (velocities its own).
+                joint.cycle.held = [0.0; 12];
+                joint.cycle.start_correction = [0.0; 12];
+                joint.cycle.substeps.clear();
+            }
+            joint.last_wrenches = finished
+                .or_else(|| joint.evaluate(bodies, self.last_step, &self.mechanism))
                 .map(|(w1, w2)| [w1, w2]);
+            joint.take_start(bodies, &self.mechanism);
             if joint.last_wrenches.is_none() {
                 joint.contact = ContactHistory::default();
                 joint.report = ClearanceReport::default();
@@ -1221,7 +1342,37 @@ impl ClearanceJointSet {
             }
             self.wrenches
                 .extend(joint.last_wrenches.into_iter().flatten());
+            if !joint.sub_cycled() {
+                self.applied
+                    .extend(joint.last_wrenches.into_iter().flatten());
+            }
         }
+    }
+
+    /// After Rapier's pass `pass.pass` of a step: at pass 0 every sub-cycled joint runs its
+    /// sub-cycle ([`ClearanceJoint::plan_cycle`]) and the set asks for pass 1 with their
+    /// deliveries when one has an impulse to deliver; later passes stand.
+    pub(crate) fn resolve_step(
+        &mut self,
+        bodies: &RigidBodySet,
+        pass: &crate::rapier::step_hooks::StepPass,
+        iterations: usize,
+    ) -> bool {
+        if pass.pass > 0 {
+            self.retaking = false;
+            return false;
+        }
+        self.planned.clear();
+        for joint in self.joints.values_mut() {
+            if let Some(deliver) = joint.plan_cycle(bodies, pass, iterations) {
+                self.planned.extend(joint.delivery(&deliver, pass.kick));
+            }
+        }
+        self.retaking = !self.planned.is_empty();
+        if self.retaking {
+            self.applied.extend_from_slice(&self.planned);
+        }
+        self.retaking
     }
 
     /// The force and torque on each body from the last evaluation (two per joint: bearing,
@@ -1230,9 +1381,11 @@ impl ClearanceJointSet {
         &self.wrenches
     }
 
-    /// Refuses Rapier substeps (`num_solver_iterations != 1`) when the set holds joints.
+    /// Refuses Rapier substeps (`num_solver_iterations != 1`) when the set holds joints that
+    /// are not sub-cycled (a sub-cycled joint delivers its impulse through any number).
     pub fn check_substeps(&self, params: &IntegrationParameters) -> Result<()> {
-        if params.num_solver_iterations != 1 && !self.joints.is_empty() {
+        let explicit = self.joints.values().any(|j| !j.sub_cycled());
+        if params.num_solver_iterations != 1 && explicit {
             return Err(Error::invalid(
                 "num_solver_iterations",
                 format!(
@@ -1262,7 +1415,7 @@ impl ClearanceJointSet {
                 ));
             }
             let r = &j.report;
-            if dt > r.max_stable_dt {
+            if dt > r.max_stable_dt && !j.sub_cycled() {
                 let (dt_max, depth, omega, zeta) = match j.impact_met(dt) {
                     Some(impact) => impact,
                     None => (r.max_stable_dt, r.state.penetration, r.omega, r.zeta),
@@ -1294,6 +1447,7 @@ impl ClearanceJointSet {
             j.save_into(d);
         }
         self.saved_wrenches.clone_from(&self.wrenches);
+        self.saved_applied.clone_from(&self.applied);
     }
 
     /// Restores what [`save_state`](Self::save_state) saved.
@@ -1302,6 +1456,15 @@ impl ClearanceJointSet {
             j.set_dynamics(d);
         }
         self.wrenches.clone_from(&self.saved_wrenches);
+        self.applied.clone_from(&self.saved_applied);
+        if self.retaking {
+            // Taken again for pass 1: with the deliveries of pass 0.
+            self.applied.extend_from_slice(&self.planned);
+        } else {
+            for j in self.joints.values_mut() {
+                j.cycle.pending = None;
+            }
+        }
     }
 
     /// [`ClearanceJoint::judge_step`] over all joints, with their contact state saved by the last
@@ -1341,8 +1504,20 @@ impl crate::rapier::step_hooks::StepHooks for ClearanceJointSet {
     fn evaluate(&mut self, bodies: &mut RigidBodySet, impulse_joints: &ImpulseJointSet) {
         ClearanceJointSet::evaluate(self, bodies, impulse_joints);
     }
+    /// What the stepper applies: the explicit joints' forces at the state, and in a step's
+    /// pass 1 the sub-cycled joints' deliveries ([`ClearanceJointSet::wrenches`] holds every
+    /// joint's force at the state, for readers).
+    #[allow(clippy::misnamed_getters)]
     fn wrenches(&self) -> &[Wrench] {
-        ClearanceJointSet::wrenches(self)
+        &self.applied
+    }
+    fn resolve_step(
+        &mut self,
+        world: &rapier3d_f64::prelude::PhysicsWorld,
+        pass: &crate::rapier::step_hooks::StepPass,
+    ) -> bool {
+        let iterations = world.integration_parameters.num_solver_iterations;
+        ClearanceJointSet::resolve_step(self, &world.bodies, pass, iterations)
     }
     fn save_state(&mut self) {
         ClearanceJointSet::save_state(self);
@@ -1368,7 +1543,7 @@ impl crate::rapier::step_hooks::StepHooks for ClearanceJointSet {
     fn record_guards(&self, guards: &mut GuardReport, t: f64, dt: f64, fixed: bool) {
         for (handle, j) in self.iter() {
             let limit = j.report().friction_stable_dt;
-            if fixed && dt > limit {
+            if fixed && dt > limit && !j.sub_cycled() {
                 guards.record(
                     Violation::new(GuardKind::Friction, dt / limit, 1.0, t)
                         .joint(j.name(), Some(handle))
@@ -1379,7 +1554,7 @@ impl crate::rapier::step_hooks::StepHooks for ClearanceJointSet {
                         )),
                 );
             }
-            let (depth, valid) = (j.report().state.penetration, j.max_valid_penetration());
+            let (depth, valid) = (j.deepest_in_step(), j.max_valid_penetration());
             let ratio = depth / valid;
             if ratio > guards.worst_penetration_ratio {
                 guards.worst_penetration_ratio = ratio;

@@ -123,6 +123,20 @@ impl ContactObservation {
         }
     }
 
+    /// A sub-cycled joint's state inside a step
+    /// ([`ClearanceJoint::substeps`](crate::rapier::joint::ClearanceJoint::substeps)).
+    pub fn of_substep(s: &crate::rapier::joint::SubStep) -> Self {
+        ContactObservation {
+            force: s.force.on_journal.length(),
+            onset: s.onset,
+            impact: s.impact,
+            penetration: s.state.penetration,
+            rate: s.state.penetration_rate,
+            approach_speed: s.approach_speed,
+            onset_fraction: s.onset_fraction,
+        }
+    }
+
     /// An ideal joint's state: its reaction force, never in contact.
     pub fn ideal(force: f64) -> Self {
         ContactObservation {
@@ -348,6 +362,32 @@ impl ImpactRecorder {
             i.max_penetration_um = i.max_penetration_um.max(obs.penetration * 1e6);
             i.duration_s += dt;
         }
+    }
+
+    /// Records one step of a joint taken from `t0` for `dt` (s): `before` the joint's state at
+    /// the step's start ([`ContactObservation::of`] read before the step), `substeps` its states
+    /// inside the step ([`ClearanceJoint::substeps`](crate::rapier::joint::ClearanceJoint::substeps)
+    /// read after it; the last is the step's end, recorded with the next step). Without
+    /// sub-steps (an explicit joint) it is [`record`](Self::record)`(t0, dt, before)`.
+    pub fn record_step(
+        &mut self,
+        t0: f64,
+        dt: f64,
+        before: &ContactObservation,
+        substeps: &[crate::rapier::joint::SubStep],
+    ) {
+        let Some((_, inside)) = substeps.split_last() else {
+            self.record(t0, dt, before);
+            return;
+        };
+        let mut obs = *before;
+        let mut t = 0.0;
+        for s in inside {
+            self.record(t0 + t, s.t - t, &obs);
+            obs = ContactObservation::of_substep(s);
+            t = s.t;
+        }
+        self.record(t0 + t, dt - t, &obs);
     }
 
     /// Records a spatial joint's report at a state ([`ClearanceReport::spatial`]), which held

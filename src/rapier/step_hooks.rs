@@ -14,12 +14,15 @@
 //!    [`evaluate`](StepHooks::evaluate) at the state before the step.
 //! 2. The step's length: the smallest [`step_limit`](StepHooks::step_limit) (adaptive), or a
 //!    fixed step checked by [`check_step`](StepHooks::check_step).
-//! 3. [`save_state`](StepHooks::save_state) (adaptive: the step may be rejected); the
+//! 3. [`save_state`](StepHooks::save_state) (the step may be rejected or taken again); the
 //!    [`wrenches`](StepHooks::wrenches) are added to the bodies for this step only;
 //!    [`before_rapier_step`](StepHooks::before_rapier_step), Rapier's step,
 //!    [`after_rapier_step`](StepHooks::after_rapier_step); then
 //!    [`set_last_step`](StepHooks::set_last_step) and [`evaluate`](StepHooks::evaluate) at the
 //!    new state.
+//!    After each Rapier pass, [`resolve_step`](StepHooks::resolve_step): a participant may ask
+//!    for the step to be taken again from its start with its new wrenches (the bodies and
+//!    every participant's state restored first).
 //! 4. [`judge_step`](StepHooks::judge_step) (adaptive): a participant that asks for a shorter
 //!    step has the step undone ([`restore_state`](StepHooks::restore_state), the bodies restored
 //!    by the stepper) and retried from 3.
@@ -99,6 +102,17 @@ pub trait StepHooks {
     /// constraint forces of large-step joints and bouncing their impacts. Default: nothing.
     fn after_rapier_step(&mut self, _world: &mut PhysicsWorld) {}
 
+    /// After each Rapier pass of a step (after [`after_rapier_step`](Self::after_rapier_step)):
+    /// whether the step must be taken again from its start, as long, with this participant's
+    /// [`wrenches`](Self::wrenches) as they are now. The stepper then restores the bodies and
+    /// every participant's state ([`restore_state`](Self::restore_state)) and takes pass
+    /// `pass.pass + 1`. A sub-cycled clearance joint reads the rest of the world's motion from
+    /// pass 0, taken without its force, and asks for pass 1 with the force that moves the bodies
+    /// as its sub-steps did. Default: the pass stands.
+    fn resolve_step(&mut self, _world: &PhysicsWorld, _pass: &StepPass) -> bool {
+        false
+    }
+
     /// Records, after an accepted step of `dt` (s) ending at `t`, what the run-time guards must
     /// know of this participant's state (penetrations beyond a law's validity, a fixed step
     /// beyond friction's limit, when `fixed`). Default: nothing.
@@ -119,6 +133,21 @@ pub trait StepHooks {
     fn check_bodies(&self, _bodies: &RigidBodySet) -> Result<()> {
         Ok(())
     }
+}
+
+/// One Rapier pass of a step, as [`StepHooks::resolve_step`] sees it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct StepPass {
+    /// The step, s.
+    pub dt: f64,
+    /// Its velocity kick, `(h_prev + h)/2` (`h/2` for a first step), s: the stepper scales every
+    /// force by `kick/dt` for the step.
+    pub kick: f64,
+    /// The step control's tolerance.
+    pub tolerance: f64,
+    /// The pass, from 0.
+    pub pass: u32,
 }
 
 /// `Ok` when `body1` and `body2` are both in `bodies`; else an error naming the one missing

@@ -82,7 +82,7 @@ use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle, RigidBodyType};
 use serde::{Deserialize, Serialize};
 
 pub use crate::rapier::guards::{GuardKind, GuardReport, Violation};
-pub use crate::rapier::step_hooks::StepHooks;
+pub use crate::rapier::step_hooks::{StepHooks, StepPass};
 
 /// How the step is chosen (`run.step` in scene files).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -101,6 +101,10 @@ pub enum StepMode {
 /// Steps at or below this many floors in a row, with no progress in simulated time, stop the
 /// run with [`Error::Stalled`].
 pub const STALL_STEPS: u64 = 100_000;
+
+/// Passes after the first that one step may take ([`StepHooks::resolve_step`]): a sub-cycled
+/// joint takes one.
+const MAX_PASSES: u32 = 3;
 
 /// Rejections of one step after which the step control gives up ([`Error::Stalled`]).
 const MAX_REJECTIONS: u32 = 60;
@@ -493,10 +497,8 @@ impl Stepper {
         // Save the state: bodies (always: their forces are restored after the scaled step) and,
         // when a step may be rejected, the sources.
         snapshot_bodies(world, &mut self.saved);
-        if adaptive {
-            for s in sources.iter_mut() {
-                s.save_state();
-            }
+        for s in sources.iter_mut() {
+            s.save_state();
         }
         let mut rejected = 0u32;
         loop {
@@ -566,16 +568,53 @@ impl Stepper {
 
     /// One Rapier step of `dt` from the saved state, with the kick `(h_prev + h)/2`: your forces,
     /// the sources' wrenches and gravity scaled to the kick for this step only, the sources'
-    /// hooks around it, the joint correction, exact kinematic poses; then the sources evaluated
-    /// at the new state. Returns the kick, s.
+    /// hooks around it, the joint correction, exact kinematic poses ([`Self::rapier_pass`]),
+    /// taken again from the saved state while a source asks ([`StepHooks::resolve_step`], at
+    /// most [`MAX_PASSES`] more); then the sources evaluated at the new state. Returns the
+    /// kick, s.
     fn take_rapier_step(
         &mut self,
         world: &mut PhysicsWorld,
         sources: &mut [&mut dyn StepHooks],
         dt: f64,
     ) -> f64 {
-        let gravity = world.gravity;
         let kick = 0.5 * (self.last_dt + dt);
+        let mut pass = StepPass {
+            dt,
+            kick,
+            tolerance: self.control.tolerance,
+            pass: 0,
+        };
+        loop {
+            self.rapier_pass(world, sources, dt, kick);
+            let mut again = false;
+            for s in sources.iter_mut() {
+                again |= s.resolve_step(world, &pass);
+            }
+            if !again || pass.pass >= MAX_PASSES {
+                break;
+            }
+            self.restore(world, sources);
+            pass.pass += 1;
+        }
+        for s in sources.iter_mut() {
+            s.set_last_step(dt);
+            s.evaluate(&mut world.bodies, &world.impulse_joints);
+        }
+        kick
+    }
+
+    /// One Rapier pass of a step of `dt` with velocity kick `kick` (s): the user's forces and the
+    /// sources' wrenches scaled to the kick for the pass only, the sources' hooks around
+    /// Rapier's step.
+    fn rapier_pass(
+        &mut self,
+        world: &mut PhysicsWorld,
+        sources: &mut [&mut dyn StepHooks],
+        dt: f64,
+        kick: f64,
+    ) {
+        let gravity = world.gravity;
         let scale = kick / dt;
         // For this step only: your forces and the sources' wrenches, scaled to the kick.
         for b in &self.saved {
@@ -616,11 +655,6 @@ impl Stepper {
         for s in sources.iter_mut() {
             s.after_rapier_step(world);
         }
-        for s in sources.iter_mut() {
-            s.set_last_step(dt);
-            s.evaluate(&mut world.bodies, &world.impulse_joints);
-        }
-        kick
     }
 
     /// Takes a step of the last step's size (or `dt` if none), lets `read` look at the world and

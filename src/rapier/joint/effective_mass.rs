@@ -164,6 +164,34 @@ impl Mechanism {
         (free - held).max(MIN_MOBILITY * free)
     }
 
+    /// The pair's mobility through the mechanism, `M^-1 - C` over its 12 coordinates (bearing's
+    /// linear and angular, then the journal's; row-major): the velocity change of the two
+    /// bodies per unit generalised impulse on them, the ideal joints taking their share. Zero
+    /// blocks for a body that is not dynamic.
+    pub(crate) fn pair_mobility(&self) -> [f64; 144] {
+        let mut p = [0.0; 144];
+        for (pos, body) in self.pair.iter().enumerate() {
+            let Some(i) = body else { continue };
+            let b = &self.island[*i];
+            for k in 0..3 {
+                let base = 6 * pos;
+                p[(base + k) * 12 + base + k] = b.inv_mass;
+                let mut e = Vector::ZERO;
+                e[k] = 1.0;
+                let col = b.inv_inertia * e;
+                for r in 0..3 {
+                    p[(base + 3 + r) * 12 + base + 3 + k] = col[r];
+                }
+            }
+        }
+        if !self.correction.is_empty() {
+            for (pq, c) in p.iter_mut().zip(&self.correction) {
+                *pq -= c;
+            }
+        }
+        p
+    }
+
     fn index(&self, handle: RigidBodyHandle) -> Option<usize> {
         self.island.iter().position(|b| b.handle == handle)
     }

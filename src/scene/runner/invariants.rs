@@ -122,6 +122,10 @@ pub(super) struct BodyBefore<'a> {
     pub(super) angvel: Vector,
     /// The body after the step: its velocities are the next half-step's.
     pub(super) after: &'a RigidBody,
+    /// The velocity (linear, angular) the state has beyond the Verlet reading of the stored
+    /// ones: sub-cycled contacts' impulses inside the steps around it
+    /// ([`ClearanceJoint::start_velocity_correction`](crate::rapier::joint::ClearanceJoint::start_velocity_correction)).
+    pub(super) beyond: (Vector, Vector),
 }
 
 impl Invariants {
@@ -143,8 +147,8 @@ impl Invariants {
         for b in bodies {
             let rb = b.after;
             let com = b.com;
-            let v = sync(b.linvel, rb.linvel());
-            let w = sync(b.angvel, rb.angvel());
+            let v = sync(b.linvel, rb.linvel()) + b.beyond.0;
+            let w = sync(b.angvel, rb.angvel()) + b.beyond.1;
             let mp = &rb.mass_properties().local_mprops;
             // I w in world: R I_principal R^T w.
             let rot = b.rotation * mp.principal_inertia_local_frame;

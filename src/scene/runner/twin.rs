@@ -298,9 +298,9 @@ impl Twin {
     /// Completes the step that started from the state [`before_step`](Self::before_step) read:
     /// ideal reactions (which only the step determines), metrics of that state over the step.
     pub(super) fn after_step(&mut self, world: &ClearanceWorld, info: &StepInfo) {
-        let (bodies, joints) = (&world.rapier.bodies, &world.rapier.impulse_joints);
-        self.update_force_metrics(info.t0, info.dt);
-        self.update_invariants(bodies, world.rapier.gravity, info);
+        let joints = &world.rapier.impulse_joints;
+        self.update_force_metrics(world, info.t0, info.dt);
+        self.update_invariants(world, info);
         // The motors' work over the step: the angular or linear impulse Rapier's motor row
         // applied to body 2 (minus its stored impulse) times the joint's speed at the state the
         // step started from (the solve's synchronous one), what a kick does to kinetic energy.
@@ -342,6 +342,11 @@ impl Twin {
                     // The power of every contact point's damping and friction at the state
                     // before the step, as the planar joint's force at that state.
                     self.invariants.dissipated_j += s.report.dissipation_power * info.dt;
+                    continue;
+                }
+                if let Some(loss) = j.step_dissipation() {
+                    // Integrated over the sub-steps.
+                    self.invariants.dissipated_j += loss;
                     continue;
                 }
                 let r = j.report();
@@ -414,7 +419,16 @@ impl Twin {
 
     /// The invariants at the state before the step just taken, from this twin's moving bodies
     /// and its sources' elastic energy there.
-    fn update_invariants(&mut self, bodies: &RigidBodySet, gravity: Vector, info: &StepInfo) {
+    fn update_invariants(&mut self, world: &ClearanceWorld, info: &StepInfo) {
+        let bodies = &world.rapier.bodies;
+        let beyond = |body: RigidBodyHandle| {
+            world
+                .clearance
+                .iter()
+                .flat_map(|(_, j)| j.start_velocity_correction())
+                .filter(|c| c.0 == body)
+                .fold((Vector::ZERO, Vector::ZERO), |(v, w), c| (v + c.1, w + c.2))
+        };
         let moving = self.bodies.iter().filter(|b| !b.fixed).map(|b| BodyBefore {
             mass: b.mass,
             com: b.com_before,
@@ -422,16 +436,28 @@ impl Twin {
             linvel: b.linvel_before,
             angvel: b.angvel_before,
             after: &bodies[b.handle],
+            beyond: beyond(b.handle),
         });
-        self.invariants
-            .update(moving, self.source_energy_before, gravity, info);
+        self.invariants.update(
+            moving,
+            self.source_energy_before,
+            world.rapier.gravity,
+            info,
+        );
     }
 
     /// Metrics of the state before the step (its sample and force), weighted by the step.
-    fn update_force_metrics(&mut self, t: f64, dt: f64) {
+    /// A sub-cycled joint's states inside the step are recorded too.
+    fn update_force_metrics(&mut self, world: &ClearanceWorld, t: f64, dt: f64) {
         for h in &mut self.hinges {
             let obs = h.observation();
-            h.recorder.record(t, dt, &obs);
+            let substeps = match h.joint {
+                HingeJoint::Clearance(c) => {
+                    world.clearance.get(c).map_or(&[][..], |j| j.substeps())
+                }
+                HingeJoint::Ideal | HingeJoint::LargeStep(_) => &[],
+            };
+            h.recorder.record_step(t, dt, &obs, substeps);
             if let Some(s) = &h.spatial_sample {
                 h.recorder.record_spatial(dt, &s.report);
             }

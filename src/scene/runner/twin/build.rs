@@ -218,7 +218,12 @@ fn build_hinges(
                 // The journal's centre starts off the bearing's by the hinge's offset.
                 let a2 = a2 + Vector::from(h.journal_offset_mm) * 1e-3;
                 match settings.model {
-                    ClearanceModel::Compliant | ClearanceModel::Spatial(_) => {
+                    ClearanceModel::Compliant => {
+                        let settings = settings.clone().integration(scene.run.contact_integration);
+                        let j = settings.joint(a1, a2, axis, axis)?;
+                        HingeJoint::Clearance(world.insert_clearance(b1, b2, j)?)
+                    }
+                    ClearanceModel::Spatial(_) => {
                         let j = settings.joint(a1, a2, axis, axis)?;
                         HingeJoint::Clearance(world.insert_clearance(b1, b2, j)?)
                     }

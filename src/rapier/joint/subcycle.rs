@@ -1,0 +1,851 @@
+//! Sub-cycled contact ([`ContactIntegration::SubCycled`]): inside one Rapier step the joint
+//! integrates its two bodies' motion on its own clock, and Rapier's step carries the result.
+//!
+//! **Free motion from Rapier.** The step is first taken without the joint's force (Rapier's
+//! pass 0). The velocities it ends with give every other force's acceleration of the pair over
+//! the step (gravity, drives, the user's forces, the ideal joints' reactions, Rapier's own
+//! integration), `a = (v_free - v_start)/kick`, held over the step.
+//!
+//! **The contact on its own clock.** From the pair's state at the step's start, the joint
+//! integrates `dv/dt = a + P F(x, v)` over the step, `P` the pair's mobility through the
+//! mechanism's ideal joints (the 12 x 12 [`Mechanism::pair_mobility`], at the step's start),
+//! with sub-steps sized by the tolerance: `2 tol` of the contact's period and `50 tol` of its
+//! damped stability limit in contact ([`ContactAhead::resolving_step`]), halving the time to
+//! contact on approach, one sub-step over a free flight that meets no wall. A sub-step is a
+//! velocity-Verlet step whose elastic force is taken at the sub-step's position and whose
+//! dissipative forces (the law's damping, friction) at the velocity of the state, solved
+//! implicitly (a trapezoidal rule in the velocity: stable at any sub-step, second order). The
+//! friction law's steep slope near zero slip therefore sets no step.
+//!
+//! **Back to Rapier.** Rapier's step is then taken again (pass 1) with the constant wrench that
+//! moves the bodies where the sub-steps did: with one solver iteration a force held over a step
+//! moves the bodies by `h kick P Q` and changes their velocities by `kick P Q`, so
+//! `Q kick = (H + Pi/h)/c_N`, `Pi` the time integral of the sub-steps' accumulated impulse,
+//! `c_N = (N + 1)/(2 N)` for `N` solver iterations (Rapier's substeps) and `H` the impulse held
+//! from the step before. Rapier's velocities are the mean over the step (Verlet's half-step
+//! velocities), so the part of the step's impulse that is not in them, `H' = H + Gamma(h) -
+//! Q kick`, is held to the next step, whose true starting velocity is Rapier's plus
+//! `(c_N kick - h/2) a + P H'`. Steps without a contact and without a held impulse take pass 0
+//! only.
+//!
+//! The sub-steps' states are the joint's [`substeps`](super::ClearanceJoint::substeps): an
+//! impact that begins, peaks and ends inside one world step is reported at its sub-steps
+//! (onset, peak, depth, lift-off), and the world steps at the rate of the slow motion.
+
+use super::effective_mass::Mechanism;
+use super::{ClearanceJoint, ClearanceReport, ContactAhead, ContactHistory};
+use crate::model::kinematics::stable_step;
+use crate::model::kinematics::{BodyMotion, ForcePair, JournalState, journal_state};
+use crate::model::laws::{FrictionLaw, NormalContact, NormalForceLaw, loaded_impact_rate};
+use crate::rapier::ledger::Wrench;
+use crate::rapier::ledger::world_center_of_mass;
+use crate::rapier::step_hooks::StepPass;
+use rapier3d_f64::math::{Rotation, Vector};
+use rapier3d_f64::prelude::{RigidBody, RigidBodyHandle, RigidBodySet};
+use serde::{Deserialize, Serialize};
+
+/// How a compliant clearance joint integrates its contact and friction forces over a step
+/// ([`ClearanceJointBuilder::integration`](super::ClearanceJointBuilder::integration)).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[non_exhaustive]
+pub enum ContactIntegration {
+    /// The forces are evaluated once per Rapier step at its start and held over it: the step
+    /// must resolve every contact (the step control shortens it to a fraction of the contact's
+    /// period and of its stability limit, and of friction's near zero slip).
+    #[default]
+    Explicit,
+    /// The contact is integrated on the joint's own clock inside each Rapier step, its damping
+    /// and friction implicitly; Rapier's step carries the result (the [module docs](self)). The
+    /// world's step is set by its slow motion: the joint adds no stability limit. Needs the
+    /// [`Stepper`](crate::rapier::stepper::Stepper) (or a world built on it); a loop of your own
+    /// that calls `ClearanceJointSet::apply` gets the explicit forces.
+    SubCycled,
+}
+
+/// One state inside the last Rapier step of a sub-cycled joint: where its contact was, at the
+/// end of a sub-step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SubStep {
+    /// Time since the step's start, s.
+    pub t: f64,
+    /// The journal's state, its rates at the state.
+    pub state: JournalState,
+    /// The contact force pair at the state.
+    pub force: ForcePair,
+    /// Whether a contact began at this state (an onset; see
+    /// [`ClearanceReport::onset`](super::ClearanceReport::onset)).
+    pub onset: bool,
+    /// Whether the onset is an impact ([`ClearanceReport::impact`](super::ClearanceReport::impact)).
+    pub impact: bool,
+    /// At an onset, the penetration rate at the crossing of delta = 0, m/s; 0 otherwise.
+    pub approach_speed: f64,
+    /// At an onset, the fraction of the sub-step before this state at which delta crossed 0;
+    /// 1 otherwise.
+    pub onset_fraction: f64,
+}
+
+/// Sub-steps in one world step beyond which the joint stops resolving and finishes the step in
+/// one sub-step (a guard: at the default tolerance an impact takes about 70).
+pub(crate) const MAX_SUBSTEPS: u32 = 100_000;
+
+/// Fraction of the predicted time to contact that one free sub-step may cover.
+const APPROACH_FRACTION: f64 = 0.5;
+
+/// The fraction of a contact's damped stability limit one sub-step may cover, per unit of
+/// tolerance: `10 tol` (0.075 at the default 0.0075). The damping is implicit, so the limit is
+/// no bound here; a heavily damped contact relaxes at about `2/limit`, and a sub-step that
+/// covers a fifth of what the explicit step may (`50 tol`) resolves that relaxation to the
+/// tolerance (the improved law's single impact: its depth within 1e-3 of its ODE at the
+/// default, `tests/references.rs`).
+const STABLE_FRACTION_PER_TOLERANCE: f64 = 10.0;
+
+/// A 12-vector over the pair's coordinates: the bearing's linear and angular, then the
+/// journal's.
+type Pair12 = [f64; 12];
+
+fn dot(a: &Pair12, b: &Pair12) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
+
+fn axpy(y: &mut Pair12, s: f64, x: &Pair12) {
+    for (y, x) in y.iter_mut().zip(x) {
+        *y += s * x;
+    }
+}
+
+fn mul(p: &[f64; 144], x: &Pair12) -> Pair12 {
+    let mut y = [0.0; 12];
+    for (r, y) in y.iter_mut().enumerate() {
+        *y = dot(p[r * 12..r * 12 + 12].try_into().expect("a row"), x);
+    }
+    y
+}
+
+fn part(x: &Pair12, k: usize) -> Vector {
+    Vector::new(x[3 * k], x[3 * k + 1], x[3 * k + 2])
+}
+
+fn put(x: &mut Pair12, k: usize, v: Vector) {
+    x[3 * k..3 * k + 3].copy_from_slice(&[v.x, v.y, v.z]);
+}
+
+/// The pair's coordinates of a load at `point` on the journal (`on_journal`) and its opposite
+/// on the bearing, about the centres of mass `com`.
+fn load(com: &[Vector; 2], point: Vector, on_journal: Vector) -> Pair12 {
+    let mut l = [0.0; 12];
+    put(&mut l, 0, -on_journal);
+    put(&mut l, 1, (point - com[0]).cross(-on_journal));
+    put(&mut l, 2, on_journal);
+    put(&mut l, 3, (point - com[1]).cross(on_journal));
+    l
+}
+
+/// The row that reads the relative velocity along `dir` of the journal's point `q_j` against
+/// the bearing's point `q_i`.
+fn row(com: &[Vector; 2], q_i: Vector, q_j: Vector, dir: Vector) -> Pair12 {
+    let mut r = [0.0; 12];
+    put(&mut r, 0, -dir);
+    put(&mut r, 1, -(q_i - com[0]).cross(dir));
+    put(&mut r, 2, dir);
+    put(&mut r, 3, (q_j - com[1]).cross(dir));
+    r
+}
+
+/// The pair at the start of a step: what the sub-cycle integrates from.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PairStart {
+    com: [Vector; 2],
+    /// Bearing centre and journal centre, from each centre of mass.
+    anchor: [Vector; 2],
+    /// The hinge's axis (the bearing's).
+    axis: Vector,
+    /// Rapier's velocities at the start (the mean over the step before).
+    velocity: Pair12,
+    mobility: [f64; 144],
+}
+
+impl PairStart {
+    /// The pair of `joint` at the bodies' current state, with its mobility through `mechanism`
+    /// (rebuilt at this state); `None` when a body is gone.
+    pub(crate) fn of(
+        joint: &ClearanceJoint,
+        bodies: &RigidBodySet,
+        mechanism: &Mechanism,
+    ) -> Option<Self> {
+        let rb: [&RigidBody; 2] = [bodies.get(joint.body1)?, bodies.get(joint.body2)?];
+        let com = rb.map(world_center_of_mass);
+        let anchor = [
+            *rb[0].position() * joint.local_anchor1 - com[0],
+            *rb[1].position() * joint.local_anchor2 - com[1],
+        ];
+        let mut velocity = [0.0; 12];
+        for (k, b) in rb.iter().enumerate() {
+            put(&mut velocity, 2 * k, b.linvel());
+            put(&mut velocity, 2 * k + 1, b.angvel());
+        }
+        Some(PairStart {
+            com,
+            anchor,
+            axis: *rb[0].rotation() * joint.local_axis1,
+            velocity,
+            mobility: mechanism.pair_mobility(),
+        })
+    }
+
+    /// The pair's velocities in `bodies` now (`None` when a body is gone).
+    pub(crate) fn velocity_now(joint: &ClearanceJoint, bodies: &RigidBodySet) -> Option<Pair12> {
+        let mut v = [0.0; 12];
+        for (k, h) in [joint.body1, joint.body2].into_iter().enumerate() {
+            let b = bodies.get(h)?;
+            put(&mut v, 2 * k, b.linvel());
+            put(&mut v, 2 * k + 1, b.angvel());
+        }
+        Some(v)
+    }
+
+    /// The pair's mobility applied to `impulse`.
+    pub(crate) fn moved_by(&self, impulse: &Pair12) -> Pair12 {
+        mul(&self.mobility, impulse)
+    }
+
+    /// Rapier's velocities at the start.
+    pub(crate) fn velocity(&self) -> &Pair12 {
+        &self.velocity
+    }
+}
+
+/// Where the pair is inside the sub-cycle: displacements of the centres of mass, rotation
+/// vectors, and velocities.
+#[derive(Clone, Copy, Debug, Default)]
+struct Motion {
+    shift: [Vector; 2],
+    turn: [Vector; 2],
+    v: Pair12,
+}
+
+fn rotate(turn: Vector, r: Vector) -> Vector {
+    if turn == Vector::ZERO {
+        r
+    } else {
+        Rotation::from_scaled_axis(turn) * r
+    }
+}
+
+/// The contact at one position of the sub-cycle, linearised for the kick.
+#[derive(Clone, Copy, Debug)]
+struct Here {
+    state: JournalState,
+    /// The acceleration of the journal's centre relative to the bearing's in the plane, from the
+    /// rest of the world's accelerations (with the bodies' centripetal terms), m/s².
+    centre_acceleration: Vector,
+    com: [Vector; 2],
+    tangent: Vector,
+    /// Rows reading the penetration rate and the slip along `tangent`.
+    rows: [Pair12; 2],
+    /// Loads of a unit normal force (pushing the journal out, along `-n`) and a unit force along
+    /// `tangent`, and the pair's velocity change per unit of each.
+    loads: [Pair12; 2],
+    moves: [Pair12; 2],
+    /// `w[r][c]`: the rate read by row `r` per unit of load `c`.
+    w: [[f64; 2]; 2],
+}
+
+impl Here {
+    /// Effective mass along the normal, kg (infinite when nothing moves along it).
+    fn mass(&self) -> f64 {
+        if self.w[0][0] < 0.0 {
+            -1.0 / self.w[0][0]
+        } else {
+            f64::INFINITY
+        }
+    }
+}
+
+/// The outcome of one sub-cycle.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SubCycle {
+    /// The contact's impulse over the step, `Gamma(h)`.
+    pub(crate) impulse: Pair12,
+    /// `Pi/h`: the mean over the step of the impulse accumulated by each sub-step's start.
+    pub(crate) mean: Pair12,
+    /// The pair's velocity at the step's end.
+    pub(crate) end_velocity: Pair12,
+    pub(crate) history: ContactHistory,
+    pub(crate) samples: Vec<SubStep>,
+    /// The normal's effective mass at the end, kg.
+    pub(crate) end_mass: f64,
+    pub(crate) substeps: u32,
+    /// The pair's velocity at the step's start beyond the Verlet reading of Rapier's
+    /// velocities around it ([`ClearanceJoint::start_velocity_correction`]).
+    pub(crate) start_correction: Pair12,
+    /// The energy the damping and friction took over the step, J.
+    pub(crate) dissipated: f64,
+}
+
+/// What a sub-cycle integrates over one world step of `h` (s), from the pair's state `start`
+/// with the velocity `u0` at the state, under the rest of the world's acceleration `a_free`.
+pub(crate) struct Cycle<'a> {
+    pub(crate) joint: &'a ClearanceJoint,
+    pub(crate) start: &'a PairStart,
+    pub(crate) u0: Pair12,
+    pub(crate) a_free: Pair12,
+    pub(crate) h: f64,
+    pub(crate) tolerance: f64,
+}
+
+impl Cycle<'_> {
+    fn here(&self, m: &Motion) -> Here {
+        let s = self.start;
+        let com = [s.com[0] + m.shift[0], s.com[1] + m.shift[1]];
+        let p_i = com[0] + rotate(m.turn[0], s.anchor[0]);
+        let p_j = com[1] + rotate(m.turn[1], s.anchor[1]);
+        let axis = rotate(m.turn[0], s.axis);
+        let motion = |k: usize| BodyMotion {
+            center_of_mass: com[k],
+            linvel: part(&m.v, 2 * k),
+            angvel: part(&m.v, 2 * k + 1),
+        };
+        let g = &self.joint.geometry;
+        let state = journal_state(g, p_i, p_j, axis, &motion(0), &motion(1));
+        let n = state.normal;
+        let tangent = axis.cross(n);
+        let q_i = p_i + g.bearing_radius() * n;
+        let q_j = p_j + g.journal_radius() * n;
+        let rows = [row(&com, q_i, q_j, n), row(&com, q_i, q_j, tangent)];
+        let loads = [
+            load(&com, state.contact_point, -n),
+            load(&com, state.contact_point, tangent),
+        ];
+        let moves = loads.map(|l| mul(&s.mobility, &l));
+        let w = [0, 1].map(|r| [0, 1].map(|c| dot(&rows[r], &moves[c])));
+        let point_acceleration = |k: usize, p: Vector| {
+            let (w, r) = (part(&m.v, 2 * k + 1), p - com[k]);
+            part(&self.a_free, 2 * k) + part(&self.a_free, 2 * k + 1).cross(r) + w.cross(w.cross(r))
+        };
+        let relative = point_acceleration(1, p_j) - point_acceleration(0, p_i);
+        Here {
+            state,
+            centre_acceleration: relative - relative.dot(axis) * axis,
+            com,
+            tangent,
+            rows,
+            loads,
+            moves,
+            w,
+        }
+    }
+
+    /// `delta_dot0` for the law in the contact of `history` at `here` (as the explicit joint's).
+    fn impact_rate(&self, history: &ContactHistory, here: &Here) -> f64 {
+        let law = &self.joint.normal_law;
+        if history.in_contact && law.uses_impact_rate() {
+            let elastic = law.elastic_energy(here.state.penetration);
+            history
+                .impact_rate
+                .max(loaded_impact_rate(elastic, here.mass()))
+        } else {
+            history.impact_rate
+        }
+    }
+
+    /// The next sub-step from `here` (velocity `v` read there), at most `left` (s).
+    fn substep(&self, here: &Here, history: &ContactHistory, left: f64) -> f64 {
+        let j = self.joint;
+        let st = &here.state;
+        let mass = here.mass();
+        let ahead = |speed: f64, depth: f64| {
+            let contact = ContactAhead {
+                mass,
+                approach_speed: speed,
+                depth,
+                impact_rate: history.in_contact.then_some(history.impact_rate),
+                min_impact_speed: j.min_impact_speed,
+            };
+            let elastic = j.normal_law.elastic_energy(depth);
+            let stable = STABLE_FRACTION_PER_TOLERANCE * self.tolerance;
+            contact.resolving_step(&j.normal_law, elastic, self.tolerance, stable)
+        };
+        let s = if st.penetration > 0.0 {
+            ahead(st.penetration_rate.abs(), st.penetration)
+        } else {
+            let c = j.geometry.clearance();
+            let (e, v, a) = (
+                st.eccentricity,
+                st.eccentricity_rate,
+                here.centre_acceleration,
+            );
+            match time_to_wall(e, v, a, c, left) {
+                None => left,
+                Some(t) => {
+                    let n = (e + v * t + 0.5 * a * t * t).normalize_or_zero();
+                    let speed = (v + a * t).dot(n).max(0.0);
+                    let own = ahead(speed, 0.0);
+                    if t <= own {
+                        // Onto the wall: the contact begins at a sub-step's end, where a law
+                        // whose force jumps at the onset (Kelvin-Voigt's damping) starts whole.
+                        t * (1.0 + 1e-9) + 1e-15 * self.h
+                    } else {
+                        (APPROACH_FRACTION * t).max(own)
+                    }
+                }
+            }
+        };
+        let s = s.max(1e-9 * self.h);
+        // No sliver of a last sub-step.
+        if s >= 0.95 * left { left } else { s }
+    }
+
+    /// The sub-step after one of `s` that left `left` (s) of the step, from `here`: 0 when that
+    /// was the last, the rest of the step beyond [`MAX_SUBSTEPS`].
+    fn next_substep(&self, here: &Here, history: &ContactHistory, left: f64, count: u32) -> f64 {
+        if left <= 0.0 {
+            0.0
+        } else if count >= MAX_SUBSTEPS {
+            left
+        } else {
+            self.substep(here, history, left)
+        }
+    }
+
+    /// A kick of span `sigma` (s) at `here`: `v += sigma (a + P F)`, the force taken at the
+    /// state's velocity `alpha v_before + beta v_after` (implicit for `beta > 0`). Returns the
+    /// force (normal, along the tangent), the impulse and the energy the damping and friction
+    /// took over the span (J).
+    fn kick(
+        &self,
+        here: &Here,
+        v: &mut Pair12,
+        sigma: f64,
+        (alpha, beta): (f64, f64),
+        impact_rate: f64,
+    ) -> ([f64; 2], Pair12, f64) {
+        let c_a = [dot(&here.rows[0], v), dot(&here.rows[1], v)];
+        let a = [
+            dot(&here.rows[0], &self.a_free),
+            dot(&here.rows[1], &self.a_free),
+        ];
+        let delta = here.state.penetration;
+        let mut f = [0.0, 0.0];
+        let mut dissipated = 0.0;
+        if delta > 0.0 {
+            let law = &self.joint.normal_law;
+            let contact = NormalContact {
+                penetration: delta,
+                penetration_rate: 0.0,
+                impact_rate,
+            };
+            let elastic = law.elastic_force(delta);
+            let damping = law.damping_coefficient(&contact);
+            let w = &here.w;
+            for _ in 0..50 {
+                // The normal force is affine in the rate (every law here): solved exactly.
+                let c0n = c_a[0] + beta * sigma * (a[0] + w[0][1] * f[1]);
+                let f_n =
+                    ((elastic + damping * c0n) / (1.0 - damping * beta * sigma * w[0][0])).max(0.0);
+                let c0t = c_a[1] + beta * sigma * (a[1] + w[1][0] * f_n);
+                let k = beta * sigma * w[1][1] * f_n;
+                let slip = implicit_slip(&self.joint.friction_law, c0t, k);
+                let f_t = -self.joint.friction_law.coefficient(slip.abs()) * f_n * slip.signum();
+                let change = (f_n - f[0]).abs() + (f_t - f[1]).abs();
+                f = [f_n, if slip == 0.0 { 0.0 } else { f_t }];
+                if change <= 1e-13 * (f_n + 1e-300) {
+                    break;
+                }
+            }
+            // The rates at the state, with the force found: the damping's share of the normal
+            // force and the friction work against them.
+            let c_m =
+                [0, 1].map(|r| c_a[r] + beta * sigma * (a[r] + w[r][0] * f[0] + w[r][1] * f[1]));
+            if f[0] > 0.0 {
+                dissipated = sigma * ((f[0] - elastic) * c_m[0] - f[1] * c_m[1]);
+            }
+        }
+        let _ = alpha;
+        let mut dv = self.a_free;
+        axpy(&mut dv, f[0], &here.moves[0]);
+        axpy(&mut dv, f[1], &here.moves[1]);
+        axpy(v, sigma, &dv);
+        let mut impulse = [0.0; 12];
+        axpy(&mut impulse, sigma * f[0], &here.loads[0]);
+        axpy(&mut impulse, sigma * f[1], &here.loads[1]);
+        (f, impulse, dissipated)
+    }
+
+    /// Integrates the step; `history` and `before` (the state at the step's start, its rates at
+    /// the state) are the contact's memory. `out` keeps its buffers.
+    pub(crate) fn run(&self, history: ContactHistory, before: &JournalState, out: &mut SubCycle) {
+        let j = self.joint;
+        out.samples.clear();
+        out.impulse = [0.0; 12];
+        let mut pi = [0.0; 12];
+        let mut m = Motion {
+            v: self.u0,
+            ..Motion::default()
+        };
+        let mut hist = history;
+        let mut prev = *before;
+        let mut here = self.here(&m);
+        let mut tau = 0.0;
+        let mut count = 0u32;
+        // The first half kick, from the state's own velocity.
+        let mut rest = self.h;
+        let mut s = self.substep(&here, &hist, rest);
+        let rate = self.impact_rate(&hist, &here);
+        let (_, dg, loss) = self.kick(&here, &mut m.v, 0.5 * s, (1.0, 0.0), rate);
+        axpy(&mut out.impulse, 1.0, &dg);
+        out.dissipated = loss;
+        loop {
+            count += 1;
+            for k in 0..2 {
+                m.shift[k] += s * part(&m.v, 2 * k);
+                m.turn[k] += s * part(&m.v, 2 * k + 1);
+            }
+            axpy(&mut pi, s, &out.impulse);
+            // A sub-step chosen as the rest of the step ends it exactly.
+            let left = if s == rest { 0.0 } else { rest - s };
+            rest = left;
+            let last = left <= 0.0;
+            tau = if last { self.h } else { tau + s };
+            here = self.here(&m);
+            let onset = hist.advance(
+                Some(&prev),
+                &here.state,
+                j.min_impact_speed,
+                j.min_separation,
+            );
+            let next = self.next_substep(&here, &hist, left, count);
+            // A contact that began inside the sub-step before acts from its crossing on: for a
+            // law whose force jumps at the onset (Kelvin-Voigt's damping) the kick's half over
+            // that sub-step is the part after the crossing.
+            let before = if onset.onset {
+                s * (1.0 - onset.fraction.clamp(0.0, 1.0))
+            } else {
+                s
+            };
+            let sigma = 0.5 * (before + next);
+            let (alpha, beta) = (next / (s + next), s / (s + next));
+            let v_before = m.v;
+            let rate = self.impact_rate(&hist, &here);
+            let (f, dg, loss) = self.kick(&here, &mut m.v, sigma, (alpha, beta), rate);
+            axpy(&mut out.impulse, 1.0, &dg);
+            out.dissipated += loss;
+            // The state: its velocity between the half steps around it.
+            let mut at_state = m;
+            for (x, b) in at_state.v.iter_mut().zip(v_before) {
+                *x = alpha * b + beta * *x;
+            }
+            let state = self.here(&at_state).state;
+            let n = here.state.normal;
+            let force = ForcePair {
+                on_journal: -f[0] * n + f[1] * here.tangent,
+                point: here.state.contact_point,
+                normal_force: f[0],
+                friction_force: f[1].abs(),
+            };
+            out.samples.push(SubStep {
+                t: tau,
+                state,
+                force,
+                onset: onset.onset,
+                impact: onset.impact,
+                approach_speed: onset.approach_speed,
+                onset_fraction: onset.fraction,
+            });
+            prev = state;
+            if last {
+                out.end_mass = here.mass();
+                break;
+            }
+            s = next;
+        }
+        let _ = here.com;
+        out.end_velocity = m.v;
+        for (mean, p) in out.mean.iter_mut().zip(pi) {
+            *mean = p / self.h;
+        }
+        out.history = hist;
+        out.substeps = count;
+    }
+}
+
+impl ClearanceJoint {
+    /// After Rapier's pass 0 of a step (`pass`), with `iterations` solver iterations: takes the
+    /// rest of the world's acceleration from the bodies' velocities, runs the sub-cycle and
+    /// returns the impulse Rapier's pass 1 must deliver, `Q kick` (`None`: nothing to deliver,
+    /// pass 0 stands). Keeps the impulse left held for the evaluation at the step's end.
+    pub(crate) fn plan_cycle(
+        &mut self,
+        bodies: &RigidBodySet,
+        pass: &StepPass,
+        iterations: usize,
+    ) -> Option<Pair12> {
+        let start = self.cycle.start?;
+        let now = PairStart::velocity_now(self, bodies)?;
+        let (h, kick) = (pass.dt, pass.kick);
+        let c_n = (iterations as f64 + 1.0) / (2.0 * iterations.max(1) as f64);
+        let mut a_free = [0.0; 12];
+        for ((a, n), v) in a_free.iter_mut().zip(now).zip(start.velocity()) {
+            *a = (n - v) / kick;
+        }
+        let mut u0 = *start.velocity();
+        axpy(&mut u0, c_n * kick - 0.5 * h, &a_free);
+        axpy(&mut u0, 1.0, &start.moved_by(&self.cycle.held));
+        let mut run = std::mem::take(&mut self.cycle.run);
+        let cycle = Cycle {
+            joint: self,
+            start: &start,
+            u0,
+            a_free,
+            h,
+            tolerance: pass.tolerance,
+        };
+        cycle.run(self.contact, &self.report.state, &mut run);
+        let mut deliver = self.cycle.held;
+        axpy(&mut deliver, 1.0, &run.mean);
+        deliver.iter_mut().for_each(|q| *q /= c_n);
+        let mut held = self.cycle.held;
+        axpy(&mut held, 1.0, &run.impulse);
+        axpy(&mut held, -1.0, &deliver);
+        // The state's velocity beyond the Verlet reading of Rapier's velocities around it,
+        // `u_before + w (u_after - u_before)`, `w = h_prev/(h_prev + h)`: `P (H - w Q kick)`.
+        let w = (2.0 * kick - h) / (2.0 * kick);
+        let mut beyond = self.cycle.held;
+        axpy(&mut beyond, -w, &deliver);
+        run.start_correction = start.moved_by(&beyond);
+        self.cycle.run = run;
+        self.cycle.pending = Some(held);
+        deliver.iter().any(|q| *q != 0.0).then_some(deliver)
+    }
+
+    /// At the evaluation after a sub-cycled step: the report from the sub-cycle's end, the
+    /// states inside the step, the impulse left held. `None` when no step was planned (the
+    /// joint is then evaluated as an explicit one) or a body is gone.
+    pub(crate) fn finish_cycle(&mut self, bodies: &RigidBodySet) -> Option<(Wrench, Wrench)> {
+        let held = self.cycle.pending.take()?;
+        let end = *self.cycle.run.samples.last()?;
+        let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
+        let history = self.cycle.run.history;
+        let mass = self.cycle.run.end_mass;
+        let law = &self.normal_law;
+        let delta = end.state.penetration;
+        let impact_rate = if history.in_contact && law.uses_impact_rate() {
+            history
+                .impact_rate
+                .max(loaded_impact_rate(law.elastic_energy(delta), mass))
+        } else {
+            history.impact_rate
+        };
+        let (omega, zeta) = if delta > 0.0 {
+            let c = NormalContact {
+                penetration: delta,
+                penetration_rate: end.state.penetration_rate,
+                impact_rate,
+            };
+            let k = law.tangent_stiffness(delta);
+            let (_, omega, zeta) = stable_step(k, law.damping_coefficient(&c), mass);
+            (omega, zeta)
+        } else {
+            (0.0, 0.0)
+        };
+        self.contact = history;
+        self.report = ClearanceReport {
+            state: end.state,
+            mode: history.mode(),
+            onset: end.onset,
+            impact: end.impact,
+            impact_rate,
+            approach_speed: end.approach_speed,
+            contact_rate: end.state.penetration_rate,
+            onset_fraction: end.onset_fraction,
+            force: end.force,
+            max_stable_dt: f64::INFINITY,
+            friction_stable_dt: f64::INFINITY,
+            omega,
+            zeta,
+            effective_mass: mass,
+            spatial: None,
+        };
+        self.elastic = std::sync::OnceLock::new();
+        self.previous_rate = None;
+        self.cycle.held = held;
+        self.cycle.start_correction = self.cycle.run.start_correction;
+        self.cycle.dissipated = self.cycle.run.dissipated;
+        std::mem::swap(&mut self.cycle.substeps, &mut self.cycle.run.samples);
+        let f = end.force.on_journal;
+        let p = end.force.point;
+        let (c1, c2) = (world_center_of_mass(rb1), world_center_of_mass(rb2));
+        Some((
+            Wrench {
+                body: self.body1,
+                force: -f,
+                torque: (p - c1).cross(-f),
+            },
+            Wrench {
+                body: self.body2,
+                force: f,
+                torque: (p - c2).cross(f),
+            },
+        ))
+    }
+
+    /// The wrenches that deliver the impulse `deliver` (`Q kick`) over a step whose kick is
+    /// `kick` (s): a force and torque on each body, held over the step.
+    pub(crate) fn delivery(&self, deliver: &Pair12, kick: f64) -> [Wrench; 2] {
+        [(self.body1, 0), (self.body2, 2)].map(|(body, k)| Wrench {
+            body,
+            force: part(deliver, k) / kick,
+            torque: part(deliver, k + 1) / kick,
+        })
+    }
+
+    /// Takes the pair's state before the next step (at each evaluation; `None` for a joint that
+    /// is not sub-cycled or whose body is gone).
+    pub(crate) fn take_start(&mut self, bodies: &RigidBodySet, mechanism: &Mechanism) {
+        self.cycle.start = if self.sub_cycled() {
+            PairStart::of(self, bodies, mechanism)
+        } else {
+            None
+        };
+    }
+
+    /// The velocity (linear, angular) of the bearing's body and of the journal's at the state
+    /// the last step began from, beyond the Verlet reading of Rapier's velocities around that
+    /// state (`(h v_before + h_prev v_after)/(h_prev + h)`, `v_before` the velocity stored
+    /// before the step, `v_after` after it, `h_prev` and `h` the steps before and after the
+    /// state): the part of a sub-cycled contact's impulse inside the steps that Rapier's mean
+    /// velocities spread over them. Zero for an explicit joint and for steps without contact.
+    /// Add it to read the bodies' momentum or energy at that state.
+    pub fn start_velocity_correction(&self) -> [(RigidBodyHandle, Vector, Vector); 2] {
+        let c = &self.cycle.start_correction;
+        [(self.body1, 0), (self.body2, 2)].map(|(b, k)| (b, part(c, k), part(c, k + 1)))
+    }
+
+    /// The energy the contact's damping and friction took over the last step, J, integrated over
+    /// a sub-cycled joint's sub-steps (`None` for an explicit joint, and before the first
+    /// sub-cycled step).
+    pub fn step_dissipation(&self) -> Option<f64> {
+        (self.sub_cycled() && !self.cycle.substeps.is_empty()).then_some(self.cycle.dissipated)
+    }
+
+    /// The deepest penetration of the last step, m: over its sub-steps for a sub-cycled joint,
+    /// at its end for an explicit one.
+    pub(crate) fn deepest_in_step(&self) -> f64 {
+        self.cycle
+            .substeps
+            .iter()
+            .map(|s| s.state.penetration)
+            .fold(self.report.state.penetration, f64::max)
+    }
+}
+
+/// The first time within `left` (s) at which the eccentricity `e + v t + a t^2/2` (m, m/s,
+/// m/s²) can reach the clearance `c` (m), `None` when it stays inside. Marched by safe steps:
+/// from each point the gap cannot close faster than the path's speed and acceleration allow,
+/// so no contact is stepped over, and a path straight at the wall lands on it in one step.
+fn time_to_wall(e: Vector, v: Vector, a: Vector, c: f64, left: f64) -> Option<f64> {
+    let acc = a.length();
+    let mut t = 0.0;
+    for _ in 0..200 {
+        let gap = c - (e + v * t + 0.5 * a * t * t).length();
+        if gap <= 0.0 {
+            return Some(t);
+        }
+        let speed = (v + a * t).length();
+        // The earliest the gap can close: speed dt + acc dt^2/2 = gap.
+        let dt = if acc > 0.0 {
+            2.0 * gap / (speed + (speed * speed + 2.0 * acc * gap).sqrt())
+        } else if speed > 0.0 {
+            gap / speed
+        } else {
+            return None;
+        };
+        t += dt;
+        if t >= left {
+            return None;
+        }
+        if dt <= 1e-12 * t {
+            return Some(t);
+        }
+    }
+    Some(t)
+}
+
+/// The slip `x` at the state with friction taken there: `x = c0 - k mu(|x|) sign(x)`, `c0` the
+/// slip without this sub-step's friction, `k >= 0` the slip friction's full coefficient removes.
+/// A root lies between 0 and `c0` (friction opposes the slip and never reverses it alone);
+/// bracketed by bisection with a secant guess, as the law may fall with speed (Stribeck).
+fn implicit_slip(law: &impl FrictionLaw, c0: f64, k: f64) -> f64 {
+    if c0 == 0.0 || !(k > 0.0) {
+        return c0;
+    }
+    let sign = c0.signum();
+    let target = c0.abs();
+    // g(x) = x + k mu(x) - target over [0, target]: g(0) <= 0 <= g(target).
+    let g = |x: f64| x + k * law.coefficient(x) - target;
+    let (mut lo, mut hi) = (0.0, target);
+    let (mut g_lo, mut g_hi) = (g(lo), g(hi));
+    if g_lo >= 0.0 {
+        return 0.0;
+    }
+    for _ in 0..200 {
+        let secant = lo - g_lo * (hi - lo) / (g_hi - g_lo);
+        let mid = 0.5 * (lo + hi);
+        // The secant when it falls well inside the bracket, else the midpoint.
+        let x = if secant > lo + 0.01 * (hi - lo) && secant < hi - 0.01 * (hi - lo) {
+            secant
+        } else {
+            mid
+        };
+        let gx = g(x);
+        if gx <= 0.0 {
+            lo = x;
+            g_lo = gx;
+        } else {
+            hi = x;
+            g_hi = gx;
+        }
+        if hi - lo <= 1e-14 * target + 1e-300 {
+            break;
+        }
+    }
+    sign * 0.5 * (lo + hi)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::model::laws::Coulomb;
+
+    #[test]
+    fn implicit_slip_by_hand() {
+        // mu = 0.2 min(1, v/0.01): with k = 0.5 and c0 = 0.003 the root is in the linear part,
+        // x + 0.5 * 20 x = 0.003 -> x = 0.003/11.
+        let law = Coulomb::new(0.2, 0.01).unwrap();
+        let x = implicit_slip(&law, 0.003, 0.5);
+        assert!((x - 0.003 / 11.0).abs() < 1e-15, "{x}");
+        let x = implicit_slip(&law, -0.003, 0.5);
+        assert!((x + 0.003 / 11.0).abs() < 1e-15, "{x}");
+        // Sliding: x + 0.5 * 0.2 = 1 -> x = 0.9.
+        assert!((implicit_slip(&law, 1.0, 0.5) - 0.9).abs() < 1e-13);
+        assert_eq!(implicit_slip(&law, 0.0, 0.5), 0.0);
+    }
+
+    #[test]
+    fn time_to_wall_by_hand() {
+        let (x, y) = (Vector::X, Vector::Y);
+        // From the centre at 2 m/s across a gap of 1 m: 0.5 s.
+        let t = time_to_wall(Vector::ZERO, 2.0 * x, Vector::ZERO, 1.0, 2.0).unwrap();
+        assert!((t - 0.5).abs() < 1e-12, "{t}");
+        // From rest under 2 m/s²: 1 = t^2 -> 1 s.
+        let t = time_to_wall(Vector::ZERO, Vector::ZERO, 2.0 * y, 1.0, 3.0).unwrap();
+        assert!((t - 1.0).abs() < 1e-12, "{t}");
+        // Sliding along the wall 1e-6 inside it at 1 m/s, pulled to it at 2 m/s²: it reaches
+        // the wall after 1e-3 s, and the march stays below that.
+        let t = time_to_wall((1.0 - 1e-6) * x, y, 2.0 * x, 1.0, 1.0).unwrap();
+        assert!(t <= 1.0e-3 + 1e-9, "{t}");
+        // Not within the time left.
+        assert_eq!(time_to_wall(Vector::ZERO, x, Vector::ZERO, 1.0, 0.5), None);
+        // Moving away from a wall it is near.
+        assert_eq!(time_to_wall(0.9 * x, -x, Vector::ZERO, 1.0, 0.5), None);
+    }
+}

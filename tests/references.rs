@@ -1007,8 +1007,7 @@ fn every_laws_single_impact_sub_cycled_in_millisecond_steps_matches_its_ode() {
         let end = r.end_t + 1e-5;
         for (tol, allowed) in [(0.0075, 2e-3), (0.001, 1e-4)] {
             for iterations in [1, 4] {
-                let (lib, _, sep) =
-                    library_single_run(model, sub_cycled(tol, iterations), end);
+                let (lib, _, sep) = library_single_run(model, sub_cycled(tol, iterations), end);
                 let label = format!("{name}, tol {tol}, {iterations} iteration(s)");
                 checks.extend(first_impact_checks(&label, &lib[0], &r, allowed).split_off(2));
                 checks.push(Check::abs(

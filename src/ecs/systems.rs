@@ -207,6 +207,8 @@ pub fn record(
         state.rate = (rb2.angvel() - rb1.angvel()).dot(*rb1.rotation() * axis1);
         // The impulse the step carried beyond its force times `h` (a large-step bounce's).
         let mut extra_impulse = 0.0;
+        // A sub-cycled contact's largest force inside the step.
+        let mut inside_peak: f64 = 0.0;
         match joint {
             HingeJoint::Ideal(_) => {
                 state.force = ideal_forces.get(&entity).copied().unwrap_or(0.0);
@@ -228,8 +230,24 @@ pub fn record(
                     state.contact = rep.mode;
                     state.spatial = rep.spatial;
                     (state.impulse, state.substeps, state.under_resolved) = (0.0, 0, false);
-                    state.onsets += u64::from(rep.onset);
-                    state.impacts += u64::from(rep.impact);
+                    match j.step_impulse() {
+                        // Sub-cycled: the contacts inside the step, from its sub-steps.
+                        Some(impulse) => {
+                            let inside = j.substeps();
+                            state.onsets += inside.iter().filter(|s| s.onset).count() as u64;
+                            state.impacts += inside.iter().filter(|s| s.impact).count() as u64;
+                            let peak = inside
+                                .iter()
+                                .map(|s| s.force.on_journal.length())
+                                .fold(0.0, f64::max);
+                            inside_peak = peak;
+                            extra_impulse = impulse.length() - physics.start_force(entity) * h;
+                        }
+                        None => {
+                            state.onsets += u64::from(rep.onset);
+                            state.impacts += u64::from(rep.impact);
+                        }
+                    }
                 }
             }
             HingeJoint::LargeStep(k) => {
@@ -254,7 +272,7 @@ pub fn record(
                 }
             }
         }
-        state.peak_force = state.peak_force.max(state.force);
+        state.peak_force = state.peak_force.max(state.force).max(inside_peak);
         // The force the step held: the state's at its start; a large-step hinge's readout is
         // its step's own.
         let start = match joint {
@@ -262,6 +280,12 @@ pub fn record(
             _ => physics.start_force(entity),
         };
         let force = state.force;
-        state.add_step(new_frame, h, start * h + extra_impulse, start, force);
+        state.add_step(
+            new_frame,
+            h,
+            start * h + extra_impulse,
+            start,
+            force.max(inside_peak),
+        );
     }
 }

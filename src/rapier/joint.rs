@@ -415,6 +415,8 @@ struct CycleState {
     start_correction: [f64; 12],
     /// [`ClearanceJoint::step_dissipation`] of the last step, J.
     dissipated: f64,
+    /// The contact's impulse over the last step ([`ClearanceJoint::step_impulse`]).
+    impulse: [f64; 12],
 }
 
 /// Default of [`ClearanceJointBuilder::min_impact_speed`], m/s.

@@ -342,16 +342,28 @@ pub fn scene(case: &Case, stepping: Stepping, end_s: f64) -> Scene {
         "run.strict=false".into(),
     ];
     match stepping {
-        Stepping::Default => set.extend(
-            [
-                "run.step=Adaptive",
-                "run.tolerance=0.0075",
-                "run.max_dt_s=0.001",
-            ]
-            .map(String::from),
-        ),
+        Stepping::Default => {
+            set.extend(
+                [
+                    "run.step=Adaptive",
+                    "run.tolerance=0.0075",
+                    "run.max_dt_s=0.001",
+                ]
+                .map(String::from),
+            );
+            // The ablation's choice of contact integration (`Explicit` or `SubCycled`), else
+            // the library's default.
+            if let Ok(integration) = std::env::var("MECHANISMS_INTEGRATION") {
+                set.push(format!("run.contact_integration={integration}"));
+            }
+        }
         Stepping::Fixed(dt) => {
-            set.extend(["run.step=Fixed".into(), format!("run.dt_s={dt}")]);
+            // The references: the explicit model at converged fixed steps.
+            set.extend([
+                "run.step=Fixed".into(),
+                format!("run.dt_s={dt}"),
+                "run.contact_integration=Explicit".into(),
+            ]);
         }
     }
     // The case's own settings last: a case may override the stepping's (a study of one knob).

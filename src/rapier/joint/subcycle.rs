@@ -235,6 +235,9 @@ fn rotate(turn: Vector, r: Vector) -> Vector {
 #[derive(Clone, Copy, Debug)]
 struct Here {
     state: JournalState,
+    /// The bearing's and the journal's centres, and the hinge's axis.
+    centres: [Vector; 2],
+    axis: Vector,
     /// The acceleration of the journal's centre relative to the bearing's in the plane, from the
     /// rest of the world's accelerations (with the bodies' centripetal terms), m/s².
     centre_acceleration: Vector,
@@ -251,6 +254,20 @@ struct Here {
 }
 
 impl Here {
+    /// The state here with its rates at the pair's velocity `v`.
+    fn rates_at(&self, v: &Pair12) -> JournalState {
+        let [p_i, p_j] = self.centres;
+        let centre =
+            |k: usize, p: Vector| part(v, 2 * k) + part(v, 2 * k + 1).cross(p - self.com[k]);
+        let centres = centre(1, p_j) - centre(0, p_i);
+        JournalState {
+            penetration_rate: dot(&self.rows[0], v),
+            slip: dot(&self.rows[1], v) * self.tangent,
+            eccentricity_rate: centres - centres.dot(self.axis) * self.axis,
+            ..self.state
+        }
+    }
+
     /// Effective mass along the normal, kg (infinite when nothing moves along it).
     fn mass(&self) -> f64 {
         if self.w[0][0] < 0.0 {
@@ -325,6 +342,8 @@ impl Cycle<'_> {
         let relative = point_acceleration(1, p_j) - point_acceleration(0, p_i);
         Here {
             state,
+            centres: [p_i, p_j],
+            axis,
             centre_acceleration: relative - relative.dot(axis) * axis,
             com,
             tangent,
@@ -530,11 +549,11 @@ impl Cycle<'_> {
             axpy(&mut out.impulse, 1.0, &dg);
             out.dissipated += loss;
             // The state: its velocity between the half steps around it.
-            let mut at_state = m;
-            for (x, b) in at_state.v.iter_mut().zip(v_before) {
+            let mut at_state = m.v;
+            for (x, b) in at_state.iter_mut().zip(v_before) {
                 *x = alpha * b + beta * *x;
             }
-            let state = self.here(&at_state).state;
+            let state = here.rates_at(&at_state);
             let n = here.state.normal;
             let force = ForcePair {
                 on_journal: -f[0] * n + f[1] * here.tangent,
@@ -670,6 +689,7 @@ impl ClearanceJoint {
         self.cycle.held = held;
         self.cycle.start_correction = self.cycle.run.start_correction;
         self.cycle.dissipated = self.cycle.run.dissipated;
+        self.cycle.impulse = self.cycle.run.impulse;
         std::mem::swap(&mut self.cycle.substeps, &mut self.cycle.run.samples);
         let f = end.force.on_journal;
         let p = end.force.point;
@@ -718,6 +738,14 @@ impl ClearanceJoint {
     pub fn start_velocity_correction(&self) -> [(RigidBodyHandle, Vector, Vector); 2] {
         let c = &self.cycle.start_correction;
         [(self.body1, 0), (self.body2, 2)].map(|(b, k)| (b, part(c, k), part(c, k + 1)))
+    }
+
+    /// The contact's impulse on the journal over the last step, N s, summed over a sub-cycled
+    /// joint's sub-steps (`None` for an explicit joint, and before the first sub-cycled step):
+    /// with [`substeps`](Self::substeps), what the step's contacts did when the step is longer
+    /// than they are.
+    pub fn step_impulse(&self) -> Option<Vector> {
+        (self.sub_cycled() && !self.cycle.substeps.is_empty()).then(|| part(&self.cycle.impulse, 2))
     }
 
     /// The energy the contact's damping and friction took over the last step, J, integrated over

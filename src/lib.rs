@@ -167,6 +167,8 @@ mod chapter_doctests {
     pub struct StepperAndAccuracy;
     #[doc = include_str!("../docs/large-step-model.md")]
     pub struct LargeStepModel;
+    #[doc = include_str!("../docs/sub-cycled-contact.md")]
+    pub struct SubCycledContact;
     #[doc = include_str!("../docs/spatial-joint.md")]
     pub struct SpatialJoint;
     #[doc = include_str!("../docs/scene-format.md")]

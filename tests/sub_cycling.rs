@@ -19,22 +19,20 @@ const MU: f64 = 0.3;
 const V_EPS: f64 = 1e-4;
 
 /// A journal of 2 kg hanging in a fixed bearing under gravity, turned by the constant torque
-/// `torque` (N m) about the hinge, in a world of steps `dt` (s) with `iterations` solver
-/// iterations and the sub-steps' `tolerance`: steel, the improved law, Coulomb friction, the
+/// `torque` (N m) about the hinge, in a world stepped by `control` with `iterations` solver
+/// iterations: steel, the improved law, Coulomb friction, the
 /// contact integrated as `integration` says. Stepped to `end` (s); returns the world and the
 /// pin.
 fn held_journal(
     torque: f64,
-    dt: f64,
+    control: StepControl,
     iterations: usize,
-    tolerance: f64,
     end: f64,
     integration: ContactIntegration,
 ) -> clearance_joint::Result<(ClearanceWorld, ClearanceJointHandle)> {
     let mut rapier = PhysicsWorld::new();
     rapier.gravity = Vector::new(0.0, -G, 0.0);
     rapier.integration_parameters.num_solver_iterations = iterations;
-    let control = StepControl::fixed(dt).with_tolerance(tolerance);
     let mut world = ClearanceWorld::new(rapier, control);
     let base = world.rapier.bodies.insert(RigidBodyBuilder::fixed());
     let journal = world.rapier.bodies.insert(
@@ -75,8 +73,8 @@ fn a_friction_held_journal_rests_at_game_and_robot_steps_with_its_static_balance
     let f_n = (weight * weight - f_t * f_t).sqrt();
     for (dt, iterations, tolerance) in [(1e-3, 1, 0.0075), (1.0 / 60.0, 4, 0.002)] {
         let sub_cycled = ContactIntegration::SubCycled;
-        let (world, pin) =
-            held_journal(f_t * r_j, dt, iterations, tolerance, 12.0, sub_cycled).unwrap();
+        let control = StepControl::fixed(dt).with_tolerance(tolerance);
+        let (world, pin) = held_journal(f_t * r_j, control, iterations, 12.0, sub_cycled).unwrap();
         let r = world.clearance.get(pin).unwrap().report();
         let e = r.state.eccentricity;
         let angle = (e.x / e.length()).asin().abs();
@@ -100,14 +98,8 @@ fn a_friction_held_journal_rests_at_game_and_robot_steps_with_its_static_balance
         assert!(world.guards().is_clean(), "{:?}", world.guards());
     }
     // The explicit joint at 1 ms: refused.
-    let explicit = held_journal(
-        f_t * r_j,
-        1e-3,
-        1,
-        0.0075,
-        12.0,
-        ContactIntegration::Explicit,
-    );
+    let control = StepControl::fixed(1e-3);
+    let explicit = held_journal(f_t * r_j, control, 1, 12.0, ContactIntegration::Explicit);
     assert!(
         matches!(explicit, Err(clearance_joint::Error::StepTooLarge { .. })),
         "{:?}",
@@ -162,4 +154,48 @@ fn sub_cycled_contact_keeps_momentum_and_energy() {
         assert!(s.onsets > 5);
         assert!(s.invariants.energy_error.unwrap() < 1e-4);
     }
+}
+
+/// A sub-cycle asked for more sub-steps in one world step than it takes (the tolerance 1e-6 in
+/// steps of 1/60 s: about 8 million) says so: a `SubSteps` violation naming the joint, and under
+/// a strict step control an error; at the default tolerance the same run is clean.
+#[test]
+fn a_sub_cycle_beyond_its_sub_step_cap_is_a_guard_violation() {
+    use clearance_joint::rapier::guards::GuardKind;
+    let sub_cycled = ContactIntegration::SubCycled;
+    let control = StepControl::fixed(1.0 / 60.0).with_tolerance(1e-6);
+    let (world, _) = held_journal(0.0, control, 1, 0.05, sub_cycled).unwrap();
+    let v = &world.guards().violations;
+    assert!(
+        v.iter()
+            .any(|v| v.kind == GuardKind::SubSteps && v.joint.as_deref() == Some("clearance joint")),
+        "{v:?}"
+    );
+    println!("{}", v[0].message());
+    let strict = held_journal(0.0, control.strict(true), 1, 0.05, sub_cycled);
+    assert!(
+        matches!(strict, Err(clearance_joint::Error::Guard { .. })),
+        "{:?}",
+        strict.err()
+    );
+    let control = StepControl::fixed(1.0 / 60.0);
+    let (world, _) = held_journal(0.0, control, 1, 0.05, sub_cycled).unwrap();
+    assert!(world.guards().is_clean(), "{:?}", world.guards());
+}
+
+/// A spatial joint asked to sub-cycle is refused, naming `integration` and what to give instead.
+#[test]
+fn a_spatial_joint_is_not_sub_cycled() {
+    use clearance_joint::model::spatial::SpatialModel;
+    let err = Clearance::steel_improved_liu(R_B, C, 0.016)
+        .unwrap()
+        .model(ClearanceModel::Spatial(SpatialModel::steel(0.1e-3, 0.015)))
+        .integration(ContactIntegration::SubCycled)
+        .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
+        .unwrap_err();
+    let text = err.to_string();
+    assert!(
+        text.contains("integration") && text.contains("Explicit"),
+        "{text}"
+    );
 }

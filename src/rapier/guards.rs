@@ -25,6 +25,11 @@ pub enum GuardKind {
     /// A velocity motor off its speed (recorded by the scene runner): `worst` the largest
     /// relative speed error, `limit` the allowed one.
     MotorSpeed,
+    /// A sub-cycled contact that needed more sub-steps in one world step than the sub-cycle
+    /// takes ([`ContactIntegration::SubCycled`](crate::rapier::joint::ContactIntegration::SubCycled)):
+    /// `worst` the sub-steps it took, `limit` that cap; the rest of the step went in one
+    /// sub-step, unresolved.
+    SubSteps,
     /// A violation recorded in words only ([`GuardReport::violation`]): `worst` and `limit` 0.
     Other,
 }
@@ -196,6 +201,14 @@ impl Violation {
                     states(self.count)
                 )
             }
+            GuardKind::SubSteps => format!(
+                "joint `{joint}`: its sub-cycled contact reached {} sub-steps in one world step \
+                 at t = {} s ({}), the rest of the step unresolved: shorten the world's step or \
+                 loosen the tolerance",
+                self.worst,
+                sig4(self.t_s),
+                states(self.count)
+            ),
             GuardKind::Other => self.note.clone(),
         }
     }

@@ -417,6 +417,8 @@ struct CycleState {
     dissipated: f64,
     /// The contact's impulse over the last step ([`ClearanceJoint::step_impulse`]).
     impulse: [f64; 12],
+    /// The sub-steps of the last step.
+    substep_count: u32,
 }
 
 /// Default of [`ClearanceJointBuilder::min_impact_speed`], m/s.
@@ -1327,6 +1329,7 @@ impl ClearanceJointSet {
                 // Explicit, or a sub-cycled joint's first evaluation (velocities its own).
                 joint.cycle.held = [0.0; 12];
                 joint.cycle.start_correction = [0.0; 12];
+                joint.cycle.substep_count = 0;
                 joint.cycle.substeps.clear();
             }
             joint.last_wrenches = finished
@@ -1554,6 +1557,17 @@ impl crate::rapier::step_hooks::StepHooks for ClearanceJointSet {
                             crate::error::sig4(dt),
                             crate::error::sig4(limit)
                         )),
+                );
+            }
+            if let Some(n) = j.substeps_beyond_cap() {
+                guards.record(
+                    Violation::new(
+                        GuardKind::SubSteps,
+                        f64::from(n),
+                        f64::from(subcycle::MAX_SUBSTEPS),
+                        t,
+                    )
+                    .joint(j.name(), Some(handle)),
                 );
             }
             let (depth, valid) = (j.deepest_in_step(), j.max_valid_penetration());

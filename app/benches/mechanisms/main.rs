@@ -5,7 +5,9 @@
 //! and prints two markdown tables, also written to `bench_out/mechanisms.md`. Options after
 //! `--`: `--quick` (or `MECHANISMS_QUICK=1`) runs the shortened scenes (the first crank turn, the
 //! first impacts); any other word keeps only the cases whose name contains it
-//! (`cargo bench --bench mechanisms -- --quick slider`).
+//! (`cargo bench --bench mechanisms -- --quick slider`). `MECHANISMS_INTEGRATION=SubCycled` (or
+//! `Explicit`) sets the contact integration of the default runs (the references stay explicit)
+//! and writes `bench_out/mechanisms[_quick]_SubCycled.md`.
 //!
 //! Per scene, three fixed steps each half the previous are run; the finest is the reference. The
 //! first impact of the default is compared with the reference's. Later statistics (the motion
@@ -132,8 +134,11 @@ fn main() {
                      second otherwise. Window: after the first turn (slider-crank, four-bar), after \
                      1 s (solar panel), 0.5 s (deployable array), 0.25 s (double pendulum); halved \
                      in the quick mode.";
+    let integration = std::env::var("MECHANISMS_INTEGRATION")
+        .map(|i| format!(", contact integration {i} at the defaults"))
+        .unwrap_or_default();
     let md = format!(
-        "## Mechanism matrix{}\n\n{summary}\n{detail}\n{unit_note}\n\nTotal wall time {:.0} s.\n",
+        "## Mechanism matrix{}{integration}\n\n{summary}\n{detail}\n{unit_note}\n\nTotal wall time {:.0} s.\n",
         if quick {
             " (quick: shortened scenes)"
         } else {
@@ -144,10 +149,15 @@ fn main() {
     println!("{md}");
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../bench_out");
     let _ = std::fs::create_dir_all(&dir);
+    // `MECHANISMS_INTEGRATION=SubCycled` writes `mechanisms_quick_SubCycled.md`, beside the
+    // default's table.
+    let suffix = std::env::var("MECHANISMS_INTEGRATION")
+        .map(|i| format!("_{i}"))
+        .unwrap_or_default();
     let name = if quick {
-        "mechanisms_quick.md"
+        format!("mechanisms_quick{suffix}.md")
     } else {
-        "mechanisms.md"
+        format!("mechanisms{suffix}.md")
     };
     if let Err(e) = std::fs::write(dir.join(name), md) {
         eprintln!("cannot write bench_out/{name}: {e}");

@@ -690,6 +690,7 @@ impl ClearanceJoint {
         self.cycle.start_correction = self.cycle.run.start_correction;
         self.cycle.dissipated = self.cycle.run.dissipated;
         self.cycle.impulse = self.cycle.run.impulse;
+        self.cycle.substep_count = self.cycle.run.substeps;
         std::mem::swap(&mut self.cycle.substeps, &mut self.cycle.run.samples);
         let f = end.force.on_journal;
         let p = end.force.point;
@@ -753,6 +754,12 @@ impl ClearanceJoint {
     /// sub-cycled step).
     pub fn step_dissipation(&self) -> Option<f64> {
         (self.sub_cycled() && !self.cycle.substeps.is_empty()).then_some(self.cycle.dissipated)
+    }
+
+    /// Sub-steps the last step took, when it reached [`MAX_SUBSTEPS`] (its rest then went in
+    /// one sub-step).
+    pub(crate) fn substeps_beyond_cap(&self) -> Option<u32> {
+        (self.cycle.substep_count > MAX_SUBSTEPS).then_some(self.cycle.substep_count)
     }
 
     /// The deepest penetration of the last step, m: over its sub-steps for a sub-cycled joint,

@@ -159,7 +159,7 @@ fn main() {
     } else {
         format!("mechanisms{suffix}.md")
     };
-    if let Err(e) = std::fs::write(dir.join(name), md) {
+    if let Err(e) = std::fs::write(dir.join(&name), md) {
         eprintln!("cannot write bench_out/{name}: {e}");
     }
 }

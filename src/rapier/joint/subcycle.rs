@@ -427,7 +427,7 @@ impl Cycle<'_> {
     }
 
     /// A kick of span `sigma` (s) at `here`: `v += sigma (a + P F)`, the force taken at the
-    /// state's velocity `alpha v_before + beta v_after` (implicit for `beta > 0`). Returns the
+    /// state's velocity `(1 - beta) v_before + beta v_after` (implicit for `beta > 0`). Returns the
     /// force (normal, along the tangent), the impulse and the energy the damping and friction
     /// took over the span (J).
     fn kick(
@@ -435,7 +435,7 @@ impl Cycle<'_> {
         here: &Here,
         v: &mut Pair12,
         sigma: f64,
-        (alpha, beta): (f64, f64),
+        beta: f64,
         impact_rate: f64,
     ) -> ([f64; 2], Pair12, f64) {
         let c_a = [dot(&here.rows[0], v), dot(&here.rows[1], v)];
@@ -479,7 +479,6 @@ impl Cycle<'_> {
                 dissipated = sigma * ((f[0] - elastic) * c_m[0] - f[1] * c_m[1]);
             }
         }
-        let _ = alpha;
         let mut dv = self.a_free;
         axpy(&mut dv, f[0], &here.moves[0]);
         axpy(&mut dv, f[1], &here.moves[1]);
@@ -510,7 +509,7 @@ impl Cycle<'_> {
         let mut rest = self.h;
         let mut s = self.substep(&here, &hist, rest);
         let rate = self.impact_rate(&hist, &here);
-        let (_, dg, loss) = self.kick(&here, &mut m.v, 0.5 * s, (1.0, 0.0), rate);
+        let (_, dg, loss) = self.kick(&here, &mut m.v, 0.5 * s, 0.0, rate);
         axpy(&mut out.impulse, 1.0, &dg);
         out.dissipated = loss;
         loop {
@@ -545,7 +544,7 @@ impl Cycle<'_> {
             let (alpha, beta) = (next / (s + next), s / (s + next));
             let v_before = m.v;
             let rate = self.impact_rate(&hist, &here);
-            let (f, dg, loss) = self.kick(&here, &mut m.v, sigma, (alpha, beta), rate);
+            let (f, dg, loss) = self.kick(&here, &mut m.v, sigma, beta, rate);
             axpy(&mut out.impulse, 1.0, &dg);
             out.dissipated += loss;
             // The state: its velocity between the half steps around it.
@@ -577,7 +576,6 @@ impl Cycle<'_> {
             }
             s = next;
         }
-        let _ = here.com;
         out.end_velocity = m.v;
         for (mean, p) in out.mean.iter_mut().zip(pi) {
             *mean = p / self.h;

@@ -478,6 +478,17 @@ fn every_law() -> Vec<(&'static str, Law, NormalModel)> {
     laws
 }
 
+/// The single impact of `law` by its ODE: the free journal of `SINGLE_MASS` at `V_APPROACH`.
+fn single_reference(law: Law) -> Impact {
+    let slide = Slide {
+        m: SINGLE_MASS,
+        length_scale: SINGLE_C,
+        speed_scale: V_APPROACH,
+    };
+    let pin = Pin::published(law, Friction::None, SINGLE_C, SINGLE_RB);
+    reference(&slide, &pin, [0.0, V_APPROACH, 0.0, 0.0], 1.0, 1)[0]
+}
+
 /// A free journal of `SINGLE_MASS` (rotations locked: an infinite inertia), centred in a fixed
 /// bearing and moving at 0.659381 m/s along x, without gravity, built with the plain API and
 /// stepped at `dt` to `end`: its impacts and its speed along x at the end.
@@ -524,15 +535,9 @@ fn library_single_run(law: NormalModel, run: Stepping, end: f64) -> (Vec<Library
 /// approach speed, within 1e-4 of the approach speed), at fixed steps of 6.25e-8 s.
 #[test]
 fn every_laws_single_impact_matches_its_ode() {
-    let slide = Slide {
-        m: SINGLE_MASS,
-        length_scale: SINGLE_C,
-        speed_scale: V_APPROACH,
-    };
     let mut checks = Vec::new();
     for (name, law, model) in every_law() {
-        let pin = Pin::published(law, Friction::None, SINGLE_C, SINGLE_RB);
-        let r = reference(&slide, &pin, [0.0, V_APPROACH, 0.0, 0.0], 1.0, 1)[0];
+        let r = single_reference(law);
         assert!(r.free_impact_ratio < 1.0, "{name}: {}", r.free_impact_ratio);
         let end = r.end_t + 1e-5;
         let (coarse, _) = library_single(model, Stepping::fixed(DT_COARSE), end);
@@ -995,15 +1000,9 @@ fn sub_cycled(tol: f64, iterations: usize) -> Stepping {
 /// Rapier's four solver iterations (its substeps).
 #[test]
 fn every_laws_single_impact_sub_cycled_in_millisecond_steps_matches_its_ode() {
-    let slide = Slide {
-        m: SINGLE_MASS,
-        length_scale: SINGLE_C,
-        speed_scale: V_APPROACH,
-    };
     let mut checks = Vec::new();
     for (name, law, model) in every_law() {
-        let pin = Pin::published(law, Friction::None, SINGLE_C, SINGLE_RB);
-        let r = reference(&slide, &pin, [0.0, V_APPROACH, 0.0, 0.0], 1.0, 1)[0];
+        let r = single_reference(law);
         let end = r.end_t + 1e-5;
         for (tol, allowed) in [(0.0075, 2e-3), (0.001, 1e-4)] {
             for iterations in [1, 4] {

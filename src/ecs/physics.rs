@@ -353,7 +353,7 @@ impl Physics {
         if let Some(Some(c)) = desired
             && c.model != ClearanceModel::LargeStep
         {
-            check_compliant(&self.world.rapier, entity, &c.model)?;
+            check_compliant(&self.world.rapier, entity, c)?;
         }
         if let Some(r) = self.hinges.get(&entity) {
             let same_place = r.bodies == bodies && r.frame == *frame;
@@ -619,13 +619,16 @@ impl Physics {
 }
 
 /// Refuses a compliant clearance hinge in a world whose settings cannot step it, naming what it
-/// needs and why; the world's settings are the user's and stay as they are.
-fn check_compliant(world: &PhysicsWorld, entity: Entity, model: &ClearanceModel) -> Result<()> {
+/// needs and why; the world's settings are the user's and stay as they are. A sub-cycled planar
+/// hinge takes any number of iterations.
+fn check_compliant(world: &PhysicsWorld, entity: Entity, c: &Clearance) -> Result<()> {
     let n = world.integration_parameters.num_solver_iterations;
-    if n == 1 {
+    let sub_cycled = c.integration == crate::rapier::joint::ContactIntegration::SubCycled
+        && !matches!(c.model, ClearanceModel::Spatial(_));
+    if n == 1 || sub_cycled {
         return Ok(());
     }
-    let (kind, alternative) = match model {
+    let (kind, alternative) = match &c.model {
         ClearanceModel::Spatial(_) => ("spatial", " (planar: it cannot tilt or slide axially)"),
         _ => ("compliant", ""),
     };
@@ -635,9 +638,10 @@ fn check_compliant(world: &PhysicsWorld, entity: Entity, model: &ClearanceModel)
             "the {kind} clearance model of hinge {entity} needs 1 (the world has {n}): its \
              contact force is evaluated once per step and held over it, and Rapier's substeps \
              would make every impact gain energy. Set it to 1 (every body of the world then gets \
-             one iteration: stacks of resting bodies soften), or give the hinge the large-step \
-             model{alternative}, `Clearance::model(ClearanceModel::LargeStep)`, which works with \
-             any number of iterations"
+             one iteration: stacks of resting bodies soften), sub-cycle the planar hinge's \
+             contact (`Clearance::integration(ContactIntegration::SubCycled)`), or give the hinge \
+             the large-step model{alternative}, `Clearance::model(ClearanceModel::LargeStep)`, \
+             which work with any number of iterations"
         ),
     ))
 }

@@ -362,16 +362,22 @@ fn an_unnamed_clearance_hinge_is_realised_once() {
     );
 }
 
-#[test]
-fn large_step_hinge_at_game_rate_with_rapiers_defaults() {
-    // 1/60 s and Rapier's four solver iterations: the compliant model refuses both.
-    let (mut world, mut schedule, arm, hinge) = pendulum(1.0 / 60.0);
+/// [`pendulum`] at 1/60 s with Rapier's four solver iterations (a game world's).
+fn game_rate_pendulum() -> (World, Schedule, Entity, Entity) {
+    let (mut world, schedule, arm, hinge) = pendulum(1.0 / 60.0);
     world
         .resource_mut::<Physics>()
         .world
         .rapier
         .integration_parameters
         .num_solver_iterations = 4;
+    (world, schedule, arm, hinge)
+}
+
+#[test]
+fn large_step_hinge_at_game_rate_with_rapiers_defaults() {
+    // 1/60 s and Rapier's four solver iterations: the explicit compliant model refuses both.
+    let (mut world, mut schedule, arm, hinge) = game_rate_pendulum();
     let large = clearance()
         .model(ClearanceModel::LargeStep)
         .restitution(0.5);
@@ -438,6 +444,26 @@ fn large_step_hinge_at_game_rate_with_rapiers_defaults() {
         world.get::<HingeState>(hinge).unwrap().mode,
         HingeMode::Clearance
     );
+}
+
+/// A sub-cycled compliant hinge at 1/60 s with Rapier's four iterations (the explicit one
+/// refuses both): its first impact, inside one frame, is in the hinge state (onset, a peak over
+/// the static load), and the arm comes to hang on the wall with the weight as its force.
+#[test]
+fn sub_cycled_compliant_hinge_at_game_rate() {
+    let (mut world, mut schedule, _, hinge) = game_rate_pendulum();
+    let sub_cycled = clearance().integration(crate::rapier::joint::ContactIntegration::SubCycled);
+    world.entity_mut(hinge).insert(ClearanceHinge(sub_cycled));
+    steps(&mut world, &mut schedule, 3).unwrap();
+    let s = *world.get::<HingeState>(hinge).unwrap();
+    assert_eq!(s.mode, HingeMode::Clearance);
+    assert!(s.onsets >= 1 && s.impacts >= 1, "{s:?}");
+    assert!(s.peak_force > 100.0, "the drop's impact: {}", s.peak_force);
+    steps(&mut world, &mut schedule, 300).unwrap();
+    let s = world.get::<HingeState>(hinge).unwrap();
+    assert!((s.force - 19.62).abs() < 0.02, "{}", s.force);
+    assert_eq!(s.contact, ContactMode::Continuous);
+    assert!(world.resource::<Physics>().guards().is_clean());
 }
 
 #[test]

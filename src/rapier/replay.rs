@@ -66,7 +66,7 @@
 use crate::error::{Error, Result};
 use crate::model::spatial::SpatialPose;
 use crate::rapier::joint::{
-    ClearanceJoint, ClearanceJointHandle, ClearanceJointSet, SpatialReport,
+    ClearanceJoint, ClearanceJointHandle, ClearanceJointSet, SpatialReport, SubStep,
 };
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::*;
@@ -394,6 +394,15 @@ impl ReplayRecorder {
     /// [`track_journal`](Self::track_journal)). Keeps it or not by the thinning rule.
     pub fn record(&mut self, t: f64, bodies: &RigidBodySet, sets: &[&ClearanceJointSet]) {
         let frame = self.frame(t, bodies, sets);
+        for inside in self.inside_frames(&frame, bodies, sets) {
+            self.record_frame(inside);
+        }
+        self.record_frame(frame);
+    }
+
+    /// Records one state (thinned as [`record`](Self::record) says).
+    fn record_frame(&mut self, frame: ReplayFrame) {
+        let t = frame.t;
         let contact = frame.journals.iter().any(|j| j.contact);
         let onset = contact && !self.in_contact;
         if onset {
@@ -489,6 +498,59 @@ impl ReplayRecorder {
         ReplayFrame { t, poses, journals }
     }
 
+    /// The states inside the step that led to `end` of the sub-cycled joints
+    /// ([`ClearanceJoint::substeps`]), in time order: each such joint at its sub-step, the other
+    /// journals as at the step's end (or at their own latest sub-step before), the bodies drawn
+    /// at the step's end (they move little within a step against the journal in its play).
+    fn inside_frames(
+        &self,
+        end: &ReplayFrame,
+        bodies: &RigidBodySet,
+        sets: &[&ClearanceJointSet],
+    ) -> Vec<ReplayFrame> {
+        let joint = |&(set, h): &(usize, ClearanceJointHandle)| sets.get(set)?.get(h);
+        let mut times: Vec<f64> = Vec::new();
+        for j in self.joints.iter().filter_map(joint) {
+            if let Some((last, inside)) = j.substeps().split_last() {
+                let start = end.t - last.t;
+                times.extend(inside.iter().map(|s| start + s.t));
+            }
+        }
+        if times.is_empty() {
+            return Vec::new();
+        }
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        let rotation = |j: &ClearanceJoint| -> Rotation {
+            bodies
+                .get(j.body1())
+                .map(|rb| *rb.rotation())
+                .unwrap_or_default()
+        };
+        times
+            .into_iter()
+            .map(|t| {
+                let mut frame = ReplayFrame {
+                    t,
+                    poses: end.poses.clone(),
+                    journals: end.journals.clone(),
+                };
+                for ((k, id), track) in self.joints.iter().enumerate().zip(&self.recording.journals)
+                {
+                    let Some(j) = joint(id) else { continue };
+                    let Some(last) = j.substeps().last() else {
+                        continue;
+                    };
+                    let start = end.t - last.t;
+                    if let Some(s) = j.substeps().iter().rev().find(|s| start + s.t <= t) {
+                        frame.journals[k] = substep_frame(s, rotation(j), track);
+                    }
+                }
+                frame
+            })
+            .collect()
+    }
+
     /// The frames kept so far.
     pub fn frames(&self) -> &[ReplayFrame] {
         &self.recording.frames
@@ -514,26 +576,56 @@ fn journal_frame(
     let r = joint.report();
     let (rb1, rb2) = (bodies.get(joint.body1()), bodies.get(joint.body2()));
     let rotation: Rotation = rb1.map(|rb| *rb.rotation()).unwrap_or_default();
-    let u = rotation * Vector::from(track.u1);
-    let v = rotation * Vector::from(track.axis1).cross(Vector::from(track.u1));
+    let (u, v) = bearing_directions(rotation, track);
     let pose = match (r.spatial, rb1, rb2) {
         (Some(_), Some(rb1), Some(rb2)) => Some(joint.spatial_pose(rb1, rb2, u)),
         _ => None,
     };
     let e = pose.map_or(r.state.eccentricity, |p| p.mid_plane_eccentricity());
-    let f = r.force.on_journal;
+    JournalFrame {
+        spatial: pose
+            .zip(r.spatial)
+            .map(|(p, s)| spatial_frame(&p, &s, u, v)),
+        ..planar_frame(e, &r.state, &r.force, r.impact, (u, v))
+    }
+}
+
+/// A planar joint's frame at one of its sub-steps, in the bearing's directions (its body's
+/// `rotation` at the step's end).
+fn substep_frame(s: &SubStep, rotation: Rotation, track: &ReplayJournal) -> JournalFrame {
+    let uv = bearing_directions(rotation, track);
+    planar_frame(s.state.eccentricity, &s.state, &s.force, s.impact, uv)
+}
+
+/// The bearing's in-plane directions `u`, `v` (world) for its body's `rotation`.
+fn bearing_directions(rotation: Rotation, track: &ReplayJournal) -> (Vector, Vector) {
+    let u1 = Vector::from(track.u1);
+    (
+        rotation * u1,
+        rotation * Vector::from(track.axis1).cross(u1),
+    )
+}
+
+/// A journal's frame from its eccentricity `e`, its state's penetration and its force, along
+/// the bearing's `u` and `v` (no spatial part).
+fn planar_frame(
+    e: Vector,
+    state: &crate::model::kinematics::JournalState,
+    force: &crate::model::kinematics::ForcePair,
+    impact: bool,
+    (u, v): (Vector, Vector),
+) -> JournalFrame {
+    let f = force.on_journal;
     JournalFrame {
         ecc_u_m: e.dot(u),
         ecc_v_m: e.dot(v),
         force_u_n: f.dot(u),
         force_v_n: f.dot(v),
         force_n: f.length(),
-        penetration_m: r.state.penetration.max(0.0),
-        contact: r.state.penetration > 0.0,
-        impact: r.impact,
-        spatial: pose
-            .zip(r.spatial)
-            .map(|(p, s)| spatial_frame(&p, &s, u, v)),
+        penetration_m: state.penetration.max(0.0),
+        contact: state.penetration > 0.0,
+        impact,
+        spatial: None,
     }
 }
 
@@ -712,6 +804,74 @@ mod tests {
         assert_eq!(rec.frames.last().unwrap().t, 0.1);
         assert!(rec.interval_s > 1e-3 && rec.contact_interval_s > 1e-3);
         assert!(ReplayRecorder::new(f64::NAN, 0.1).is_err());
+    }
+
+    /// A sub-cycled joint's impact inside one 1/60 s step is in the recording at its sub-steps:
+    /// the recording's largest force is the largest sub-step force, at that sub-step's time,
+    /// where the steps' own states see nothing of the impact.
+    #[test]
+    fn a_sub_cycled_impact_inside_a_step_is_recorded_at_its_sub_steps() {
+        use crate::prelude::*;
+        let mut rapier = PhysicsWorld::new();
+        rapier.gravity = Vector::new(0.0, -9.81, 0.0);
+        let base = rapier.bodies.insert(RigidBodyBuilder::fixed());
+        let arm = rapier.bodies.insert(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(0.0, -0.3, 0.0))
+                .additional_mass_properties(MassProperties::new(
+                    Vector::ZERO,
+                    2.0,
+                    Vector::splat(0.02),
+                ))
+                .can_sleep(false),
+        );
+        let pin = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
+            .unwrap()
+            .integration(ContactIntegration::SubCycled)
+            .joint(
+                Vector::ZERO,
+                Vector::new(0.0, 0.3, 0.0),
+                Vector::Z,
+                Vector::Z,
+            )
+            .unwrap();
+        let mut world = ClearanceWorld::new(rapier, StepControl::fixed(1.0 / 60.0));
+        let hinge = world.insert_clearance(base, arm, pin).unwrap();
+        let mut r = ReplayRecorder::new(1.0 / 60.0, 1e-5).unwrap();
+        let (b, c) = (&world.rapier.bodies, &world.rapier.colliders);
+        r.track_body("base", "clearance", base, b, c);
+        r.track_body("arm", "clearance", arm, b, c);
+        r.track_journal("pin", "clearance", 0, hinge, &world.clearance)
+            .unwrap();
+        let (mut peak, mut peak_t, mut at_steps) = (0.0_f64, 0.0, 0.0_f64);
+        while world.time() < 0.1 {
+            let t0 = world.time();
+            world.step(0.1).unwrap();
+            r.record(world.time(), &world.rapier.bodies, &[&world.clearance]);
+            let j = world.clearance.get(hinge).unwrap();
+            at_steps = at_steps.max(j.report().force.normal_force);
+            for s in j.substeps() {
+                if s.force.on_journal.length() > peak {
+                    (peak, peak_t) = (s.force.on_journal.length(), t0 + s.t);
+                }
+            }
+        }
+        let recording = r.finish();
+        let kept = recording
+            .frames
+            .iter()
+            .max_by(|a, b| force(a).total_cmp(&force(b)))
+            .unwrap();
+        assert!(
+            peak > 5.0 * at_steps.max(19.62),
+            "{peak} N inside, {at_steps} N at the steps"
+        );
+        assert_eq!(force(kept), peak);
+        assert!(
+            (kept.t - peak_t).abs() < 1e-12,
+            "{} against {peak_t}",
+            kept.t
+        );
     }
 
     #[test]

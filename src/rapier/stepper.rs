@@ -32,6 +32,11 @@
 //!   in, is rejected; the world is restored from the state saved before the step and the step is
 //!   retried shorter. With fixed steps nothing is retried: a step beyond the stability limit is an
 //!   [`Error::StepTooLarge`], before (from the state at the step's start) or after it.
+//! - **Passes.** A participant may have a step taken again from its start, as long, with new
+//!   wrenches ([`StepHooks::resolve_step`]): a sub-cycled clearance joint
+//!   ([`ContactIntegration::SubCycled`](crate::rapier::joint::ContactIntegration::SubCycled))
+//!   reads the rest of the world's motion from the first pass and delivers its contact's impulse
+//!   in the second. The bodies and every participant's state are restored between passes.
 //! - **Guards** ([`GuardReport`]): a body that left the physical range is an error
 //!   ([`Error::Diverged`]); a contact deeper than its law's validity and runs of steps at the step
 //!   floor are recorded (and fail the run under [`StepControl::strict`]); a step control that

@@ -393,8 +393,12 @@ impl Cycle<'_> {
                 st.eccentricity_rate,
                 here.centre_acceleration,
             );
-            match time_to_wall(e, v, a, c, left) {
-                None => left,
+            // The wall is predicted from the centre's path as a parabola: a free sub-step
+            // moves it by at most `tolerance` of the clearance (the world step's own journal
+            // path bound), so a turning body's path meets the wall where the parabola says.
+            let path = super::flight_step(self.tolerance, c, v.length());
+            match time_to_wall(e, v, a, c, left.min(path)) {
+                None => left.min(path),
                 Some(t) => {
                     let n = (e + v * t + 0.5 * a * t * t).normalize_or_zero();
                     let speed = (v + a * t).dot(n).max(0.0);
@@ -426,22 +430,24 @@ impl Cycle<'_> {
         }
     }
 
-    /// A kick of span `sigma` (s) at `here`: `v += sigma (a + P F)`, the force taken at the
-    /// state's velocity `(1 - beta) v_before + beta v_after` (implicit for `beta > 0`). Returns the
-    /// force (normal, along the tangent), the impulse and the energy the damping and friction
-    /// took over the span (J).
+    /// A kick at `here`: `v += sigma a + sigma_c P F`, the rest of the world acting over `sigma`
+    /// (s) and the contact over `sigma_c` (s; shorter at an onset, where it acts from the
+    /// crossing on), its force taken at the state's velocity `(1 - beta) v_before + beta v_after`
+    /// (implicit for `beta > 0`). Returns the force (normal, along the tangent), the impulse and
+    /// the energy the damping and friction took over the span (J).
     fn kick(
         &self,
         here: &Here,
         v: &mut Pair12,
-        sigma: f64,
+        (sigma, sigma_c): (f64, f64),
         beta: f64,
         impact_rate: f64,
     ) -> ([f64; 2], Pair12, f64) {
         let c_a = [dot(&here.rows[0], v), dot(&here.rows[1], v)];
+        // The rates the rest of the world brings over the span.
         let a = [
-            dot(&here.rows[0], &self.a_free),
-            dot(&here.rows[1], &self.a_free),
+            sigma * dot(&here.rows[0], &self.a_free),
+            sigma * dot(&here.rows[1], &self.a_free),
         ];
         let delta = here.state.penetration;
         let mut f = [0.0, 0.0];
@@ -456,13 +462,13 @@ impl Cycle<'_> {
             let elastic = law.elastic_force(delta);
             let damping = law.damping_coefficient(&contact);
             let w = &here.w;
+            let bs = beta * sigma_c;
             for _ in 0..50 {
                 // The normal force is affine in the rate (every law here): solved exactly.
-                let c0n = c_a[0] + beta * sigma * (a[0] + w[0][1] * f[1]);
-                let f_n =
-                    ((elastic + damping * c0n) / (1.0 - damping * beta * sigma * w[0][0])).max(0.0);
-                let c0t = c_a[1] + beta * sigma * (a[1] + w[1][0] * f_n);
-                let k = beta * sigma * w[1][1] * f_n;
+                let c0n = c_a[0] + beta * a[0] + bs * w[0][1] * f[1];
+                let f_n = ((elastic + damping * c0n) / (1.0 - damping * bs * w[0][0])).max(0.0);
+                let c0t = c_a[1] + beta * a[1] + bs * w[1][0] * f_n;
+                let k = bs * w[1][1] * f_n;
                 let slip = implicit_slip(&self.joint.friction_law, c0t, k);
                 let f_t = -self.joint.friction_law.coefficient(slip.abs()) * f_n * slip.signum();
                 let change = (f_n - f[0]).abs() + (f_t - f[1]).abs();
@@ -473,19 +479,17 @@ impl Cycle<'_> {
             }
             // The rates at the state, with the force found: the damping's share of the normal
             // force and the friction work against them.
-            let c_m =
-                [0, 1].map(|r| c_a[r] + beta * sigma * (a[r] + w[r][0] * f[0] + w[r][1] * f[1]));
+            let c_m = [0, 1].map(|r| c_a[r] + beta * a[r] + bs * (w[r][0] * f[0] + w[r][1] * f[1]));
             if f[0] > 0.0 {
-                dissipated = sigma * ((f[0] - elastic) * c_m[0] - f[1] * c_m[1]);
+                dissipated = sigma_c * ((f[0] - elastic) * c_m[0] - f[1] * c_m[1]);
             }
         }
-        let mut dv = self.a_free;
-        axpy(&mut dv, f[0], &here.moves[0]);
-        axpy(&mut dv, f[1], &here.moves[1]);
-        axpy(v, sigma, &dv);
+        axpy(v, sigma, &self.a_free);
+        axpy(v, sigma_c * f[0], &here.moves[0]);
+        axpy(v, sigma_c * f[1], &here.moves[1]);
         let mut impulse = [0.0; 12];
-        axpy(&mut impulse, sigma * f[0], &here.loads[0]);
-        axpy(&mut impulse, sigma * f[1], &here.loads[1]);
+        axpy(&mut impulse, sigma_c * f[0], &here.loads[0]);
+        axpy(&mut impulse, sigma_c * f[1], &here.loads[1]);
         (f, impulse, dissipated)
     }
 
@@ -509,7 +513,7 @@ impl Cycle<'_> {
         let mut rest = self.h;
         let mut s = self.substep(&here, &hist, rest);
         let rate = self.impact_rate(&hist, &here);
-        let (_, dg, loss) = self.kick(&here, &mut m.v, 0.5 * s, 0.0, rate);
+        let (_, dg, loss) = self.kick(&here, &mut m.v, (0.5 * s, 0.5 * s), 0.0, rate);
         axpy(&mut out.impulse, 1.0, &dg);
         out.dissipated = loss;
         loop {
@@ -540,11 +544,11 @@ impl Cycle<'_> {
             } else {
                 s
             };
-            let sigma = 0.5 * (before + next);
+            let spans = (0.5 * (s + next), 0.5 * (before + next));
             let (alpha, beta) = (next / (s + next), s / (s + next));
             let v_before = m.v;
             let rate = self.impact_rate(&hist, &here);
-            let (f, dg, loss) = self.kick(&here, &mut m.v, sigma, beta, rate);
+            let (f, dg, loss) = self.kick(&here, &mut m.v, spans, beta, rate);
             axpy(&mut out.impulse, 1.0, &dg);
             out.dissipated += loss;
             // The state: its velocity between the half steps around it.

@@ -92,7 +92,10 @@ impl RunSettings {
     /// The stepper's control for these settings.
     pub fn step_control(&self) -> crate::rapier::stepper::StepControl {
         let c = match self.step {
-            StepMode::Fixed => crate::rapier::stepper::StepControl::fixed(self.dt_s),
+            // The tolerance also sets a sub-cycled contact's sub-steps.
+            StepMode::Fixed => {
+                crate::rapier::stepper::StepControl::fixed(self.dt_s).with_tolerance(self.tolerance)
+            }
             StepMode::Adaptive => {
                 crate::rapier::stepper::StepControl::adaptive(self.max_dt_s, self.tolerance)
             }

@@ -9,9 +9,10 @@
 //! **The contact on its own clock.** From the pair's state at the step's start, the joint
 //! integrates `dv/dt = a + P F(x, v)` over the step, `P` the pair's mobility through the
 //! mechanism's ideal joints (the 12 x 12 [`Mechanism::pair_mobility`], at the step's start),
-//! with sub-steps sized by the tolerance: `2 tol` of the contact's period and `50 tol` of its
+//! with sub-steps sized by the tolerance: `2 tol` of the contact's period and `10 tol` of its
 //! damped stability limit in contact ([`ContactAhead::resolving_step`]), halving the time to
-//! contact on approach, one sub-step over a free flight that meets no wall. A sub-step is a
+//! contact on approach and landing on the wall, and moving the journal by at most `tol` of the
+//! clearance in free flight. A sub-step is a
 //! velocity-Verlet step whose elastic force is taken at the sub-step's position and whose
 //! dissipative forces (the law's damping, friction) at the velocity of the state, solved
 //! implicitly (a trapezoidal rule in the velocity: stable at any sub-step, second order). The
@@ -55,7 +56,8 @@ pub enum ContactIntegration {
     #[default]
     Explicit,
     /// The contact is integrated on the joint's own clock inside each Rapier step, its damping
-    /// and friction implicitly; Rapier's step carries the result (the [module docs](self)). The
+    /// and friction implicitly; Rapier's step carries the result (two Rapier passes: the rest of
+    /// the world's motion, then the contact's impulse; docs/sub-cycled-contact.md). The
     /// world's step is set by its slow motion: the joint adds no stability limit. Needs the
     /// [`Stepper`](crate::rapier::stepper::Stepper) (or a world built on it); a loop of your own
     /// that calls `ClearanceJointSet::apply` gets the explicit forces.

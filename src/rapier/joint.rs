@@ -1221,6 +1221,14 @@ impl ClearanceJointSet {
                 .filter_map(|j| j.last_wrenches)
                 .flatten(),
         );
+        self.applied.clear();
+        self.applied.extend(
+            self.joints
+                .values()
+                .filter(|j| !j.sub_cycled())
+                .filter_map(|j| j.last_wrenches)
+                .flatten(),
+        );
         self.ledger.replace(bodies, self.wrenches.iter().copied());
         Some(joint)
     }

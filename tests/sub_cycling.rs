@@ -16,18 +16,13 @@ const C: f64 = 0.2e-3;
 const MU: f64 = 0.3;
 const V_EPS: f64 = 1e-4;
 
-/// A journal of 2 kg hanging in a fixed bearing under gravity, turned by the constant torque
-/// `torque` (N m) about the hinge, in a world stepped by `control` with `iterations` solver
-/// iterations: steel, the improved law, Coulomb friction, the
-/// contact integrated as `integration` says. Stepped to `end` (s); returns the world and the
-/// pin.
-fn held_journal(
-    torque: f64,
+/// A world under gravity stepped by `control` with `iterations` solver iterations, holding a
+/// fixed base and a free 2 kg journal (0.01 kg m² about each axis) at the origin: `(world, base,
+/// journal)`.
+fn journal_world(
     control: StepControl,
     iterations: usize,
-    end: f64,
-    integration: ContactIntegration,
-) -> clearance_joint::Result<(ClearanceWorld, ClearanceJointHandle)> {
+) -> (ClearanceWorld, RigidBodyHandle, RigidBodyHandle) {
     let mut rapier = PhysicsWorld::new();
     rapier.gravity = Vector::new(0.0, -G, 0.0);
     rapier.integration_parameters.num_solver_iterations = iterations;
@@ -42,6 +37,22 @@ fn held_journal(
             ))
             .can_sleep(false),
     );
+    (world, base, journal)
+}
+
+/// A journal of 2 kg hanging in a fixed bearing under gravity, turned by the constant torque
+/// `torque` (N m) about the hinge, in a world stepped by `control` with `iterations` solver
+/// iterations: steel, the improved law, Coulomb friction, the
+/// contact integrated as `integration` says. Stepped to `end` (s); returns the world and the
+/// pin.
+fn held_journal(
+    torque: f64,
+    control: StepControl,
+    iterations: usize,
+    end: f64,
+    integration: ContactIntegration,
+) -> clearance_joint::Result<(ClearanceWorld, ClearanceJointHandle)> {
+    let (mut world, base, journal) = journal_world(control, iterations);
     world.rapier.bodies[journal].add_torque(Vector::new(0.0, 0.0, torque), true);
     let pin = Clearance::steel_improved_liu(R_B, C, 0.016)
         .unwrap()
@@ -158,20 +169,8 @@ fn an_elastic_bounce_under_gravity_keeps_its_height_at_any_step() {
     use clearance_joint::model::laws::{BearingGeometry, Hertz, NormalModel};
     let speed = (2.0 * G * C).sqrt();
     for dt in [1.0 / 60.0, 1e-3] {
-        let mut rapier = PhysicsWorld::new();
-        rapier.gravity = Vector::new(0.0, -G, 0.0);
-        rapier.integration_parameters.num_solver_iterations = 1;
-        let mut world = ClearanceWorld::new(rapier, StepControl::fixed(dt).with_tolerance(0.0075));
-        let base = world.rapier.bodies.insert(RigidBodyBuilder::fixed());
-        let journal = world.rapier.bodies.insert(
-            RigidBodyBuilder::dynamic()
-                .additional_mass_properties(MassProperties::new(
-                    Vector::ZERO,
-                    MASS,
-                    Vector::splat(0.01),
-                ))
-                .can_sleep(false),
-        );
+        let control = StepControl::fixed(dt).with_tolerance(0.0075);
+        let (mut world, base, journal) = journal_world(control, 1);
         let hertz = NormalModel::Hertz(Hertz::new(1e10, 1.5).unwrap());
         let pin = Clearance::new(BearingGeometry::new(R_B, R_B - C, 0.016).unwrap(), hertz)
             .integration(ContactIntegration::SubCycled)

@@ -35,11 +35,9 @@
 
 use super::effective_mass::Mechanism;
 use super::{ClearanceJoint, ClearanceReport, ContactAhead, ContactHistory};
-use crate::model::kinematics::stable_step;
-use crate::model::kinematics::{BodyMotion, ForcePair, JournalState, journal_state};
+use crate::model::kinematics::{BodyMotion, ForcePair, JournalState, journal_state, stable_step};
 use crate::model::laws::{FrictionLaw, NormalContact, NormalForceLaw, loaded_impact_rate};
-use crate::rapier::ledger::Wrench;
-use crate::rapier::ledger::world_center_of_mass;
+use crate::rapier::ledger::{Wrench, world_center_of_mass};
 use crate::rapier::step_hooks::StepPass;
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::{RigidBody, RigidBodyHandle, RigidBodySet};

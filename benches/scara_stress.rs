@@ -1,0 +1,340 @@
+//! The SCARA arm of `examples/robot_backlash.rs` on compliant, sub-cycled pins
+//! (`ContactIntegration::SubCycled`) with Rapier's four solver iterations, across pin clearances
+//! and world rates: the stress table of `docs/sub-cycled-contact.md`.
+//!
+//! `cargo bench --bench scara_stress` (`-- --quick`: one clearance, three rates). For each
+//! clearance and world rate the controller ticks at the world rate (its torque held over a tick)
+//! and three arms run the same 1.5 s pick-and-place cycle: the ideal arm (Rapier revolutes), the
+//! arm on sub-cycled pins stepped once per tick, and the reference, the same pins integrated
+//! explicitly by the adaptive stepper at a tight tolerance (one solver iteration) under the same
+//! controller. The table gives, against the reference: each pin's largest force and deepest
+//! penetration, and the RMS distance of the hand from the ideal arm's hand (what the play costs);
+//! and the cost of a world step against the ideal arm's, measured in the same run.
+
+use clearance_joint::model::laws::{Coulomb, FrictionModel};
+use clearance_joint::prelude::*;
+use clearance_joint::rapier::metrics::{ContactObservation, ImpactRecorder};
+use rapier3d_f64::prelude::*;
+use std::f64::consts::PI;
+use std::time::Instant;
+
+/// Simulated time: one swing out, hold, swing back, hold, s.
+const END: f64 = 1.5;
+const UPPER: (f64, f64) = (2.0, 0.4); // mass kg, length m
+const LOWER: (f64, f64) = (1.0, 0.3);
+/// Inertia each joint's controller is tuned for (about its pin, elbow straight), kg m^2.
+const TUNED_INERTIA: [f64; 2] = [0.45, 0.035];
+/// Pin: bearing radius and width, m; dry friction.
+const PIN_RADIUS: f64 = 0.006;
+const PIN_WIDTH: f64 = 0.012;
+const MU: f64 = 0.1;
+/// The reference's tolerance (the default is 0.0075).
+const REFERENCE_TOLERANCE: f64 = 0.001;
+const MOVE: f64 = 0.5;
+const HOLD: f64 = 0.25;
+
+/// PD gains per joint for a controller ticking every `dt`: closed-loop bandwidth 5 Hz, damping
+/// ratio 0.7, slowed to `0.1/dt` rad/s when the tick is too slow for it (a 60 Hz tick).
+fn gains(dt: f64) -> [(f64, f64); 2] {
+    let w = (2.0 * PI * 5.0).min(0.1 / dt);
+    TUNED_INERTIA.map(|i| (i * w * w, 2.0 * 0.7 * i * w))
+}
+
+/// Target joint angles and rates at `t`: swing out in `MOVE`, hold, swing back, hold.
+fn target(t: f64) -> ([f64; 2], [f64; 2]) {
+    let out = [90f64.to_radians(), -75f64.to_radians()];
+    let p = t % (2.0 * (MOVE + HOLD));
+    let w = PI / MOVE;
+    let (s, ds) = if p < MOVE {
+        (0.5 * (1.0 - (w * p).cos()), 0.5 * w * (w * p).sin())
+    } else if p < MOVE + HOLD {
+        (1.0, 0.0)
+    } else if p < 2.0 * MOVE + HOLD {
+        let p = p - MOVE - HOLD;
+        (0.5 * (1.0 + (w * p).cos()), -0.5 * w * (w * p).sin())
+    } else {
+        (0.0, 0.0)
+    };
+    ([out[0] * s, out[1] * s], [out[0] * ds, out[1] * ds])
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Pins {
+    Ideal,
+    Compliant(ContactIntegration),
+}
+
+struct Arm {
+    world: ClearanceWorld,
+    pairs: [(RigidBodyHandle, RigidBodyHandle); 2],
+    lower: RigidBodyHandle,
+    pins: Vec<ClearanceJointHandle>,
+    recorders: [ImpactRecorder; 2],
+    angles: [clearance_joint::model::angle::HingeAngle; 2],
+}
+
+fn link(world: &mut PhysicsWorld, (mass, length): (f64, f64), start: f64) -> RigidBodyHandle {
+    let j = mass * length * length / 12.0;
+    world.bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(Vector::new(start + 0.5 * length, 0.0, 0.0))
+            .additional_mass_properties(MassProperties::new(
+                Vector::ZERO,
+                mass,
+                Vector::new(1e-3 * j, j, j),
+            ))
+            .can_sleep(false),
+    )
+}
+
+impl Arm {
+    fn new(pins: Pins, clearance: f64, control: StepControl) -> clearance_joint::Result<Arm> {
+        let mut rapier = PhysicsWorld::new();
+        rapier.gravity = Vector::new(0.0, 0.0, -9.81);
+        // Four iterations, Rapier's default, except for the explicit reference, which needs one.
+        if pins == Pins::Compliant(ContactIntegration::Explicit) {
+            rapier.integration_parameters.num_solver_iterations = 1;
+        }
+        let base = rapier.bodies.insert(RigidBodyBuilder::fixed());
+        let upper = link(&mut rapier, UPPER, 0.0);
+        let lower = link(&mut rapier, LOWER, UPPER.1);
+        let pairs = [(base, upper), (upper, lower)];
+        let anchors = [
+            (Vector::ZERO, Vector::new(-0.5 * UPPER.1, 0.0, 0.0)),
+            (
+                Vector::new(0.5 * UPPER.1, 0.0, 0.0),
+                Vector::new(-0.5 * LOWER.1, 0.0, 0.0),
+            ),
+        ];
+        let mut world = ClearanceWorld::new(rapier, control);
+        let mut handles = Vec::new();
+        for (i, ((b1, b2), (a1, a2))) in pairs.into_iter().zip(anchors).enumerate() {
+            match pins {
+                Pins::Compliant(integration) => {
+                    let joint = Clearance::steel_improved_liu(PIN_RADIUS, clearance, PIN_WIDTH)?
+                        .friction(FrictionModel::Coulomb(Coulomb::new(MU, 1e-4)?))
+                        .integration(integration)
+                        .name(["shoulder", "elbow"][i])
+                        .joint(a1, a2, Vector::Z, Vector::Z)?;
+                    handles.push(world.insert_clearance(b1, b2, joint)?);
+                }
+                Pins::Ideal => {
+                    world.rapier.impulse_joints.insert(
+                        b1,
+                        b2,
+                        RevoluteJointBuilder::new(Vector::Z)
+                            .local_anchor1(a1)
+                            .local_anchor2(a2)
+                            .contacts_enabled(false),
+                        true,
+                    );
+                }
+            }
+        }
+        world.prepare()?;
+        Ok(Arm {
+            world,
+            pairs,
+            lower,
+            pins: handles,
+            recorders: Default::default(),
+            angles: Default::default(),
+        })
+    }
+
+    /// The hand: the tip of the lower link.
+    fn hand(&self) -> Vector {
+        *self.world.rapier.bodies[self.lower].position() * Vector::new(0.5 * LOWER.1, 0.0, 0.0)
+    }
+
+    /// The controller's torques at `t` (held over the tick), then the world stepped to `until`.
+    fn tick(&mut self, t: f64, until: f64, gains: [(f64, f64); 2]) -> clearance_joint::Result<()> {
+        let (qt, rt) = target(t);
+        for (k, (b1, b2)) in self.pairs.iter().enumerate() {
+            let bodies = &self.world.rapier.bodies;
+            let (r1, r2) = (&bodies[*b1], &bodies[*b2]);
+            let q = self.angles[k].update(r1.rotation(), r2.rotation(), Vector::Z);
+            let rate = (r2.angvel() - r1.angvel()).z;
+            let (kp, kd) = gains[k];
+            let tau = Vector::new(0.0, 0.0, kp * (qt[k] - q) + kd * (rt[k] - rate));
+            for (body, sign) in [(*b2, 1.0), (*b1, -1.0)] {
+                let rb = &mut self.world.rapier.bodies[body];
+                if k == 0 || sign > 0.0 {
+                    rb.reset_torques(false);
+                }
+                rb.add_torque(sign * tau, true);
+            }
+        }
+        // Torques changed by hand: the joints' evaluation at this state stands, the forces on
+        // the bodies are read by Rapier's step.
+        while self.world.time() < until {
+            let before: Vec<ContactObservation> = self
+                .pins
+                .iter()
+                .map(|h| ContactObservation::of(self.world.clearance.get(*h).expect("inserted")))
+                .collect();
+            let info = self.world.step(until)?;
+            for (k, h) in self.pins.iter().enumerate() {
+                let j = self.world.clearance.get(*h).expect("inserted");
+                self.recorders[k].record_step(info.t0, info.dt, &before[k], j.substeps());
+            }
+        }
+        Ok(())
+    }
+}
+
+/// What one arm did over the run.
+#[derive(Clone, Debug, Default)]
+struct Outcome {
+    /// Per pin: largest force (N), deepest penetration (um), onsets.
+    peak: [f64; 2],
+    depth: [f64; 2],
+    onsets: [u64; 2],
+    /// The hands at each tick.
+    hands: Vec<Vector>,
+    steps: u64,
+    /// Largest sub-steps of one world step (either pin).
+    max_substeps: usize,
+    wall_s: f64,
+    /// The guards' messages (empty: the run stayed valid).
+    guards: Vec<String>,
+}
+
+fn run(
+    pins: Pins,
+    clearance: f64,
+    rate: f64,
+    control: StepControl,
+) -> clearance_joint::Result<Outcome> {
+    let tick = 1.0 / rate;
+    let gains = gains(tick);
+    let mut arm = Arm::new(pins, clearance, control)?;
+    let ticks = (END / tick).round() as u64;
+    let mut o = Outcome::default();
+    let clock = Instant::now();
+    for i in 0..ticks {
+        let t = i as f64 * tick;
+        arm.tick(t, (i + 1) as f64 * tick, gains)?;
+        o.hands.push(arm.hand());
+        for h in &arm.pins {
+            let n = arm
+                .world
+                .clearance
+                .get(*h)
+                .expect("inserted")
+                .substeps()
+                .len();
+            o.max_substeps = o.max_substeps.max(n);
+        }
+    }
+    o.wall_s = clock.elapsed().as_secs_f64();
+    o.steps = arm.world.steps();
+    for k in 0..arm.pins.len() {
+        let m = arm.recorders[k].metrics();
+        o.peak[k] = m.peak_force_n;
+        o.depth[k] = m.max_penetration_um;
+        o.onsets[k] = m.onsets;
+    }
+    o.guards = arm.world.guards().messages();
+    Ok(o)
+}
+
+/// RMS distance between two arms' hands, mm.
+fn rms_offset(a: &Outcome, b: &Outcome) -> f64 {
+    let sq: f64 = a
+        .hands
+        .iter()
+        .zip(&b.hands)
+        .map(|(p, q)| (*p - *q).length_squared())
+        .sum();
+    (sq / a.hands.len() as f64).sqrt() * 1e3
+}
+
+fn pct(x: f64, reference: f64) -> String {
+    if reference > 0.0 {
+        format!("{:+.1} %", (x / reference - 1.0) * 100.0)
+    } else {
+        format!("{x:.3e} (ref 0)")
+    }
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "--quick");
+    let clearances: &[f64] = if quick {
+        &[0.1e-3]
+    } else {
+        &[0.01e-3, 0.1e-3, 1e-3]
+    };
+    let rates: &[f64] = if quick {
+        &[60.0, 1000.0, 10_000.0]
+    } else {
+        &[60.0, 250.0, 1000.0, 4000.0, 10_000.0]
+    };
+    println!(
+        "| clearance (mm) | world rate (Hz) | world steps | largest sub-steps per step | peak force shoulder, elbow (N) vs reference | deepest penetration shoulder, elbow (um) vs reference | onsets vs reference | hand RMS offset from the ideal arm (mm) vs reference | cost per world step / ideal arm's |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    for &c in clearances {
+        for &rate in rates {
+            let tick = 1.0 / rate;
+            let ideal = run(Pins::Ideal, c, rate, StepControl::fixed(tick));
+            let sub = run(
+                Pins::Compliant(ContactIntegration::SubCycled),
+                c,
+                rate,
+                StepControl::fixed(tick),
+            );
+            let reference = run(
+                Pins::Compliant(ContactIntegration::Explicit),
+                c,
+                rate,
+                StepControl::adaptive(tick, REFERENCE_TOLERANCE),
+            );
+            let (ideal, sub, reference) = match (ideal, sub, reference) {
+                (Ok(i), Ok(s), Ok(r)) => (i, s, r),
+                (i, s, r) => {
+                    let err = |x: &clearance_joint::Result<Outcome>| match x {
+                        Ok(_) => "ok".to_string(),
+                        Err(e) => format!("{e}"),
+                    };
+                    println!(
+                        "| {} | {rate} | failed: ideal {}; sub-cycled {}; reference {} |",
+                        c * 1e3,
+                        err(&i),
+                        err(&s),
+                        err(&r)
+                    );
+                    continue;
+                }
+            };
+            for (name, o) in [("sub-cycled", &sub), ("reference", &reference)] {
+                for g in &o.guards {
+                    eprintln!("  {} mm, {rate} Hz, {name}: {g}", c * 1e3);
+                }
+            }
+            let (off, off_ref) = (rms_offset(&sub, &ideal), rms_offset(&reference, &ideal));
+            let cost = (sub.wall_s / sub.steps as f64) / (ideal.wall_s / ideal.steps as f64);
+            println!(
+                "| {} | {rate} | {} | {} | {:.1}, {:.1} ({}, {}) | {:.3}, {:.3} ({}, {}) | {}, {} ({}, {}) | {:.4} ({}) | {:.2} |",
+                c * 1e3,
+                sub.steps,
+                sub.max_substeps,
+                sub.peak[0],
+                sub.peak[1],
+                pct(sub.peak[0], reference.peak[0]),
+                pct(sub.peak[1], reference.peak[1]),
+                sub.depth[0],
+                sub.depth[1],
+                pct(sub.depth[0], reference.depth[0]),
+                pct(sub.depth[1], reference.depth[1]),
+                sub.onsets[0],
+                sub.onsets[1],
+                reference.onsets[0],
+                reference.onsets[1],
+                off,
+                pct(off, off_ref),
+                cost
+            );
+        }
+    }
+}

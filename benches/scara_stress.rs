@@ -10,6 +10,11 @@
 //! controller. The table gives, against the reference: each pin's largest force and deepest
 //! penetration, and the RMS distance of the hand from the ideal arm's hand (what the play costs);
 //! and the cost of a world step against the ideal arm's, measured in the same run.
+//!
+//! Knobs for diagnosis (environment): `SCARA_RATES=60,1000` (world rates, Hz),
+//! `SCARA_TOLERANCE` (the sub-cycled arms' tolerance, default 0.0075), `SCARA_PINS=shoulder` or
+//! `elbow` (play in that pin only, the other an ideal revolute), `SCARA_ITERS` (the sub-cycled
+//! arms' solver iterations, default 4), `SCARA_IMPACTS=1` (each arm's five largest impacts).
 
 use clearance_joint::model::laws::{Coulomb, FrictionModel};
 use clearance_joint::prelude::*;
@@ -30,13 +35,17 @@ const PIN_WIDTH: f64 = 0.012;
 const MU: f64 = 0.1;
 /// The reference's tolerance (the default is 0.0075).
 const REFERENCE_TOLERANCE: f64 = 0.001;
+/// The reference's largest step, s: Rapier's ideal joints converge with the step, not with the
+/// tolerance.
+const REFERENCE_MAX_DT: f64 = 1e-5;
 const MOVE: f64 = 0.5;
 const HOLD: f64 = 0.25;
 
 /// PD gains per joint for a controller ticking every `dt`: closed-loop bandwidth 5 Hz, damping
-/// ratio 0.7, slowed to `0.1/dt` rad/s when the tick is too slow for it (a 60 Hz tick).
+/// ratio 0.7, slowed to `0.03/dt` rad/s when the tick is too slow for it (below 200 Hz: the
+/// ideal arm at 60 Hz diverges with `0.1/dt`).
 fn gains(dt: f64) -> [(f64, f64); 2] {
-    let w = (2.0 * PI * 5.0).min(0.1 / dt);
+    let w = (2.0 * PI * 5.0).min(0.03 / dt);
     TUNED_INERTIA.map(|i| (i * w * w, 2.0 * 0.7 * i * w))
 }
 
@@ -95,6 +104,14 @@ impl Arm {
         if pins == Pins::Compliant(ContactIntegration::Explicit) {
             rapier.integration_parameters.num_solver_iterations = 1;
         }
+        if let (Pins::Compliant(ContactIntegration::SubCycled), Some(n)) = (
+            pins,
+            std::env::var("SCARA_ITERS")
+                .ok()
+                .and_then(|t| t.parse().ok()),
+        ) {
+            rapier.integration_parameters.num_solver_iterations = n;
+        }
         let base = rapier.bodies.insert(RigidBodyBuilder::fixed());
         let upper = link(&mut rapier, UPPER, 0.0);
         let lower = link(&mut rapier, LOWER, UPPER.1);
@@ -109,8 +126,10 @@ impl Arm {
         let mut world = ClearanceWorld::new(rapier, control);
         let mut handles = Vec::new();
         for (i, ((b1, b2), (a1, a2))) in pairs.into_iter().zip(anchors).enumerate() {
+            let only = std::env::var("SCARA_PINS").unwrap_or_default();
+            let ideal_here = (only == "shoulder" && i == 1) || (only == "elbow" && i == 0);
             match pins {
-                Pins::Compliant(integration) => {
+                Pins::Compliant(integration) if !ideal_here => {
                     let joint = Clearance::steel_improved_liu(PIN_RADIUS, clearance, PIN_WIDTH)?
                         .friction(FrictionModel::Coulomb(Coulomb::new(MU, 1e-4)?))
                         .integration(integration)
@@ -118,7 +137,7 @@ impl Arm {
                         .joint(a1, a2, Vector::Z, Vector::Z)?;
                     handles.push(world.insert_clearance(b1, b2, joint)?);
                 }
-                Pins::Ideal => {
+                _ => {
                     world.rapier.impulse_joints.insert(
                         b1,
                         b2,
@@ -236,6 +255,23 @@ fn run(
         o.onsets[k] = m.onsets;
     }
     o.guards = arm.world.guards().messages();
+    if std::env::var("SCARA_IMPACTS").is_ok() {
+        for (k, r) in arm.recorders.iter().enumerate() {
+            let mut list: Vec<_> = r.contacts().to_vec();
+            list.sort_by(|a, b| b.peak_force_n.total_cmp(&a.peak_force_n));
+            for i in list.iter().take(5) {
+                eprintln!(
+                    "{pins:?} pin {k}: onset {:.5} s, approach {:.4} m/s, peak {:.1} N at {:.5}, depth {:.3} um, {:.1} us",
+                    i.onset_t_s,
+                    i.approach_speed_m_s,
+                    i.peak_force_n,
+                    i.peak_t_s,
+                    i.max_penetration_um,
+                    i.duration_s * 1e6
+                );
+            }
+        }
+    }
     Ok(o)
 }
 
@@ -260,35 +296,40 @@ fn pct(x: f64, reference: f64) -> String {
 
 fn main() {
     let quick = std::env::args().any(|a| a == "--quick");
+    // The sub-cycled arms' tolerance (`SCARA_TOLERANCE`, default the library's 0.0075).
+    let tolerance = std::env::var("SCARA_TOLERANCE")
+        .ok()
+        .and_then(|t| t.parse().ok())
+        .unwrap_or(0.0075);
     let clearances: &[f64] = if quick {
         &[0.1e-3]
     } else {
         &[0.01e-3, 0.1e-3, 1e-3]
     };
-    let rates: &[f64] = if quick {
-        &[60.0, 1000.0, 10_000.0]
-    } else {
-        &[60.0, 250.0, 1000.0, 4000.0, 10_000.0]
+    let rates: Vec<f64> = match std::env::var("SCARA_RATES") {
+        Ok(list) => list.split(',').filter_map(|r| r.parse().ok()).collect(),
+        Err(_) if quick => vec![60.0, 1000.0, 10_000.0],
+        Err(_) => vec![60.0, 250.0, 1000.0, 4000.0, 10_000.0],
     };
     println!(
         "| clearance (mm) | world rate (Hz) | world steps | largest sub-steps per step | peak force shoulder, elbow (N) vs reference | deepest penetration shoulder, elbow (um) vs reference | onsets vs reference | hand RMS offset from the ideal arm (mm) vs reference | cost per world step / ideal arm's |"
     );
     println!("|---|---|---|---|---|---|---|---|---|");
     for &c in clearances {
-        for &rate in rates {
+        for &rate in &rates {
             let tick = 1.0 / rate;
             let ideal = run(Pins::Ideal, c, rate, StepControl::fixed(tick));
             let sub = run(
                 Pins::Compliant(ContactIntegration::SubCycled),
                 c,
                 rate,
-                StepControl::fixed(tick),
+                StepControl::fixed(tick).with_tolerance(tolerance),
             );
             let reference = run(
                 Pins::Compliant(ContactIntegration::Explicit),
                 c,
                 rate,
-                StepControl::adaptive(tick, REFERENCE_TOLERANCE),
+                StepControl::adaptive(tick.min(REFERENCE_MAX_DT), REFERENCE_TOLERANCE),
             );
             let (ideal, sub, reference) = match (ideal, sub, reference) {
                 (Ok(i), Ok(s), Ok(r)) => (i, s, r),

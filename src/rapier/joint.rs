@@ -419,6 +419,9 @@ struct CycleState {
     impulse: [f64; 12],
     /// The sub-steps of the last step.
     substep_count: u32,
+    /// The mobilities from the contact loads of the other sub-cycled joints of the island to
+    /// this pair (their bearing and journal bodies, `P_ij`), taken with `start`.
+    coupled: Vec<([RigidBodyHandle; 2], [f64; 144])>,
 }
 
 /// Default of [`ClearanceJointBuilder::min_impact_speed`], m/s.
@@ -1139,6 +1142,8 @@ pub struct ClearanceJointSet {
     /// The sub-cycled joints' deliveries of the step being taken, and whether its pass 1 is on.
     planned: Vec<Wrench>,
     retaking: bool,
+    /// Scratch: each joint's bearing and journal bodies when it is sub-cycled.
+    partners: Vec<Option<[RigidBodyHandle; 2]>>,
     saved: Vec<JointDynamics>,
     saved_wrenches: Vec<Wrench>,
     saved_applied: Vec<Wrench>,
@@ -1324,7 +1329,13 @@ impl ClearanceJointSet {
         self.wrenches.clear();
         self.applied.clear();
         self.retaking = false;
-        for joint in self.joints.values_mut() {
+        self.partners.clear();
+        self.partners.extend(
+            self.joints
+                .values()
+                .map(|j| j.sub_cycled().then_some([j.body1, j.body2])),
+        );
+        for (index, joint) in self.joints.values_mut().enumerate() {
             if !joint.prepared {
                 ensure_mass_properties(bodies, None, joint.body1);
                 ensure_mass_properties(bodies, None, joint.body2);
@@ -1344,6 +1355,11 @@ impl ClearanceJointSet {
                 .or_else(|| joint.evaluate(bodies, self.last_step, &self.mechanism))
                 .map(|(w1, w2)| [w1, w2]);
             joint.take_start(bodies, &self.mechanism);
+            let partners = self.partners.iter().enumerate();
+            let others = partners
+                .filter(|(i, _)| *i != index)
+                .filter_map(|(_, p)| *p);
+            joint.take_coupling(&self.mechanism, others);
             if joint.last_wrenches.is_none() {
                 joint.contact = ContactHistory::default();
                 joint.report = ClearanceReport::default();
@@ -1376,8 +1392,10 @@ impl ClearanceJointSet {
             return false;
         }
         self.planned.clear();
-        for joint in self.joints.values_mut() {
-            if let Some(deliver) = joint.plan_cycle(bodies, pass, iterations) {
+        let mut joints: Vec<&mut ClearanceJoint> = self.joints.values_mut().collect();
+        let deliveries = subcycle::plan_cycles(&mut joints, bodies, pass, iterations);
+        for (joint, deliver) in joints.iter().zip(deliveries) {
+            if let Some(deliver) = deliver {
                 self.planned.extend(joint.delivery(&deliver, pass.kick));
             }
         }

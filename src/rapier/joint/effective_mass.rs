@@ -192,6 +192,65 @@ impl Mechanism {
         p
     }
 
+    /// The mobility from loads on another pair of bodies (`other`: bearing, journal) to this
+    /// joint's pair, `P_ab = M^-1 [a = b] - C_ab` over the two pairs' 12 coordinates (row:
+    /// this pair's, column: the other's; row-major): how a contact force in another clearance
+    /// joint of the same island moves this pair, through a shared body or the ideal joints.
+    /// `None` when no body of `other` is in this joint's island (the pairs do not interact
+    /// within a step).
+    pub(crate) fn cross_mobility(&self, other: [RigidBodyHandle; 2]) -> Option<[f64; 144]> {
+        let ids = other.map(|h| self.index(h));
+        if ids == [None, None] {
+            return None;
+        }
+        let mut p = [0.0; 144];
+        for (pa, a) in self.pair.iter().enumerate() {
+            for (pb, b) in ids.iter().enumerate() {
+                let Some(i) = a.filter(|a| Some(*a) == *b) else {
+                    continue;
+                };
+                let body = &self.island[i];
+                for k in 0..3 {
+                    let mut e = Vector::ZERO;
+                    e[k] = 1.0;
+                    let (r, c) = (6 * pa, 6 * pb);
+                    p[(r + k) * 12 + c + k] = body.inv_mass;
+                    let col = body.inv_inertia * e;
+                    for q in 0..3 {
+                        p[(r + 3 + q) * 12 + c + 3 + k] = col[q];
+                    }
+                }
+            }
+        }
+        if self.correction.is_empty() {
+            return Some(p);
+        }
+        // The other pair's `(G M^-1)`, row by row; `x = A^-1 (G M^-1)_pair` from the factoring.
+        let n = self.rows.len();
+        let mut other_b = vec![0.0; n * 12];
+        for (k, row) in self.rows.iter().enumerate() {
+            for (side, body) in row.bodies.iter().enumerate() {
+                for pos in (0..2).filter(|&pos| body.is_some() && ids[pos] == *body) {
+                    let b = &self.island[body.expect("checked")];
+                    let (mf, mt) = b.mobility(row.jac[2 * side], row.jac[2 * side + 1]);
+                    let base = k * 12 + 6 * pos;
+                    for d in 0..3 {
+                        other_b[base + d] += mf[d];
+                        other_b[base + 3 + d] += mt[d];
+                    }
+                }
+            }
+        }
+        for r in 0..12 {
+            for c in 0..12 {
+                p[r * 12 + c] -= (0..n)
+                    .map(|k| self.x[k * 12 + r] * other_b[k * 12 + c])
+                    .sum::<f64>();
+            }
+        }
+        Some(p)
+    }
+
     fn index(&self, handle: RigidBodyHandle) -> Option<usize> {
         self.island.iter().position(|b| b.handle == handle)
     }
@@ -488,5 +547,56 @@ mod tests {
         let (bodies, joints, base, arm) = pinned(Some(limited));
         let (_, capped) = feels(&bodies, &joints, base, arm, p, Vector::Y);
         assert!((1.0 / capped - 0.135).abs() < 1e-12, "{}", 1.0 / capped);
+    }
+
+    /// Two arms in a chain, the second pinned to the first's tip: the mobility between the
+    /// pairs (base, arm 1) and (arm 1, arm 2) is the same read from either pair's mechanism
+    /// (`P_ab = P_ba^T`: the mobility is symmetric), and a pair's own block is its
+    /// `pair_mobility`.
+    #[test]
+    fn the_mobility_between_two_pairs_of_a_chain_is_symmetric_and_holds_the_own_block() {
+        let (mut bodies, mut joints, base, arm1) = pinned(Some(pivot()));
+        let mut rb = RigidBodyBuilder::dynamic()
+            .translation(Vector::new(0.15, 0.0, 0.0))
+            .additional_mass_properties(MassProperties::new(Vector::ZERO, 0.3, Vector::splat(5e-5)))
+            .build();
+        rb.recompute_mass_properties_from_colliders(&Default::default());
+        let arm2 = bodies.insert(rb);
+        let elbow = RevoluteJointBuilder::new(Vector::Z)
+            .local_anchor1(Vector::new(0.05, 0.0, 0.0))
+            .local_anchor2(Vector::new(-0.05, 0.0, 0.0));
+        joints.insert(arm1, arm2, elbow, true);
+        let mechanism = |pair: [RigidBodyHandle; 2]| {
+            let mut m = Mechanism::default();
+            m.rebuild(&bodies, &joints, pair[0], pair[1]);
+            m
+        };
+        let (a, b) = ([base, arm1], [arm1, arm2]);
+        let (ma, mb) = (mechanism(a), mechanism(b));
+        let (p_ab, p_ba) = (ma.cross_mobility(b).unwrap(), mb.cross_mobility(a).unwrap());
+        let scale = p_ab.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        // Arm 1 turns about the pivot: 1/I_pivot = 1/(1e-4 + 0.5 0.05^2) at least, less what
+        // arm 2 holds.
+        assert!(scale > 100.0, "{scale}");
+        for r in 0..12 {
+            for c in 0..12 {
+                let (x, y) = (p_ab[r * 12 + c], p_ba[c * 12 + r]);
+                assert!(
+                    (x - y).abs() <= 1e-9 * scale,
+                    "P_ab[{r}][{c}] {x} vs P_ba^T {y}, scale {scale}"
+                );
+            }
+        }
+        let own = mb.cross_mobility(b).unwrap();
+        for (x, y) in own.iter().zip(mb.pair_mobility()) {
+            assert!((x - y).abs() <= 1e-12 * scale, "{x} vs {y}");
+        }
+        // The base is fixed: no load moves it, no load on it moves anything.
+        for k in 0..6 {
+            for c in 0..12 {
+                assert_eq!(p_ab[k * 12 + c], 0.0);
+                assert_eq!(p_ba[c * 12 + k], 0.0);
+            }
+        }
     }
 }

@@ -162,6 +162,8 @@ pub(crate) struct PairStart {
     /// Rapier's velocities at the start (the mean over the step before).
     velocity: Pair12,
     mobility: [f64; 144],
+    /// The bodies' orientations.
+    rotation: [Rotation; 2],
 }
 
 impl PairStart {
@@ -189,6 +191,7 @@ impl PairStart {
             axis: *rb[0].rotation() * joint.local_axis1,
             velocity,
             mobility: mechanism.pair_mobility(),
+            rotation: rb.map(|b| *b.rotation()),
         })
     }
 
@@ -201,6 +204,37 @@ impl PairStart {
             put(&mut v, 2 * k + 1, b.angvel());
         }
         Some(v)
+    }
+
+    /// Where Rapier's pass 0 put the bodies beyond the integration of their velocities (its
+    /// joints' position stabilisation, which removes the drift of the velocity-level
+    /// constraints): the shift of each centre of mass and the turn of each body (rotation
+    /// vector) over the step of `h` whose velocities went from the start's to `now`, with
+    /// `c_n` the share of a velocity change that Rapier's substeps turn into displacement.
+    /// The sub-cycle moves the bodies by it too, spread over the step, so that they end where
+    /// Rapier puts them.
+    pub(crate) fn stabilisation(
+        &self,
+        joint: &ClearanceJoint,
+        bodies: &RigidBodySet,
+        now: &Pair12,
+        h: f64,
+        c_n: f64,
+    ) -> Option<[[Vector; 2]; 2]> {
+        let rb: [&RigidBody; 2] = [bodies.get(joint.body1)?, bodies.get(joint.body2)?];
+        let mut out = [[Vector::ZERO; 2]; 2];
+        for k in 0..2 {
+            if !rb[k].is_dynamic() {
+                continue;
+            }
+            let moved = |i: usize| {
+                h * part(&self.velocity, i) + c_n * h * (part(now, i) - part(&self.velocity, i))
+            };
+            out[0][k] = world_center_of_mass(rb[k]) - self.com[k] - moved(2 * k);
+            let turn = (*rb[k].rotation() * self.rotation[k].inverse()).to_scaled_axis();
+            out[1][k] = turn - moved(2 * k + 1);
+        }
+        Some(out)
     }
 
     /// The pair's mobility applied to `impulse`.
@@ -306,6 +340,8 @@ pub(crate) struct Cycle<'a> {
     pub(crate) start: &'a PairStart,
     pub(crate) u0: Pair12,
     pub(crate) a_free: Pair12,
+    /// [`PairStart::stabilisation`]: shifts, then turns.
+    pub(crate) stabilisation: [[Vector; 2]; 2],
     pub(crate) h: f64,
     pub(crate) tolerance: f64,
 }
@@ -492,150 +528,384 @@ impl Cycle<'_> {
         axpy(&mut impulse, sigma_c * f[1], &here.loads[1]);
         (f, impulse, dissipated)
     }
+}
 
-    /// Integrates the step; `history` and `before` (the state at the step's start, its rates at
-    /// the state) are the contact's memory. `out` keeps its buffers.
-    pub(crate) fn run(&self, history: ContactHistory, before: &JournalState, out: &mut SubCycle) {
-        let j = self.joint;
-        out.samples.clear();
-        out.impulse = [0.0; 12];
-        let mut pi = [0.0; 12];
-        let mut m = Motion {
-            v: self.u0,
-            ..Motion::default()
-        };
-        let mut hist = history;
-        let mut prev = *before;
-        let mut here = self.here(&m);
-        let mut tau = 0.0;
-        let mut count = 0u32;
-        // The first half kick, from the state's own velocity.
-        let mut rest = self.h;
-        let mut s = self.substep(&here, &hist, rest);
-        let rate = self.impact_rate(&hist, &here);
-        let (_, dg, loss) = self.kick(&here, &mut m.v, (0.5 * s, 0.5 * s), 0.0, rate);
-        axpy(&mut out.impulse, 1.0, &dg);
-        out.dissipated = loss;
+/// One joint's state inside a sub-cycle.
+struct Lane {
+    m: Motion,
+    history: ContactHistory,
+    /// The state at the sub-step before, its rates at the state.
+    prev: JournalState,
+    here: Here,
+    /// `Pi`: the time integral of the impulse accumulated by each sub-step's start.
+    pi: Pair12,
+}
+
+/// What the sub-steps of one world step integrate: the coupled joints of one island, each with
+/// its [`Cycle`], the mobilities between their pairs (`cross[i]`: `(k, P_ik)`, how joint `k`'s
+/// contact moves joint `i`'s pair) and each contact's memory at the step's start (history, and
+/// the state with its rates at the state).
+pub(crate) struct Group<'a> {
+    pub(crate) cycles: Vec<Cycle<'a>>,
+    pub(crate) cross: Vec<Vec<(usize, [f64; 144])>>,
+    pub(crate) memory: Vec<(ContactHistory, JournalState)>,
+}
+
+impl Group<'_> {
+    /// The sub-step all joints can take from their lanes, at most `left` (s); 0 after the last.
+    fn substep(&self, lanes: &[Lane], left: f64, count: u32) -> f64 {
+        self.cycles
+            .iter()
+            .zip(lanes)
+            .map(|(c, l)| c.next_substep(&l.here, &l.history, left, count))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Joint `k`'s contact impulse `dg` moves the other joints' pairs.
+    fn spread(&self, lanes: &mut [Lane], k: usize, dg: &Pair12) {
+        if dg.iter().all(|x| *x == 0.0) {
+            return;
+        }
+        for (lane, cross) in lanes.iter_mut().zip(&self.cross) {
+            for (_, p) in cross.iter().filter(|(from, _)| *from == k) {
+                axpy(&mut lane.m.v, 1.0, &mul(p, dg));
+            }
+        }
+    }
+
+    /// Integrates the step of every joint in lockstep (the contacts of one sub-step kicked in
+    /// turn, each seeing the ones before: Gauss-Seidel across joints); `outs[k]` receives joint
+    /// `k`'s sub-cycle and keeps its buffers.
+    pub(crate) fn run(&self, outs: &mut [SubCycle]) {
+        let h = self.cycles[0].h;
+        let mut lanes: Vec<Lane> = self
+            .cycles
+            .iter()
+            .zip(&self.memory)
+            .map(|(c, (history, before))| {
+                let m = Motion {
+                    v: c.u0,
+                    ..Motion::default()
+                };
+                let here = c.here(&m);
+                Lane {
+                    here,
+                    m,
+                    history: *history,
+                    prev: *before,
+                    pi: [0.0; 12],
+                }
+            })
+            .collect();
+        for out in outs.iter_mut() {
+            out.samples.clear();
+            out.impulse = [0.0; 12];
+            out.dissipated = 0.0;
+        }
+        // The first half kicks, from the states' own velocities.
+        let mut rest = h;
+        let mut s = self.substep(&lanes, rest, 0);
+        for k in 0..lanes.len() {
+            let c = &self.cycles[k];
+            let rate = c.impact_rate(&lanes[k].history, &lanes[k].here);
+            let lane = &mut lanes[k];
+            let (_, dg, loss) = c.kick(&lane.here, &mut lane.m.v, (0.5 * s, 0.5 * s), 0.0, rate);
+            self.spread(&mut lanes, k, &dg);
+            axpy(&mut outs[k].impulse, 1.0, &dg);
+            outs[k].dissipated += loss;
+        }
+        let (mut tau, mut count) = (0.0, 0u32);
+        let mut onsets = Vec::with_capacity(lanes.len());
+        let mut v_before = Vec::with_capacity(lanes.len());
+        let mut forces = Vec::with_capacity(lanes.len());
         loop {
             count += 1;
-            for k in 0..2 {
-                m.shift[k] += s * part(&m.v, 2 * k);
-                m.turn[k] += s * part(&m.v, 2 * k + 1);
+            for ((lane, out), c) in lanes.iter_mut().zip(outs.iter()).zip(&self.cycles) {
+                let share = s / h;
+                for k in 0..2 {
+                    lane.m.shift[k] += s * part(&lane.m.v, 2 * k) + share * c.stabilisation[0][k];
+                    lane.m.turn[k] +=
+                        s * part(&lane.m.v, 2 * k + 1) + share * c.stabilisation[1][k];
+                }
+                axpy(&mut lane.pi, s, &out.impulse);
             }
-            axpy(&mut pi, s, &out.impulse);
             // A sub-step chosen as the rest of the step ends it exactly.
             let left = if s == rest { 0.0 } else { rest - s };
             rest = left;
             let last = left <= 0.0;
-            tau = if last { self.h } else { tau + s };
-            here = self.here(&m);
-            let onset = hist.advance(
-                Some(&prev),
-                &here.state,
-                j.min_impact_speed,
-                j.min_separation,
-            );
-            let next = self.next_substep(&here, &hist, left, count);
-            // A contact that began inside the sub-step before acts from its crossing on: for a
-            // law whose force jumps at the onset (Kelvin-Voigt's damping) the kick's half over
-            // that sub-step is the part after the crossing.
-            let before = if onset.onset {
-                s * (1.0 - onset.fraction.clamp(0.0, 1.0))
-            } else {
-                s
-            };
-            let spans = (0.5 * (s + next), 0.5 * (before + next));
-            let (alpha, beta) = (next / (s + next), s / (s + next));
-            let v_before = m.v;
-            let rate = self.impact_rate(&hist, &here);
-            let (f, dg, loss) = self.kick(&here, &mut m.v, spans, beta, rate);
-            axpy(&mut out.impulse, 1.0, &dg);
-            out.dissipated += loss;
-            // The state: its velocity between the half steps around it.
-            let mut at_state = m.v;
-            for (x, b) in at_state.iter_mut().zip(v_before) {
-                *x = alpha * b + beta * *x;
+            tau = if last { h } else { tau + s };
+            onsets.clear();
+            for (c, lane) in self.cycles.iter().zip(lanes.iter_mut()) {
+                let j = c.joint;
+                lane.here = c.here(&lane.m);
+                let onset = lane.history.advance(
+                    Some(&lane.prev),
+                    &lane.here.state,
+                    j.min_impact_speed,
+                    j.min_separation,
+                );
+                onsets.push(onset);
             }
-            let state = here.rates_at(&at_state);
-            let n = here.state.normal;
-            let force = ForcePair {
-                on_journal: -f[0] * n + f[1] * here.tangent,
-                point: here.state.contact_point,
-                normal_force: f[0],
-                friction_force: f[1].abs(),
-            };
-            out.samples.push(SubStep {
-                t: tau,
-                state,
-                force,
-                onset: onset.onset,
-                impact: onset.impact,
-                approach_speed: onset.approach_speed,
-                onset_fraction: onset.fraction,
-            });
-            prev = state;
+            let next = self.substep(&lanes, left, count);
+            let (alpha, beta) = (next / (s + next), s / (s + next));
+            v_before.clear();
+            v_before.extend(lanes.iter().map(|l| l.m.v));
+            forces.clear();
+            for k in 0..lanes.len() {
+                let c = &self.cycles[k];
+                // A contact that began inside the sub-step before acts from its crossing on:
+                // for a law whose force jumps at the onset (Kelvin-Voigt's damping) the kick's
+                // half over that sub-step is the part after the crossing.
+                let before = if onsets[k].onset {
+                    s * (1.0 - onsets[k].fraction.clamp(0.0, 1.0))
+                } else {
+                    s
+                };
+                let spans = (0.5 * (s + next), 0.5 * (before + next));
+                let rate = c.impact_rate(&lanes[k].history, &lanes[k].here);
+                let lane = &mut lanes[k];
+                let (f, dg, loss) = c.kick(&lane.here, &mut lane.m.v, spans, beta, rate);
+                self.spread(&mut lanes, k, &dg);
+                axpy(&mut outs[k].impulse, 1.0, &dg);
+                outs[k].dissipated += loss;
+                forces.push(f);
+            }
+            for k in 0..lanes.len() {
+                let (lane, onset, f) = (&mut lanes[k], &onsets[k], forces[k]);
+                // The state: its velocity between the half steps around it.
+                let mut at_state = lane.m.v;
+                for (x, b) in at_state.iter_mut().zip(v_before[k]) {
+                    *x = alpha * b + beta * *x;
+                }
+                let state = lane.here.rates_at(&at_state);
+                let n = lane.here.state.normal;
+                let force = ForcePair {
+                    on_journal: -f[0] * n + f[1] * lane.here.tangent,
+                    point: lane.here.state.contact_point,
+                    normal_force: f[0],
+                    friction_force: f[1].abs(),
+                };
+                outs[k].samples.push(SubStep {
+                    t: tau,
+                    state,
+                    force,
+                    onset: onset.onset,
+                    impact: onset.impact,
+                    approach_speed: onset.approach_speed,
+                    onset_fraction: onset.fraction,
+                });
+                lane.prev = state;
+            }
             if last {
-                out.end_mass = here.mass();
                 break;
             }
             s = next;
         }
-        out.end_velocity = m.v;
-        for (mean, p) in out.mean.iter_mut().zip(pi) {
-            *mean = p / self.h;
+        for (lane, out) in lanes.iter().zip(outs.iter_mut()) {
+            out.end_mass = lane.here.mass();
+            out.end_velocity = lane.m.v;
+            for (mean, p) in out.mean.iter_mut().zip(lane.pi) {
+                *mean = p / h;
+            }
+            out.history = lane.history;
+            out.substeps = count;
         }
-        out.history = hist;
-        out.substeps = count;
+    }
+}
+
+/// After Rapier's pass 0 of a step (`pass`), with `iterations` solver iterations: runs the
+/// sub-cycle of every sub-cycled joint of `joints` that has a start, the joints of one island
+/// together ([`Group`]), and returns the impulse Rapier's pass 1 must deliver for each, `Q kick`
+/// (`None`: nothing to deliver). Each keeps the impulse left held for the evaluation at the
+/// step's end.
+pub(crate) fn plan_cycles(
+    joints: &mut [&mut ClearanceJoint],
+    bodies: &RigidBodySet,
+    pass: &StepPass,
+    iterations: usize,
+) -> Vec<Option<Pair12>> {
+    let mut deliveries = vec![None; joints.len()];
+    let planned: Vec<usize> = (0..joints.len())
+        .filter(|&i| {
+            joints[i].cycle.start.is_some() && PairStart::velocity_now(joints[i], bodies).is_some()
+        })
+        .collect();
+    for group in islands(joints, &planned) {
+        plan_group(joints, &group, bodies, pass, iterations, &mut deliveries);
+    }
+    deliveries
+}
+
+/// The members of `planned` in groups whose pairs move each other (a block of
+/// `cycle.coupled`), each in the set's order.
+fn islands(joints: &[&mut ClearanceJoint], planned: &[usize]) -> Vec<Vec<usize>> {
+    let mut group: Vec<usize> = (0..planned.len()).collect();
+    fn root(group: &mut [usize], mut i: usize) -> usize {
+        while group[i] != i {
+            group[i] = group[group[i]];
+            i = group[i];
+        }
+        i
+    }
+    for (a, &i) in planned.iter().enumerate() {
+        for (b, &j) in planned.iter().enumerate().skip(a + 1) {
+            if joints[i].coupling_to(joints[j]).is_some() {
+                let (ra, rb) = (root(&mut group, a), root(&mut group, b));
+                group[ra.max(rb)] = ra.min(rb);
+            }
+        }
+    }
+    let roots: Vec<usize> = (0..planned.len()).map(|a| root(&mut group, a)).collect();
+    let mut out: Vec<(usize, Vec<usize>)> = Vec::new();
+    for (a, r) in roots.into_iter().enumerate() {
+        match out.iter_mut().find(|(root, _)| *root == r) {
+            Some((_, g)) => g.push(planned[a]),
+            None => out.push((r, vec![planned[a]])),
+        }
+    }
+    out.into_iter().map(|(_, g)| g).collect()
+}
+
+/// Runs the sub-cycle of the joints `group` (indices into `joints`, one island) and fills
+/// their `deliveries`.
+fn plan_group(
+    joints: &mut [&mut ClearanceJoint],
+    group: &[usize],
+    bodies: &RigidBodySet,
+    pass: &StepPass,
+    iterations: usize,
+    deliveries: &mut [Option<Pair12>],
+) {
+    let (h, kick) = (pass.dt, pass.kick);
+    let c_n = (iterations as f64 + 1.0) / (2.0 * iterations.max(1) as f64);
+    let mut runs: Vec<SubCycle> = group
+        .iter()
+        .map(|&i| std::mem::take(&mut joints[i].cycle.run))
+        .collect();
+    let shared: &[&mut ClearanceJoint] = joints;
+    let members: Vec<&ClearanceJoint> = group.iter().map(|&i| &*shared[i]).collect();
+    let starts: Vec<PairStart> = members
+        .iter()
+        .map(|j| j.cycle.start.expect("a planned joint has a start"))
+        .collect();
+    let held: Vec<Pair12> = members.iter().map(|j| j.cycle.held).collect();
+    let cross: Vec<Vec<(usize, [f64; 144])>> = members
+        .iter()
+        .enumerate()
+        .map(|(a, j)| {
+            let others = members.iter().enumerate().filter(|(b, _)| *b != a);
+            others
+                .filter_map(|(b, other)| j.coupling_to(other).map(|p| (b, p)))
+                .collect()
+        })
+        .collect();
+    // The velocity change of each pair from impulses on every pair of the group.
+    let moved = |a: usize, impulses: &[Pair12]| {
+        let mut v = starts[a].moved_by(&impulses[a]);
+        for (b, p) in &cross[a] {
+            axpy(&mut v, 1.0, &mul(p, &impulses[*b]));
+        }
+        v
+    };
+    let cycles = members
+        .iter()
+        .enumerate()
+        .map(|(a, &joint)| {
+            let now = PairStart::velocity_now(joint, bodies).expect("a planned joint's bodies");
+            let mut a_free = [0.0; 12];
+            for ((x, n), v) in a_free.iter_mut().zip(now).zip(starts[a].velocity()) {
+                *x = (n - v) / kick;
+            }
+            let mut u0 = *starts[a].velocity();
+            axpy(&mut u0, c_n * kick - 0.5 * h, &a_free);
+            axpy(&mut u0, 1.0, &moved(a, &held));
+            let stabilisation = starts[a]
+                .stabilisation(joint, bodies, &now, h, c_n)
+                .unwrap_or_default();
+            Cycle {
+                joint,
+                start: &starts[a],
+                u0,
+                a_free,
+                stabilisation,
+                h,
+                tolerance: pass.tolerance,
+            }
+        })
+        .collect();
+    let memory = members
+        .iter()
+        .map(|j| (j.contact, j.report.state))
+        .collect();
+    Group {
+        cycles,
+        cross: cross.clone(),
+        memory,
+    }
+    .run(&mut runs);
+    let deliver: Vec<Pair12> = (0..group.len())
+        .map(|a| {
+            let mut d = held[a];
+            axpy(&mut d, 1.0, &runs[a].mean);
+            d.map(|q| q / c_n)
+        })
+        .collect();
+    // The state's velocity beyond the Verlet reading of Rapier's velocities around it,
+    // `u_before + w (u_after - u_before)`, `w = h_prev/(h_prev + h)`: `P (H - w Q kick)`.
+    let w = (2.0 * kick - h) / (2.0 * kick);
+    let beyond: Vec<Pair12> = (0..group.len())
+        .map(|a| {
+            let mut b = held[a];
+            axpy(&mut b, -w, &deliver[a]);
+            b
+        })
+        .collect();
+    for (a, run) in runs.iter_mut().enumerate() {
+        run.start_correction = moved(a, &beyond);
+    }
+    for ((a, &i), mut run) in group.iter().enumerate().zip(runs) {
+        let mut left = held[a];
+        axpy(&mut left, 1.0, &run.impulse);
+        axpy(&mut left, -1.0, &deliver[a]);
+        let joint = &mut *joints[i];
+        std::mem::swap(&mut joint.cycle.run, &mut run);
+        joint.cycle.pending = Some(left);
+        deliveries[i] = deliver[a].iter().any(|q| *q != 0.0).then_some(deliver[a]);
     }
 }
 
 impl ClearanceJoint {
-    /// After Rapier's pass 0 of a step (`pass`), with `iterations` solver iterations: takes the
-    /// rest of the world's acceleration from the bodies' velocities, runs the sub-cycle and
-    /// returns the impulse Rapier's pass 1 must deliver, `Q kick` (`None`: nothing to deliver,
-    /// pass 0 stands). Keeps the impulse left held for the evaluation at the step's end.
-    pub(crate) fn plan_cycle(
+    /// The mobility from `other`'s contact loads to this joint's pair, when the two are
+    /// sub-cycled in one island (taken with the start, [`ClearanceJoint::take_coupling`]).
+    fn coupling_to(&self, other: &ClearanceJoint) -> Option<[f64; 144]> {
+        let pair = [other.body1, other.body2];
+        self.cycle
+            .coupled
+            .iter()
+            .find(|(p, _)| *p == pair)
+            .map(|(_, m)| *m)
+    }
+
+    /// Takes the mobilities from the contact loads of the other sub-cycled joints' pairs
+    /// (`partners`: their bearing and journal bodies) to this pair through `mechanism`, rebuilt
+    /// for this joint at the state: the pairs whose contacts move this one within a step.
+    pub(crate) fn take_coupling(
         &mut self,
-        bodies: &RigidBodySet,
-        pass: &StepPass,
-        iterations: usize,
-    ) -> Option<Pair12> {
-        let start = self.cycle.start?;
-        let now = PairStart::velocity_now(self, bodies)?;
-        let (h, kick) = (pass.dt, pass.kick);
-        let c_n = (iterations as f64 + 1.0) / (2.0 * iterations.max(1) as f64);
-        let mut a_free = [0.0; 12];
-        for ((a, n), v) in a_free.iter_mut().zip(now).zip(start.velocity()) {
-            *a = (n - v) / kick;
+        mechanism: &Mechanism,
+        partners: impl Iterator<Item = [RigidBodyHandle; 2]>,
+    ) {
+        self.cycle.coupled.clear();
+        if self.cycle.start.is_none() {
+            return;
         }
-        let mut u0 = *start.velocity();
-        axpy(&mut u0, c_n * kick - 0.5 * h, &a_free);
-        axpy(&mut u0, 1.0, &start.moved_by(&self.cycle.held));
-        let mut run = std::mem::take(&mut self.cycle.run);
-        let cycle = Cycle {
-            joint: self,
-            start: &start,
-            u0,
-            a_free,
-            h,
-            tolerance: pass.tolerance,
-        };
-        cycle.run(self.contact, &self.report.state, &mut run);
-        let mut deliver = self.cycle.held;
-        axpy(&mut deliver, 1.0, &run.mean);
-        deliver.iter_mut().for_each(|q| *q /= c_n);
-        let mut held = self.cycle.held;
-        axpy(&mut held, 1.0, &run.impulse);
-        axpy(&mut held, -1.0, &deliver);
-        // The state's velocity beyond the Verlet reading of Rapier's velocities around it,
-        // `u_before + w (u_after - u_before)`, `w = h_prev/(h_prev + h)`: `P (H - w Q kick)`.
-        let w = (2.0 * kick - h) / (2.0 * kick);
-        let mut beyond = self.cycle.held;
-        axpy(&mut beyond, -w, &deliver);
-        run.start_correction = start.moved_by(&beyond);
-        self.cycle.run = run;
-        self.cycle.pending = Some(held);
-        deliver.iter().any(|q| *q != 0.0).then_some(deliver)
+        for pair in partners {
+            if self.cycle.coupled.iter().any(|(p, _)| *p == pair) {
+                continue;
+            }
+            if let Some(p) = mechanism.cross_mobility(pair) {
+                self.cycle.coupled.push((pair, p));
+            }
+        }
     }
 
     /// At the evaluation after a sub-cycled step: the report from the sub-cycle's end, the

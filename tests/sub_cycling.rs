@@ -197,3 +197,48 @@ fn an_elastic_bounce_under_gravity_keeps_its_height_at_any_step() {
         assert!(worst < 0.02, "an approach {worst:.3e} off sqrt(2 g c)");
     }
 }
+
+/// In contact the world steps through the contact in a few steps of its own: a journal resting
+/// on its wall (Hertz, no damping, no friction), whose path bounds no step, asks for `20 tol`
+/// of its contact's natural period, `2 pi sqrt(m/k)` with `k = 1.5 K delta^0.5` the Hertz
+/// law's stiffness at its depth (closed form; the 2 kg journal's normal passes through its
+/// centre of mass), within 1 %, at the default tolerance and at half of it. A world step that
+/// spans a contact integrates it under the mechanism's state at the step's start (the rest of
+/// the world's acceleration and the pair's mobility held): on the deployable array's chattering
+/// root hinge every window statistic left its converged range.
+#[test]
+fn a_resting_sub_cycled_journal_bounds_the_world_step_by_its_contact_period() {
+    use clearance_joint::model::laws::{BearingGeometry, Hertz, NormalModel};
+    let k_hertz = 1e10;
+    let static_depth = (MASS * G / k_hertz).powf(1.0 / 1.5);
+    for tol in [0.0075, 0.00375] {
+        let control = StepControl::adaptive(1e-3, tol);
+        let (mut world, base, journal) = journal_world(control, 1);
+        let hertz = NormalModel::Hertz(Hertz::new(k_hertz, 1.5).unwrap());
+        let pin = Clearance::new(BearingGeometry::new(R_B, R_B - C, 0.016).unwrap(), hertz)
+            .integration(ContactIntegration::SubCycled)
+            .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
+            .unwrap();
+        let at_rest = Vector::new(0.0, -(C + static_depth), 0.0);
+        world.rapier.bodies[journal].set_translation(at_rest, true);
+        let pin = world.insert_clearance(base, journal, pin).unwrap();
+        world.step_to(0.01).unwrap();
+        let joint = world.clearance.get(pin).unwrap();
+        let depth = joint.report().state.penetration;
+        let stiffness = 1.5 * k_hertz * depth.sqrt();
+        let period = std::f64::consts::TAU * (MASS / stiffness).sqrt();
+        let step = joint.adaptive_step(tol, world.last_dt());
+        println!(
+            "tol {tol}: depth {:.4} um (static {:.4}), step {step:.4e} s, 20 tol of the period \
+             {:.4e} s",
+            depth * 1e6,
+            static_depth * 1e6,
+            20.0 * tol * period
+        );
+        assert!((depth / static_depth - 1.0).abs() < 0.01);
+        assert!(
+            (step / (20.0 * tol * period) - 1.0).abs() < 0.01,
+            "{step:e}"
+        );
+    }
+}

@@ -740,6 +740,10 @@ impl ClearanceJoint {
     ///   where and how fast the next impact comes), and the contact ahead is predicted from the
     ///   gap, closing speed and acceleration; a step covers at most half the time to it, and no
     ///   less than the step that contact will need.
+    /// - A sub-cycled joint ([`ContactIntegration::SubCycled`]) resolves its contacts in its
+    ///   sub-steps: the journal's path bounds the step, and in contact or approaching the wall
+    ///   the step covers at most 10 of the sub-steps the contact needs (`20 tolerance` of its
+    ///   period) and half the time to the wall.
     pub fn adaptive_step(&self, tolerance: f64, last_dt: f64) -> f64 {
         let r = &self.report;
         let m = r.effective_mass;
@@ -747,12 +751,13 @@ impl ClearanceJoint {
             return f64::INFINITY;
         }
         if self.sub_cycled() {
-            // The sub-steps resolve the contact: the journal's path alone bounds the step.
+            // The sub-steps resolve the contact; the world steps through it in a few steps.
             return flight_step(
                 tolerance,
                 self.geometry.clearance(),
                 r.state.eccentricity_rate.length(),
-            );
+            )
+            .min(self.world_contact_step(tolerance));
         }
         let delta = r.state.penetration;
         let rate = r.state.penetration_rate;

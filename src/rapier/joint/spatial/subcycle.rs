@@ -1,4 +1,5 @@
-//! Sub-cycled contact of the spatial joint ([`ContactIntegration::SubCycled`]).
+//! Sub-cycled contact of the spatial joint
+//! ([`ContactIntegration::SubCycled`](crate::rapier::joint::ContactIntegration::SubCycled)).
 //!
 //! The planar sub-cycle's frame is kept (`super::super::subcycle`): Rapier's pass 0 gives the
 //! rest of the world's acceleration `a` of the pair's 12 velocities, the joint integrates the

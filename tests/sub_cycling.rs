@@ -143,23 +143,6 @@ fn a_sub_cycle_beyond_its_sub_step_cap_is_a_guard_violation() {
     assert!(world.guards().is_clean(), "{:?}", world.guards());
 }
 
-/// A spatial joint asked to sub-cycle is refused, naming `integration` and what to give instead.
-#[test]
-fn a_spatial_joint_is_not_sub_cycled() {
-    use clearance_joint::model::spatial::SpatialModel;
-    let err = Clearance::steel_improved_liu(R_B, C, 0.016)
-        .unwrap()
-        .model(ClearanceModel::Spatial(SpatialModel::steel(0.1e-3, 0.015)))
-        .integration(ContactIntegration::SubCycled)
-        .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
-        .unwrap_err();
-    let text = err.to_string();
-    assert!(
-        text.contains("integration") && text.contains("Explicit"),
-        "{text}"
-    );
-}
-
 /// A journal bouncing elastically (Hertz, no damping, no friction) under gravity in a bearing,
 /// sub-cycled in steps of 1/60 s and of 1 ms: every bounce comes back to the bearing's centre,
 /// the drop's height, and strikes at `sqrt(2 g c)` (each approach within 2 % of it over 3 s and

@@ -197,14 +197,6 @@ impl ClearanceJointBuilder {
                 .map_err(|e| e.within("spatial"))?;
             j.lock = OutOfPlaneLock::None;
             j.spatial = Some(SpatialParts::new(model, face_law, j.local_axis1));
-            if j.integration == ContactIntegration::SubCycled {
-                return Err(Error::invalid(
-                    "integration",
-                    "is SubCycled, which the planar joint has and the spatial joint has not: \
-                     give the spatial joint ContactIntegration::Explicit, or drop its spatial \
-                     model",
-                ));
-            }
         }
         Ok(self.joint)
     }
@@ -419,6 +411,10 @@ struct CycleState {
     impulse: [f64; 12],
     /// The sub-steps of the last step.
     substep_count: u32,
+    /// A spatial joint's pair at the state before the next step.
+    spatial_start: Option<spatial::subcycle::SpatialStart>,
+    /// A spatial joint's last accepted sub-step, s: the next step's first guess (0: none).
+    substep_guess: f64,
 }
 
 /// Default of [`ClearanceJointBuilder::min_impact_speed`], m/s.
@@ -640,9 +636,9 @@ impl ClearanceJoint {
     pub fn substeps(&self) -> &[SubStep] {
         &self.cycle.substeps
     }
-    /// Whether the contact is sub-cycled (a planar joint with [`ContactIntegration::SubCycled`]).
+    /// Whether the contact is sub-cycled ([`ContactIntegration::SubCycled`]).
     fn sub_cycled(&self) -> bool {
-        self.integration == ContactIntegration::SubCycled && self.spatial.is_none()
+        self.integration == ContactIntegration::SubCycled
     }
     /// What the hook computed at its last application.
     pub fn report(&self) -> &ClearanceReport {
@@ -748,7 +744,11 @@ impl ClearanceJoint {
             return f64::INFINITY;
         }
         if self.sub_cycled() {
-            // The sub-steps resolve the contact; the world steps through it in a few steps.
+            // The sub-steps resolve the contact; the world steps through it in a few steps (a
+            // spatial joint's: every region's path across its gap bounds the step).
+            if let Some(parts) = &self.spatial {
+                return parts.flight_step(tolerance);
+            }
             return flight_step(
                 tolerance,
                 self.geometry.clearance(),
@@ -1337,7 +1337,11 @@ impl ClearanceJointSet {
             }
             self.mechanism
                 .rebuild(bodies, impulse_joints, joint.body1, joint.body2);
-            let finished = joint.finish_cycle(bodies);
+            let finished = if joint.spatial.is_some() {
+                joint.finish_spatial_cycle(bodies, &self.mechanism)
+            } else {
+                joint.finish_cycle(bodies)
+            };
             if finished.is_none() {
                 // Explicit, or a sub-cycled joint's first evaluation (velocities its own).
                 joint.cycle.held = [0.0; 12];
@@ -1349,6 +1353,7 @@ impl ClearanceJointSet {
                 .or_else(|| joint.evaluate(bodies, self.last_step, &self.mechanism))
                 .map(|(w1, w2)| [w1, w2]);
             joint.take_start(bodies, &self.mechanism);
+            joint.take_spatial_start(bodies, &self.mechanism);
             if joint.last_wrenches.is_none() {
                 joint.contact = ContactHistory::default();
                 joint.report = ClearanceReport::default();
@@ -1382,7 +1387,12 @@ impl ClearanceJointSet {
         }
         self.planned.clear();
         for joint in self.joints.values_mut() {
-            if let Some(deliver) = joint.plan_cycle(bodies, pass, iterations) {
+            let planned = if joint.spatial.is_some() {
+                joint.plan_spatial_cycle(bodies, pass, iterations)
+            } else {
+                joint.plan_cycle(bodies, pass, iterations)
+            };
+            if let Some(deliver) = planned {
                 self.planned.extend(joint.delivery(&deliver, pass.kick));
             }
         }

@@ -1,7 +1,7 @@
 //! The clearance joint in a Rapier world: a revolute hinge whose radial play is left to the
 //! contact law. [`ClearanceJointSet::apply`] is the per-step force hook.
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, StepLimit};
 use crate::model::kinematics::{
     BodyMotion, ContactMode, ForcePair, JournalState, StepBefore, contact_force, force_and_damping,
     journal_state, stable_step,
@@ -1448,19 +1448,15 @@ impl ClearanceJointSet {
                     Some(impact) => impact,
                     None => (r.max_stable_dt, r.state.penetration, r.omega, r.zeta),
                 };
-                return Err(Error::StepTooLarge {
-                    field: "dt".into(),
-                    joint: j.name.clone(),
+                return Err(Error::StepTooLarge(Box::new(StepLimit::new(
+                    j.name.clone(),
                     dt,
                     dt_max,
-                    t: None,
-                    penetration_um: depth * 1e6,
+                    depth * 1e6,
                     omega,
                     zeta,
-                    parameter: j.normal_law.kind().stiff_parameter(zeta),
-                    adaptive: None,
-                    names: None,
-                });
+                    j.normal_law.kind().stiff_parameter(zeta),
+                ))));
             }
         }
         Ok(())

@@ -1,5 +1,7 @@
 //! Errors as values: every failure names the field or file it concerns and says why.
 
+use crate::rapier::guards::Violation;
+use crate::rapier::stall::Stall;
 use std::path::PathBuf;
 
 /// Everything that can go wrong in this crate. Nothing here panics on bad input.
@@ -34,41 +36,9 @@ pub enum Error {
     /// integration would blow up. Raised before the state is destroyed, never silently. The
     /// message names the contact parameter that makes the contact this stiff
     /// ([`ContactParameter`]) and gives advice fitting the step mode (when the code that raised
-    /// it knows the mode, see [`Error::with_step_mode`]).
-    #[error(
-        "`{field}` = {} s is too large for the contact of joint `{joint}`{at}: the explicit step is \
-         stable only below {} s there (penetration {} um, natural frequency {} rad/s, damping ratio {}). {}",
-        sig4(*dt), sig4(*dt_max), sig4(*penetration_um), sig4(*omega), sig4(*zeta),
-        step_advice(field, *dt_max, *parameter, *adaptive, names.as_deref()),
-        at = t.map_or(String::new(), |t| format!(" at t = {} s", sig4(t)))
-    )]
-    StepTooLarge {
-        /// The parameter that sets the step, as the caller names it: `dt` from the plain API,
-        /// `Physics::world.rapier.integration_parameters.dt` from the ECS layer, `run.dt_s` from a scene.
-        field: String,
-        /// The name of the joint whose contact limits the step.
-        joint: String,
-        /// The step in use, s.
-        dt: f64,
-        /// The largest stable step for this contact, s.
-        dt_max: f64,
-        /// Simulated time when detected, when the caller knows it.
-        t: Option<f64>,
-        /// Penetration at detection, micrometres.
-        penetration_um: f64,
-        /// Linearised natural frequency of the contact, rad/s.
-        omega: f64,
-        /// Linearised damping ratio of the contact.
-        zeta: f64,
-        /// The contact parameter that makes the contact this stiff (or this damped).
-        parameter: ContactParameter,
-        /// Whether the step was adaptive (`Some(true)`), fixed (`Some(false)`) or unknown to the
-        /// code that raised the error (`None`); see [`Error::with_step_mode`].
-        adaptive: Option<bool>,
-        /// The caller's names of the parameters the advice mentions, when a layer above the
-        /// plain API put its own ([`Error::named`]); `None`: the plain API's names.
-        names: Option<Box<ParameterNames>>,
-    },
+    /// it knows the mode, see [`Error::with_step_mode`]); the numbers are [`StepLimit`]'s.
+    #[error("{0}")]
+    StepTooLarge(Box<StepLimit>),
     /// The simulation state became non-physical (non-finite, or energy/momentum destroyed).
     #[error("simulation diverged at t = {t:.6} s: {reason}")]
     Diverged {
@@ -79,22 +49,23 @@ pub enum Error {
     },
     /// The step control could not make progress: every step it tried was rejected, or it stayed
     /// at its floor without advancing the simulated time.
-    #[error("the step control stalled at t = {t:.6} s: {reason}")]
+    #[error("the step control stalled at t = {t:.6} s: {stall}")]
     Stalled {
         /// Simulated time when detected.
         t: f64,
-        /// What was seen, with the likely cause.
-        reason: String,
+        /// What was seen, the contact that stopped the step control and the cause found from
+        /// its numbers (in words through its `Display`).
+        stall: Box<Stall>,
     },
     /// A run-time guard was violated and the step control is strict
     /// ([`StepControl::strict`](crate::rapier::stepper::StepControl::strict), a scene's
     /// `run.strict`).
-    #[error("guard violated (strict) by t = {t:.6} s: {violations}")]
+    #[error("guard violated (strict) by t = {t:.6} s: {}", in_words(violations))]
     Guard {
         /// Simulated time when detected.
         t: f64,
-        /// The violations in words.
-        violations: String,
+        /// The violations (in words: [`Violation::message`], joined by `; `).
+        violations: Vec<Violation>,
     },
     /// A convergence check found metrics that move beyond their bounds at a tighter step
     /// control ([`ConvergenceCheck::strict`](crate::scene::runner::convergence::ConvergenceCheck::strict)).
@@ -108,6 +79,15 @@ pub enum Error {
         /// The worst, in words.
         worst: String,
     },
+    /// A result folder cannot be used: it is not a folder, or another run is writing into it.
+    /// The message calls it the output folder: an application names its own option for it.
+    #[error("invalid `output folder`: {reason}")]
+    OutputFolder {
+        /// The folder.
+        folder: PathBuf,
+        /// What is wrong with it.
+        reason: String,
+    },
     /// A file could not be read or written.
     #[error("{action} `{path}`: {source}")]
     Io {
@@ -119,6 +99,137 @@ pub enum Error {
         #[source]
         source: std::io::Error,
     },
+}
+
+/// A step beyond the stability limit of a contact: the numbers of [`Error::StepTooLarge`].
+/// Its `Display` is the error's message.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepLimit {
+    pub(crate) field: String,
+    pub(crate) joint: String,
+    pub(crate) dt: f64,
+    pub(crate) dt_max: f64,
+    pub(crate) t: Option<f64>,
+    pub(crate) penetration_um: f64,
+    pub(crate) omega: f64,
+    pub(crate) zeta: f64,
+    pub(crate) parameter: ContactParameter,
+    pub(crate) adaptive: Option<bool>,
+    pub(crate) names: Option<ParameterNames>,
+}
+
+impl StepLimit {
+    /// A step `dt` (s, the plain API's `dt`) beyond the limit `dt_max` (s) of the contact of
+    /// joint `joint`, linearised at a penetration of `penetration_um` (um) to a natural
+    /// frequency `omega` (rad/s) and a damping ratio `zeta`; `parameter` makes it this stiff.
+    pub fn new(
+        joint: impl Into<String>,
+        dt: f64,
+        dt_max: f64,
+        penetration_um: f64,
+        omega: f64,
+        zeta: f64,
+        parameter: ContactParameter,
+    ) -> StepLimit {
+        StepLimit {
+            field: "dt".into(),
+            joint: joint.into(),
+            dt,
+            dt_max,
+            t: None,
+            penetration_um,
+            omega,
+            zeta,
+            parameter,
+            adaptive: None,
+            names: None,
+        }
+    }
+
+    /// The parameter that sets the step, as the caller names it: `dt` from the plain API,
+    /// `Physics::world.rapier.integration_parameters.dt` from the ECS layer, `run.dt_s` from a
+    /// scene.
+    pub fn field(&self) -> &str {
+        &self.field
+    }
+
+    /// The name of the joint whose contact limits the step.
+    pub fn joint(&self) -> &str {
+        &self.joint
+    }
+
+    /// The step in use, s.
+    pub fn dt(&self) -> f64 {
+        self.dt
+    }
+
+    /// The largest stable step for this contact, s.
+    pub fn dt_max(&self) -> f64 {
+        self.dt_max
+    }
+
+    /// Simulated time when detected, s, when the caller knows it.
+    pub fn t(&self) -> Option<f64> {
+        self.t
+    }
+
+    /// Penetration at detection, micrometres.
+    pub fn penetration_um(&self) -> f64 {
+        self.penetration_um
+    }
+
+    /// Linearised natural frequency of the contact, rad/s.
+    pub fn omega(&self) -> f64 {
+        self.omega
+    }
+
+    /// Linearised damping ratio of the contact.
+    pub fn zeta(&self) -> f64 {
+        self.zeta
+    }
+
+    /// The contact parameter that makes the contact this stiff (or this damped).
+    pub fn parameter(&self) -> ContactParameter {
+        self.parameter
+    }
+
+    /// Whether the step was adaptive (`Some(true)`), fixed (`Some(false)`) or unknown to the
+    /// code that raised the error (`None`); see [`Error::with_step_mode`].
+    pub fn adaptive(&self) -> Option<bool> {
+        self.adaptive
+    }
+
+    /// The caller's names of the parameters the advice mentions, when a layer above the plain
+    /// API put its own ([`Error::named`]); `None`: the plain API's names.
+    pub fn names(&self) -> Option<&ParameterNames> {
+        self.names.as_ref()
+    }
+}
+
+impl std::fmt::Display for StepLimit {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "`{}` = {} s is too large for the contact of joint `{}`{}: the explicit step is \
+             stable only below {} s there (penetration {} um, natural frequency {} rad/s, damping ratio {}). {}",
+            self.field,
+            sig4(self.dt),
+            self.joint,
+            self.t
+                .map_or(String::new(), |t| format!(" at t = {} s", sig4(t))),
+            sig4(self.dt_max),
+            sig4(self.penetration_um),
+            sig4(self.omega),
+            sig4(self.zeta),
+            step_advice(
+                &self.field,
+                self.dt_max,
+                self.parameter,
+                self.adaptive,
+                self.names.as_ref()
+            ),
+        )
+    }
 }
 
 /// The contact parameter that makes a contact stiff (or, when it is over-damped, damped): what
@@ -199,6 +310,15 @@ pub struct ParameterNames {
     pub contact: Vec<String>,
 }
 
+/// Guard violations in words, as [`Error::Guard`] shows them.
+fn in_words(violations: &[Violation]) -> String {
+    violations
+        .iter()
+        .map(Violation::message)
+        .collect::<Vec<_>>()
+        .join("; ")
+}
+
 /// Shorthand for results of this crate.
 pub type Result<T, E = Error> = std::result::Result<T, E>;
 
@@ -223,8 +343,8 @@ impl Error {
     /// Tells an [`Error::StepTooLarge`] whether the step was adaptive, so its message gives the
     /// advice that fits the mode; other variants pass through.
     pub fn with_step_mode(mut self, is_adaptive: bool) -> Self {
-        if let Error::StepTooLarge { adaptive, .. } = &mut self {
-            *adaptive = Some(is_adaptive);
+        if let Error::StepTooLarge(limit) = &mut self {
+            limit.adaptive = Some(is_adaptive);
         }
         self
     }
@@ -233,12 +353,9 @@ impl Error {
     /// the step, and the names of `names` for the rest (how the layer above the plain API calls
     /// them); other variants pass through.
     pub fn named(mut self, step: &str, names: ParameterNames) -> Self {
-        if let Error::StepTooLarge {
-            field, names: n, ..
-        } = &mut self
-        {
-            *field = step.into();
-            *n = Some(Box::new(names));
+        if let Error::StepTooLarge(limit) = &mut self {
+            limit.field = step.into();
+            limit.names = Some(names);
         }
         self
     }
@@ -248,11 +365,11 @@ impl Error {
     /// other variants). An application phrases it in its own options.
     pub fn suggested_step(&self) -> Option<f64> {
         match self {
-            Error::StepTooLarge {
-                dt_max,
-                adaptive: Some(false),
-                ..
-            } if 0.8 * dt_max >= SMALLEST_STEP => Some(0.8 * dt_max),
+            Error::StepTooLarge(limit)
+                if limit.adaptive == Some(false) && 0.8 * limit.dt_max >= SMALLEST_STEP =>
+            {
+                Some(0.8 * limit.dt_max)
+            }
             _ => None,
         }
     }
@@ -471,19 +588,18 @@ mod tests {
 
     /// A step-limit error as the plain API raises it (field `dt`, no caller names).
     fn step_error(parameter: ContactParameter, adaptive: Option<bool>) -> Error {
-        Error::StepTooLarge {
-            field: "dt".into(),
-            joint: "pin".into(),
-            dt: 1e-3,
-            dt_max: 1.3122521820485098e-4,
-            t: Some(0.08800000000000001),
-            penetration_um: 11.333333333333334,
-            omega: 15241.234567890123,
-            zeta: 0.1234567890123,
+        let mut limit = StepLimit::new(
+            "pin",
+            1e-3,
+            1.3122521820485098e-4,
+            11.333333333333334,
+            15241.234567890123,
+            0.1234567890123,
             parameter,
-            adaptive,
-            names: None,
-        }
+        );
+        limit.t = Some(0.08800000000000001);
+        limit.adaptive = adaptive;
+        Error::StepTooLarge(Box::new(limit))
     }
 
     #[test]

@@ -1,7 +1,9 @@
 //! The README is a front page and its chapters live in `docs/`: every relative link and image in
 //! `README.md` and `docs/*.md` must lead to a file that exists (and a `#anchor` to a heading of
 //! that file), the front page must stay short, and every chapter's code blocks must be compiled as
-//! doctests (listed in `src/lib.rs`). Pure file reading: no network, no build of the docs.
+//! doctests (listed in `src/lib.rs`). A constant's rustdoc is a rule and its reason: no paragraph
+//! of it longer than [`CONST_DOC_MAX_LINES`] lines (measurements live in `docs/` and
+//! CHANGELOG.md). Pure file reading: no network, no build of the docs.
 
 use std::collections::BTreeSet;
 use std::fs;
@@ -9,6 +11,9 @@ use std::path::{Path, PathBuf};
 
 /// The front page's budget, in lines.
 const README_MAX_LINES: usize = 400;
+
+/// The longest paragraph a constant's rustdoc may have, in lines.
+const CONST_DOC_MAX_LINES: usize = 6;
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -206,6 +211,103 @@ fn broken_links(file: &Path) -> (Vec<String>, usize) {
     (broken, checked)
 }
 
+/// Every `.rs` file under `dir`, sorted.
+fn rust_files(dir: &Path) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    let mut entries: Vec<PathBuf> = fs::read_dir(dir)
+        .expect("a readable folder")
+        .map(|e| e.expect("a readable entry").path())
+        .collect();
+    entries.sort();
+    for path in entries {
+        if path.is_dir() {
+            files.extend(rust_files(&path));
+        } else if path.extension().is_some_and(|x| x == "rs") {
+            files.push(path);
+        }
+    }
+    files
+}
+
+/// Whether a line declares a constant (`const X: T`, `pub const`, `pub(crate) const`; not a
+/// `const fn`).
+fn declares_const(line: &str) -> bool {
+    let mut rest = line.trim_start();
+    if let Some(r) = rest.strip_prefix("pub") {
+        rest = match r.strip_prefix('(') {
+            Some(r) => r.split_once(')').map_or(r, |(_, after)| after),
+            None => r,
+        }
+        .trim_start();
+    }
+    let Some(r) = rest.strip_prefix("const ") else {
+        return false;
+    };
+    let name: String = r
+        .trim_start()
+        .chars()
+        .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+        .collect();
+    !name.is_empty() && name != "fn" && r.trim_start()[name.len()..].trim_start().starts_with(':')
+}
+
+/// The constants of `text` whose rustdoc (the `///` lines directly above, attributes skipped)
+/// has a paragraph longer than `max` lines: (line of the constant, longest paragraph).
+fn long_const_docs(text: &str, max: usize) -> Vec<(usize, usize)> {
+    let lines: Vec<&str> = text.lines().collect();
+    let mut long = Vec::new();
+    for (i, line) in lines.iter().enumerate() {
+        if !declares_const(line) {
+            continue;
+        }
+        let mut j = i;
+        while j > 0 && lines[j - 1].trim_start().starts_with("#[") {
+            j -= 1;
+        }
+        let (mut longest, mut run) = (0, 0);
+        while j > 0 && lines[j - 1].trim_start().starts_with("///") {
+            j -= 1;
+            if lines[j].trim_start()[3..].trim().is_empty() {
+                run = 0;
+            } else {
+                run += 1;
+                longest = longest.max(run);
+            }
+        }
+        if longest > max {
+            long.push((i + 1, longest));
+        }
+    }
+    long
+}
+
+#[test]
+fn constant_docs_are_rules_not_histories() {
+    let mut long = Vec::new();
+    let mut constants = 0;
+    for file in rust_files(&root().join("src")) {
+        let text = fs::read_to_string(&file).unwrap();
+        constants += text.lines().filter(|l| declares_const(l)).count();
+        for (line, n) in long_const_docs(&text, CONST_DOC_MAX_LINES) {
+            long.push(format!(
+                "{}:{line}: a paragraph of {n} lines",
+                file.strip_prefix(root()).unwrap_or(&file).display()
+            ));
+        }
+    }
+    assert!(
+        long.is_empty(),
+        "constants' rustdoc with a paragraph longer than {CONST_DOC_MAX_LINES} lines (state the \
+         rule and its reason; measurements go to docs/ and CHANGELOG.md):\n{}",
+        long.join("\n")
+    );
+    // A scanner that finds nothing checks nothing.
+    assert!(
+        constants >= 50,
+        "only {constants} constants found under src/"
+    );
+}
+
 #[test]
 fn every_relative_link_and_image_of_the_docs_resolves() {
     let files = markdown_files();
@@ -288,6 +390,15 @@ fn the_checker_finds_what_it_should() {
         headings,
         BTreeSet::from(["a".to_string(), "a-1".to_string()])
     );
+    assert!(declares_const(
+        "    pub const FILE: &'static str = \".lock\";"
+    ));
+    assert!(declares_const("pub(crate) const X: f64 = 1.0;"));
+    assert!(!declares_const("pub const fn new() -> Self {"));
+    assert!(!declares_const("// const X: f64"));
+    let doc = "/// a\n/// b\n///\n/// c\n/// d\n/// e\n#[doc(hidden)]\nconst X: u8 = 0;\n";
+    assert!(long_const_docs(doc, 3).is_empty());
+    assert_eq!(long_const_docs(doc, 2), [(8, 3)]);
     let lines = prose_lines("text\n```rust\n[x](gone.md)\n```\n[y](here.md)\n");
     assert_eq!(lines.len(), 2);
     assert_eq!(link_targets(&lines[1].1), ["here.md"]);

@@ -84,8 +84,8 @@ fn a_fixed_step_too_large_names_the_api() {
     let e = run_until_error(&mut world, &mut set, StepControl::fixed(1e-3), 1.0);
     let m = e.to_string();
     assert!(
-        matches!(&e, Error::StepTooLarge { field, joint, adaptive: Some(false), t: Some(_), .. }
-            if field == "StepControl::max_dt" && joint == "pin"),
+        matches!(&e, Error::StepTooLarge(l) if l.field() == "StepControl::max_dt"
+            && l.joint() == "pin" && l.adaptive() == Some(false) && l.t().is_some()),
         "{m}"
     );
     for part in [
@@ -132,7 +132,7 @@ fn a_fixed_step_too_large_names_the_api() {
     };
     let m2 = e.to_string();
     assert!(
-        matches!(&e, Error::StepTooLarge { field, .. } if field == "StepControl::max_dt"),
+        matches!(&e, Error::StepTooLarge(l) if l.field() == "StepControl::max_dt"),
         "{m2}"
     );
     assert_plain(&m2);
@@ -156,7 +156,7 @@ fn the_force_hook_in_a_users_own_loop_names_rapiers_dt() {
         .expect("the contact refuses a 1 ms step");
     let m = e.to_string();
     assert!(
-        matches!(&e, Error::StepTooLarge { field, adaptive: None, .. } if field == "dt"),
+        matches!(&e, Error::StepTooLarge(l) if l.field() == "dt" && l.adaptive().is_none()),
         "{m}"
     );
     assert!(m.contains("smaller `dt`"), "{m}");
@@ -410,7 +410,7 @@ fn the_scene_layer_names_the_scene_fields() {
     let e = run_scene(&scene).unwrap_err();
     let m = e.to_string();
     assert!(
-        matches!(&e, Error::StepTooLarge { field, .. } if field == "run.dt_s"),
+        matches!(&e, Error::StepTooLarge(l) if l.field() == "run.dt_s"),
         "{m}"
     );
     for part in [
@@ -591,5 +591,5 @@ fn a_refused_fixed_step_suggests_the_step_the_impact_needs() {
     assert!(suggested > 1e-4, "{e}");
     assert!(run(suggested).is_ok(), "the suggested {suggested} s");
     let e = run(2.0 * suggested).unwrap_err();
-    assert!(matches!(e, Error::StepTooLarge { .. }), "{e}");
+    assert!(matches!(e, Error::StepTooLarge(_)), "{e}");
 }

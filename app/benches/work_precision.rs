@@ -7,8 +7,8 @@
 //! peaks are) and printed with the table.
 
 use clearance_joint::scene::Scene;
-use clearance_joint::scene::output::write_atomic;
 use clearance_joint::scene::runner::{RunOptions, Simulation, TwinKind, Twins};
+use clearance_joint_app::process::files::write_atomic;
 use plotters::prelude::*;
 use std::path::Path;
 use std::time::Instant;

@@ -3,15 +3,15 @@
 //! carries the numbers, and this module adds what to type (`--dt`, `--set run.step=Adaptive`,
 //! `--strict`, `--out`, `--max-memory`), as ripgrep's binary phrases its libraries' errors.
 
+use crate::process::memory::MemoryEstimate;
 use clearance_joint::error::{Error, sig4};
 use clearance_joint::scene::Scene;
-use clearance_joint::scene::output::{MemoryEstimate, OUTPUT_FOLDER};
 
 /// `e` as the command line shows it: the library's message, then the options that act on it.
 pub fn describe(e: &Error) -> String {
     let message = e.to_string();
     match e {
-        Error::StepTooLarge { .. } => match e.suggested_step() {
+        Error::StepTooLarge(_) => match e.suggested_step() {
             Some(dt) => format!(
                 "{message} On the command line: `--dt {}` (or smaller), or `--set run.step=Adaptive`.",
                 sig4(dt)
@@ -19,7 +19,7 @@ pub fn describe(e: &Error) -> String {
             None => message,
         },
         // The library's result folder is this program's `--out`.
-        Error::Invalid { field, reason } if field == OUTPUT_FOLDER => {
+        Error::OutputFolder { reason, .. } => {
             format!("invalid `--out`: {reason}")
         }
         Error::Guard { .. } => format!(
@@ -67,7 +67,7 @@ pub fn memory_options(
     let options = if estimate.replay_bytes > 0 {
         format!(
             "`--no-replay` drops the replay (`replay.html`, about {}), or {options}",
-            clearance_joint::scene::output::bytes_text(estimate.replay_bytes)
+            crate::process::memory::bytes_text(estimate.replay_bytes)
         )
     } else {
         options

@@ -6,6 +6,8 @@
 //! - [`study`]: sweeps over any scene field (parallel, resumable, shardable) and studies, the
 //!   named sweeps a scene file declares (the paper's three for its scene), with their reports.
 //! - [`figures`]: the figures of a run and of the studies (PNG and SVG).
+//! - [`process`]: this process's plumbing: files in flight removed on an interrupt, folder
+//!   locks, memory probing and sizes.
 //! - [`progress`]: progress of a long run on a terminal.
 //! - [`replay`]: the self-contained `replay.html` of a run (3D, journal insets, timeline).
 //! - [`resultset`]: a result set (data, figures, report, replay) written as one unit.
@@ -22,6 +24,7 @@
 pub mod advice;
 pub mod cli;
 pub mod figures;
+pub mod process;
 pub mod progress;
 pub mod replay;
 pub mod resultset;

@@ -581,7 +581,7 @@ fn main() -> ExitCode {
     // Ctrl-C (or a kill with SIGTERM/SIGHUP): remove our temporaries and lock files, then exit.
     // A set being renamed into place is finished first; finished points of a sweep or study stay.
     if let Err(e) = ctrlc::set_handler(|| {
-        clearance_joint::scene::output::remove_inflight();
+        clearance_joint_app::process::files::remove_inflight();
         clearance_joint_app::resultset::abandon_all();
         // Not `eprintln!`: it panics on a closed standard error, and the process would not exit.
         let _ = std::io::Write::write_all(

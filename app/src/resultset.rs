@@ -15,8 +15,9 @@
 //! - A set that fails before its commit is dropped: the old set stays as it was (with `keep`,
 //!   the carried entries go back into the target). [`abandon_all`] does the same on an interrupt.
 
+use crate::process::files::{clean_stale_temps, process_alive};
+use crate::process::lock::DirLock;
 use clearance_joint::error::{Error, Result};
-use clearance_joint::scene::output::{DirLock, clean_stale_temps, process_alive};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;

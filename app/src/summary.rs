@@ -2,8 +2,8 @@
 //! ([`RunResult::write_checked`]) with the scene the run used, every `--set` override applied
 //! and every default filled in, under [`EFFECTIVE_SCENE`].
 
+use crate::process::files::write_atomic;
 use clearance_joint::error::{Error, Result};
-use clearance_joint::scene::output::write_atomic;
 use clearance_joint::scene::report::{Summary, summary_json};
 use clearance_joint::scene::runner::RunResult;
 use clearance_joint::scene::runner::convergence::ConvergenceVerdict;
@@ -23,7 +23,7 @@ pub fn write_run(
     dir: &Path,
     convergence: &ConvergenceVerdict,
 ) -> Result<Summary> {
-    let summary = result.write_checked(dir, convergence)?;
+    let summary = result.write_checked(dir, convergence, &crate::process::files::STAGING)?;
     let text = summary_with_scene(&summary, &result.scene)?;
     write_atomic(&dir.join("summary.json"), text.as_bytes())?;
     Ok(summary)

@@ -3,9 +3,10 @@
 //! memory, too many threads) leave no mixed, partial or stale files.
 
 use clearance_joint::Error;
-use clearance_joint::scene::output::{MemoryEstimate, clean_stale_temps, write_all_atomic};
 use clearance_joint::scene::runner::{Progress, RunOptions, Simulation};
 use clearance_joint::scene::{SOLAR_PANEL_RON, Scene};
+use clearance_joint_app::process::files::{clean_stale_temps, write_all_atomic};
+use clearance_joint_app::process::memory::MemoryEstimate;
 use clearance_joint_app::progress::{RunProgress, status};
 use clearance_joint_app::study::report::Verdict;
 use clearance_joint_app::study::sweep::{self, ExecOptions};
@@ -436,7 +437,7 @@ fn step_limit_messages() {
         .run()
         .unwrap_err();
     let lib = e.to_string();
-    assert!(matches!(e, Error::StepTooLarge { .. }), "{lib}");
+    assert!(matches!(e, Error::StepTooLarge(_)), "{lib}");
     for part in [
         "`run.dt_s` = 0.001 s",
         "`run.step = Adaptive`",

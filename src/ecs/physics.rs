@@ -619,12 +619,11 @@ impl Physics {
 }
 
 /// Refuses a compliant clearance hinge in a world whose settings cannot step it, naming what it
-/// needs and why; the world's settings are the user's and stay as they are. A sub-cycled planar
-/// hinge takes any number of iterations.
+/// needs and why; the world's settings are the user's and stay as they are. A sub-cycled hinge
+/// takes any number of iterations.
 fn check_compliant(world: &PhysicsWorld, entity: Entity, c: &Clearance) -> Result<()> {
     let n = world.integration_parameters.num_solver_iterations;
-    let sub_cycled = c.integration == crate::rapier::joint::ContactIntegration::SubCycled
-        && !matches!(c.model, ClearanceModel::Spatial(_));
+    let sub_cycled = c.integration == crate::rapier::joint::ContactIntegration::SubCycled;
     if n == 1 || sub_cycled {
         return Ok(());
     }
@@ -638,7 +637,7 @@ fn check_compliant(world: &PhysicsWorld, entity: Entity, c: &Clearance) -> Resul
             "the {kind} clearance model of hinge {entity} needs 1 (the world has {n}): its \
              contact force is evaluated once per step and held over it, and Rapier's substeps \
              would make every impact gain energy. Set it to 1 (every body of the world then gets \
-             one iteration: stacks of resting bodies soften), sub-cycle the planar hinge's \
+             one iteration: stacks of resting bodies soften), sub-cycle the hinge's \
              contact (`Clearance::integration(ContactIntegration::SubCycled)`), or give the hinge \
              the large-step model{alternative}, `Clearance::model(ClearanceModel::LargeStep)`, \
              which work with any number of iterations"

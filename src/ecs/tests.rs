@@ -293,9 +293,9 @@ fn errors_are_values_and_stop_the_systems() {
     world.entity_mut(hinge).insert(ClearanceHinge(clearance()));
     let e = steps(&mut world, &mut schedule, 2_000).unwrap_err();
     match &e {
-        Error::StepTooLarge { field, t, .. } => {
-            assert_eq!(field, "Physics::world.rapier.integration_parameters.dt");
-            assert!(t.is_some_and(|t| t.is_finite() && t > 0.0));
+        Error::StepTooLarge(l) => {
+            assert_eq!(l.field(), "Physics::world.rapier.integration_parameters.dt");
+            assert!(l.t().is_some_and(|t| t.is_finite() && t > 0.0));
             // The ECS's names, never the app's options or the scene's paths.
             let msg = e.to_string();
             assert!(

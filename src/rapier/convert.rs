@@ -135,6 +135,7 @@ use rapier3d_f64::prelude::{
 /// # Ok::<(), clearance_joint::Error>(())
 /// ```
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub enum ClearanceModel {
     /// The compliant contact-law joint ([`ClearanceJoint`] in a [`ClearanceJointSet`]).
     #[default]

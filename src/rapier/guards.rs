@@ -9,6 +9,7 @@ use serde::{Serialize, Serializer};
 /// Which guard a [`Violation`] is of. What `worst` and `limit` measure depends on it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
 #[serde(rename_all = "snake_case")]
+#[non_exhaustive]
 pub enum GuardKind {
     /// A contact deeper than its law's validity: `worst` the deepest penetration, `limit` the
     /// joint's `max_valid_penetration`, both in m.

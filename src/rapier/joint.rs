@@ -1,7 +1,7 @@
 //! The clearance joint in a Rapier world: a revolute hinge whose radial play is left to the
 //! contact law. [`ClearanceJointSet::apply`] is the per-step force hook.
 
-use crate::error::{Error, Result};
+use crate::error::{Error, Result, StepLimit};
 use crate::model::kinematics::{
     BodyMotion, ContactMode, ForcePair, JournalState, StepBefore, contact_force, force_and_damping,
     journal_state, stable_step,
@@ -197,14 +197,6 @@ impl ClearanceJointBuilder {
                 .map_err(|e| e.within("spatial"))?;
             j.lock = OutOfPlaneLock::None;
             j.spatial = Some(SpatialParts::new(model, face_law, j.local_axis1));
-            if j.integration == ContactIntegration::SubCycled {
-                return Err(Error::invalid(
-                    "integration",
-                    "is SubCycled, which the planar joint has and the spatial joint has not: \
-                     give the spatial joint ContactIntegration::Explicit, or drop its spatial \
-                     model",
-                ));
-            }
         }
         Ok(self.joint)
     }
@@ -422,6 +414,10 @@ struct CycleState {
     /// The mobilities from the contact loads of the other sub-cycled joints of the island to
     /// this pair (their bearing and journal bodies, `P_ij`), taken with `start`.
     coupled: Vec<([RigidBodyHandle; 2], [f64; 144])>,
+    /// A spatial joint's pair at the state before the next step.
+    spatial_start: Option<spatial::subcycle::SpatialStart>,
+    /// A spatial joint's last accepted sub-step, s: the next step's first guess (0: none).
+    substep_guess: f64,
 }
 
 /// Default of [`ClearanceJointBuilder::min_impact_speed`], m/s.
@@ -643,9 +639,9 @@ impl ClearanceJoint {
     pub fn substeps(&self) -> &[SubStep] {
         &self.cycle.substeps
     }
-    /// Whether the contact is sub-cycled (a planar joint with [`ContactIntegration::SubCycled`]).
+    /// Whether the contact is sub-cycled ([`ContactIntegration::SubCycled`]).
     fn sub_cycled(&self) -> bool {
-        self.integration == ContactIntegration::SubCycled && self.spatial.is_none()
+        self.integration == ContactIntegration::SubCycled
     }
     /// What the hook computed at its last application.
     pub fn report(&self) -> &ClearanceReport {
@@ -751,7 +747,11 @@ impl ClearanceJoint {
             return f64::INFINITY;
         }
         if self.sub_cycled() {
-            // The sub-steps resolve the contact; the world steps through it in a few steps.
+            // The sub-steps resolve the contact; the world steps through it in a few steps (a
+            // spatial joint's: every region's path across its gap bounds the step).
+            if let Some(parts) = &self.spatial {
+                return parts.flight_step(tolerance);
+            }
             return flight_step(
                 tolerance,
                 self.geometry.clearance(),
@@ -1348,7 +1348,11 @@ impl ClearanceJointSet {
             }
             self.mechanism
                 .rebuild(bodies, impulse_joints, joint.body1, joint.body2);
-            let finished = joint.finish_cycle(bodies);
+            let finished = if joint.spatial.is_some() {
+                joint.finish_spatial_cycle(bodies, &self.mechanism)
+            } else {
+                joint.finish_cycle(bodies)
+            };
             if finished.is_none() {
                 // Explicit, or a sub-cycled joint's first evaluation (velocities its own).
                 joint.cycle.held = [0.0; 12];
@@ -1360,6 +1364,7 @@ impl ClearanceJointSet {
                 .or_else(|| joint.evaluate(bodies, self.last_step, &self.mechanism))
                 .map(|(w1, w2)| [w1, w2]);
             joint.take_start(bodies, &self.mechanism);
+            joint.take_spatial_start(bodies, &self.mechanism);
             let partners = self.partners.iter().enumerate();
             let others = partners
                 .filter(|(i, _)| *i != index)
@@ -1383,9 +1388,10 @@ impl ClearanceJointSet {
         }
     }
 
-    /// After Rapier's pass `pass.pass` of a step: at pass 0 every sub-cycled joint runs its
-    /// sub-cycle ([`ClearanceJoint::plan_cycle`]) and the set asks for pass 1 with their
-    /// deliveries when one has an impulse to deliver; later passes stand.
+    /// After Rapier's pass `pass.pass` of a step: at pass 0 the sub-cycled joints run their
+    /// sub-cycles (the planar joints of one island together, `subcycle::plan_cycles`; each
+    /// spatial joint on its own) and the set asks for pass 1 with their deliveries when one has
+    /// an impulse to deliver; later passes stand.
     pub(crate) fn resolve_step(
         &mut self,
         bodies: &RigidBodySet,
@@ -1398,7 +1404,13 @@ impl ClearanceJointSet {
         }
         self.planned.clear();
         let mut joints: Vec<&mut ClearanceJoint> = self.joints.values_mut().collect();
-        let deliveries = subcycle::plan_cycles(&mut joints, bodies, pass, iterations);
+        // The planar joints of one island together; each spatial joint on its own.
+        let mut deliveries = subcycle::plan_cycles(&mut joints, bodies, pass, iterations);
+        for (joint, deliver) in joints.iter_mut().zip(deliveries.iter_mut()) {
+            if joint.spatial.is_some() {
+                *deliver = joint.plan_spatial_cycle(bodies, pass, iterations);
+            }
+        }
         for (joint, deliver) in joints.iter().zip(deliveries) {
             if let Some(deliver) = deliver {
                 self.planned.extend(joint.delivery(&deliver, pass.kick));
@@ -1456,19 +1468,15 @@ impl ClearanceJointSet {
                     Some(impact) => impact,
                     None => (r.max_stable_dt, r.state.penetration, r.omega, r.zeta),
                 };
-                return Err(Error::StepTooLarge {
-                    field: "dt".into(),
-                    joint: j.name.clone(),
+                return Err(Error::StepTooLarge(Box::new(StepLimit::new(
+                    j.name.clone(),
                     dt,
                     dt_max,
-                    t: None,
-                    penetration_um: depth * 1e6,
+                    depth * 1e6,
                     omega,
                     zeta,
-                    parameter: j.normal_law.kind().stiff_parameter(zeta),
-                    adaptive: None,
-                    names: None,
-                });
+                    j.normal_law.kind().stiff_parameter(zeta),
+                ))));
             }
         }
         Ok(())

@@ -31,17 +31,11 @@ use rapier3d_f64::prelude::PhysicsWorld;
 /// (0.054 deg at the default 0.0075). Each bound of the step is its own error source, and the
 /// factors balance them (as
 /// [`CONTACT_PERIODS_PER_TOLERANCE`](crate::rapier::joint::CONTACT_PERIODS_PER_TOLERANCE) does
-/// for the contact). At a turn of `tol` the turn dominated on a driven mechanism: on Flores
-/// and Ambrósio's slider-crank (first crank turn, against fixed 2.5e-7 s steps) the second
-/// impact came 1.02 us late and the sequence amplified it to 47 us by the sixth; halving the
-/// contact's bound changed nothing (1.10 us, 10,519 steps against 6,711), halving the free
-/// flight's took 0.72 us (9,603 steps), and a turn of `tol/2`, `tol/4` and `tol/8` took 0.59,
-/// 0.36 and 0.20 us (6,803, 7,035 and 8,173 steps; the sixth impact 9.3 us late at `tol/8`, and
-/// the second half turn's largest force, depth, onsets and contact fraction within 0.22 % of the
-/// reference, against 1.6 %, 1.0 %, one onset and 1.6 %). A crank at 5000 rpm then takes steps
-/// of 1.8 us where no contact is near. Scenes whose bodies turn slowly (the paper's panel, the
-/// deployable array) are not affected at the default tolerance: their steps and results are
-/// unchanged (at 0.002 the paper's scene takes 0.3 % more steps).
+/// for the contact): at a turn of `tol` the turn is the largest error on a driven mechanism;
+/// scenes whose bodies turn slowly are not affected at the default tolerance.
+///
+/// Measured in docs/stepper-and-accuracy.md (step choice, the work-precision table of
+/// `cargo bench --bench work_precision` and the mechanism matrix of `cargo bench --bench mechanisms`).
 pub const TURN_PER_TOLERANCE: f64 = 0.125;
 
 /// The step that turns a body spinning at `angular_speed` (rad/s) by `angle` radians,

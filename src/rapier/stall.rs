@@ -81,6 +81,7 @@ pub struct StalledContact {
 
 /// The cause [`diagnose`] finds.
 #[derive(Clone, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum StallCause {
     /// A body's inertia makes the effective mass at the contact tiny against its mass.
     TinyInertia(BodyShare),
@@ -96,6 +97,105 @@ pub enum StallCause {
     Stiffness,
     /// No joint was in contact: nothing the contact laws do explains it.
     NoContact,
+    /// The turn bound, not a contact: the fastest-turning movable body may turn `per_step` rad
+    /// a step (`tolerance/8`), which at its rate needs steps of `step` s, at the floor.
+    TurnBound {
+        /// The body.
+        body: RigidBodyHandle,
+        /// Its angular speed, rad/s.
+        rate: f64,
+        /// The turn a step may take, rad.
+        per_step: f64,
+        /// The step that turn allows, s.
+        step: f64,
+    },
+}
+
+/// Why the step control stalled: what it saw, the contact that stopped it (the one whose step
+/// limit is the shortest) and the cause found from its numbers. Its `Display` is the message of
+/// [`Error::Stalled`](crate::Error::Stalled).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Stall {
+    /// What the step control saw (`12 steps in a row at the floor`).
+    pub seen: String,
+    /// The step floor `min_dt`, s.
+    pub min_dt: f64,
+    /// The contact that stopped the step control, with its numbers; `None` when no clearance
+    /// joint was in contact, or the turn bound stopped it.
+    pub contact: Option<StalledContact>,
+    /// The cause: [`diagnose`]d from the contact's numbers, [`StallCause::NoContact`] without a
+    /// contact, or [`StallCause::TurnBound`].
+    pub cause: StallCause,
+    /// Bodies named in the message, by handle (see [`name_body`](Self::name_body)).
+    body_names: Vec<(RigidBodyHandle, String)>,
+}
+
+impl Stall {
+    /// A stall seen as `seen` under the step floor `min_dt` (s) at `contact`, its cause
+    /// [`diagnose`]d from the contact's numbers.
+    pub fn at_contact(seen: String, contact: Option<StalledContact>, min_dt: f64) -> Stall {
+        let cause = contact
+            .as_ref()
+            .map_or(StallCause::NoContact, |c| diagnose(c, min_dt));
+        Stall {
+            seen,
+            min_dt,
+            contact,
+            cause,
+            body_names: Vec::new(),
+        }
+    }
+
+    /// A stall seen as `seen` under the step floor `min_dt` (s) that the turn bound explains
+    /// (`cause` a [`StallCause::TurnBound`]).
+    pub fn turn_bound(seen: String, min_dt: f64, cause: StallCause) -> Stall {
+        Stall {
+            seen,
+            min_dt,
+            contact: None,
+            cause,
+            body_names: Vec::new(),
+        }
+    }
+
+    /// Names body `handle` `label` in the message (a scene's `` body `crank` ``): the step
+    /// control knows only Rapier's handles, `body (0, 0)`. The first label given for a handle
+    /// is used.
+    pub fn name_body(&mut self, handle: RigidBodyHandle, label: impl Into<String>) {
+        self.body_names.push((handle, label.into()));
+    }
+}
+
+impl std::fmt::Display for Stall {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut text = match &self.cause {
+            StallCause::TurnBound {
+                body,
+                rate,
+                per_step,
+                step,
+            } => format!(
+                "{} (the floor `min_dt` is {} s); cause: the turn bound, not a contact: body {:?} \
+                 turns at {} rad/s and may turn at most tolerance/8 = {} rad a step, which needs \
+                 steps of {} s; raise `tolerance`, or check what spins the body so fast (a motor, \
+                 a drive, a prescribed motion, an initial velocity)",
+                self.seen,
+                sig4(self.min_dt),
+                body.into_raw_parts(),
+                sig4(*rate),
+                sig4(*per_step),
+                sig4(*step)
+            ),
+            cause => explain(&self.seen, self.contact.as_ref(), cause, self.min_dt),
+        };
+        for (handle, label) in &self.body_names {
+            let raw = format!("body {:?}", handle.into_raw_parts());
+            if text.contains(&raw) {
+                text = text.replace(&raw, label);
+            }
+        }
+        f.write_str(&text)
+    }
 }
 
 impl StalledContact {
@@ -251,7 +351,12 @@ fn is_hysteresis(law: LawKind) -> bool {
 
 /// The stall message: what was seen (`seen`), the contact state, the cause and what to change.
 /// `min_dt` is the step floor, s.
-pub fn explain(seen: &str, contact: Option<&StalledContact>, min_dt: f64) -> String {
+fn explain(
+    seen: &str,
+    contact: Option<&StalledContact>,
+    cause: &StallCause,
+    min_dt: f64,
+) -> String {
     let Some(c) = contact else {
         return format!(
             "{seen}, with no clearance joint in contact: no contact law explains it (a body moved \
@@ -260,8 +365,8 @@ pub fn explain(seen: &str, contact: Option<&StalledContact>, min_dt: f64) -> Str
             sig4(min_dt)
         );
     };
-    let cause = match diagnose(c, min_dt) {
-        StallCause::NoContact => format!(
+    let cause = match *cause {
+        StallCause::NoContact | StallCause::TurnBound { .. } => format!(
             "no contact law explains it (the joint is not in contact: a body moved by hand or by \
              a kinematic position target, which any step reaches at once, or a step floor \
              `min_dt` = {} s too high)",
@@ -510,7 +615,12 @@ mod tests {
             impact_rate: 1e-4,
             ..contact()
         };
-        let m = explain("no step resolves the contact", Some(&c), 1e-10);
+        let m = Stall::at_contact(
+            "no step resolves the contact".into(),
+            Some(c.clone()),
+            1e-10,
+        )
+        .to_string();
         for part in [
             "joint `pin`",
             "penetration 1 um",
@@ -540,7 +650,12 @@ mod tests {
             ..contact()
         };
         assert_eq!(diagnose(&c, 1e-10), StallCause::Damping);
-        let m = explain("no step resolves the contact", Some(&c), 1e-10);
+        let m = Stall::at_contact(
+            "no step resolves the contact".into(),
+            Some(c.clone()),
+            1e-10,
+        )
+        .to_string();
         for part in [
             "a shoulder on a bearing face",
             "its slope stiffens the contact",
@@ -552,7 +667,12 @@ mod tests {
         assert!(!m.contains("check the law's stiffness"), "{m}");
         // The same numbers on the bore's own law name that law's damping.
         let bore = StalledContact { face: false, ..c };
-        let m = explain("no step resolves the contact", Some(&bore), 1e-10);
+        let m = Stall::at_contact(
+            "no step resolves the contact".into(),
+            Some(bore.clone()),
+            1e-10,
+        )
+        .to_string();
         assert!(
             m.contains("lower the law's damping (a higher `restitution`"),
             "{m}"

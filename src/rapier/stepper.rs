@@ -82,6 +82,7 @@
 use crate::error::{Error, Result};
 use crate::rapier::joint_correction::JointCorrection;
 use crate::rapier::motion_step::motion_step;
+use crate::rapier::stall::{Stall, StallCause};
 use rapier3d_f64::math::{Pose, Vector};
 use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle, RigidBodyType};
 use serde::{Deserialize, Serialize};
@@ -91,6 +92,7 @@ pub use crate::rapier::step_hooks::{StepHooks, StepPass};
 
 /// How the step is chosen (`run.step` in scene files).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub enum StepMode {
     /// A constant step (the paper's way); the last step is shortened to land on the end.
     Fixed,
@@ -563,7 +565,10 @@ impl Stepper {
                     });
                     self.restore(world, sources);
                     if let Some(reason) = stalled {
-                        return Err(Error::Stalled { t: self.t, reason });
+                        return Err(Error::Stalled {
+                            t: self.t,
+                            stall: reason,
+                        });
                     }
                     dt = next;
                 }
@@ -755,12 +760,9 @@ impl Stepper {
         world: &PhysicsWorld,
         sources: &[&mut dyn StepHooks],
         seen: &str,
-    ) -> String {
+    ) -> Box<Stall> {
         if let Some(turn) = self.turn_stall(world) {
-            return format!(
-                "{seen} (the floor `min_dt` is {} s); {turn}",
-                crate::error::sig4(self.control.min_dt)
-            );
+            return Box::new(Stall::turn_bound(seen.into(), self.control.min_dt, turn));
         }
         // The contact whose step limit is the shortest stops the step control.
         let limit = |c: &crate::rapier::stall::StalledContact| c.stable_dt.min(c.friction_dt);
@@ -768,12 +770,12 @@ impl Stepper {
             .iter()
             .filter_map(|s| s.stalled_contact(&world.bodies))
             .min_by(|a, b| limit(a).total_cmp(&limit(b)));
-        crate::rapier::stall::explain(seen, contact.as_ref(), self.control.min_dt)
+        Box::new(Stall::at_contact(seen.into(), contact, self.control.min_dt))
     }
 
     /// The turn bound in words when it alone asks for steps at the floor: the fastest-turning
     /// movable body may turn `tolerance/8` rad a step.
-    fn turn_stall(&self, world: &PhysicsWorld) -> Option<String> {
+    fn turn_stall(&self, world: &PhysicsWorld) -> Option<StallCause> {
         let per_step = crate::rapier::motion_step::TURN_PER_TOLERANCE * self.control.tolerance;
         let (handle, rb) = world
             .bodies
@@ -782,18 +784,11 @@ impl Stepper {
             .max_by(|a, b| a.1.angvel().length().total_cmp(&b.1.angvel().length()))?;
         let w = rb.angvel().length();
         let step = crate::rapier::motion_step::turn_step(per_step, w);
-        (step <= 2.0 * self.control.min_dt).then(|| {
-            let sig4 = crate::error::sig4;
-            format!(
-                "cause: the turn bound, not a contact: body {:?} turns at {} rad/s and may turn \
-                 at most tolerance/8 = {} rad a step, which needs steps of {} s; raise \
-                 `tolerance`, or check what spins the body so fast (a motor, a drive, a \
-                 prescribed motion, an initial velocity)",
-                handle.into_raw_parts(),
-                sig4(w),
-                sig4(per_step),
-                sig4(step)
-            )
+        (step <= 2.0 * self.control.min_dt).then_some(StallCause::TurnBound {
+            body: handle,
+            rate: w,
+            per_step,
+            step,
         })
     }
 
@@ -819,7 +814,7 @@ impl Stepper {
                 let seen = format!("{} steps in a row at the floor", self.floor_run);
                 return Err(Error::Stalled {
                     t: self.t,
-                    reason: self.stall_reason(world, sources, &seen),
+                    stall: self.stall_reason(world, sources, &seen),
                 });
             }
         } else {
@@ -858,7 +853,7 @@ impl Stepper {
         if self.control.strict && !self.guards.is_clean() {
             return Err(Error::Guard {
                 t: self.t,
-                violations: self.guards.messages().join("; "),
+                violations: self.guards.violations.clone(),
             });
         }
         Ok(())
@@ -867,9 +862,9 @@ impl Stepper {
     /// Adds the time, the step mode and the parameter that set the step to a step-limit error
     /// (the joints know none of them).
     fn locate(&self, mut e: Error) -> Error {
-        if let Error::StepTooLarge { t, field, .. } = &mut e {
-            *t = Some(self.t);
-            *field = "StepControl::max_dt".into();
+        if let Error::StepTooLarge(limit) = &mut e {
+            limit.t = Some(self.t);
+            limit.field = "StepControl::max_dt".into();
         }
         e.with_step_mode(self.control.mode == StepMode::Adaptive)
     }

@@ -10,15 +10,12 @@ use crate::error::{ContactParameter, Error, ParameterNames};
 /// that make its contact stiff (the clearance joint of a scene hinge bears the hinge's name).
 /// Other errors pass through.
 pub(crate) fn in_scene(e: Error, step_field: &str) -> Error {
-    let Error::StepTooLarge {
-        joint, parameter, ..
-    } = &e
-    else {
+    let Error::StepTooLarge(limit) = &e else {
         return e;
     };
     let names = ParameterNames {
         adaptive: "run.step = Adaptive".into(),
-        contact: contact_fields(joint, *parameter),
+        contact: contact_fields(limit.joint(), limit.parameter()),
     };
     e.named(step_field, names)
 }
@@ -49,19 +46,18 @@ mod tests {
     use super::*;
 
     fn error(parameter: ContactParameter, zeta: f64, adaptive: Option<bool>) -> Error {
-        Error::StepTooLarge {
-            field: "dt".into(),
-            joint: "hinge".into(),
-            dt: 1e-3,
-            dt_max: 1.3122521820485098e-4,
-            t: Some(0.08800000000000001),
-            penetration_um: 11.333333333333334,
-            omega: 15241.234567890123,
+        let mut limit = crate::error::StepLimit::new(
+            "hinge",
+            1e-3,
+            1.3122521820485098e-4,
+            11.333333333333334,
+            15241.234567890123,
             zeta,
             parameter,
-            adaptive,
-            names: None,
-        }
+        );
+        limit.t = Some(0.08800000000000001);
+        limit.adaptive = adaptive;
+        Error::StepTooLarge(Box::new(limit))
     }
 
     /// The step-limit message in a scene names the scene's field

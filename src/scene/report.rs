@@ -1,7 +1,7 @@
 //! Run summaries (`summary.json`), result files and the printed comparison table.
 
 use crate::error::{Error, Result};
-use crate::scene::output::{Render, write_set};
+use crate::scene::output::{Render, Staging, write_set};
 use crate::scene::runner::convergence::ConvergenceVerdict;
 use crate::scene::runner::{HingeMetrics, Invariants, RunResult, Twin};
 use serde::Serialize;
@@ -147,13 +147,20 @@ impl RunResult {
     /// (`"complete": false`, `reached_s`, `error`). Its `convergence` says no check was run;
     /// [`write_checked`](Self::write_checked) records one.
     pub fn write(&self, dir: &Path) -> Result<Summary> {
-        self.write_checked(dir, &ConvergenceVerdict::default())
+        self.write_checked(dir, &ConvergenceVerdict::default(), &Staging::new())
     }
 
     /// As [`write`](Self::write), `summary.json` recording `convergence`, the verdict of the
     /// run's convergence check
-    /// ([`Convergence::verdict`](crate::scene::runner::convergence::Convergence::verdict)).
-    pub fn write_checked(&self, dir: &Path, convergence: &ConvergenceVerdict) -> Result<Summary> {
+    /// ([`Convergence::verdict`](crate::scene::runner::convergence::Convergence::verdict)), the
+    /// temporaries recorded in `staging` while they exist (an application's, which removes them
+    /// on an interrupt).
+    pub fn write_checked(
+        &self,
+        dir: &Path,
+        convergence: &ConvergenceVerdict,
+        staging: &Staging,
+    ) -> Result<Summary> {
         let mut summary = self.summary();
         summary.convergence = convergence.clone();
         let json = summary_json(&summary)?;
@@ -228,7 +235,7 @@ impl RunResult {
                 })
             }),
         ));
-        write_set(&files)?;
+        write_set(&files, staging)?;
         Ok(summary)
     }
 }

@@ -39,7 +39,7 @@ pub fn memory_budget(max_memory: Option<&str>) -> Result<Option<u64>> {
         ));
     }
     max_memory
-        .map(clearance_joint::scene::output::parse_bytes)
+        .map(crate::process::memory::parse_bytes)
         .transpose()
         .map_err(|e| crate::advice::from_option(e, "--max-memory"))
 }

@@ -1,9 +1,10 @@
 //! The `run` command (and the default job): one scene's ideal and clearance twins, run into a
 //! result set (data and figures, one unit: see [`crate::resultset`]) for a folder claimed for it.
 
+use crate::process::files::write_atomic;
+use crate::process::memory::available_memory;
 use crate::resultset::ResultSet;
 use clearance_joint::error::Result;
-use clearance_joint::scene::output::{available_memory, write_atomic};
 use clearance_joint::scene::runner::convergence::{self, Convergence, ConvergenceCheck};
 use clearance_joint::scene::runner::{Progress, RunOptions, RunResult, Simulation};
 use clearance_joint::scene::{StepMode, ValidatedScene};

@@ -1,11 +1,11 @@
 //! The `sweep` command: a grid of ideal-vs-clearance runs over a base scene, or one shard of
 //! it, into a folder whose table it claims.
 
+use crate::process::lock::DirLock;
 use crate::study::grid::{Axis, Grid, Shard};
 use crate::study::sweep::{ExecOptions, MetricsTable, Sweep, SweepOutcome};
 use clearance_joint::error::{Error, Result};
 use clearance_joint::scene::Scene;
-use clearance_joint::scene::output::DirLock;
 use std::path::PathBuf;
 
 /// A sweep ready to run: its grid built and checked, and its table claimed (until dropped).

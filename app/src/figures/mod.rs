@@ -23,9 +23,9 @@ pub mod series;
 pub mod text;
 pub mod ticks;
 
+use crate::process::files::write_atomic;
 use ab_glyph::FontRef;
 use clearance_joint::error::{Error, Result};
-use clearance_joint::scene::output::write_atomic;
 use legend::{Entry, INSET, Legend, Mark};
 use plotters::coord::Shift;
 use plotters::coord::types::RangedCoordf64;

@@ -17,9 +17,10 @@
 //! Series: the table's rows cut into [`SERIES_BUCKETS`] buckets of time, each keeping its
 //! smallest and largest value (so every impact's force peak stays).
 
+use crate::process::files::write_atomic;
+use crate::process::memory::MemoryEstimate;
 use clearance_joint::error::{Error, Result};
 use clearance_joint::rapier::replay::Recording;
-use clearance_joint::scene::output::{MemoryEstimate, write_atomic};
 use clearance_joint::scene::runner::{Progress, RunOptions, RunResult, Simulation, TwinKind};
 use clearance_joint::scene::{Scene, ValidatedScene};
 use clearance_joint::table::Table;
@@ -531,6 +532,7 @@ fn stepping_short(run: &clearance_joint::scene::RunSettings) -> String {
             time(run.max_dt_s),
             run.tolerance
         ),
+        other => format!("{other:?} steps"),
     }
 }
 

@@ -8,10 +8,10 @@ use super::report;
 use super::sweep::{ExecOptions, Failure, Job, MetricsTable, Sweep, TableRow, execute};
 use crate::figures::series::{CaseSeries, StreamedCase};
 use crate::figures::{Figure, FigureKind};
+use crate::process::files::write_atomic;
 use crate::resultset::ResultSet;
 use clearance_joint::error::{Error, Result};
 use clearance_joint::scene::Scene;
-use clearance_joint::scene::output::write_atomic;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 

@@ -12,9 +12,10 @@
 use super::grid::{Axis, Grid, Point, Shard};
 use super::metrics::RunMetrics;
 use crate::advice::memory_options;
+use crate::process::files::{write_all_atomic, write_atomic};
+use crate::process::memory::bytes_text;
 use crate::resultset::{ResultSet, pause_at};
 use clearance_joint::error::{Error, Result};
-use clearance_joint::scene::output::{bytes_text, write_all_atomic, write_atomic};
 use clearance_joint::scene::runner::convergence::{self, ConvergenceVerdict};
 use clearance_joint::scene::{Scene, ValidatedScene, field_within};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -120,7 +121,7 @@ pub struct ExecOptions {
     /// Recompute finished points instead of reusing them.
     pub rerun: bool,
     /// Memory the parallel runs may hold, bytes (`None`: 80 % of what the system reports
-    /// available, see [`clearance_joint::scene::output::available_memory`]).
+    /// available, see [`crate::process::memory::available_memory`]).
     pub max_memory: Option<u64>,
     /// Write each point's replay (`replay.html`, see [`crate::replay`]); a finished point
     /// without one is run again.
@@ -304,7 +305,7 @@ impl Sweep {
         budget: Option<u64>,
         replay: bool,
     ) -> Result<Option<u64>> {
-        let Some(budget) = budget.or_else(clearance_joint::scene::output::available_memory) else {
+        let Some(budget) = budget.or_else(crate::process::memory::available_memory) else {
             return Ok(None);
         };
         let per_point = self.kept_bytes_per_point(base)?;
@@ -671,7 +672,7 @@ fn execute_with(
 /// `budget` (default: what the system has available): the largest point's estimate times the
 /// runs in flight at once.
 pub fn check_memory(jobs: &[Job], threads: usize, budget: Option<u64>, replay: bool) -> Result<()> {
-    let Some(budget) = budget.or_else(clearance_joint::scene::output::available_memory) else {
+    let Some(budget) = budget.or_else(crate::process::memory::available_memory) else {
         return Ok(());
     };
     let Some((job, estimate)) = jobs

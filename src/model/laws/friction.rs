@@ -208,6 +208,7 @@ impl FrictionLaw for Frictionless {
 
 /// A friction law chosen by name: static dispatch over every law of MODEL.md §3.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum FrictionModel {
     /// See [`Frictionless`].
     None,

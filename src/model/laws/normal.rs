@@ -523,6 +523,7 @@ impl NormalForceLaw for ImprovedLiu {
 
 /// A normal law chosen by name: static dispatch over every law of MODEL.md §2.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
 pub enum NormalModel {
     /// See [`Hertz`].
     Hertz(Hertz),

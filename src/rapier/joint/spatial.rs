@@ -15,6 +15,8 @@ use crate::rapier::ledger::{Wrench, world_center_of_mass};
 use rapier3d_f64::math::{AngularInertia, Vector};
 use rapier3d_f64::prelude::{RigidBody, RigidBodySet};
 
+pub(super) mod subcycle;
+
 /// What a spatial joint computed at its last application, beyond [`ClearanceReport`]'s
 /// deepest point.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -1038,7 +1038,8 @@ impl ClearanceJoint {
     /// Takes the pair's state before the next step (at each evaluation; `None` for a joint that
     /// is not sub-cycled or whose body is gone).
     pub(crate) fn take_start(&mut self, bodies: &RigidBodySet, mechanism: &Mechanism) {
-        self.cycle.start = if self.sub_cycled() {
+        // A spatial joint takes its own start (`take_spatial_start`).
+        self.cycle.start = if self.sub_cycled() && self.spatial.is_none() {
             PairStart::of(self, bodies, mechanism)
         } else {
             None

@@ -59,10 +59,10 @@ pub struct RunSettings {
     /// needs one, ran 24 % longer at 32.
     #[serde(default = "default_solver_sweeps")]
     pub solver_sweeps: usize,
-    /// How the planar compliant hinges integrate their contact: `Explicit` (the forces held
-    /// over each step, which must then resolve every contact) or `SubCycled` (each contact
-    /// integrated on the hinge's own clock inside the step, its damping and friction implicitly;
-    /// the step follows the slow motion). Spatial hinges integrate explicitly.
+    /// How the compliant hinges (planar and spatial) integrate their contact: `Explicit` (the
+    /// forces held over each step, which must then resolve every contact) or `SubCycled` (each
+    /// contact integrated on the hinge's own clock inside the step, its damping and friction
+    /// implicitly; the step follows the slow motion).
     #[serde(default)]
     pub contact_integration: crate::rapier::joint::ContactIntegration,
 }

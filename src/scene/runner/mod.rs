@@ -288,7 +288,7 @@ impl Simulation {
         if stopped.is_none() && self.scene.run.strict && !guards.is_clean() {
             return Err(crate::Error::Guard {
                 t: self.time(),
-                violations: guards.messages().join("; "),
+                violations: guards.violations.clone(),
             });
         }
         Ok(RunResult {
@@ -501,16 +501,13 @@ fn start_mismatch_note(inv: &Invariants) -> String {
 
 /// Names the scene's bodies in a stall's message (the stepper knows only Rapier handles).
 fn name_bodies(mut e: crate::Error, twins: &[Twin]) -> crate::Error {
-    if let crate::Error::Stalled { reason, .. } = &mut e {
+    if let crate::Error::Stalled { stall, .. } = &mut e {
         for twin in twins {
             for b in &twin.bodies {
-                let handle = format!("body {:?}", b.handle.into_raw_parts());
-                if reason.contains(&handle) {
-                    *reason = reason.replace(
-                        &handle,
-                        &format!("body `{}` (of the {} twin)", b.name, twin.kind.name()),
-                    );
-                }
+                stall.name_body(
+                    b.handle,
+                    format!("body `{}` (of the {} twin)", b.name, twin.kind.name()),
+                );
             }
         }
     }

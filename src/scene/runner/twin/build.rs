@@ -224,6 +224,7 @@ fn build_hinges(
                         HingeJoint::Clearance(world.insert_clearance(b1, b2, j)?)
                     }
                     ClearanceModel::Spatial(_) => {
+                        let settings = settings.clone().integration(scene.run.contact_integration);
                         let j = settings.joint(a1, a2, axis, axis)?;
                         HingeJoint::Clearance(world.insert_clearance(b1, b2, j)?)
                     }

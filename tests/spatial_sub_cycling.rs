@@ -1,0 +1,225 @@
+//! The spatial joint sub-cycled ([`ContactIntegration::SubCycled`]): a door on one pin resting
+//! edge-loaded and friction-held at robot and game steps with its static balance, a face knock
+//! against the explicit joint at a tiny fixed step, and the energy of an elastic door. Runs
+//! optimised.
+
+use clearance_joint::model::laws::{Bai, FrictionModel};
+use clearance_joint::model::spatial::SpatialModel;
+use clearance_joint::prelude::*;
+use clearance_joint::scene::Scene;
+use clearance_joint::scene::runner::{RunOptions, Simulation, Twins};
+use rapier3d_f64::prelude::*;
+
+const G: f64 = 9.81;
+/// The door: 2 kg, its centre of mass 0.2 m off the hinge axis (y).
+const MASS: f64 = 2.0;
+const ARM: f64 = 0.2;
+/// The pin: bearing radius 6 mm, radial clearance 0.1 mm, width 20 mm.
+const R_B: f64 = 0.006;
+const C: f64 = 0.1e-3;
+const WIDTH: f64 = 0.020;
+
+/// A fixed post and a door (its centre of mass `arm` off the axis along x) whose journal sits
+/// centred in the post's bore (axis y), in a world of gravity `gravity` stepped by `control` with `iterations` solver iterations; the pin's law is
+/// steel improved-Liu with `friction`, spatial (axial play 0.3 mm, collars of 10 mm), integrated
+/// as `integration`. Returns `(world, door, pin)`.
+fn door_world(
+    arm: f64,
+    control: StepControl,
+    iterations: usize,
+    gravity: f64,
+    friction: FrictionModel,
+    integration: ContactIntegration,
+) -> (ClearanceWorld, RigidBodyHandle, ClearanceJointHandle) {
+    let mut rapier = PhysicsWorld::new();
+    rapier.gravity = Vector::new(0.0, -gravity, 0.0);
+    rapier.integration_parameters.num_solver_iterations = iterations;
+    let post = rapier.bodies.insert(RigidBodyBuilder::fixed());
+    let door = rapier.bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(Vector::new(arm, 0.0, 0.0))
+            .additional_mass_properties(MassProperties::new(
+                Vector::ZERO,
+                MASS,
+                Vector::new(0.0150667, 0.0267333, 0.0416667),
+            ))
+            .can_sleep(false),
+    );
+    let pin = Clearance::steel_improved_liu(R_B, C, WIDTH)
+        .unwrap()
+        .friction(friction)
+        .model(ClearanceModel::Spatial(SpatialModel::steel(0.3e-3, 0.010)))
+        .integration(integration)
+        .joint(
+            Vector::ZERO,
+            Vector::new(-arm, 0.0, 0.0),
+            Vector::Y,
+            Vector::Y,
+        )
+        .unwrap();
+    let mut world = ClearanceWorld::new(rapier, control);
+    let pin = world.insert_clearance(post, door, pin).unwrap();
+    (world, door, pin)
+}
+
+/// A door on one spatial pin, turned by a torque `tau` about the hinge that friction holds,
+/// comes to rest at world steps of 1 ms (one solver iteration) and of 1/60 s (Rapier's four) at
+/// the default tolerance, with its static balance by hand: the contact carries the weight
+/// (`F = m g` up, within 0.5 %) and the torque (its moment about the door's centre of mass is
+/// `-tau` about the axis, within 0.5 % of `m g ARM`); the weight's moment about the pin,
+/// `m g ARM`, less the face's (its force at its resultant's distance from the axis: the tilted
+/// shoulder bears at its rim) is held by the bore's two edges as a couple,
+/// `F_edge = (m g ARM - F_face x_face)/l` on each, `l` the distance between the edges'
+/// resultants along the axis, within 1 %, and `l` lies within the width. The door swings no
+/// more: it creeps at the regularised friction's slip (below 1e-3 rad/s; 7e-4 at 1 ms).
+#[test]
+fn a_door_rests_edge_loaded_and_friction_held_with_its_static_balance() {
+    let weight = MASS * G;
+    let tau = 0.05;
+    for (dt, iterations) in [(1e-3, 1), (1.0 / 60.0, 4)] {
+        let control = StepControl::fixed(dt).with_tolerance(0.0075);
+        let friction = FrictionModel::Bai(Bai::DRY);
+        let sub_cycled = ContactIntegration::SubCycled;
+        let (mut world, door, pin) = door_world(ARM, control, iterations, G, friction, sub_cycled);
+        world.rapier.bodies[door].add_torque(Vector::new(0.0, tau, 0.0), true);
+        world.step_to(5.0).unwrap();
+        let joint = world.clearance.get(pin).unwrap();
+        let [_, on_door] = joint.last_wrenches().unwrap();
+        let s = joint.report().spatial.unwrap();
+        let spin = world.rapier.bodies[door].angvel().length();
+        let l = (s.edge_point[1] - s.edge_point[0]).y.abs();
+        let face = s.face_force[0] * s.face_point[0].x + s.face_force[1] * s.face_point[1].x;
+        let couple = (weight * ARM - face) / l;
+        println!(
+            "dt {dt:.3e} s, {iterations} iteration(s): force {:?} N (weight {weight:.4}), \
+             torque {:?} N m, edges {:.3}/{:.3} N at {l:.5} m apart (couple {couple:.3} N), faces \
+             {:.3}/{:.3} N (moment {face:.4} N m), tilt {:?} rad, spin {spin:.2e} rad/s, {} steps",
+            on_door.force,
+            on_door.torque,
+            s.edge_force[0],
+            s.edge_force[1],
+            s.face_force[0],
+            s.face_force[1],
+            s.tilt,
+            world.steps(),
+        );
+        assert!((on_door.force - Vector::new(0.0, weight, 0.0)).length() < 5e-3 * weight);
+        let torque = on_door.torque + Vector::new(0.0, tau, 0.0);
+        assert!(torque.length() < 5e-3 * weight * ARM, "{torque:?}");
+        for f in s.edge_force {
+            assert!((f / couple - 1.0).abs() < 1e-2, "{f} against {couple}");
+        }
+        assert!(l > 0.5 * WIDTH && l <= WIDTH, "{l}");
+        // The regularised friction creeps under a steady torque: the edges slip at a few um/s.
+        assert!(spin < 1e-3, "{spin}");
+        assert!(world.guards().is_clean(), "{:?}", world.guards());
+    }
+}
+
+/// What one face knock did: the face's peak force (N), the shoulder's deepest penetration (m),
+/// and the journal's axial speed after it (m/s).
+#[derive(Debug)]
+struct Knock {
+    peak: f64,
+    depth: f64,
+    separation: f64,
+}
+
+/// A journal (its centre of mass on the pin) moving along its axis at 0.1 m/s without gravity or friction knocks on the
+/// bearing's upper face (the play's half, 0.15 mm, away), integrated as `integration` at steps
+/// `control`; read at every state (the sub-steps of a sub-cycled joint).
+fn face_knock(control: StepControl, integration: ContactIntegration) -> Knock {
+    let (mut world, door, pin) = door_world(0.0, control, 1, 0.0, FrictionModel::None, integration);
+    world.rapier.bodies[door].set_linvel(Vector::new(0.0, 0.1, 0.0), true);
+    let (mut peak, mut depth) = (0.0_f64, 0.0_f64);
+    while world.time() < 3e-3 {
+        world.step(3e-3).unwrap();
+        let joint = world.clearance.get(pin).unwrap();
+        let mut seen: Vec<(f64, f64)> = joint
+            .substeps()
+            .iter()
+            .map(|s| (s.force.normal_force, s.state.penetration))
+            .collect();
+        let r = joint.report();
+        seen.push((r.force.normal_force, r.state.penetration));
+        for (f, d) in seen {
+            peak = peak.max(f);
+            depth = depth.max(d);
+        }
+    }
+    let separation = world.rapier.bodies[door].linvel().y;
+    Knock {
+        peak,
+        depth,
+        separation,
+    }
+}
+
+/// A face knock sub-cycled inside world steps of 1 ms matches the explicit joint at fixed 1e-7 s
+/// steps: peak force, depth and separation speed within 1e-3 at the tolerance 1e-4, and closer
+/// as the tolerance tightens from the default.
+#[test]
+fn a_face_knock_matches_the_explicit_joint_at_a_tiny_step() {
+    let reference = face_knock(StepControl::fixed(1e-7), ContactIntegration::Explicit);
+    println!("explicit at 1e-7 s: {reference:?}");
+    assert!(reference.peak > 100.0 && reference.separation < -0.05);
+    let mut last = f64::INFINITY;
+    for tolerance in [0.0075, 1e-3, 1e-4] {
+        let control = StepControl::fixed(1e-3).with_tolerance(tolerance);
+        let k = face_knock(control, ContactIntegration::SubCycled);
+        let errors = [
+            k.peak / reference.peak - 1.0,
+            k.depth / reference.depth - 1.0,
+            k.separation / reference.separation - 1.0,
+        ];
+        let worst = errors.iter().map(|e| e.abs()).fold(0.0, f64::max);
+        println!("sub-cycled at tolerance {tolerance}: {k:?}, errors {errors:?}");
+        assert!(worst <= last.max(1e-4), "{worst} after {last}");
+        last = worst;
+    }
+    assert!(last < 1e-3, "{last}");
+}
+
+/// The door with its damping and friction off (the bore's law without damping, the faces'
+/// restitution 1) sub-cycled on its adaptive steps over 0.3 s of knocks and edge contacts (the
+/// runner's energy balance): its energy never grows (1e-9 of its scale), and its loss is the
+/// integration's error: ROS2 damps what it does not resolve, and the loss falls with the
+/// tolerance (at most 1e-3 of the energy's scale at 0.001, and ten times less than at the
+/// default 0.0075).
+#[test]
+fn an_elastic_sub_cycled_door_keeps_its_energy() {
+    let text = std::fs::read_to_string("assets/door_hinge.ron").unwrap();
+    let elastic = text.replace(
+        "collar_radius: 0.010))",
+        "collar_radius: 0.010), face: (stiffness: 2.27e9, restitution: 1.0))",
+    );
+    assert_ne!(text, elastic, "the door's model line");
+    let error = |tolerance: &str| {
+        let scene = Scene::from_ron(&elastic, "door_hinge (elastic)")
+            .unwrap()
+            .with_overrides(&[
+                "hinge.eta_s=0",
+                "hinge.friction=None",
+                "run.contact_integration=SubCycled",
+                "run.end_s=0.3",
+                &format!("run.tolerance={tolerance}"),
+            ])
+            .unwrap();
+        let options = RunOptions {
+            twins: Twins::ClearanceOnly,
+            skip_rows: false,
+        };
+        let r = Simulation::new(&scene, options).unwrap().run().unwrap();
+        let s = r.summary().twins["clearance"].clone();
+        println!(
+            "tolerance {tolerance}: {} onsets, energy error {:?}, growth {:?}",
+            s.onsets, s.invariants.energy_error, s.invariants.energy_growth
+        );
+        assert!(s.onsets > 5);
+        assert!(s.invariants.energy_growth.unwrap() < 1e-9);
+        s.invariants.energy_error.unwrap()
+    };
+    let (default, tight) = (error("0.0075"), error("0.001"));
+    assert!(tight < 1e-3, "{tight}");
+    assert!(tight < 0.1 * default, "{tight} against {default}");
+}

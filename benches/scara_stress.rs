@@ -8,8 +8,9 @@
 //! arm on sub-cycled pins stepped once per tick, and the reference, the same pins integrated
 //! explicitly by the adaptive stepper at a tight tolerance (one solver iteration) under the same
 //! controller. The table gives, against the reference: each pin's largest force and deepest
-//! penetration, and the RMS distance of the hand from the ideal arm's hand (what the play costs);
-//! and the cost of a world step against the ideal arm's, measured in the same run.
+//! penetration, and the RMS distance of the hand from the ideal arm's hand (what the play costs;
+//! the reference's against an ideal arm at the reference's steps); and the cost of a world step
+//! against the ideal arm's at the world rate, measured in the same run.
 //!
 //! Knobs for diagnosis (environment): `SCARA_RATES=60,1000` (world rates, Hz),
 //! `SCARA_TOLERANCE` (the sub-cycled arms' tolerance, default 0.0075), `SCARA_PINS=shoulder` or
@@ -331,6 +332,15 @@ fn main() {
                 rate,
                 StepControl::adaptive(tick.min(REFERENCE_MAX_DT), REFERENCE_TOLERANCE),
             );
+            // The reference's own ideal arm, at the reference's steps: what the play costs
+            // when neither arm carries Rapier's error at the world rate.
+            let ideal_reference = run(
+                Pins::Ideal,
+                c,
+                rate,
+                StepControl::fixed(tick.min(REFERENCE_MAX_DT)),
+            )
+            .expect("the ideal arm at the reference's steps");
             let (ideal, sub, reference) = match (ideal, sub, reference) {
                 (Ok(i), Ok(s), Ok(r)) => (i, s, r),
                 (i, s, r) => {
@@ -353,7 +363,10 @@ fn main() {
                     eprintln!("  {} mm, {rate} Hz, {name}: {g}", c * 1e3);
                 }
             }
-            let (off, off_ref) = (rms_offset(&sub, &ideal), rms_offset(&reference, &ideal));
+            let (off, off_ref) = (
+                rms_offset(&sub, &ideal),
+                rms_offset(&reference, &ideal_reference),
+            );
             let cost = (sub.wall_s / sub.steps as f64) / (ideal.wall_s / ideal.steps as f64);
             println!(
                 "| {} | {rate} | {} | {} | {:.1}, {:.1} ({}, {}) | {:.3}, {:.3} ({}, {}) | {}, {} ({}, {}) | {:.4} ({}) | {:.2} |",

@@ -101,16 +101,10 @@ const APPROACH_FRACTION: f64 = 0.5;
 const STABLE_FRACTION_PER_TOLERANCE: f64 = 10.0;
 
 /// Sub-steps of a contact one world step may cover in or on the way into contact
-/// ([`ClearanceJoint::world_contact_step`]): 10, a world step of `20 tol` of the contact's
-/// period (0.15 of it at the default tolerance) and `100 tol` of its damped stability limit.
-/// The sub-cycle holds the rest of the world's acceleration and the pair's mobility over a
-/// world step, and Rapier hands the step's impulse to the rest of the mechanism as one constant
-/// wrench: a world step that spans whole impacts gives the bodies beyond the pair the impacts'
-/// mean. On the deployable array (`assets/deployable_array.ron`, its root hinge's window
-/// 0.15-0.3 s, mean of five starts) world steps that spanned the root's impacts put every window
-/// statistic outside the converged runs' range: largest force 85.8 N against 42.8-68.9, depth
-/// 0.742 um against 0.479-0.652, 147 onsets/s against 167-333, contact fraction 0.039 against
-/// 0.046-0.119, and an energy gain flagged; with this bound 53.2 N, 0.551 um, 231/s and 0.070.
+/// ([`ClearanceJoint::world_contact_step`]): 10, `20 tol` of the contact's period and `100 tol`
+/// of its damped stability limit. Rapier hands a step's impulse to the rest of the mechanism as
+/// one constant wrench, so a world step spanning whole impacts gives the bodies beyond the pair
+/// only their mean (the deployable array's window statistics: docs/sub-cycled-contact.md).
 const WORLD_SUBSTEPS_IN_CONTACT: f64 = 10.0;
 
 /// A 12-vector over the pair's coordinates: the bearing's linear and angular, then the

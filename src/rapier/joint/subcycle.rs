@@ -188,11 +188,7 @@ impl PairStart {
             *rb[0].position() * joint.local_anchor1 - com[0],
             *rb[1].position() * joint.local_anchor2 - com[1],
         ];
-        let mut velocity = [0.0; 12];
-        for (k, b) in rb.iter().enumerate() {
-            put(&mut velocity, 2 * k, b.linvel());
-            put(&mut velocity, 2 * k + 1, b.angvel());
-        }
+        let velocity = Self::velocity_now(joint, bodies)?;
         Some(PairStart {
             com,
             anchor,

@@ -32,7 +32,7 @@
 //! explicit joint's); a region a trial state presses without a history takes its own approach
 //! speed.
 
-use super::super::subcycle::{MAX_SUBSTEPS, SubCycle, SubStep};
+use super::super::subcycle::{MAX_SUBSTEPS, PairStart, SubCycle, SubStep};
 use super::super::{ClearanceJoint, ContactHistory, Mechanism, motion};
 use super::{Mobility, Pair, SpatialParts, Totals, apply_region, deepest_state, region_points};
 use crate::model::kinematics::{BodyMotion, ForcePair, JournalState};
@@ -129,11 +129,7 @@ impl SpatialStart {
         let parts = joint.spatial.as_ref()?;
         let rb: [&RigidBody; 2] = [bodies.get(joint.body1)?, bodies.get(joint.body2)?];
         let com = rb.map(world_center_of_mass);
-        let mut velocity = [0.0; 12];
-        for (k, b) in rb.iter().enumerate() {
-            put(&mut velocity, 2 * k, b.linvel());
-            put(&mut velocity, 2 * k + 1, b.angvel());
-        }
+        let velocity = PairStart::velocity_now(joint, bodies)?;
         Some(SpatialStart {
             com,
             anchor: [
@@ -147,17 +143,6 @@ impl SpatialStart {
             mobility: mechanism.pair_mobility(),
         })
     }
-}
-
-/// The pair's velocities in `bodies` now.
-fn velocity_now(joint: &ClearanceJoint, bodies: &RigidBodySet) -> Option<Pair12> {
-    let mut v = [0.0; 12];
-    for (k, h) in [joint.body1, joint.body2].into_iter().enumerate() {
-        let b = bodies.get(h)?;
-        put(&mut v, 2 * k, b.linvel());
-        put(&mut v, 2 * k + 1, b.angvel());
-    }
-    Some(v)
 }
 
 /// One region's memory inside the sub-cycle.
@@ -687,7 +672,7 @@ impl ClearanceJoint {
         iterations: usize,
     ) -> Option<Pair12> {
         let start = self.cycle.spatial_start?;
-        let now = velocity_now(self, bodies)?;
+        let now = PairStart::velocity_now(self, bodies)?;
         let (h, kick) = (pass.dt, pass.kick);
         let c_n = (iterations as f64 + 1.0) / (2.0 * iterations.max(1) as f64);
         let a_free: Pair12 = std::array::from_fn(|i| (now[i] - start.velocity[i]) / kick);

@@ -551,7 +551,7 @@ struct Lane {
 /// the state with its rates at the state).
 pub(crate) struct Group<'a> {
     pub(crate) cycles: Vec<Cycle<'a>>,
-    pub(crate) cross: Vec<Vec<(usize, [f64; 144])>>,
+    pub(crate) cross: &'a [Vec<(usize, [f64; 144])>],
     pub(crate) memory: Vec<(ContactHistory, JournalState)>,
 }
 
@@ -570,7 +570,7 @@ impl Group<'_> {
         if dg.iter().all(|x| *x == 0.0) {
             return;
         }
-        for (lane, cross) in lanes.iter_mut().zip(&self.cross) {
+        for (lane, cross) in lanes.iter_mut().zip(self.cross) {
             for (_, p) in cross.iter().filter(|(from, _)| *from == k) {
                 axpy(&mut lane.m.v, 1.0, &mul(p, dg));
             }
@@ -843,7 +843,7 @@ fn plan_group(
         .collect();
     Group {
         cycles,
-        cross: cross.clone(),
+        cross: &cross,
         memory,
     }
     .run(&mut runs);
@@ -875,6 +875,19 @@ fn plan_group(
         std::mem::swap(&mut joint.cycle.run, &mut run);
         joint.cycle.pending = Some(left);
         deliveries[i] = deliver[a].iter().any(|q| *q != 0.0).then_some(deliver[a]);
+    }
+}
+
+impl super::CycleState {
+    /// Takes the step's sub-cycle as the last step's: the impulse left `held`, and what the
+    /// step did (its velocity correction, dissipation, impulse and sub-steps), for the readers.
+    pub(crate) fn adopt_run(&mut self, held: Pair12) {
+        self.held = held;
+        self.start_correction = self.run.start_correction;
+        self.dissipated = self.run.dissipated;
+        self.impulse = self.run.impulse;
+        self.substep_count = self.run.substeps;
+        std::mem::swap(&mut self.substeps, &mut self.run.samples);
     }
 }
 
@@ -992,12 +1005,7 @@ impl ClearanceJoint {
         };
         self.elastic = std::sync::OnceLock::new();
         self.previous_rate = None;
-        self.cycle.held = held;
-        self.cycle.start_correction = self.cycle.run.start_correction;
-        self.cycle.dissipated = self.cycle.run.dissipated;
-        self.cycle.impulse = self.cycle.run.impulse;
-        self.cycle.substep_count = self.cycle.run.substeps;
-        std::mem::swap(&mut self.cycle.substeps, &mut self.cycle.run.samples);
+        self.cycle.adopt_run(held);
         let f = end.force.on_journal;
         let p = end.force.point;
         let (c1, c2) = (world_center_of_mass(rb1), world_center_of_mass(rb2));

@@ -740,12 +740,7 @@ impl ClearanceJoint {
         self.report.max_stable_dt = f64::INFINITY;
         self.report.friction_stable_dt = f64::INFINITY;
         self.elastic = std::sync::OnceLock::new();
-        self.cycle.held = held;
-        self.cycle.start_correction = self.cycle.run.start_correction;
-        self.cycle.dissipated = self.cycle.run.dissipated;
-        self.cycle.impulse = self.cycle.run.impulse;
-        self.cycle.substep_count = self.cycle.run.substeps;
-        std::mem::swap(&mut self.cycle.substeps, &mut self.cycle.run.samples);
+        self.cycle.adopt_run(held);
         result
     }
 }

@@ -28,10 +28,10 @@
 
 use clearance_joint::model::angle::HingeAngle;
 use clearance_joint::model::laws::{Bai, FrictionModel};
-use clearance_joint::rapier::convert::Clearance;
-use clearance_joint::rapier::drive::{DriveSet, TorsionSpring};
+use clearance_joint::rapier::hinge::convert::Clearance;
 use clearance_joint::rapier::joint::ClearanceJointSet;
 use clearance_joint::rapier::large_step::LargeStepJointSet;
+use clearance_joint::rapier::sources::drive::{DriveSet, TorsionSpring};
 use rapier3d_f64::math::{Pose, Rotation, Vector};
 use rapier3d_f64::prelude::{
     IntegrationParameters, MassProperties, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder,

@@ -12,7 +12,7 @@
 //! `cargo bench --bench scale`. Medians of 5 runs; ratios within one run of the bench.
 
 use clearance_joint::model::laws::{Bai, FrictionModel};
-use clearance_joint::rapier::convert::Clearance;
+use clearance_joint::rapier::hinge::convert::Clearance;
 use clearance_joint::rapier::joint::ClearanceJointSet;
 use clearance_joint::rapier::large_step::{
     DEFAULT_MAX_SUBSTEPS, LargeStepJointBuilder, LargeStepJointSet,

@@ -19,7 +19,7 @@
 
 use clearance_joint::model::laws::{Coulomb, FrictionModel};
 use clearance_joint::prelude::*;
-use clearance_joint::rapier::metrics::{ContactObservation, ImpactRecorder};
+use clearance_joint::rapier::observers::metrics::{ContactObservation, ImpactRecorder};
 use rapier3d_f64::prelude::*;
 use std::f64::consts::PI;
 use std::time::Instant;

@@ -9,9 +9,9 @@
 use clearance_joint::Result;
 use clearance_joint::model::angle::{UnwrappedAngle, twist_angle};
 use clearance_joint::model::laws::{Bai, FrictionModel};
-use clearance_joint::rapier::convert::{BearingSide, Clearance, ConvertRevolute};
-use clearance_joint::rapier::stepper::StepControl;
-use clearance_joint::rapier::world::ClearanceWorld;
+use clearance_joint::rapier::hinge::convert::{BearingSide, Clearance, ConvertRevolute};
+use clearance_joint::rapier::pipeline::stepper::StepControl;
+use clearance_joint::rapier::pipeline::world::ClearanceWorld;
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::{
     ImpulseJointHandle, MassProperties, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder,

@@ -15,7 +15,7 @@ use clearance_joint::ecs::{
     run_step,
 };
 use clearance_joint::model::laws::{Bai, FrictionModel};
-use clearance_joint::rapier::convert::Clearance;
+use clearance_joint::rapier::hinge::convert::Clearance;
 use rapier3d_f64::math::{Pose, Rotation, Vector};
 use rapier3d_f64::prelude::{MassProperties, RigidBodyBuilder};
 use std::process::ExitCode;

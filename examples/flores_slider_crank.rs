@@ -17,11 +17,11 @@ use clearance_joint::model::angle::{UnwrappedAngle, twist_angle};
 use clearance_joint::model::laws::{
     Ambrosio, BearingGeometry, FrictionModel, LankaraniNikravesh, Material, NormalModel,
 };
-use clearance_joint::rapier::convert::{BearingSide, Clearance, ConvertRevolute};
+use clearance_joint::rapier::hinge::convert::{BearingSide, Clearance, ConvertRevolute};
 use clearance_joint::rapier::joint::ClearanceJointHandle;
-use clearance_joint::rapier::metrics::{ContactObservation, ImpactRecorder};
-use clearance_joint::rapier::stepper::StepControl;
-use clearance_joint::rapier::world::ClearanceWorld;
+use clearance_joint::rapier::observers::metrics::{ContactObservation, ImpactRecorder};
+use clearance_joint::rapier::pipeline::stepper::StepControl;
+use clearance_joint::rapier::pipeline::world::ClearanceWorld;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::*;
 use std::f64::consts::TAU;

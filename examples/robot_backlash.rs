@@ -20,8 +20,8 @@ use clearance_joint::Result;
 use clearance_joint::model::angle::HingeAngle;
 use clearance_joint::model::laws::BearingGeometry;
 use clearance_joint::rapier::large_step::{LargeStepJointBuilder, LargeStepJointHandle};
-use clearance_joint::rapier::stepper::StepControl;
-use clearance_joint::rapier::world::ClearanceWorld;
+use clearance_joint::rapier::pipeline::stepper::StepControl;
+use clearance_joint::rapier::pipeline::world::ClearanceWorld;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     IntegrationParameters, MassProperties, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder,

@@ -12,13 +12,13 @@ use clearance_joint::model::laws::{
     Bai, BearingGeometry, FrictionModel, ImprovedLiu, Material, MaxDamping, NormalModel,
     effective_modulus,
 };
-use clearance_joint::rapier::drive::TorsionSpring;
 use clearance_joint::rapier::joint::{ClearanceJointBuilder, ClearanceJointHandle};
-use clearance_joint::rapier::reaction::{
+use clearance_joint::rapier::observers::reaction::{
     IdealJoint, IdealRevolute, ReactionSolver, prepare_mass_properties,
 };
-use clearance_joint::rapier::stepper::StepControl;
-use clearance_joint::rapier::world::ClearanceWorld;
+use clearance_joint::rapier::pipeline::stepper::StepControl;
+use clearance_joint::rapier::pipeline::world::ClearanceWorld;
+use clearance_joint::rapier::sources::drive::TorsionSpring;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     MassProperties, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder, RigidBodyHandle,

@@ -1,13 +1,13 @@
 //! Errors as values: every failure names the field or file it concerns and says why.
 
-use crate::rapier::guards::Violation;
-use crate::rapier::stall::Stall;
+use crate::rapier::observers::guards::Violation;
+use crate::rapier::observers::stall::Stall;
 use std::path::PathBuf;
 
 /// Everything that can go wrong in this crate. Nothing here panics on bad input.
 ///
 /// The messages speak to the caller of the layer that returns them: the plain API's errors name
-/// the API's parameters (`dt`, [`StepControl`](crate::rapier::stepper::StepControl)'s `max_dt`,
+/// the API's parameters (`dt`, [`StepControl`](crate::rapier::pipeline::stepper::StepControl)'s `max_dt`,
 /// a law's `stiffness`); the ECS layer and the scene layer put their own names in
 /// ([`Error::named`]: `Physics::world.rapier.integration_parameters.dt`, `run.dt_s`,
 /// `hinges[NAME].clearance.contact.eta_s`). No message carries an application's command-line
@@ -58,7 +58,7 @@ pub enum Error {
         stall: Box<Stall>,
     },
     /// A run-time guard was violated and the step control is strict
-    /// ([`StepControl::strict`](crate::rapier::stepper::StepControl::strict), a scene's
+    /// ([`StepControl::strict`](crate::rapier::pipeline::stepper::StepControl::strict), a scene's
     /// `run.strict`).
     #[error("guard violated (strict) by t = {t:.6} s: {}", in_words(violations))]
     Guard {
@@ -303,7 +303,7 @@ impl ContactParameter {
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct ParameterNames {
     /// How the caller turns adaptive stepping on (e.g. `run.step = Adaptive`); empty: the plain
-    /// API's [`StepControl::adaptive`](crate::rapier::stepper::StepControl::adaptive).
+    /// API's [`StepControl::adaptive`](crate::rapier::pipeline::stepper::StepControl::adaptive).
     pub adaptive: String,
     /// The contact parameters, in the order of [`ContactParameter::api_names`] (e.g.
     /// `hinges[pin].clearance.contact.eta_s`, `d_max_n_s_per_m`); empty: the plain API's names.
@@ -541,7 +541,7 @@ pub fn sig4(x: f64) -> String {
 }
 
 /// The smallest step a run takes, s: the adaptive steps' default floor.
-const SMALLEST_STEP: f64 = crate::rapier::stepper::StepControl::SMALLEST_STEP;
+const SMALLEST_STEP: f64 = crate::rapier::pipeline::stepper::StepControl::SMALLEST_STEP;
 
 /// What to do about a step beyond a contact's stability limit, fitting the step mode, in the
 /// caller's names (`names`) or the plain API's.

@@ -14,8 +14,8 @@
 //!
 //! Keep your world and your loop. Two changes make a loop clearance-ready: one solver iteration
 //! (the hook's force is constant over a step; Rapier's substeps would make every impact gain
-//! energy), and a [`ClearanceWorld`](rapier::world::ClearanceWorld) around your `PhysicsWorld`,
-//! whose [`step`](rapier::world::ClearanceWorld::step) takes the place of `world.step()`: it
+//! energy), and a [`ClearanceWorld`](rapier::pipeline::world::ClearanceWorld) around your `PhysicsWorld`,
+//! whose [`step`](rapier::pipeline::world::ClearanceWorld::step) takes the place of `world.step()`: it
 //! evaluates the joints' and drives' forces, chooses the step (adaptive by default, or fixed with
 //! a stability check), takes it with every joint set's hooks, judges it and retries it if a
 //! contact was entered blindly, and keeps the run's guards. Then one call turns a revolute joint
@@ -48,30 +48,30 @@
 //! # Ok::<(), clearance_joint::Error>(())
 //! ```
 //!
-//! The pieces: [`Clearance`](rapier::convert::Clearance) (geometry and laws, any law of
+//! The pieces: [`Clearance`](rapier::hinge::convert::Clearance) (geometry and laws, any law of
 //! [`model::laws`]), [`ClearanceJointSet`](rapier::joint::ClearanceJointSet) (the joints and their
 //! force hook), [`LargeStepJointSet`](rapier::large_step::LargeStepJointSet) (the play as a
-//! constraint, for game and robot rates), [`Stepper`](rapier::stepper::Stepper) with
-//! [`StepControl`](rapier::stepper::StepControl) (step choice, acceptance,
-//! [`GuardReport`](rapier::stepper::GuardReport)), the step protocol every set implements
-//! ([`StepHooks`](rapier::step_hooks::StepHooks)), and
+//! constraint, for game and robot rates), [`Stepper`](rapier::pipeline::stepper::Stepper) with
+//! [`StepControl`](rapier::pipeline::stepper::StepControl) (step choice, acceptance,
+//! [`GuardReport`](rapier::pipeline::stepper::GuardReport)), the step protocol every set implements
+//! ([`StepHooks`](rapier::pipeline::step_hooks::StepHooks)), and
 //! [`ClearanceJointBuilder`](rapier::joint::ClearanceJointBuilder) for a joint built from scratch.
-//! [`ClearanceWorld`](rapier::world::ClearanceWorld) bundles them; the scene runner and the
+//! [`ClearanceWorld`](rapier::pipeline::world::ClearanceWorld) bundles them; the scene runner and the
 //! bevy_ecs layer are built on it.
 //!
 //! # 2. A driven mechanism, with its metrics
 //!
 //! Any Rapier mechanism works: prismatic guides, kinematic bodies with a prescribed motion
-//! ([`rapier::prescribed`]), torsion springs and torques ([`rapier::drive`]). Around the loop, the
+//! ([`rapier::sources::prescribed`]), torsion springs and torques ([`rapier::sources::drive`]). Around the loop, the
 //! same public pieces the scene runner uses:
-//! - [`ImpactRecorder`](rapier::metrics::ImpactRecorder): the impact list (onset, approach speed,
+//! - [`ImpactRecorder`](rapier::observers::metrics::ImpactRecorder): the impact list (onset, approach speed,
 //!   peak force, deepest penetration, duration), contact fraction, peak and first-impact figures,
 //!   and per-turn statistics of a driven mechanism;
-//! - [`ReactionSolver`](rapier::reaction::ReactionSolver): the exact reactions of the ideal joints
+//! - [`ReactionSolver`](rapier::observers::reaction::ReactionSolver): the exact reactions of the ideal joints
 //!   at a state, from the constrained equations (no difference quotients);
-//! - [`StepInfo`](rapier::stepper::StepInfo) of every step and the stepper's guards (penetration
+//! - [`StepInfo`](rapier::pipeline::stepper::StepInfo) of every step and the stepper's guards (penetration
 //!   beyond the law's validity, energy gained, steps at the floor).
-//! - [`ReplayRecorder`](rapier::replay::ReplayRecorder): the bodies' poses and each journal in its
+//! - [`ReplayRecorder`](rapier::observers::replay::ReplayRecorder): the bodies' poses and each journal in its
 //!   bearing, thinned by time, for a replay of the run (the app writes it as `replay.html`).
 //!
 //! The README's "A driven mechanism" builds a slider-crank with a clearance pin this way in under
@@ -82,7 +82,7 @@
 //! A mechanism can instead be described in a RON scene file ([`scene::Scene`]: bodies, ideal
 //! joints, hinges with or without clearance, drives, prescribed motions, run settings), validated
 //! with errors that name the field. [`scene::runner::Simulation`] builds an ideal and a clearance
-//! twin in one world, steps them with the same [`Stepper`](rapier::stepper::Stepper), and returns
+//! twin in one world, steps them with the same [`Stepper`](rapier::pipeline::stepper::Stepper), and returns
 //! their time series, impact lists, reactions, energy and momentum checks and guards;
 //! [`RunResult::write`](scene::runner::RunResult::write) writes the result set whole or not at
 //! all:
@@ -199,9 +199,9 @@ mod chapter_doctests {
 /// # Ok::<(), clearance_joint::Error>(())
 /// ```
 pub mod prelude {
-    pub use crate::rapier::convert::{BearingSide, Clearance, ClearanceModel, ConvertRevolute};
-    pub use crate::rapier::drive::{DriveHandle, DriveSet, TorsionSpring};
-    pub use crate::rapier::guards::GuardReport;
+    pub use crate::rapier::hinge::convert::{
+        BearingSide, Clearance, ClearanceModel, ConvertRevolute,
+    };
     pub use crate::rapier::joint::{
         ClearanceJoint, ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet,
         ContactIntegration, OutOfPlaneLock,
@@ -209,13 +209,15 @@ pub mod prelude {
     pub use crate::rapier::large_step::{
         LargeStepJoint, LargeStepJointBuilder, LargeStepJointHandle, LargeStepJointSet, Restitution,
     };
-    pub use crate::rapier::metrics::{ContactObservation, ImpactRecorder};
-    pub use crate::rapier::reaction::{
+    pub use crate::rapier::observers::guards::GuardReport;
+    pub use crate::rapier::observers::metrics::{ContactObservation, ImpactRecorder};
+    pub use crate::rapier::observers::reaction::{
         IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, KinematicState,
         ReactionSolver,
     };
-    pub use crate::rapier::stepper::{StepControl, StepHooks, StepInfo, Stepper};
-    pub use crate::rapier::world::ClearanceWorld;
+    pub use crate::rapier::pipeline::stepper::{StepControl, StepHooks, StepInfo, Stepper};
+    pub use crate::rapier::pipeline::world::ClearanceWorld;
+    pub use crate::rapier::sources::drive::{DriveHandle, DriveSet, TorsionSpring};
     /// The same item as Rapier's (`rapier3d_f64::math::Vector`), so no clash with its prelude.
     pub use rapier3d_f64::math::Vector;
 }

@@ -7,7 +7,7 @@
 use clearance_joint::error::Error;
 use clearance_joint::model::laws::{BearingGeometry, Hertz, KelvinVoigt, NormalModel};
 use clearance_joint::prelude::*;
-use clearance_joint::rapier::stepper::{StepControl, Stepper};
+use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::runner::{RunOptions, Simulation};
 use rapier3d_f64::prelude::*;

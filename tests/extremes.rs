@@ -203,15 +203,16 @@ fn api_pendulum() -> (
                 Vector::splat(0.02),
             )),
     );
-    let joint = clearance_joint::rapier::convert::Clearance::steel_improved_liu(0.01, 2e-4, 0.016)
-        .unwrap()
-        .joint(
-            Vector::ZERO,
-            Vector::new(0.0, 0.3, 0.0),
-            Vector::Z,
-            Vector::Z,
-        )
-        .unwrap();
+    let joint =
+        clearance_joint::rapier::hinge::convert::Clearance::steel_improved_liu(0.01, 2e-4, 0.016)
+            .unwrap()
+            .joint(
+                Vector::ZERO,
+                Vector::new(0.0, 0.3, 0.0),
+                Vector::Z,
+                Vector::Z,
+            )
+            .unwrap();
     let mut joints = clearance_joint::rapier::joint::ClearanceJointSet::new();
     joints
         .insert(ground, arm, joint, &world.bodies, &mut world.impulse_joints)
@@ -221,7 +222,7 @@ fn api_pendulum() -> (
 
 #[test]
 fn api_refuses_a_gravity_that_is_not_finite() {
-    use clearance_joint::rapier::stepper::{StepControl, Stepper};
+    use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
     let (mut world, mut joints, _) = api_pendulum();
     world.gravity = rapier3d_f64::math::Vector::new(0.0, f64::NAN, 0.0);
     let mut stepper = Stepper::new(StepControl::fixed(1e-5));
@@ -237,7 +238,7 @@ fn api_refuses_a_gravity_that_is_not_finite() {
 #[test]
 fn api_names_a_journal_body_removed_after_the_joint() {
     // The step check used to read "stable only below 0 s ... use `dt` below 0 s".
-    use clearance_joint::rapier::stepper::{StepControl, Stepper};
+    use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
     let (mut world, mut joints, arm) = api_pendulum();
     let mut stepper = Stepper::new(StepControl::fixed(1e-5));
     stepper.step(&mut world, &mut [&mut joints], 1e-3).unwrap();
@@ -265,7 +266,7 @@ fn api_names_a_journal_body_removed_after_the_joint() {
 #[test]
 fn api_divergence_names_the_handle_and_the_likely_cause() {
     // A stone flung at 300 m/s beside the pendulum leaves the physical range at once.
-    use clearance_joint::rapier::stepper::{StepControl, Stepper};
+    use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
     use rapier3d_f64::prelude::{MassProperties, RigidBodyBuilder};
     let (mut world, mut joints, _) = api_pendulum();
     let stone = world.bodies.insert(

@@ -2,7 +2,7 @@
 //! handle valid, a removed joint's handle finds nothing (also after its slot is reused), and the
 //! sets visit their joints in insertion order.
 
-use clearance_joint::rapier::convert::Clearance;
+use clearance_joint::rapier::hinge::convert::Clearance;
 use clearance_joint::rapier::joint::ClearanceJointSet;
 use clearance_joint::rapier::large_step::LargeStepJointSet;
 use rapier3d_f64::prelude::*;
@@ -135,7 +135,7 @@ fn large_step_handles_survive_removals_and_stale_ones_find_nothing() {
 /// handle finds nothing, also after a new drive is inserted, and only the drives left act.
 #[test]
 fn drive_handles_survive_removals_and_stale_ones_find_nothing() {
-    use clearance_joint::rapier::drive::{DriveSet, TorsionSpring};
+    use clearance_joint::rapier::sources::drive::{DriveSet, TorsionSpring};
     let (mut w, base, arms) = world(3);
     let mut drives = DriveSet::new();
     let handles: Vec<_> = (0..3)

@@ -12,16 +12,18 @@
 use clearance_joint::model::angle::{HingeAngle, UnwrappedAngle, twist_angle};
 use clearance_joint::model::kinematics::{BodyMotion, contact_force, journal_state, stable_step};
 use clearance_joint::model::laws::*;
-use clearance_joint::rapier::drive::TorsionSpring;
 use clearance_joint::rapier::joint::ClearanceJointBuilder;
 use clearance_joint::rapier::large_step::LargeStepJointBuilder;
 use clearance_joint::rapier::large_step::resolution::{
     quantized_substeps, rocking_frequency, substeps_needed,
 };
-use clearance_joint::rapier::metrics::{ContactObservation, Impact, ImpactRecorder, per_period};
-use clearance_joint::rapier::prescribed::Table;
-use clearance_joint::rapier::reaction::SoftMotor;
-use clearance_joint::rapier::stepper::StepControl;
+use clearance_joint::rapier::observers::metrics::{
+    ContactObservation, Impact, ImpactRecorder, per_period,
+};
+use clearance_joint::rapier::observers::reaction::SoftMotor;
+use clearance_joint::rapier::pipeline::stepper::StepControl;
+use clearance_joint::rapier::sources::drive::TorsionSpring;
+use clearance_joint::rapier::sources::prescribed::Table;
 use clearance_joint::{Error, error};
 use proptest::prelude::*;
 use rapier3d_f64::math::{Rotation, Vector};
@@ -254,7 +256,7 @@ proptest! {
     ) {
         let impacts = [Impact { onset_t_s: onset, duration_s: duration, peak_force_n: force, ..Impact::default() }];
         match per_period(&impacts, period, end) {
-            Ok(p) => prop_assert!(p.len() <= clearance_joint::rapier::metrics::MAX_PERIODS),
+            Ok(p) => prop_assert!(p.len() <= clearance_joint::rapier::observers::metrics::MAX_PERIODS),
             Err(e) => prop_assert!(e.to_string().contains("period"), "{e}"),
         }
         let mut rec = ImpactRecorder::new();
@@ -291,9 +293,9 @@ proptest! {
             .min_impact_speed(b)
             .build();
         refuses_non_finite(&[&vectors[..], &[a, b]].concat(), &r)?;
-        let r = clearance_joint::rapier::convert::Clearance::steel_improved_liu(a, b, 0.016);
+        let r = clearance_joint::rapier::hinge::convert::Clearance::steel_improved_liu(a, b, 0.016);
         refuses_non_finite(&[a, b], &r)?;
-        if let Ok(c) = clearance_joint::rapier::convert::Clearance::steel_improved_liu(0.01, 2e-4, 0.016) {
+        if let Ok(c) = clearance_joint::rapier::hinge::convert::Clearance::steel_improved_liu(0.01, 2e-4, 0.016) {
             let c = c.min_impact_speed(a).restitution(b);
             let r = c.joint(anchor, anchor, axis, axis);
             refuses_non_finite(&[&vectors[..], &[a]].concat(), &r)?;

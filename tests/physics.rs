@@ -425,10 +425,10 @@ fn adaptive_steps_resolve_contact_onset() {
 }
 
 /// The impact of [`ln_impact`] stepped at `dt` through `apply` and recorded by the
-/// [`ImpactRecorder`](clearance_joint::rapier::metrics::ImpactRecorder) a plain loop uses: its
+/// [`ImpactRecorder`](clearance_joint::rapier::observers::metrics::ImpactRecorder) a plain loop uses: its
 /// onset and duration, s.
 fn ln_recorded(dt: f64) -> (f64, f64) {
-    use clearance_joint::rapier::metrics::{ContactObservation, ImpactRecorder};
+    use clearance_joint::rapier::observers::metrics::{ContactObservation, ImpactRecorder};
     let (mut world, mut set, pin) = ln_impact(dt);
     let mut recorder = ImpactRecorder::new();
     let steps = (0.003 / dt).round() as usize;

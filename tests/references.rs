@@ -32,7 +32,7 @@ use clearance_joint::model::laws::{
     LankaraniNikravesh, LiuEtAl, MaxDamping, NormalModel,
 };
 use clearance_joint::prelude::*;
-use clearance_joint::rapier::metrics::Impact as LibraryImpact;
+use clearance_joint::rapier::observers::metrics::Impact as LibraryImpact;
 use clearance_joint::scene::runner::{RunOptions, Simulation, TwinKind, Twins};
 use clearance_joint::scene::{MotionSpec, Scene};
 use rapier3d_f64::prelude::{

@@ -4,14 +4,14 @@
 //! corrects its joints' drift within each step; when the step drops near a contact that
 //! multiplies the correcting velocity and the locked tilt of the bars grows at each change of
 //! the step until the run diverges. The stepper's joint correction spreads the correction over
-//! the longest recent step (`rapier::joint_correction`): the same run then ends clean.
+//! the longest recent step (`rapier::pipeline::joint_correction`): the same run then ends clean.
 
 use clearance_joint::model::laws::{
     Ambrosio, BearingGeometry, FrictionModel, LankaraniNikravesh, Material, NormalModel,
 };
-use clearance_joint::rapier::convert::Clearance;
+use clearance_joint::rapier::hinge::convert::Clearance;
 use clearance_joint::rapier::joint::ClearanceJointSet;
-use clearance_joint::rapier::stepper::{StepControl, Stepper};
+use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
 use clearance_joint::{Error, Result};
 use rapier3d_f64::prelude::*;
 

@@ -5,8 +5,8 @@
 
 use clearance_joint::model::laws::{Material, effective_modulus};
 use clearance_joint::model::spatial::{FaceLaw, SpatialModel};
-use clearance_joint::rapier::convert::ClearanceModel;
-use clearance_joint::rapier::metrics::SpatialMetrics;
+use clearance_joint::rapier::hinge::convert::ClearanceModel;
+use clearance_joint::rapier::observers::metrics::SpatialMetrics;
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::report::TwinSummary;
 use clearance_joint::scene::runner::{RunOptions, RunResult, Simulation, Twins};

@@ -9,8 +9,8 @@ mod flores;
 
 use clearance_joint::model::laws::{BearingGeometry, LankaraniNikravesh, Material, NormalModel};
 use clearance_joint::prelude::*;
-use clearance_joint::rapier::metrics::{ContactObservation, ImpactRecorder};
-use clearance_joint::rapier::stepper::{StepControl, Stepper};
+use clearance_joint::rapier::observers::metrics::{ContactObservation, ImpactRecorder};
+use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
 use flores::*;
 use rapier3d_f64::prelude::*;
 

@@ -4,10 +4,12 @@
 
 use clearance_joint::error::Error;
 use clearance_joint::model::laws::{BearingGeometry, Hertz, NormalModel};
-use clearance_joint::rapier::convert::Clearance;
+use clearance_joint::rapier::hinge::convert::Clearance;
 use clearance_joint::rapier::joint::ClearanceJointSet;
-use clearance_joint::rapier::reaction::{IdealRevolute, ReactionSolver, prepare_mass_properties};
-use clearance_joint::rapier::stepper::{StepControl, Stepper};
+use clearance_joint::rapier::observers::reaction::{
+    IdealRevolute, ReactionSolver, prepare_mass_properties,
+};
+use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::runner::{RunOptions, RunResult, Simulation, TwinKind, Twins};
 use rapier3d_f64::math::Vector;

@@ -390,7 +390,7 @@ fn a_set_joint_on_a_missing_body_is_refused() {
 /// motion is pushed into the public field; `PrescribedMotion::angle` normalises its axis.
 #[test]
 fn prescribed_motions_the_world_cannot_honour_are_refused() {
-    use clearance_joint::rapier::prescribed::{PrescribedMotion, PrescribedPath, Table};
+    use clearance_joint::rapier::sources::prescribed::{PrescribedMotion, PrescribedPath, Table};
     let table = || Table::new(&[0.0, 0.1], &[0.0, 1.0]).unwrap();
     // The arm world with a removed body and a position-based kinematic one (the same handles
     // every time it is built).

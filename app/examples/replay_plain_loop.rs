@@ -7,7 +7,7 @@
 //! (default `out/replay_plain_loop`).
 
 use clearance_joint::prelude::*;
-use clearance_joint::rapier::replay::{Recording, ReplayRecorder};
+use clearance_joint::rapier::observers::replay::{Recording, ReplayRecorder};
 use clearance_joint_app::replay::{Line, ReplayPage, Series};
 use rapier3d_f64::prelude::*;
 use std::path::PathBuf;
@@ -42,7 +42,7 @@ pub fn run(end: f64) -> clearance_joint::Result<Recording> {
     let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.0075));
     stepper.prepare(&mut world, &mut [&mut clearance])?;
     // Mass properties before the first step (Rapier computes them in it).
-    clearance_joint::rapier::reaction::prepare_mass_properties(&mut world.bodies);
+    clearance_joint::rapier::observers::reaction::prepare_mass_properties(&mut world.bodies);
     // A frame per ms in free flight, per 10 us in contact (every onset and the state before it).
     let mut recorder = ReplayRecorder::new(1e-3, 1e-5)?;
     recorder.track_body("base", "clearance", base, &world.bodies, &world.colliders);
@@ -75,7 +75,7 @@ fn main() -> clearance_joint::Result<()> {
         t: t.clone(),
         v,
     };
-    let journal = |f: &dyn Fn(&clearance_joint::rapier::replay::JournalFrame) -> f64| {
+    let journal = |f: &dyn Fn(&clearance_joint::rapier::observers::replay::JournalFrame) -> f64| {
         recording
             .frames
             .iter()

@@ -4,7 +4,7 @@
 use crate::error::{Error, Result, unit_vector};
 use crate::model::angle::HingeAngle;
 use crate::model::kinematics::ContactMode;
-use crate::rapier::convert::Clearance;
+use crate::rapier::hinge::convert::Clearance;
 use bevy_ecs::prelude::*;
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::{RevoluteJoint, RigidBody, RigidBodyHandle};
@@ -122,7 +122,7 @@ impl Hinge {
     /// The ideal Rapier revolute joint of this hinge (axes normalised, contacts between the
     /// bodies disabled).
     pub fn revolute(&self) -> RevoluteJoint {
-        crate::rapier::convert::revolute_joint([
+        crate::rapier::hinge::convert::revolute_joint([
             self.local_anchor1,
             self.local_anchor2,
             self.local_axis1.normalize_or_zero(),
@@ -187,7 +187,7 @@ pub enum HingeMode {
     /// A clearance joint.
     Clearance,
     /// A large-step clearance joint
-    /// ([`ClearanceModel::LargeStep`](crate::rapier::convert::ClearanceModel::LargeStep)).
+    /// ([`ClearanceModel::LargeStep`](crate::rapier::hinge::convert::ClearanceModel::LargeStep)).
     LargeStep,
 }
 
@@ -207,14 +207,14 @@ pub struct HingeState {
     /// step: the normal force of the radial limit (its last substep's impulse over the substep).
     /// Ideal: the exact reaction at the state the step reached, from the constrained equations of
     /// the ideal revolute hinges under gravity, your forces and the drives
-    /// ([`ReactionSolver`](crate::rapier::reaction::ReactionSolver)); contacts with colliders and
+    /// ([`ReactionSolver`](crate::rapier::observers::reaction::ReactionSolver)); contacts with colliders and
     /// other kinds of joints on the same bodies are not part of it.
     pub force: f64,
     /// Largest `force` so far, N.
     pub peak_force: f64,
     /// The joint force averaged over the last frame, N: its impulse over the frame's steps over
     /// the frame's time, each state's force held over the step that followed it (as
-    /// [`HingeMetrics::rms_force_n`](crate::rapier::metrics::HingeMetrics::rms_force_n) weighs
+    /// [`HingeMetrics::rms_force_n`](crate::rapier::observers::metrics::HingeMetrics::rms_force_n) weighs
     /// it). A frame is one [`run_step`](super::run_step), the steps of one
     /// [`run_frame`](super::run_frame), or the steps since [`Physics::begin_frame`](super::Physics::begin_frame).
     /// Large step: the normal force times each step plus the bounces' impulses
@@ -224,14 +224,14 @@ pub struct HingeState {
     /// The largest joint force at the last frame's states, N: the state it began at and every
     /// state it reached (at least every `force` read after its steps).
     pub frame_peak_force: f64,
-    /// [Onsets](crate::rapier::metrics#onsets-impacts-and-chatter) so far: every contact that
+    /// [Onsets](crate::rapier::observers::metrics#onsets-impacts-and-chatter) so far: every contact that
     /// began, chatter included (clearance and large step; 0 for ideal hinges). Equals
-    /// [`HingeMetrics::onsets`](crate::rapier::metrics::HingeMetrics::onsets) of the same states.
+    /// [`HingeMetrics::onsets`](crate::rapier::observers::metrics::HingeMetrics::onsets) of the same states.
     pub onsets: u64,
-    /// [Impacts](crate::rapier::metrics#onsets-impacts-and-chatter) so far: onsets after a free
+    /// [Impacts](crate::rapier::observers::metrics#onsets-impacts-and-chatter) so far: onsets after a free
     /// flight that opened at least the joint's `min_separation` (large step: its bounces, onsets
     /// faster than its `min_impact_speed`); `onsets - impacts` is the chatter. Equals
-    /// [`HingeMetrics::impacts`](crate::rapier::metrics::HingeMetrics::impacts) of the same
+    /// [`HingeMetrics::impacts`](crate::rapier::observers::metrics::HingeMetrics::impacts) of the same
     /// states. 0 for ideal hinges.
     pub impacts: u64,
     /// Penetration (clearance; negative: free gap), m.
@@ -259,7 +259,7 @@ pub struct HingeState {
     /// step; `false` for the other modes).
     pub under_resolved: bool,
     /// A spatial hinge's tilt, axial offset and forces by contact kind over the last step
-    /// ([`ClearanceModel::Spatial`](crate::rapier::convert::ClearanceModel::Spatial)); `None`
+    /// ([`ClearanceModel::Spatial`](crate::rapier::hinge::convert::ClearanceModel::Spatial)); `None`
     /// for the other models and for ideal hinges. For a spatial hinge, `penetration`,
     /// `eccentricity` and `contact` are its deepest station's (a bore station or, when
     /// [`governed_by_face`](crate::rapier::joint::SpatialReport::governed_by_face), a face's).

@@ -3,8 +3,8 @@
 //!
 //! A thin layer: the physics is the core's
 //! ([`ClearanceJointSet`](crate::rapier::joint::ClearanceJointSet),
-//! [`DriveSet`](crate::rapier::drive::DriveSet), the conversions of
-//! [`convert`](crate::rapier::convert)). The systems reconcile the Rapier world with the components
+//! [`DriveSet`](crate::rapier::sources::drive::DriveSet), the conversions of
+//! [`convert`](crate::rapier::hinge::convert)). The systems reconcile the Rapier world with the components
 //! every step: spawning, changing or removing a component is all a user does.
 //!
 //! - [`Physics`] (resource): the Rapier `PhysicsWorld`, the clearance joints and the drives;
@@ -17,19 +17,19 @@
 //! - [`HingeState`] and [`BodyState`] (added automatically): what the last step did (a hinge's
 //!   force, eccentricity and `|e|/c`, contact, impulse, the substeps of a large-step hinge;
 //!   the counts of onsets and impacts, see the
-//!   [definitions](crate::rapier::metrics#onsets-impacts-and-chatter); the force averaged over
+//!   [definitions](crate::rapier::observers::metrics#onsets-impacts-and-chatter); the force averaged over
 //!   the last frame and its peak: [`run_frame`] runs one frame of a game loop).
 //!
 //! A `ClearanceHinge` builds the compliant model unless its
-//! [`Clearance::model`](crate::rapier::convert::Clearance::model) is
-//! [`ClearanceModel::LargeStep`](crate::rapier::convert::ClearanceModel::LargeStep): the one-line
+//! [`Clearance::model`](crate::rapier::hinge::convert::Clearance::model) is
+//! [`ClearanceModel::LargeStep`](crate::rapier::hinge::convert::ClearanceModel::LargeStep): the one-line
 //! choice of the large-step model (see [`large_step`](crate::rapier::large_step)), stepped by the
 //! same schedule.
 //!
 //! Swapping an entity's `IdealHinge` for a `ClearanceHinge` is the whole change, at spawn or
 //! while running: the sync system converts the Rapier revolute joint into a clearance joint with
-//! [`revolute_to_clearance`](crate::rapier::convert::revolute_to_clearance) (and back with
-//! [`clearance_to_revolute`](crate::rapier::convert::clearance_to_revolute) when the `ClearanceHinge`
+//! [`revolute_to_clearance`](crate::rapier::hinge::convert::revolute_to_clearance) (and back with
+//! [`clearance_to_revolute`](crate::rapier::hinge::convert::clearance_to_revolute) when the `ClearanceHinge`
 //! is removed again).
 //!
 //! # The world's settings are yours
@@ -47,11 +47,11 @@
 //! Gauss-Seidel sweep over the ideal joints a step: a chain with a light body between stiff joints
 //! (a motor-driven crank carrying a heavier coupler) wants more sweeps,
 //! `integration_parameters.num_internal_pgs_iterations` (see
-//! [`ClearanceWorld`](crate::rapier::world)'s docs), which keeps the one substep.
+//! [`ClearanceWorld`](crate::rapier::pipeline::world)'s docs), which keeps the one substep.
 //!
 //! ```
 //! use bevy_ecs::prelude::*;
-//! use clearance_joint::rapier::convert::Clearance;
+//! use clearance_joint::rapier::hinge::convert::Clearance;
 //! use clearance_joint::ecs::*;
 //! use rapier3d_f64::math::Vector;
 //! use rapier3d_f64::prelude::{MassProperties, RigidBodyBuilder};
@@ -97,7 +97,7 @@
 //!
 //! ```
 //! use bevy_ecs::prelude::*;
-//! use clearance_joint::rapier::convert::{Clearance, ClearanceModel};
+//! use clearance_joint::rapier::hinge::convert::{Clearance, ClearanceModel};
 //! use clearance_joint::ecs::*;
 //! use rapier3d_f64::math::Vector;
 //! use rapier3d_f64::prelude::{MassProperties, PhysicsWorld, RigidBodyBuilder};

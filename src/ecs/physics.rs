@@ -4,13 +4,13 @@
 
 use super::components::{Drive, Hinge};
 use crate::error::{Error, Result};
-use crate::rapier::convert::{BearingSide, Clearance, ClearanceModel, ConvertRevolute};
-use crate::rapier::drive::{DriveHandle, TorsionSpring};
+use crate::rapier::hinge::convert::{BearingSide, Clearance, ClearanceModel, ConvertRevolute};
 use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle, ClearanceJointSet};
 use crate::rapier::large_step::{LargeStepJoint, LargeStepJointHandle, LargeStepJointSet};
-use crate::rapier::reaction::{IdealJoint, IdealRevolute, ReactionSolver};
-use crate::rapier::stepper::{GuardReport, StepControl, StepMode};
-use crate::rapier::world::ClearanceWorld;
+use crate::rapier::observers::reaction::{IdealJoint, IdealRevolute, ReactionSolver};
+use crate::rapier::pipeline::stepper::{GuardReport, StepControl, StepMode};
+use crate::rapier::pipeline::world::ClearanceWorld;
+use crate::rapier::sources::drive::{DriveHandle, TorsionSpring};
 use bevy_ecs::prelude::*;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{ImpulseJointHandle, PhysicsWorld, RigidBody, RigidBodyHandle};

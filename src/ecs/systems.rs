@@ -1,6 +1,6 @@
 //! The systems of a physics step, in [`PhysicsSet`](super::PhysicsSet) order: components to
 //! Rapier ([`sync_bodies`], [`sync_hinges`]), the forces and the step ([`apply_forces`],
-//! [`step_physics`]: the [`ClearanceWorld`](crate::rapier::world::ClearanceWorld)'s, which runs
+//! [`step_physics`]: the [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld)'s, which runs
 //! every joint set's hooks, the large-step joints' included), and Rapier back to the components
 //! ([`record`]). Each does nothing while [`Physics::error`] is set. Entities are
 //! visited in order, so that Rapier sees the same calls in the same order on every run.
@@ -149,7 +149,7 @@ pub fn apply_forces(mut physics: ResMut<Physics>) {
     }
 }
 
-/// One accepted step of the [`ClearanceWorld`](crate::rapier::world::ClearanceWorld) (fixed steps
+/// One accepted step of the [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld) (fixed steps
 /// of `world.rapier.integration_parameters.dt` unless [`Physics::set_step_control`] chose otherwise):
 /// variable-step consistent kicks, step acceptance, guards. An error stops the systems where the
 /// state was last valid.

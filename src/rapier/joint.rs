@@ -10,12 +10,12 @@ use crate::model::laws::{
     BearingGeometry, FrictionLaw, FrictionModel, NormalContact, NormalForceLaw, NormalModel,
     crossing_fraction, loaded_impact_rate, penetration_for_energy, speed_at_crossing,
 };
-use crate::rapier::arena::OrderedArena;
-use crate::rapier::guards::{GuardKind, GuardReport, Violation};
-use crate::rapier::ledger::{
+use crate::rapier::observers::guards::{GuardKind, GuardReport, Violation};
+use crate::rapier::observers::stall::StalledContact;
+use crate::rapier::pipeline::arena::OrderedArena;
+use crate::rapier::pipeline::ledger::{
     ForceLedger, Wrench, ensure_mass_properties, inverse_mass_along, world_center_of_mass,
 };
-use crate::rapier::stall::StalledContact;
 use rapier3d_f64::data::Index;
 use std::sync::OnceLock;
 
@@ -135,7 +135,7 @@ impl ClearanceJointBuilder {
         self
     }
     /// The gap a free flight must open for the next onset to count as an
-    /// [impact](crate::rapier::metrics#onsets-impacts-and-chatter), m (default 0.1 um, about 8
+    /// [impact](crate::rapier::observers::metrics#onsets-impacts-and-chatter), m (default 0.1 um, about 8
     /// times the resting penetration of the paper's hinge load): onsets after smaller
     /// separations are the chatter of a journal following the wall.
     pub fn min_separation(mut self, gap: f64) -> Self {
@@ -145,7 +145,7 @@ impl ClearanceJointBuilder {
     /// The deepest penetration at which the contact law is still trusted, m (default
     /// [`DEFAULT_VALID_STRAIN`] times the journal radius, see
     /// [`default_max_valid_penetration`]). A journal pressed deeper is outside the model; the
-    /// steppers report it as a guard violation ([`crate::rapier::stepper::GuardReport`]), with
+    /// steppers report it as a guard violation ([`crate::rapier::pipeline::stepper::GuardReport`]), with
     /// the worst depth, when and how often. It is not a force limit.
     pub fn max_valid_penetration(mut self, depth: f64) -> Self {
         self.joint.max_valid_penetration = Some(depth);
@@ -303,9 +303,9 @@ pub struct ClearanceReport {
     /// Motion mode.
     pub mode: ContactMode,
     /// Whether a contact began at this application: an
-    /// [onset](crate::rapier::metrics#onsets-impacts-and-chatter), chatter included.
+    /// [onset](crate::rapier::observers::metrics#onsets-impacts-and-chatter), chatter included.
     pub onset: bool,
-    /// Whether this onset is an [impact](crate::rapier::metrics#onsets-impacts-and-chatter): the
+    /// Whether this onset is an [impact](crate::rapier::observers::metrics#onsets-impacts-and-chatter): the
     /// first contact, or one after a free flight that opened a gap of at least the joint's
     /// `min_separation`. Re-contacts after smaller separations are chatter of a journal
     /// following the wall, not impacts.
@@ -635,7 +635,7 @@ impl ClearanceJoint {
     /// A sub-cycled joint's states inside the last step, in time order, the step's end last
     /// (empty for an explicit joint, and before the first step): its contacts resolved where
     /// the step itself is too long to see them. A loop that records a sub-cycled joint's
-    /// contacts records these ([`ImpactRecorder::record_step`](crate::rapier::metrics::ImpactRecorder::record_step)).
+    /// contacts records these ([`ImpactRecorder::record_step`](crate::rapier::observers::metrics::ImpactRecorder::record_step)).
     pub fn substeps(&self) -> &[SubStep] {
         &self.cycle.substeps
     }
@@ -1177,7 +1177,7 @@ impl ClearanceJointSet {
         bodies: &RigidBodySet,
         impulse_joints: &mut ImpulseJointSet,
     ) -> Result<ClearanceJointHandle> {
-        crate::rapier::step_hooks::joint_pair(bodies, body1, body2)?;
+        crate::rapier::pipeline::step_hooks::joint_pair(bodies, body1, body2)?;
         joint.check_start(&bodies[body1], &bodies[body2])?;
         Ok(self.insert_unchecked(body1, body2, joint, impulse_joints))
     }
@@ -1305,7 +1305,7 @@ impl ClearanceJointSet {
     /// (every contact peak then converges at first order). Knowing the step, the joints carry the
     /// penetration rate to the state ([`ClearanceReport::contact_rate`]). [`apply`](Self::apply)
     /// sets it to `params.dt` itself, and the
-    /// [`Stepper`](crate::rapier::stepper::Stepper) to each step it takes; call it yourself only
+    /// [`Stepper`](crate::rapier::pipeline::stepper::Stepper) to each step it takes; call it yourself only
     /// when you call `evaluate` or `apply_forces` in your own loop. 0 (the default, and the value
     /// for velocities that are the state's own: at the start, or after you set them by hand)
     /// gives the laws the stored rate. A negative or non-finite `dt` counts as 0.
@@ -1323,7 +1323,7 @@ impl ClearanceJointSet {
 
     /// Evaluates every joint at the bodies' current state (contact history, report, the
     /// wrenches of [`wrenches`](Self::wrenches)) without touching the bodies' forces: the
-    /// [`Stepper`](crate::rapier::stepper::Stepper) adds the wrenches for the duration of its step only,
+    /// [`Stepper`](crate::rapier::pipeline::stepper::Stepper) adds the wrenches for the duration of its step only,
     /// so the bodies carry nothing but the user's own forces between steps. A joint whose body is
     /// gone reports free flight and applies nothing.
     ///
@@ -1395,7 +1395,7 @@ impl ClearanceJointSet {
     pub(crate) fn resolve_step(
         &mut self,
         bodies: &RigidBodySet,
-        pass: &crate::rapier::step_hooks::StepPass,
+        pass: &crate::rapier::pipeline::step_hooks::StepPass,
         iterations: usize,
     ) -> bool {
         if pass.pass > 0 {
@@ -1543,8 +1543,8 @@ impl ClearanceJointSet {
 }
 
 /// The clearance joints take part in the stepper's steps: their contact forces, step limits,
-/// acceptance and guards ([`crate::rapier::step_hooks`]).
-impl crate::rapier::step_hooks::StepHooks for ClearanceJointSet {
+/// acceptance and guards ([`crate::rapier::pipeline::step_hooks`]).
+impl crate::rapier::pipeline::step_hooks::StepHooks for ClearanceJointSet {
     fn evaluate(&mut self, bodies: &mut RigidBodySet, impulse_joints: &ImpulseJointSet) {
         ClearanceJointSet::evaluate(self, bodies, impulse_joints);
     }
@@ -1558,7 +1558,7 @@ impl crate::rapier::step_hooks::StepHooks for ClearanceJointSet {
     fn resolve_step(
         &mut self,
         world: &rapier3d_f64::prelude::PhysicsWorld,
-        pass: &crate::rapier::step_hooks::StepPass,
+        pass: &crate::rapier::pipeline::step_hooks::StepPass,
     ) -> bool {
         let iterations = world.integration_parameters.num_solver_iterations;
         ClearanceJointSet::resolve_step(self, &world.bodies, pass, iterations)
@@ -1623,7 +1623,7 @@ impl crate::rapier::step_hooks::StepHooks for ClearanceJointSet {
         }
     }
     fn stalled_contact(&self, bodies: &RigidBodySet) -> Option<StalledContact> {
-        crate::rapier::stall::stalled_contact([self], bodies)
+        crate::rapier::observers::stall::stalled_contact([self], bodies)
     }
     fn joints_of(&self, body: RigidBodyHandle, names: &mut Vec<String>) {
         for (_, j) in self.iter() {
@@ -1634,7 +1634,7 @@ impl crate::rapier::step_hooks::StepHooks for ClearanceJointSet {
     }
     fn check_bodies(&self, bodies: &RigidBodySet) -> Result<()> {
         for (_, j) in self.iter() {
-            crate::rapier::step_hooks::joint_bodies(
+            crate::rapier::pipeline::step_hooks::joint_bodies(
                 bodies,
                 || format!("clearance joint `{}`", j.name()),
                 j.body1(),

@@ -35,7 +35,7 @@ pub struct Summary {
     pub stepping: String,
     /// What the run-time guards saw: rejected steps, the deepest penetration against its law's
     /// validity, steps at the floor, and violations in words (empty when the run stayed valid).
-    pub guards: crate::rapier::stepper::GuardReport,
+    pub guards: crate::rapier::pipeline::stepper::GuardReport,
     /// The convergence check's verdict: which metrics converged against a run at half the
     /// tolerance, which did not, and what the check cost; or why none was made
     /// ([`ConvergenceVerdict`]).
@@ -53,7 +53,7 @@ pub struct TwinSummary {
     pub final_angles_deg: BTreeMap<String, f64>,
     /// Largest joint force over all hinges, N.
     pub peak_joint_force_n: f64,
-    /// [Onsets](crate::rapier::metrics#onsets-impacts-and-chatter) over all hinges, chatter
+    /// [Onsets](crate::rapier::observers::metrics#onsets-impacts-and-chatter) over all hinges, chatter
     /// included.
     pub onsets: u64,
     /// Earliest contact onset, s (null without contact).
@@ -137,9 +137,9 @@ impl RunResult {
     }
 
     /// Writes `<twin>.csv` for each twin, `<twin>_<joint>_impacts.csv` for each clearance joint
-    /// (its contact list, every onset, [`ImpactRecorder::contacts_table`](crate::rapier::metrics::ImpactRecorder::contacts_table)),
+    /// (its contact list, every onset, [`ImpactRecorder::contacts_table`](crate::rapier::observers::metrics::ImpactRecorder::contacts_table)),
     /// `<twin>_<joint>_turns.csv` when a body spins (per-turn statistics,
-    /// [`per_period`](crate::rapier::metrics::per_period))
+    /// [`per_period`](crate::rapier::observers::metrics::per_period))
     /// and `summary.json` into `dir` as one set
     /// ([`write_set`]): the tables are streamed (and checked finite) into temporary files, then
     /// renamed into place, `summary.json` last. An incomplete run ([`RunResult::stopped`])
@@ -178,11 +178,15 @@ impl RunResult {
                 ));
                 // Per crank turn when a body spins.
                 if let Some(p) = period {
-                    let turns = crate::rapier::metrics::per_period(recorders[h].contacts(), p, end)
-                        .map_err(|e| e.within("run.end_s"))?;
+                    let turns = crate::rapier::observers::metrics::per_period(
+                        recorders[h].contacts(),
+                        p,
+                        end,
+                    )
+                    .map_err(|e| e.within("run.end_s"))?;
                     impact_tables.push((
                         dir.join(format!("{}_{h}_turns.csv", t.kind.name())),
-                        crate::rapier::metrics::per_period_table(&turns),
+                        crate::rapier::observers::metrics::per_period_table(&turns),
                     ));
                 }
             }
@@ -288,7 +292,7 @@ fn spatial_rows(twins: &[(&String, &TwinSummary)], rows: &mut Vec<(String, Vec<S
         .filter(|(_, m)| m.spatial.is_some())
         .map(|(name, _)| name)
         .collect();
-    type Cell = fn(&crate::rapier::metrics::SpatialMetrics) -> String;
+    type Cell = fn(&crate::rapier::observers::metrics::SpatialMetrics) -> String;
     let cells: [(&str, Cell); 3] = [
         ("max tilt (deg)", |m| format!("{:.4}", m.max_tilt_deg)),
         ("peak edge forces (N)", |m| {

@@ -221,7 +221,7 @@ fn detail_row(case: &Case, r: &Row, reference: &Row) -> String {
         );
     }
     let first = o.impacts.first();
-    let f = |g: &dyn Fn(&clearance_joint::rapier::metrics::Impact) -> f64| {
+    let f = |g: &dyn Fn(&clearance_joint::rapier::observers::metrics::Impact) -> f64| {
         first.map_or("-".into(), |i| sig(g(i)))
     };
     let w = r.w.unwrap_or_default();

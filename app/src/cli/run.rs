@@ -64,7 +64,7 @@ impl SceneRun {
         replay: bool,
     ) -> Result<(
         RunResult,
-        Option<clearance_joint::rapier::replay::Recording>,
+        Option<clearance_joint::rapier::observers::replay::Recording>,
     )> {
         crate::replay::run_recorded(&self.scene, progress, replay)
             .map_err(|e| e.with_step_mode(self.scene.run.step == StepMode::Adaptive))

@@ -49,7 +49,7 @@ pub struct CaseSeries {
     /// them ([`force_with_peaks`](Self::force_with_peaks)), so it never shows less than the
     /// run's peak. Empty when unknown (a point saved without its `peak_t_s` column).
     ///
-    /// [`Impact::peak_t_s`]: clearance_joint::rapier::metrics::Impact::peak_t_s
+    /// [`Impact::peak_t_s`]: clearance_joint::rapier::observers::metrics::Impact::peak_t_s
     pub peaks: Vec<(f64, f64)>,
 }
 
@@ -63,9 +63,12 @@ impl CaseSeries {
     /// The case with `peaks` set from a contact list ([`Impact::peak_t_s`],
     /// [`Impact::peak_force_n`]).
     ///
-    /// [`Impact::peak_t_s`]: clearance_joint::rapier::metrics::Impact::peak_t_s
-    /// [`Impact::peak_force_n`]: clearance_joint::rapier::metrics::Impact::peak_force_n
-    pub fn with_contacts(mut self, contacts: &[clearance_joint::rapier::metrics::Impact]) -> Self {
+    /// [`Impact::peak_t_s`]: clearance_joint::rapier::observers::metrics::Impact::peak_t_s
+    /// [`Impact::peak_force_n`]: clearance_joint::rapier::observers::metrics::Impact::peak_force_n
+    pub fn with_contacts(
+        mut self,
+        contacts: &[clearance_joint::rapier::observers::metrics::Impact],
+    ) -> Self {
         self.peaks = peaks_of(contacts);
         self
     }
@@ -286,7 +289,9 @@ impl CaseSeries {
 
 /// Each contact's peak `(peak_t_s, peak_force_n)` of a contact list, in time order: the points
 /// a force plot of thinned rows must pass through.
-pub fn peaks_of(contacts: &[clearance_joint::rapier::metrics::Impact]) -> Vec<(f64, f64)> {
+pub fn peaks_of(
+    contacts: &[clearance_joint::rapier::observers::metrics::Impact],
+) -> Vec<(f64, f64)> {
     contacts
         .iter()
         .map(|i| (i.peak_t_s, i.peak_force_n))

@@ -4,7 +4,7 @@
 //! timeline with every impact, play/pause/speed (slow motion near impacts), a scrubber, and the
 //! hinge's angle, rate and force plotted under it with a cursor that follows.
 //!
-//! The data comes from the library's [`ReplayRecorder`](clearance_joint::rapier::replay::ReplayRecorder)
+//! The data comes from the library's [`ReplayRecorder`](clearance_joint::rapier::observers::replay::ReplayRecorder)
 //! (any Rapier loop can feed one; [`ReplayPage`] writes its [`Recording`]), the plotted series
 //! from the run's tables. The viewer is a hand-written canvas-2D renderer (a few hundred lines,
 //! no library, no WebGL: it draws wherever a canvas does, headless browsers included).
@@ -12,7 +12,7 @@
 //! **Size.** Frames: one per `end_s / FRAMES` of free flight and sustained contact, one per
 //! `end_s / CONTACT_FRAMES` over the first 100 of those after each contact's onset, and every
 //! onset with the state before it (the recorder's thinning rule,
-//! [`clearance_joint::rapier::replay`]); journal values with 7 significant digits, positions to 0.1 um and
+//! [`clearance_joint::rapier::observers::replay`]); journal values with 7 significant digits, positions to 0.1 um and
 //! rotations to 1e-7 (times in full).
 //! Series: the table's rows cut into [`SERIES_BUCKETS`] buckets of time, each keeping its
 //! smallest and largest value (so every impact's force peak stays).
@@ -20,7 +20,7 @@
 use crate::process::files::write_atomic;
 use crate::process::memory::MemoryEstimate;
 use clearance_joint::error::{Error, Result};
-use clearance_joint::rapier::replay::Recording;
+use clearance_joint::rapier::observers::replay::Recording;
 use clearance_joint::scene::runner::{Progress, RunOptions, RunResult, Simulation, TwinKind};
 use clearance_joint::scene::{Scene, ValidatedScene};
 use clearance_joint::table::Table;
@@ -36,7 +36,7 @@ pub const CONTACT_FRAMES: f64 = 100_000.0;
 /// Time buckets of the plotted series (each keeps its smallest and largest value).
 pub const SERIES_BUCKETS: usize = 1500;
 /// Frames a replay keeps at most: beyond, the recorder halves them, keeping the largest force
-/// (its cap, [`clearance_joint::rapier::replay`]); so a replay's memory does not grow with the
+/// (its cap, [`clearance_joint::rapier::observers::replay`]); so a replay's memory does not grow with the
 /// run's length or its impacts.
 pub const MAX_FRAMES: usize = 20_000;
 /// Numbers per journal and frame in the page's spatial array `sf`: tilt about `u` and `v`
@@ -68,7 +68,8 @@ pub fn memory_bytes(scene: &Scene) -> u64 {
     };
     // A frame: time and two vectors' headers (8 + 48), their heap blocks (+ 32 of allocator);
     // a journal's frame holds room for the spatial part whether used or not.
-    let journal = std::mem::size_of::<clearance_joint::rapier::replay::JournalFrame>() as u64;
+    let journal =
+        std::mem::size_of::<clearance_joint::rapier::observers::replay::JournalFrame>() as u64;
     let recorded = 88 + 56 * bodies + journal * journals;
     let flattened = 8 + 56 * bodies + 49 * journals + 8 * spatial;
     let numbers = 1 + 7 * bodies + 7 * journals + spatial;
@@ -264,9 +265,9 @@ struct PageData<'a> {
     title: &'a str,
     subtitle: &'a str,
     notes: &'a str,
-    bodies: &'a [clearance_joint::rapier::replay::ReplayBody],
-    journals: &'a [clearance_joint::rapier::replay::ReplayJournal],
-    pins: &'a [clearance_joint::rapier::replay::ReplayPin],
+    bodies: &'a [clearance_joint::rapier::observers::replay::ReplayBody],
+    journals: &'a [clearance_joint::rapier::observers::replay::ReplayJournal],
+    pins: &'a [clearance_joint::rapier::observers::replay::ReplayPin],
     t: Vec<f64>,
     poses: Vec<f64>,
     jf: Vec<f64>,
@@ -371,7 +372,9 @@ fn spatial_journals(r: &Recording) -> Vec<bool> {
 
 /// A journal frame's spatial numbers in the page's order ([`SPATIAL_NUMBERS`]; zeros for a
 /// planar journal).
-fn spatial_numbers(j: &clearance_joint::rapier::replay::JournalFrame) -> [f64; SPATIAL_NUMBERS] {
+fn spatial_numbers(
+    j: &clearance_joint::rapier::observers::replay::JournalFrame,
+) -> [f64; SPATIAL_NUMBERS] {
     let s = j.spatial.unwrap_or_default();
     let [e0, e1] = s.edge_at_m;
     let [f0, f1] = s.face_at_m;
@@ -471,7 +474,8 @@ pub fn run_page<'a>(scene: &Scene, result: &RunResult, recording: &'a Recording)
             clearance_joint::error::sig4(recording.interval_s),
             clearance_joint::error::sig4(recording.contact_interval_s),
             clearance_joint::error::sig4(
-                clearance_joint::rapier::replay::DENSE_FRAMES * recording.contact_interval_s
+                clearance_joint::rapier::observers::replay::DENSE_FRAMES
+                    * recording.contact_interval_s
             ),
         ),
         recording,

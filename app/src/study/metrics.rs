@@ -68,12 +68,12 @@ pub struct BodyRunMetrics {
 pub struct HingeRunMetrics {
     /// Radial clearance of the clearance twin, mm (0 for an ideal hinge).
     pub clearance_mm: f64,
-    /// Contact [onsets](clearance_joint::rapier::metrics#onsets-impacts-and-chatter), chatter
+    /// Contact [onsets](clearance_joint::rapier::observers::metrics#onsets-impacts-and-chatter), chatter
     /// included (every step). JSON key `onsets`; a point written with the key `impacts` reads
     /// back here.
     #[serde(alias = "impacts")]
     pub onsets: u64,
-    /// [Impacts](clearance_joint::rapier::metrics#onsets-impacts-and-chatter): onsets after a
+    /// [Impacts](clearance_joint::rapier::observers::metrics#onsets-impacts-and-chatter): onsets after a
     /// free flight that opened at least the joint's minimum separation (0.1 um by default), the
     /// onsets without the chatter of a journal following the wall. JSON key `separated_impacts`.
     #[serde(default, rename = "separated_impacts")]

@@ -20,8 +20,8 @@
 //! Without a row on either body, the correction is exactly zero and the free mass is kept to the
 //! bit.
 
-use crate::rapier::ledger::world_center_of_mass;
-use crate::rapier::reaction::lu::{factor_regularised, lu_solve};
+use crate::rapier::observers::reaction::lu::{factor_regularised, lu_solve};
+use crate::rapier::pipeline::ledger::world_center_of_mass;
 use rapier3d_f64::math::{AngularInertia, Vector};
 use rapier3d_f64::prelude::{
     ImpulseJointSet, JointAxesMask, MotorModel, RigidBody, RigidBodyHandle, RigidBodySet,
@@ -435,7 +435,7 @@ impl Mechanism {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rapier::ledger::inverse_mass_along;
+    use crate::rapier::pipeline::ledger::inverse_mass_along;
     use rapier3d_f64::prelude::{
         JointAxis, MassProperties, PrismaticJointBuilder, RevoluteJointBuilder, RigidBodyBuilder,
     };

@@ -11,7 +11,7 @@ use crate::model::laws::{FrictionLaw, NormalContact, NormalForceLaw, NormalModel
 use crate::model::spatial::{
     ContactPoint, End, Shoulder, SpatialModel, SpatialPose, bore_points, bore_region, bore_section,
 };
-use crate::rapier::ledger::{Wrench, world_center_of_mass};
+use crate::rapier::pipeline::ledger::{Wrench, world_center_of_mass};
 use rapier3d_f64::math::{AngularInertia, Vector};
 use rapier3d_f64::prelude::{RigidBody, RigidBodySet};
 

@@ -38,8 +38,8 @@ use super::effective_mass::Mechanism;
 use super::{ClearanceJoint, ClearanceReport, ContactAhead, ContactHistory};
 use crate::model::kinematics::{BodyMotion, ForcePair, JournalState, journal_state, stable_step};
 use crate::model::laws::{FrictionLaw, NormalContact, NormalForceLaw, loaded_impact_rate};
-use crate::rapier::ledger::{Wrench, world_center_of_mass};
-use crate::rapier::step_hooks::StepPass;
+use crate::rapier::pipeline::ledger::{Wrench, world_center_of_mass};
+use crate::rapier::pipeline::step_hooks::StepPass;
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::{RigidBody, RigidBodyHandle, RigidBodySet};
 use serde::{Deserialize, Serialize};
@@ -58,7 +58,7 @@ pub enum ContactIntegration {
     /// and friction implicitly; Rapier's step carries the result (two Rapier passes: the rest of
     /// the world's motion, then the contact's impulse; docs/sub-cycled-contact.md). The
     /// world's step is set by its slow motion: the joint adds no stability limit. Needs the
-    /// [`Stepper`](crate::rapier::stepper::Stepper) (or a world built on it); a loop of your own
+    /// [`Stepper`](crate::rapier::pipeline::stepper::Stepper) (or a world built on it); a loop of your own
     /// that calls `ClearanceJointSet::apply` gets the explicit forces.
     SubCycled,
 }

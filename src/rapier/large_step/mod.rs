@@ -37,7 +37,7 @@
 //!   with their approach and rebound speeds.
 //! - **Counts**: [onsets](LargeStepJoint::onsets) (every contact that began) and
 //!   [bounces](LargeStepJoint::bounces) (onsets faster than `min_impact_speed`, the ones
-//!   Newton's law gives a rebound); see the [definitions](crate::rapier::metrics#onsets-impacts-and-chatter).
+//!   Newton's law gives a rebound); see the [definitions](crate::rapier::observers::metrics#onsets-impacts-and-chatter).
 //!   The model resolves the journal's position to a few percent of `c`, too coarse for the
 //!   compliant model's `min_separation`: its bounces stand for its impacts in the metrics.
 //!
@@ -81,8 +81,8 @@ pub mod resolution;
 
 use crate::error::{Error, Result, non_negative, positive, unit_vector};
 use crate::model::laws::{BearingGeometry, NormalModel, impact_restitution};
-use crate::rapier::arena::OrderedArena;
-use crate::rapier::ledger::{
+use crate::rapier::pipeline::arena::OrderedArena;
+use crate::rapier::pipeline::ledger::{
     Wrench, ensure_mass_properties, inverse_mass_along, world_center_of_mass,
 };
 use rapier3d_f64::data::Index;
@@ -279,9 +279,9 @@ pub struct LargeStepReport {
     /// `examples/robot_backlash.rs` at 1 kHz.
     pub contact: bool,
     /// Whether a contact began in this step: an
-    /// [onset](crate::rapier::metrics#onsets-impacts-and-chatter).
+    /// [onset](crate::rapier::observers::metrics#onsets-impacts-and-chatter).
     pub onset: bool,
-    /// Whether that onset was a [bounce](crate::rapier::metrics#onsets-impacts-and-chatter): its
+    /// Whether that onset was a [bounce](crate::rapier::observers::metrics#onsets-impacts-and-chatter): its
     /// approach speed exceeded the joint's `min_impact_speed`, so Newton's law gave it a rebound.
     pub bounce: bool,
     /// Normal approach speed of this step's bounce, m/s (0 without one).
@@ -431,12 +431,12 @@ impl LargeStepJoint {
     pub fn report(&self) -> &LargeStepReport {
         &self.report
     }
-    /// [Onsets](crate::rapier::metrics#onsets-impacts-and-chatter) so far: every contact that
+    /// [Onsets](crate::rapier::observers::metrics#onsets-impacts-and-chatter) so far: every contact that
     /// began.
     pub fn onsets(&self) -> u64 {
         self.state.onsets
     }
-    /// [Bounces](crate::rapier::metrics#onsets-impacts-and-chatter) so far: onsets whose
+    /// [Bounces](crate::rapier::observers::metrics#onsets-impacts-and-chatter) so far: onsets whose
     /// approach speed exceeded `min_impact_speed` (they bounced, or would have with a non-zero
     /// restitution).
     pub fn bounces(&self) -> u64 {
@@ -693,7 +693,7 @@ impl LargeStepJointSet {
         bodies: &RigidBodySet,
         impulse_joints: &mut ImpulseJointSet,
     ) -> Result<LargeStepJointHandle> {
-        crate::rapier::step_hooks::joint_pair(bodies, body1, body2)?;
+        crate::rapier::pipeline::step_hooks::joint_pair(bodies, body1, body2)?;
         Ok(self.insert_unchecked(body1, body2, joint, impulse_joints))
     }
 
@@ -907,9 +907,9 @@ impl LargeStepJointSet {
     /// Appends to `out` the forces the joints' constraints exerted over the last step, as
     /// wrenches on both bodies (the normal force at the journal centre and the friction moment,
     /// from the [`report`](LargeStepJoint::report)s): what an exact reaction solve
-    /// ([`ReactionSolver`](crate::rapier::reaction::ReactionSolver)) must be given to know the
+    /// ([`ReactionSolver`](crate::rapier::observers::reaction::ReactionSolver)) must be given to know the
     /// joints, which are no ideal joints. Not the step protocol's
-    /// [`wrenches`](crate::rapier::step_hooks::StepHooks::wrenches): Rapier's solver applies these
+    /// [`wrenches`](crate::rapier::pipeline::step_hooks::StepHooks::wrenches): Rapier's solver applies these
     /// forces itself.
     pub fn constraint_wrenches(&self, bodies: &RigidBodySet, out: &mut Vec<Wrench>) {
         for j in self.joints.values() {
@@ -969,10 +969,10 @@ impl LargeStepJointSet {
 
 /// The large-step joints take part in the stepper's steps: their substeps and friction motors
 /// before each Rapier step, their readout and bounces after it, saved and restored with a
-/// rejected step ([`crate::rapier::step_hooks`]). Under a
-/// [`Stepper`](crate::rapier::stepper::Stepper) or a
-/// [`ClearanceWorld`](crate::rapier::world::ClearanceWorld) no hook can be forgotten.
-impl crate::rapier::step_hooks::StepHooks for LargeStepJointSet {
+/// rejected step ([`crate::rapier::pipeline::step_hooks`]). Under a
+/// [`Stepper`](crate::rapier::pipeline::stepper::Stepper) or a
+/// [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld) no hook can be forgotten.
+impl crate::rapier::pipeline::step_hooks::StepHooks for LargeStepJointSet {
     fn save_state(&mut self) {
         self.saved.clear();
         self.saved
@@ -1003,7 +1003,7 @@ impl crate::rapier::step_hooks::StepHooks for LargeStepJointSet {
     }
     fn check_bodies(&self, bodies: &rapier3d_f64::prelude::RigidBodySet) -> crate::Result<()> {
         for (_, j) in self.iter() {
-            crate::rapier::step_hooks::joint_bodies(
+            crate::rapier::pipeline::step_hooks::joint_bodies(
                 bodies,
                 || format!("large-step clearance joint `{}`", j.name()),
                 j.body1(),

@@ -209,7 +209,7 @@ fn validate_motion(b: &BodySpec, p: &str) -> Result<()> {
             for (i, x) in point_m.iter().enumerate() {
                 position(&format!("{p}.motion.point_m[{i}]"), *x)?;
             }
-            let table = crate::rapier::prescribed::Table::new(t_s, angle_rad)
+            let table = crate::rapier::sources::prescribed::Table::new(t_s, angle_rad)
                 .map_err(|e| table_error(e, p, "angle_rad"))?;
             let field = format!("{p}.motion.angle_rad");
             let rate = table.max_rate();
@@ -231,7 +231,7 @@ fn validate_motion(b: &BodySpec, p: &str) -> Result<()> {
             position_m,
         }) => {
             unit(direction, &format!("{p}.motion.direction"))?;
-            let table = crate::rapier::prescribed::Table::new(t_s, position_m)
+            let table = crate::rapier::sources::prescribed::Table::new(t_s, position_m)
                 .map_err(|e| table_error(e, p, "position_m"))?;
             let rate = table.max_rate();
             if rate > SPEED_MAX {

@@ -8,7 +8,7 @@ use crate::model::laws::{
     LiuEtAl, Material, MaxDamping, NormalModel, Threlfall, effective_modulus,
 };
 use crate::model::spatial::{FaceLaw, SpatialGeometry, SpatialModel};
-use crate::rapier::convert::{Clearance, ClearanceModel};
+use crate::rapier::hinge::convert::{Clearance, ClearanceModel};
 use crate::rapier::joint::OutOfPlaneLock;
 use serde::{Deserialize, Serialize};
 

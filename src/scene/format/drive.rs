@@ -70,8 +70,10 @@ impl Scene {
     /// driven body adds none): exact for a body pinned to the ground. Checked after the rest.
     pub(super) fn validate_drive_steps(&self) -> Result<()> {
         let (field, dt) = match self.run.step {
-            crate::rapier::stepper::StepMode::Fixed => ("run.dt_s", self.run.dt_s),
-            crate::rapier::stepper::StepMode::Adaptive => ("run.max_dt_s", self.run.max_dt_s),
+            crate::rapier::pipeline::stepper::StepMode::Fixed => ("run.dt_s", self.run.dt_s),
+            crate::rapier::pipeline::stepper::StepMode::Adaptive => {
+                ("run.max_dt_s", self.run.max_dt_s)
+            }
         };
         for d in &self.drives {
             let Some(h) = self.hinges.iter().find(|h| h.name == d.hinge) else {

@@ -3,7 +3,7 @@
 use super::limits::*;
 use super::{ClearanceSpec, FrictionSpec, ModelSpec, Scene};
 use crate::error::{Error, Result, sig4};
-use crate::rapier::convert::Clearance;
+use crate::rapier::hinge::convert::Clearance;
 use crate::rapier::joint::OutOfPlaneLock;
 use rapier3d_f64::math::Vector;
 use serde::{Deserialize, Serialize};
@@ -148,7 +148,7 @@ fn journal_offset(h: &HingeSpec, clearance: Option<&Clearance>, p: &str) -> Resu
         ));
     }
     let play = match c.model {
-        crate::rapier::convert::ClearanceModel::Spatial(m) => m.geometry.axial_play,
+        crate::rapier::hinge::convert::ClearanceModel::Spatial(m) => m.geometry.axial_play,
         _ => 0.0,
     };
     if axial.abs() > 0.5 * play * (1.0 + 1e-12) {

@@ -114,8 +114,8 @@ impl Scene {
     }
 
     /// The one check of a scene: every field, the error naming the first invalid one; returns
-    /// each hinge's [`Clearance`](crate::rapier::convert::Clearance) (`None` for an ideal hinge).
-    fn check(&self) -> Result<Vec<Option<crate::rapier::convert::Clearance>>> {
+    /// each hinge's [`Clearance`](crate::rapier::hinge::convert::Clearance) (`None` for an ideal hinge).
+    fn check(&self) -> Result<Vec<Option<crate::rapier::hinge::convert::Clearance>>> {
         if !is_plain_name(&self.name) {
             return Err(Error::invalid(
                 "name",
@@ -148,9 +148,9 @@ impl Scene {
     }
 
     /// The per-turn statistics of a driven scene must fit: at most
-    /// [`MAX_PERIODS`](crate::rapier::metrics::MAX_PERIODS) turns in `run.end_s`.
+    /// [`MAX_PERIODS`](crate::rapier::observers::metrics::MAX_PERIODS) turns in `run.end_s`.
     fn validate_periods(&self) -> Result<()> {
-        let max = crate::rapier::metrics::MAX_PERIODS as f64;
+        let max = crate::rapier::observers::metrics::MAX_PERIODS as f64;
         if let Some(p) = self.drive_period()
             && self.run.end_s / p > max
         {

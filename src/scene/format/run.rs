@@ -67,7 +67,7 @@ pub struct RunSettings {
     pub contact_integration: crate::rapier::joint::ContactIntegration,
 }
 
-pub use crate::rapier::stepper::StepMode;
+pub use crate::rapier::pipeline::stepper::StepMode;
 
 fn default_tolerance() -> f64 {
     0.0075
@@ -90,15 +90,15 @@ fn default_end() -> f64 {
 
 impl RunSettings {
     /// The stepper's control for these settings.
-    pub fn step_control(&self) -> crate::rapier::stepper::StepControl {
+    pub fn step_control(&self) -> crate::rapier::pipeline::stepper::StepControl {
         let c = match self.step {
             // The tolerance also sets a sub-cycled contact's sub-steps.
-            StepMode::Fixed => {
-                crate::rapier::stepper::StepControl::fixed(self.dt_s).with_tolerance(self.tolerance)
-            }
-            StepMode::Adaptive => {
-                crate::rapier::stepper::StepControl::adaptive(self.max_dt_s, self.tolerance)
-            }
+            StepMode::Fixed => crate::rapier::pipeline::stepper::StepControl::fixed(self.dt_s)
+                .with_tolerance(self.tolerance),
+            StepMode::Adaptive => crate::rapier::pipeline::stepper::StepControl::adaptive(
+                self.max_dt_s,
+                self.tolerance,
+            ),
         };
         c.strict(self.strict)
     }

@@ -2,7 +2,7 @@
 
 use super::Scene;
 use crate::error::Result;
-use crate::rapier::convert::Clearance;
+use crate::rapier::hinge::convert::Clearance;
 use std::path::Path;
 
 /// A [`Scene`] whose every field was checked, with each clearance hinge's settings built into a

@@ -1,6 +1,6 @@
 //! Conservation checks over every step: momentum drift and the energy balance.
 
-use crate::rapier::stepper::StepInfo;
+use crate::rapier::pipeline::stepper::StepInfo;
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::RigidBody;
 use serde::Serialize;

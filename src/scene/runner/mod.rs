@@ -12,9 +12,9 @@ pub use invariants::{ENERGY_GROWTH_LIMIT, Invariants, MOTOR_SPEED_ERROR_LIMIT};
 pub use twin::{Twin, TwinKind};
 
 use crate::error::Result;
-use crate::rapier::replay::ReplayRecorder;
-use crate::rapier::stepper::{GuardKind, GuardReport, Violation};
-use crate::rapier::world::ClearanceWorld;
+use crate::rapier::observers::replay::ReplayRecorder;
+use crate::rapier::pipeline::stepper::{GuardKind, GuardReport, Violation};
+use crate::rapier::pipeline::world::ClearanceWorld;
 use crate::scene::{Scene, ValidatedScene};
 use comparison::ComparisonSums;
 use rapier3d_f64::math::Vector;
@@ -42,7 +42,7 @@ pub struct RunOptions {
     pub skip_rows: bool,
 }
 
-pub use crate::rapier::metrics::HingeMetrics;
+pub use crate::rapier::observers::metrics::HingeMetrics;
 
 /// A scene built in a Rapier world, ready to step.
 pub struct Simulation {
@@ -64,7 +64,7 @@ pub struct Simulation {
     last_read: f64,
 }
 
-pub use crate::rapier::stepper::left_physical_range;
+pub use crate::rapier::pipeline::stepper::left_physical_range;
 
 /// Where a run is, passed to the callback of [`Simulation::run_with_progress`].
 #[derive(Clone, Copy, Debug)]
@@ -115,7 +115,7 @@ impl Simulation {
     }
 
     /// Builds the world for a checked scene: its hinges' joints from the
-    /// [`Clearance`](crate::rapier::convert::Clearance)s its check built.
+    /// [`Clearance`](crate::rapier::hinge::convert::Clearance)s its check built.
     pub fn from_validated(scene: &ValidatedScene, options: RunOptions) -> Result<Simulation> {
         let control = scene.run.step_control();
         control.validate().map_err(|e| e.within("run"))?;
@@ -137,7 +137,7 @@ impl Simulation {
         }
         // Mass properties before the first step (Rapier computes them in it; the reactions and
         // the hooks need them at the initial state).
-        crate::rapier::reaction::prepare_mass_properties(&mut world.rapier.bodies);
+        crate::rapier::observers::reaction::prepare_mass_properties(&mut world.rapier.bodies);
         Ok(Simulation {
             world,
             twins,

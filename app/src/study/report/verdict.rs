@@ -28,7 +28,7 @@ pub enum Verdict {
     TooLittleData,
 }
 
-/// [Onsets](clearance_joint::rapier::metrics#onsets-impacts-and-chatter) (contacts, chatter
+/// [Onsets](clearance_joint::rapier::observers::metrics#onsets-impacts-and-chatter) (contacts, chatter
 /// included) every case needs before a verdict is given: the conclusions are about impacts,
 /// impact forces and the rattle they cause, and a run without contacts shows none.
 pub const MIN_IMPACTS: u64 = 10;

@@ -37,8 +37,8 @@ use super::super::{ClearanceJoint, ContactHistory, Mechanism, motion};
 use super::{Mobility, Pair, SpatialParts, Totals, apply_region, deepest_state, region_points};
 use crate::model::kinematics::{BodyMotion, ForcePair, JournalState};
 use crate::model::spatial::SpatialPose;
-use crate::rapier::ledger::{Wrench, world_center_of_mass};
-use crate::rapier::step_hooks::StepPass;
+use crate::rapier::pipeline::ledger::{Wrench, world_center_of_mass};
+use crate::rapier::pipeline::step_hooks::StepPass;
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::{RigidBody, RigidBodySet};
 

@@ -48,14 +48,14 @@
 //! `run.solver_sweeps`; the scene takes 32).
 
 use crate::error::Result;
-use crate::rapier::drive::{DriveHandle, DriveSet, TorsionSpring};
 use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle, ClearanceJointSet};
 use crate::rapier::large_step::{LargeStepJoint, LargeStepJointHandle, LargeStepJointSet};
-use crate::rapier::ledger::Wrench;
-use crate::rapier::prescribed::{PrescribedMotion, PrescribedSet};
-use crate::rapier::reaction::{IdealJoint, KinematicState, ReactionSolver};
-use crate::rapier::step_hooks::StepHooks;
-use crate::rapier::stepper::{GuardReport, StepControl, StepInfo, Stepper};
+use crate::rapier::observers::reaction::{IdealJoint, KinematicState, ReactionSolver};
+use crate::rapier::pipeline::ledger::Wrench;
+use crate::rapier::pipeline::step_hooks::StepHooks;
+use crate::rapier::pipeline::stepper::{GuardReport, StepControl, StepInfo, Stepper};
+use crate::rapier::sources::drive::{DriveHandle, DriveSet, TorsionSpring};
+use crate::rapier::sources::prescribed::{PrescribedMotion, PrescribedSet};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle};
 

@@ -2,9 +2,9 @@
 
 use crate::error::{Result, in_range, unit_vector};
 use crate::model::angle::HingeAngle;
-use crate::rapier::arena::OrderedArena;
-use crate::rapier::ledger::{ForceLedger, Wrench};
-use crate::rapier::step_hooks::StepHooks;
+use crate::rapier::pipeline::arena::OrderedArena;
+use crate::rapier::pipeline::ledger::{ForceLedger, Wrench};
+use crate::rapier::pipeline::step_hooks::StepHooks;
 use rapier3d_f64::data::Index;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
@@ -112,8 +112,8 @@ impl TorsionSpring {
 pub struct DriveHandle(Index);
 
 /// All drives of a world, visited in insertion order. Under the
-/// [`Stepper`](crate::rapier::stepper::Stepper) (or a
-/// [`ClearanceWorld`](crate::rapier::world::ClearanceWorld)) their torques act during the steps
+/// [`Stepper`](crate::rapier::pipeline::stepper::Stepper) (or a
+/// [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld)) their torques act during the steps
 /// only; a loop that calls `world.step()` itself calls [`DriveSet::apply`] before every step.
 #[derive(Clone, Debug, Default)]
 pub struct DriveSet {
@@ -159,7 +159,7 @@ impl DriveSet {
         self.drives.is_empty()
     }
     /// Replaces the torques applied at the previous call by the current ones (for a loop that
-    /// calls `world.step()` itself; the [`Stepper`](crate::rapier::stepper::Stepper) uses
+    /// calls `world.step()` itself; the [`Stepper`](crate::rapier::pipeline::stepper::Stepper) uses
     /// [`evaluate`](Self::evaluate) and adds the torques for its step only).
     pub fn apply(&mut self, bodies: &mut RigidBodySet) {
         self.evaluate(bodies);
@@ -216,7 +216,7 @@ impl DriveSet {
 }
 
 /// The drives take part in the stepper's steps: their torques, saved and restored with a rejected
-/// step ([`crate::rapier::step_hooks`]).
+/// step ([`crate::rapier::pipeline::step_hooks`]).
 impl StepHooks for DriveSet {
     fn evaluate(
         &mut self,

@@ -3,7 +3,7 @@
 //! force, penetration, contact and impact flags), thinned by time.
 //!
 //! The recorder only reads the world (after each step, with the force sources evaluated at the
-//! new state as [`Stepper::step`](crate::rapier::stepper::Stepper::step) leaves them), so the
+//! new state as [`Stepper::step`](crate::rapier::pipeline::stepper::Stepper::step) leaves them), so the
 //! same piece serves a plain-Rapier loop and the scene runner. Its [`Recording`] is plain data
 //! (serde); the app turns it into a self-contained `replay.html`.
 //!
@@ -26,7 +26,7 @@
 //!
 //! ```
 //! use clearance_joint::prelude::*;
-//! use clearance_joint::rapier::replay::{ReplayRecorder, ReplayShape};
+//! use clearance_joint::rapier::observers::replay::{ReplayRecorder, ReplayShape};
 //! use rapier3d_f64::prelude::*;
 //!
 //! let mut world = PhysicsWorld::new();
@@ -44,7 +44,7 @@
 //! let hinge = clearance.convert_revolute(hinge, BearingSide::Body1, play, &mut world.impulse_joints)?;
 //!
 //! // Mass properties now (Rapier computes them in the first step): the arm's box comes from them.
-//! clearance_joint::rapier::reaction::prepare_mass_properties(&mut world.bodies);
+//! clearance_joint::rapier::observers::reaction::prepare_mass_properties(&mut world.bodies);
 //! // One frame per ms in free flight, one per 10 us in contact.
 //! let mut recorder = ReplayRecorder::new(1e-3, 1e-5)?;
 //! recorder.track_body("base", "clearance", base, &world.bodies, &world.colliders);
@@ -303,7 +303,7 @@ impl ReplayRecorder {
     /// Tracks a body (in group `group`), its shapes from its colliders or its mass properties
     /// (see [`ReplayBody::shapes`]; call after the mass properties are known: Rapier computes
     /// them in the first step,
-    /// [`prepare_mass_properties`](crate::rapier::reaction::prepare_mass_properties) before it).
+    /// [`prepare_mass_properties`](crate::rapier::observers::reaction::prepare_mass_properties) before it).
     /// Returns its index.
     pub fn track_body(
         &mut self,
@@ -765,7 +765,7 @@ mod tests {
                 j,
             )),
         );
-        crate::rapier::reaction::prepare_mass_properties(&mut bodies);
+        crate::rapier::observers::reaction::prepare_mass_properties(&mut bodies);
         let shapes = body_shapes(&bodies[h], &ColliderSet::new());
         let ReplayShape::Box { half_extents_m, .. } = shapes[0] else {
             panic!("expected a box, got {shapes:?}");

@@ -3,13 +3,13 @@
 //! (cubic Hermite, continuous slope: [`Table`]).
 //!
 //! A [`PrescribedSet`] takes part in the stepper's steps ([`StepHooks`]) but applies no force:
-//! before each Rapier step the [`Stepper`](crate::rapier::stepper::Stepper) hands it the step's start and
+//! before each Rapier step the [`Stepper`](crate::rapier::pipeline::stepper::Stepper) hands it the step's start and
 //! length, and it sets each body's next pose at the step's end (Rapier's position-based kinematic
 //! bodies then move there, their velocity being the step's mean). Poses are exact at every
 //! state, whatever the step.
 
 use crate::error::{Error, Result};
-use crate::rapier::step_hooks::StepHooks;
+use crate::rapier::pipeline::step_hooks::StepHooks;
 use rapier3d_f64::math::{Pose, Rotation, Vector};
 use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle, RigidBodySet, RigidBodyType};
 
@@ -293,7 +293,7 @@ pub struct PrescribedSet {
 }
 
 /// The tabulated motions take part in the stepper's steps: each Rapier step (a retried one
-/// included) gets the bodies' poses at its end time ([`crate::rapier::step_hooks`]).
+/// included) gets the bodies' poses at its end time ([`crate::rapier::pipeline::step_hooks`]).
 impl StepHooks for PrescribedSet {
     fn check_bodies(&self, bodies: &RigidBodySet) -> Result<()> {
         for (i, m) in self.motions.iter().enumerate() {

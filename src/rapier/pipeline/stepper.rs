@@ -1,7 +1,7 @@
 //! The step control, public: one [`Stepper`] chooses, takes, judges and (when needed) retries
 //! every Rapier step of a world that holds clearance joints. It steps whatever takes part in the
 //! step through the step protocol ([`StepHooks`]: the joint sets, the drives, the prescribed
-//! motions; called the sources here). [`ClearanceWorld`](crate::rapier::world::ClearanceWorld)
+//! motions; called the sources here). [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld)
 //! bundles it with the sets (the scene runner and the bevy_ecs layer are built on it); a loop that
 //! keeps its sets apart calls [`Stepper::step`] with them in place of `world.step()`.
 //!
@@ -18,9 +18,9 @@
 //!   velocity; on slender bodies that makes the locked tilt grow at each change of the step. The
 //!   stepper gives the joints (those with Rapier's default softness, for the step only) the
 //!   correction rate of the longest recent step
-//!   ([`joint_correction`](crate::rapier::joint_correction); [`StepControl::joint_correction`]).
+//!   ([`joint_correction`](crate::rapier::pipeline::joint_correction); [`StepControl::joint_correction`]).
 //! - **Step choice** ([`StepControl`]): fixed, or adaptive from the motion (no body turns more
-//!   than `tolerance/8` rad in a step: [`motion_step`](crate::rapier::motion_step)) and the
+//!   than `tolerance/8` rad in a step: [`motion_step`](crate::rapier::pipeline::motion_step)) and the
 //!   contacts (the joints'
 //!   [`adaptive_step`](crate::rapier::joint::ClearanceJoint::adaptive_step)), growing by at most
 //!   [`StepControl::max_growth`] per step and landing exactly on the time given to
@@ -45,7 +45,7 @@
 //!
 //! ```
 //! use clearance_joint::prelude::*;
-//! use clearance_joint::rapier::stepper::{StepControl, Stepper};
+//! use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
 //! use rapier3d_f64::prelude::*;
 //!
 //! // A 2 kg arm on a steel pin with 0.2 mm of play, released horizontal under gravity.
@@ -80,15 +80,15 @@
 //! ```
 
 use crate::error::{Error, Result};
-use crate::rapier::joint_correction::JointCorrection;
-use crate::rapier::motion_step::motion_step;
-use crate::rapier::stall::{Stall, StallCause};
+use crate::rapier::observers::stall::{Stall, StallCause};
+use crate::rapier::pipeline::joint_correction::JointCorrection;
+use crate::rapier::pipeline::motion_step::motion_step;
 use rapier3d_f64::math::{Pose, Vector};
 use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle, RigidBodyType};
 use serde::{Deserialize, Serialize};
 
-pub use crate::rapier::guards::{GuardKind, GuardReport, Violation};
-pub use crate::rapier::step_hooks::{StepHooks, StepPass};
+pub use crate::rapier::observers::guards::{GuardKind, GuardReport, Violation};
+pub use crate::rapier::pipeline::step_hooks::{StepHooks, StepPass};
 
 /// How the step is chosen (`run.step` in scene files).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -127,7 +127,7 @@ pub struct StepControl {
     /// this fraction of a contact's natural period
     /// ([`CONTACT_PERIODS_PER_TOLERANCE`](crate::rapier::joint::CONTACT_PERIODS_PER_TOLERANCE)),
     /// turns no body by more than an eighth of it in rad
-    /// ([`TURN_PER_TOLERANCE`](crate::rapier::motion_step::TURN_PER_TOLERANCE)), and moves a
+    /// ([`TURN_PER_TOLERANCE`](crate::rapier::pipeline::motion_step::TURN_PER_TOLERANCE)), and moves a
     /// journal's centre relative to its bearing's by at most this fraction of the clearance.
     pub tolerance: f64,
     /// Adaptive: the smallest step, s (the floor; see [`STALL_STEPS`]).
@@ -141,7 +141,7 @@ pub struct StepControl {
     /// [`Error::Guard`] instead of only being recorded.
     pub strict: bool,
     /// Whether Rapier's joints correct their drift at the rate of the longest recent step
-    /// ([`joint_correction`](crate::rapier::joint_correction)), not within each step whatever
+    /// ([`joint_correction`](crate::rapier::pipeline::joint_correction)), not within each step whatever
     /// its length. On by default: without it a jointed chain of slender bodies can diverge when
     /// the step changes.
     pub joint_correction: bool,
@@ -445,7 +445,7 @@ impl Stepper {
     /// position, whatever steps were rejected). A kinematic position target
     /// (`set_next_kinematic_position`) set by hand is reached within one step whatever its length:
     /// under adaptive steps prescribe such motion as a function of time with a
-    /// [`PrescribedSet`](crate::rapier::prescribed::PrescribedSet), which sets the target of each
+    /// [`PrescribedSet`](crate::rapier::sources::prescribed::PrescribedSet), which sets the target of each
     /// step (retried ones included) from the step's end time.
     pub fn step(
         &mut self,
@@ -754,7 +754,7 @@ impl Stepper {
     }
 
     /// The stall message for `seen`: the contact that stops the steps, its state and its cause
-    /// ([`crate::rapier::stall`]).
+    /// ([`crate::rapier::observers::stall`]).
     fn stall_reason(
         &self,
         world: &PhysicsWorld,
@@ -765,7 +765,8 @@ impl Stepper {
             return Box::new(Stall::turn_bound(seen.into(), self.control.min_dt, turn));
         }
         // The contact whose step limit is the shortest stops the step control.
-        let limit = |c: &crate::rapier::stall::StalledContact| c.stable_dt.min(c.friction_dt);
+        let limit =
+            |c: &crate::rapier::observers::stall::StalledContact| c.stable_dt.min(c.friction_dt);
         let contact = sources
             .iter()
             .filter_map(|s| s.stalled_contact(&world.bodies))
@@ -776,14 +777,15 @@ impl Stepper {
     /// The turn bound in words when it alone asks for steps at the floor: the fastest-turning
     /// movable body may turn `tolerance/8` rad a step.
     fn turn_stall(&self, world: &PhysicsWorld) -> Option<StallCause> {
-        let per_step = crate::rapier::motion_step::TURN_PER_TOLERANCE * self.control.tolerance;
+        let per_step =
+            crate::rapier::pipeline::motion_step::TURN_PER_TOLERANCE * self.control.tolerance;
         let (handle, rb) = world
             .bodies
             .iter()
             .filter(|(_, rb)| !rb.is_fixed())
             .max_by(|a, b| a.1.angvel().length().total_cmp(&b.1.angvel().length()))?;
         let w = rb.angvel().length();
-        let step = crate::rapier::motion_step::turn_step(per_step, w);
+        let step = crate::rapier::pipeline::motion_step::turn_step(per_step, w);
         (step <= 2.0 * self.control.min_dt).then_some(StallCause::TurnBound {
             body: handle,
             rate: w,
@@ -953,7 +955,7 @@ fn check_body_states(world: &PhysicsWorld) -> Result<()> {
 /// participant's joint joins bodies of the world: Rapier's step panics on one whose body is gone.
 fn check_joint_bodies(world: &PhysicsWorld, sources: &[&mut dyn StepHooks]) -> Result<()> {
     for (handle, joint) in world.impulse_joints.iter() {
-        crate::rapier::step_hooks::joint_bodies(
+        crate::rapier::pipeline::step_hooks::joint_bodies(
             &world.bodies,
             || format!("impulse joint {:?}", handle.into_raw_parts()),
             joint.body1(),

@@ -39,7 +39,7 @@
 //! 1/60 s and 1 kHz worlds with any number of solver iterations) into a [`LargeStepJointSet`]:
 //!
 //! ```
-//! use clearance_joint::rapier::convert::{BearingSide, Clearance, ClearanceModel, ConvertRevolute};
+//! use clearance_joint::rapier::hinge::convert::{BearingSide, Clearance, ClearanceModel, ConvertRevolute};
 //! use clearance_joint::rapier::large_step::LargeStepJointSet;
 //! use rapier3d_f64::prelude::*;
 //!
@@ -70,7 +70,7 @@
 //!
 //! What a clearance joint cannot carry is refused with an error before anything changes: a joint
 //! that is not a revolute, a revolute with a motor or limits (use a
-//! [`TorsionSpring`](crate::rapier::drive::TorsionSpring) for a drive), or a disabled joint.
+//! [`TorsionSpring`](crate::rapier::sources::drive::TorsionSpring) for a drive), or a disabled joint.
 
 use crate::error::{Error, Result};
 use crate::model::laws::{
@@ -177,7 +177,7 @@ pub struct Clearance {
     /// Floor on the impact velocity of the hysteresis laws, m/s (default 1e-4).
     pub min_impact_speed: f64,
     /// Gap a free flight must open for the next onset to count as an
-    /// [impact](crate::rapier::metrics#onsets-impacts-and-chatter), m (default 0.1 um; the
+    /// [impact](crate::rapier::observers::metrics#onsets-impacts-and-chatter), m (default 0.1 um; the
     /// large-step model does not count impacts and ignores it).
     pub min_separation: f64,
     /// The deepest penetration at which the contact law is trusted, m; deeper contacts are guard
@@ -282,7 +282,7 @@ impl Clearance {
     }
 
     /// Sets the gap a free flight must open for the next onset to count as an
-    /// [impact](crate::rapier::metrics#onsets-impacts-and-chatter), m (checked when the joint is
+    /// [impact](crate::rapier::observers::metrics#onsets-impacts-and-chatter), m (checked when the joint is
     /// built: not negative).
     pub fn min_separation(mut self, gap: f64) -> Self {
         self.min_separation = gap;
@@ -826,8 +826,9 @@ mod tests {
         assert_eq!(j.local_anchor1(), Vector::new(0.01, 0.3, 0.0));
         assert_eq!(j.local_anchor2(), Vector::new(0.01, 0.0, 0.0));
         // Either way the contact carries the arm's weight at rest (2 kg x 9.81 m/s^2).
-        let mut stepper =
-            crate::rapier::stepper::Stepper::new(crate::rapier::stepper::StepControl::fixed(1e-5));
+        let mut stepper = crate::rapier::pipeline::stepper::Stepper::new(
+            crate::rapier::pipeline::stepper::StepControl::fixed(1e-5),
+        );
         while stepper.time() < 0.3 {
             stepper.step(&mut r.world, &mut [&mut set], 0.3).unwrap();
         }

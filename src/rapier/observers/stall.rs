@@ -15,7 +15,7 @@ use crate::error::sig4;
 use crate::model::kinematics::stable_step;
 use crate::model::laws::{LawKind, NormalContact, NormalForceLaw, penetration_for_energy};
 use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle};
-use crate::rapier::ledger::world_center_of_mass;
+use crate::rapier::pipeline::ledger::world_center_of_mass;
 use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
 
 /// One body's share of the inverse effective mass along the contact normal.

@@ -35,7 +35,7 @@
 //! step's start and length once the step is taken, and finish with the final state.
 //!
 //! ```
-//! use clearance_joint::rapier::metrics::{ContactObservation, ImpactRecorder};
+//! use clearance_joint::rapier::observers::metrics::{ContactObservation, ImpactRecorder};
 //! use clearance_joint::prelude::*;
 //! use rapier3d_f64::prelude::*;
 //!
@@ -87,10 +87,10 @@ pub struct ContactObservation {
     /// Joint force magnitude, N (the contact and friction force on the journal; for an ideal
     /// joint, its reaction).
     pub force: f64,
-    /// Whether a contact began at this state: an [onset](crate::rapier::metrics#onsets-impacts-and-chatter),
+    /// Whether a contact began at this state: an [onset](crate::rapier::observers::metrics#onsets-impacts-and-chatter),
     /// chatter included.
     pub onset: bool,
-    /// Whether this onset is an [impact](crate::rapier::metrics#onsets-impacts-and-chatter), after a separation
+    /// Whether this onset is an [impact](crate::rapier::observers::metrics#onsets-impacts-and-chatter), after a separation
     /// of at least the joint's `min_separation`
     /// ([`ClearanceReport::impact`](crate::rapier::joint::ClearanceReport::impact)).
     pub impact: bool,
@@ -153,7 +153,7 @@ impl ContactObservation {
 }
 
 /// One contact of a clearance joint, from its onset to the first state out of contact: an
-/// impact or chatter ([`separated`](Self::separated); see the [definitions](crate::rapier::metrics#onsets-impacts-and-chatter)).
+/// impact or chatter ([`separated`](Self::separated); see the [definitions](crate::rapier::observers::metrics#onsets-impacts-and-chatter)).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
 pub struct Impact {
     /// Time of the crossing of delta = 0, s: interpolated inside the step that led to the first
@@ -174,7 +174,7 @@ pub struct Impact {
     /// inside the step that led to the first state out of contact as the onset is (up to the end
     /// of the run for a contact still closed there).
     pub duration_s: f64,
-    /// Whether the onset is an [impact](crate::rapier::metrics#onsets-impacts-and-chatter): it came after a free
+    /// Whether the onset is an [impact](crate::rapier::observers::metrics#onsets-impacts-and-chatter): it came after a free
     /// flight that opened at least the joint's `min_separation` (otherwise it is chatter).
     pub separated: bool,
 }
@@ -184,10 +184,10 @@ pub struct Impact {
 pub struct HingeMetrics {
     /// Largest joint force, N.
     pub peak_force_n: f64,
-    /// [Onsets](crate::rapier::metrics#onsets-impacts-and-chatter): every contact that began, chatter included.
+    /// [Onsets](crate::rapier::observers::metrics#onsets-impacts-and-chatter): every contact that began, chatter included.
     /// JSON key `onsets`.
     pub onsets: u64,
-    /// [Impacts](crate::rapier::metrics#onsets-impacts-and-chatter): onsets after a free flight that opened at
+    /// [Impacts](crate::rapier::observers::metrics#onsets-impacts-and-chatter): onsets after a free flight that opened at
     /// least the joint's `min_separation` (the first contact always counts); `onsets - impacts`
     /// is the chatter. JSON key `separated_impacts`.
     #[serde(rename = "separated_impacts")]
@@ -497,10 +497,10 @@ pub struct PeriodStats {
     pub start_s: f64,
     /// Its length, s (the last period may be cut short by the end of the run).
     pub length_s: f64,
-    /// [Onsets](crate::rapier::metrics#onsets-impacts-and-chatter) in it: contacts that began in it, chatter
+    /// [Onsets](crate::rapier::observers::metrics#onsets-impacts-and-chatter) in it: contacts that began in it, chatter
     /// included.
     pub onsets: u64,
-    /// [Impacts](crate::rapier::metrics#onsets-impacts-and-chatter) in it: its onsets after a
+    /// [Impacts](crate::rapier::observers::metrics#onsets-impacts-and-chatter) in it: its onsets after a
     /// separation. JSON key `separated_impacts`.
     #[serde(rename = "separated_impacts")]
     pub impacts: u64,
@@ -565,7 +565,7 @@ pub fn per_period(impacts: &[Impact], period: f64, end: f64) -> Result<Vec<Perio
 pub const MAX_PERIODS: usize = 1_000_000;
 
 /// The per-period statistics as a table: `turn, start_s, onsets, separated_impacts,
-/// peak_force_n, contact_fraction` (`separated_impacts`: the [impacts](crate::rapier::metrics#onsets-impacts-and-chatter)).
+/// peak_force_n, contact_fraction` (`separated_impacts`: the [impacts](crate::rapier::observers::metrics#onsets-impacts-and-chatter)).
 pub fn per_period_table(periods: &[PeriodStats]) -> Table {
     let mut t = Table::new(
         [

@@ -1,10 +1,10 @@
-//! The step protocol: what the [`Stepper`](crate::rapier::stepper::Stepper) asks of everything
+//! The step protocol: what the [`Stepper`](crate::rapier::pipeline::stepper::Stepper) asks of everything
 //! that takes part in a step, as a hook trait with default methods (as Rapier's
 //! `PhysicsHooks`). Every joint set of this crate implements it
 //! ([`ClearanceJointSet`](crate::rapier::joint::ClearanceJointSet),
 //! [`LargeStepJointSet`](crate::rapier::large_step::LargeStepJointSet)), as do the drives
-//! ([`DriveSet`](crate::rapier::drive::DriveSet)) and the prescribed motions
-//! ([`PrescribedSet`](crate::rapier::prescribed::PrescribedSet)). A new joint model plugs in
+//! ([`DriveSet`](crate::rapier::sources::drive::DriveSet)) and the prescribed motions
+//! ([`PrescribedSet`](crate::rapier::sources::prescribed::PrescribedSet)). A new joint model plugs in
 //! here: it overrides what it needs, the rest does nothing.
 //!
 //! One step of the stepper, in the order the hooks are called:
@@ -29,14 +29,14 @@
 //! 5. On acceptance: [`check_step`](StepHooks::check_step) again (fixed steps: the contact the step
 //!    ended in) and [`record_guards`](StepHooks::record_guards).
 //!
-//! Users rarely call these methods themselves: [`ClearanceWorld`](crate::rapier::world::ClearanceWorld)
+//! Users rarely call these methods themselves: [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld)
 //! and the stepper do. A loop that calls `world.step()` itself uses each set's own
 //! `apply`/`before_step`/`after_step` instead.
 
 use crate::error::Result;
-use crate::rapier::guards::GuardReport;
-use crate::rapier::ledger::Wrench;
-use crate::rapier::stall::StalledContact;
+use crate::rapier::observers::guards::GuardReport;
+use crate::rapier::observers::stall::StalledContact;
+use crate::rapier::pipeline::ledger::Wrench;
 use rapier3d_f64::prelude::{
     ImpulseJointSet, IntegrationParameters, PhysicsWorld, RigidBodyHandle, RigidBodySet,
 };
@@ -62,7 +62,7 @@ pub trait StepHooks {
     fn restore_state(&mut self) {}
 
     /// Whether the world's settings can step this participant (checked before the first step
-    /// and after [`Stepper::invalidate`](crate::rapier::stepper::Stepper::invalidate)). Default:
+    /// and after [`Stepper::invalidate`](crate::rapier::pipeline::stepper::Stepper::invalidate)). Default:
     /// any settings.
     fn check_world(&self, _params: &IntegrationParameters) -> Result<()> {
         Ok(())

@@ -1,6 +1,6 @@
 //! The bodies of the solve: prescribed kinematic states; each body's mass, state and wrench.
 
-use crate::rapier::ledger::Wrench;
+use crate::rapier::pipeline::ledger::Wrench;
 use rapier3d_f64::math::{AngularInertia, Pose, Rotation, Vector};
 use rapier3d_f64::prelude::{RigidBody, RigidBodyHandle};
 
@@ -84,7 +84,7 @@ impl Entry {
             principal: mp.principal_inertia(),
             pose: *rb.position(),
             rot: *rb.rotation(),
-            com: crate::rapier::ledger::world_center_of_mass(rb),
+            com: crate::rapier::pipeline::ledger::world_center_of_mass(rb),
             stored_v: rb.linvel(),
             stored_w: rb.angvel(),
             v: rb.linvel(),

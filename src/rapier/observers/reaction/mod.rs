@@ -14,7 +14,7 @@
 //!
 //! **The state's velocities.** Rapier's stored velocities are not the state's: with one solver
 //! iteration a step is symplectic Euler, whose velocities live half a step before the positions
-//! (the [`Stepper`](crate::rapier::stepper::Stepper) makes that exactly half the last step), and
+//! (the [`Stepper`](crate::rapier::pipeline::stepper::Stepper) makes that exactly half the last step), and
 //! they satisfy the joints at the previous positions, not the current ones. The solver therefore
 //! (1) advances the stored velocities by [`velocity_lag`](ReactionSolver::velocity_lag) with the
 //! accelerations it solves at them (second order in the lag: a second pass), and (2) projects
@@ -40,7 +40,7 @@
 //! All a user needs, nothing hidden:
 //!
 //! ```
-//! use clearance_joint::rapier::reaction::{IdealRevolute, ReactionSolver};
+//! use clearance_joint::rapier::observers::reaction::{IdealRevolute, ReactionSolver};
 //! use rapier3d_f64::prelude::*;
 //! use rapier3d_f64::math::Vector;
 //!
@@ -80,7 +80,7 @@ pub use body::KinematicState;
 pub use joints::{IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical};
 pub use motor::SoftMotor;
 
-use crate::rapier::ledger::Wrench;
+use crate::rapier::pipeline::ledger::Wrench;
 use body::Entry;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
@@ -98,7 +98,7 @@ pub struct ReactionSolver {
     pub kinematic: Vec<KinematicState>,
     /// How long before the state the bodies' stored velocities are, s: the stored velocities are
     /// advanced by it with the accelerations solved. Half the last step for Rapier's velocities
-    /// after a step of the [`Stepper`](crate::rapier::stepper::Stepper)
+    /// after a step of the [`Stepper`](crate::rapier::pipeline::stepper::Stepper)
     /// (`stepper.last_dt() / 2`; 0 before the first step, whose velocities are the initial
     /// state's) or of a plain Rapier loop at constant steps (`dt / 2`). Default 0: the stored
     /// velocities are taken as the state's (and only projected onto the joints).
@@ -194,7 +194,7 @@ impl ReactionSolver {
     }
 
     /// [`solve`](Self::solve) with further applied wrenches on the bodies: those of the force
-    /// sources the [`Stepper`](crate::rapier::stepper::Stepper) adds during its steps only (drives,
+    /// sources the [`Stepper`](crate::rapier::pipeline::stepper::Stepper) adds during its steps only (drives,
     /// clearance contacts), which the bodies' user forces do not hold between steps.
     pub fn solve_with(
         &mut self,
@@ -375,6 +375,6 @@ fn with_mass_properties(rb: &RigidBody) -> RigidBody {
 pub fn prepare_mass_properties(bodies: &mut RigidBodySet) {
     let handles: Vec<RigidBodyHandle> = bodies.iter().map(|(h, _)| h).collect();
     for h in handles {
-        crate::rapier::ledger::ensure_mass_properties(bodies, None, h);
+        crate::rapier::pipeline::ledger::ensure_mass_properties(bodies, None, h);
     }
 }

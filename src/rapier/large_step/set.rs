@@ -22,7 +22,7 @@ impl std::fmt::Display for LargeStepJointHandle {
 ///
 /// Call [`before_step`](Self::before_step) before every `PhysicsPipeline::step` and
 /// [`after_step`](Self::after_step) after it. The set manages the `additional_solver_iterations`
-/// of its joints' dynamic bodies (see the [module](self) docs): it never sets them below the value
+/// of its joints' dynamic bodies (see the [module](super) docs): it never sets them below the value
 /// a body had when its first joint was inserted, and restores that value when the body's last
 /// joint is removed. Joints that share a dynamic body share one substep count (Rapier substeps a
 /// connected component together); the force readout assumes no other body in that component asks

@@ -3,8 +3,8 @@
 //! `cargo bench --bench fidelity` prints one Markdown table (and writes it to
 //! `bench_out/fidelity.md`).
 //!
-//! Scenes (every joint built from one `Clearance` with `Clearance::joint` or
-//! `Clearance::large_step_joint`: same geometry, the law's own restitution, Bai dry friction's
+//! Scenes (every joint built from one `HingeDesign` with `HingeDesign::joint` or
+//! `HingeDesign::large_step_joint`: same geometry, the law's own restitution, Bai dry friction's
 //! sliding coefficient):
 //! - `solar panel`: the paper's satellite and panel, free-floating, torsion-spring drive, 0.5 mm,
 //!   5 s. Observed: the deployment angle.
@@ -28,7 +28,7 @@
 
 use clearance_joint::model::angle::HingeAngle;
 use clearance_joint::model::laws::{Bai, FrictionModel};
-use clearance_joint::rapier::hinge::convert::Clearance;
+use clearance_joint::rapier::hinge::design::HingeDesign;
 use clearance_joint::rapier::joint::ClearanceJointSet;
 use clearance_joint::rapier::large_step::LargeStepJointSet;
 use clearance_joint::rapier::sources::drive::{DriveSet, TorsionSpring};
@@ -72,13 +72,13 @@ struct Scene {
 }
 
 /// The scenes' clearance: steel, the paper's law, Bai dry friction or none.
-fn steel(radius: f64, c: f64, width: f64, friction: bool) -> Clearance {
+fn steel(radius: f64, c: f64, width: f64, friction: bool) -> HingeDesign {
     let law = if friction {
         FrictionModel::Bai(Bai::DRY)
     } else {
         FrictionModel::None
     };
-    Clearance::steel_improved_liu(radius, c, width)
+    HingeDesign::steel_improved_liu(radius, c, width)
         .unwrap()
         .friction(law)
 }
@@ -109,7 +109,7 @@ fn body(w: &mut PhysicsWorld, mass: f64, inertia: Vector, pose: Pose) -> RigidBo
 fn joint(
     built: &mut Built,
     model: Model,
-    c: &Clearance,
+    c: &HingeDesign,
     b1: RigidBodyHandle,
     b2: RigidBodyHandle,
     a1: Vector,

@@ -12,7 +12,7 @@
 //! `cargo bench --bench scale`. Medians of 5 runs; ratios within one run of the bench.
 
 use clearance_joint::model::laws::{Bai, FrictionModel};
-use clearance_joint::rapier::hinge::convert::Clearance;
+use clearance_joint::rapier::hinge::design::HingeDesign;
 use clearance_joint::rapier::joint::ClearanceJointSet;
 use clearance_joint::rapier::large_step::{
     DEFAULT_MAX_SUBSTEPS, LargeStepJointBuilder, LargeStepJointSet,
@@ -44,13 +44,13 @@ struct Chain {
     pins: Vec<(RigidBodyHandle, RigidBodyHandle, Vector, Vector)>,
 }
 
-fn clearance(friction: bool) -> Clearance {
+fn clearance(friction: bool) -> HingeDesign {
     let law = if friction {
         FrictionModel::Bai(Bai::DRY)
     } else {
         FrictionModel::None
     };
-    Clearance::steel_improved_liu(0.004, 0.1e-3, 0.006)
+    HingeDesign::steel_improved_liu(0.004, 0.1e-3, 0.006)
         .unwrap()
         .friction(law)
 }

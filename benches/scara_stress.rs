@@ -131,7 +131,7 @@ impl Arm {
             let ideal_here = (only == "shoulder" && i == 1) || (only == "elbow" && i == 0);
             match pins {
                 Pins::Compliant(integration) if !ideal_here => {
-                    let joint = Clearance::steel_improved_liu(PIN_RADIUS, clearance, PIN_WIDTH)?
+                    let joint = HingeDesign::steel_improved_liu(PIN_RADIUS, clearance, PIN_WIDTH)?
                         .friction(FrictionModel::Coulomb(Coulomb::new(MU, 1e-4)?))
                         .integration(integration)
                         .name(["shoulder", "elbow"][i])

@@ -32,7 +32,7 @@ fn median_us_per_step(mut make: impl FnMut() -> Simulation) -> f64 {
 /// 16 mm, dry friction) at fixed steps of `dt`, its centre of mass `offset` m off the hinge's
 /// mid-plane along the axis; `model` None is the planar joint with its default lock.
 fn arm(model: Option<SpatialModel>, offset: f64, dt: f64) -> ClearanceWorld {
-    let mut clearance = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
+    let mut clearance = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
         .friction(FrictionModel::Bai(Bai::DRY));
     if let Some(model) = model {

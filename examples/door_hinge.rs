@@ -70,8 +70,9 @@ pub struct Outcome {
 }
 
 /// The pin: steel improved-Liu, bearing radius 6 mm, radial clearance 0.1 mm, dry friction.
-pub fn pin() -> Result<Clearance> {
-    Ok(Clearance::steel_improved_liu(0.006, 0.1e-3, WIDTH)?.friction(FrictionModel::Bai(Bai::DRY)))
+pub fn pin() -> Result<HingeDesign> {
+    Ok(HingeDesign::steel_improved_liu(0.006, 0.1e-3, WIDTH)?
+        .friction(FrictionModel::Bai(Bai::DRY)))
 }
 
 /// The spatial model: axial play 0.3 mm, collars of 10 mm radius.

@@ -9,7 +9,8 @@
 use clearance_joint::Result;
 use clearance_joint::model::angle::{UnwrappedAngle, twist_angle};
 use clearance_joint::model::laws::{Bai, FrictionModel};
-use clearance_joint::rapier::hinge::convert::{BearingSide, Clearance, ConvertRevolute};
+use clearance_joint::rapier::hinge::convert::{BearingSide, ConvertRevolute};
+use clearance_joint::rapier::hinge::design::HingeDesign;
 use clearance_joint::rapier::pipeline::stepper::StepControl;
 use clearance_joint::rapier::pipeline::world::ClearanceWorld;
 use rapier3d_f64::math::{Rotation, Vector};
@@ -160,8 +161,8 @@ fn simulate(mut world: ClearanceWorld, arm: &Arm) -> Result<Run> {
 }
 
 /// The elbow's clearance: a 10 mm steel bearing, 8 mm wide, 0.1 mm radial play, dry friction.
-pub fn elbow_clearance() -> Result<Clearance> {
-    Ok(Clearance::steel_improved_liu(0.005, 0.1e-3, 0.008)?
+pub fn elbow_clearance() -> Result<HingeDesign> {
+    Ok(HingeDesign::steel_improved_liu(0.005, 0.1e-3, 0.008)?
         .friction(FrictionModel::Bai(Bai::DRY))
         .name("elbow"))
 }

@@ -15,7 +15,7 @@ use clearance_joint::ecs::{
     run_step,
 };
 use clearance_joint::model::laws::{Bai, FrictionModel};
-use clearance_joint::rapier::hinge::convert::Clearance;
+use clearance_joint::rapier::hinge::design::HingeDesign;
 use rapier3d_f64::math::{Pose, Rotation, Vector};
 use rapier3d_f64::prelude::{MassProperties, RigidBodyBuilder};
 use std::process::ExitCode;
@@ -30,8 +30,8 @@ const UPPER: (f64, f64) = (1.0, 0.4); // mass kg, length m
 const LOWER: (f64, f64) = (0.5, 0.3);
 
 /// The elbow's clearance: a 10 mm steel bearing, 8 mm wide, 0.1 mm radial play, dry friction.
-pub fn elbow_clearance() -> Result<Clearance> {
-    Ok(Clearance::steel_improved_liu(0.005, 0.1e-3, 0.008)?
+pub fn elbow_clearance() -> Result<HingeDesign> {
+    Ok(HingeDesign::steel_improved_liu(0.005, 0.1e-3, 0.008)?
         .friction(FrictionModel::Bai(Bai::DRY))
         .name("elbow"))
 }

@@ -17,7 +17,8 @@ use clearance_joint::model::angle::{UnwrappedAngle, twist_angle};
 use clearance_joint::model::laws::{
     Ambrosio, BearingGeometry, FrictionModel, LankaraniNikravesh, Material, NormalModel,
 };
-use clearance_joint::rapier::hinge::convert::{BearingSide, Clearance, ConvertRevolute};
+use clearance_joint::rapier::hinge::convert::{BearingSide, ConvertRevolute};
+use clearance_joint::rapier::hinge::design::HingeDesign;
 use clearance_joint::rapier::joint::ClearanceJointHandle;
 use clearance_joint::rapier::observers::metrics::{ContactObservation, ImpactRecorder};
 use clearance_joint::rapier::pipeline::stepper::StepControl;
@@ -43,13 +44,13 @@ pub const TURN: f64 = TAU / OMEGA;
 
 /// The pin's clearance: radial play `c` (m) in a 10 mm steel bearing (16 mm wide, which the
 /// Lankarani-Nikravesh law does not use), cr = 0.9, geometric stiffness, Ambrósio friction.
-pub fn pin_clearance(c: f64) -> Result<Clearance> {
+pub fn pin_clearance(c: f64) -> Result<HingeDesign> {
     let geometry = BearingGeometry::from_clearance(0.010, c, 0.016)?;
     let k =
         LankaraniNikravesh::stiffness_from_geometry(&geometry, &Material::STEEL, &Material::STEEL);
     let law = LankaraniNikravesh::new(k, LankaraniNikravesh::EXPONENT, 0.9)?;
     Ok(
-        Clearance::new(geometry, NormalModel::LankaraniNikravesh(law))
+        HingeDesign::new(geometry, NormalModel::LankaraniNikravesh(law))
             .friction(FrictionModel::Ambrosio(Ambrosio::new(0.01, 1e-4, 1e-2)?))
             .name("slider_pin"),
     )
@@ -79,7 +80,7 @@ pub struct Mechanism {
 
 /// Builds the mechanism with the crank along +x, the rod-slider pin a clearance joint when
 /// `clearance` is given, stepped with `control`.
-pub fn build(clearance: Option<Clearance>, control: StepControl) -> Result<Mechanism> {
+pub fn build(clearance: Option<HingeDesign>, control: StepControl) -> Result<Mechanism> {
     let (r, l) = (CRANK, ROD);
     let mut world = PhysicsWorld::new();
     world.gravity = Vector::new(0.0, -9.81, 0.0);
@@ -183,7 +184,7 @@ pub struct Run {
 }
 
 /// Runs to `end` (s) with `control`.
-pub fn simulate(clearance: Option<Clearance>, control: StepControl, end: f64) -> Result<Run> {
+pub fn simulate(clearance: Option<HingeDesign>, control: StepControl, end: f64) -> Result<Run> {
     let Mechanism {
         mut world,
         pin,

@@ -20,7 +20,8 @@
 
 use clearance_joint::Result;
 use clearance_joint::model::angle::twist_angle;
-use clearance_joint::rapier::hinge::convert::{BearingSide, Clearance, ConvertRevolute};
+use clearance_joint::rapier::hinge::convert::{BearingSide, ConvertRevolute};
+use clearance_joint::rapier::hinge::design::HingeDesign;
 use clearance_joint::rapier::joint::ClearanceJointHandle;
 use clearance_joint::rapier::observers::metrics::{
     ContactObservation, HingeMetrics, ImpactRecorder,
@@ -47,8 +48,8 @@ pub const SLIDER_MASS: f64 = 0.5;
 
 /// The rod-slider pin's clearance: 0.5 mm radial play in a 20 mm steel bearing, 16 mm wide,
 /// the paper's improved law, frictionless.
-pub fn pin_clearance() -> Result<Clearance> {
-    Ok(Clearance::steel_improved_liu(0.010, 0.5e-3, 0.016)?.name("slider_pin"))
+pub fn pin_clearance() -> Result<HingeDesign> {
+    Ok(HingeDesign::steel_improved_liu(0.010, 0.5e-3, 0.016)?.name("slider_pin"))
 }
 
 /// The slider's position at crank angle `theta` (crank pin at `L1 (cos, sin)`, slider on the x
@@ -85,7 +86,7 @@ pub struct Mechanism {
 /// Builds the mechanism at top dead centre (crank along +x, slider at rest, the rod turning
 /// about its slider end), with the rod-slider pin a clearance joint when `clearance` is given,
 /// stepped with `control`.
-pub fn build(clearance: Option<Clearance>, control: StepControl) -> Result<Mechanism> {
+pub fn build(clearance: Option<HingeDesign>, control: StepControl) -> Result<Mechanism> {
     let (r, l) = (CRANK, ROD);
     let mut world = PhysicsWorld::new();
     world.gravity = Vector::new(0.0, -9.81, 0.0);
@@ -231,7 +232,7 @@ impl Run {
 }
 
 /// Runs the mechanism with fixed steps `dt` to `end` (s); the ideal twin without `clearance`.
-pub fn simulate(clearance: Option<Clearance>, dt: f64, end: f64) -> Result<Run> {
+pub fn simulate(clearance: Option<HingeDesign>, dt: f64, end: f64) -> Result<Run> {
     let Mechanism {
         mut world,
         pin,

@@ -39,7 +39,7 @@
 //! let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.0075));
 //!
 //! // 0.2 mm of play in a 20 mm steel bearing, 16 mm wide; the base carries the bearing.
-//! let play = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?;
+//! let play = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)?;
 //! let hinge = world.clearance.convert_revolute(hinge, BearingSide::Body1, play, &mut world.rapier.impulse_joints)?;
 //!
 //! world.step_to(0.1)?;
@@ -48,7 +48,7 @@
 //! # Ok::<(), clearance_joint::Error>(())
 //! ```
 //!
-//! The pieces: [`Clearance`](rapier::hinge::convert::Clearance) (geometry and laws, any law of
+//! The pieces: [`HingeDesign`](rapier::hinge::design::HingeDesign) (geometry and laws, any law of
 //! [`model::laws`]), [`ClearanceJointSet`](rapier::joint::ClearanceJointSet) (the joints and their
 //! force hook), [`LargeStepJointSet`](rapier::large_step::LargeStepJointSet) (the play as a
 //! constraint, for game and robot rates), [`Stepper`](rapier::pipeline::stepper::Stepper) with
@@ -114,7 +114,7 @@
 //! - The **large-step** model ([`rapier::large_step`]) solves the play as a constraint inside
 //!   Rapier's solver, for worlds stepped at 1/60 s or 1 kHz with the default four iterations:
 //!   angles, orbits, backlash, settling and sustained loads, not peak forces. One setter chooses
-//!   it: `Clearance::model(ClearanceModel::LargeStep)`.
+//!   it: `HingeDesign::model(ClearanceModel::LargeStep)`.
 //!
 //! The README's fidelity ladder measures both against a converged reference.
 //!
@@ -194,14 +194,13 @@ mod chapter_doctests {
 /// use clearance_joint::prelude::*;
 /// use rapier3d_f64::prelude::*;
 ///
-/// let play = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?.friction(FrictionModel::Bai(Bai::DRY));
+/// let play = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)?.friction(FrictionModel::Bai(Bai::DRY));
 /// # let _ = (play, PhysicsWorld::new());
 /// # Ok::<(), clearance_joint::Error>(())
 /// ```
 pub mod prelude {
-    pub use crate::rapier::hinge::convert::{
-        BearingSide, Clearance, ClearanceModel, ConvertRevolute,
-    };
+    pub use crate::rapier::hinge::convert::{BearingSide, ConvertRevolute};
+    pub use crate::rapier::hinge::design::{ClearanceModel, HingeDesign};
     pub use crate::rapier::joint::{
         ClearanceJoint, ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet,
         ContactIntegration, OutOfPlaneLock,

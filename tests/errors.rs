@@ -25,7 +25,7 @@ fn assert_plain(message: &str) {
 /// A 2 kg arm on a steel pin with radial play, released with the journal centred (it falls
 /// across the gap and hits the bearing after about 6 ms), in a world with `iterations` solver
 /// iterations.
-fn pendulum(clearance: Clearance, iterations: usize) -> (PhysicsWorld, ClearanceJointSet) {
+fn pendulum(clearance: HingeDesign, iterations: usize) -> (PhysicsWorld, ClearanceJointSet) {
     let mut world = PhysicsWorld::new();
     world.integration_parameters.num_solver_iterations = iterations;
     let base = world.bodies.insert(RigidBodyBuilder::fixed());
@@ -58,8 +58,8 @@ fn run_scene(
     Simulation::new(scene, RunOptions::default())?.run()
 }
 
-fn steel() -> Clearance {
-    Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016).unwrap()
+fn steel() -> HingeDesign {
+    HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016).unwrap()
 }
 
 /// Steps `set`'s world with `control` until an error (or `end` s, then panics).
@@ -166,8 +166,8 @@ fn the_force_hook_in_a_users_own_loop_names_rapiers_dt() {
 #[test]
 fn invalid_clearance_parameters_name_the_api_parameter() {
     let bad = [
-        Clearance::steel_improved_liu(0.010, -0.2e-3, 0.016).unwrap_err(),
-        Clearance::steel_improved_liu(0.010, 0.2e-3, f64::NAN).unwrap_err(),
+        HingeDesign::steel_improved_liu(0.010, -0.2e-3, 0.016).unwrap_err(),
+        HingeDesign::steel_improved_liu(0.010, 0.2e-3, f64::NAN).unwrap_err(),
         KelvinVoigt::new(-1.0, 10.0).unwrap_err(),
         Hertz::new(1e10, 0.5).unwrap_err(),
         BearingGeometry::from_clearance(0.010, 0.020, 0.016).unwrap_err(),
@@ -329,7 +329,7 @@ fn rapiers_default_iterations_suggest_the_large_step_model() {
     assert!(
         m.contains("is 4")
             && m.contains("num_solver_iterations = 1")
-            && m.contains("Clearance::model(ClearanceModel::LargeStep)")
+            && m.contains("HingeDesign::model(ClearanceModel::LargeStep)")
             && m.contains("any number of iterations"),
         "{m}"
     );
@@ -375,7 +375,7 @@ fn a_stall_names_the_api() {
     // resolves it.
     let geometry = BearingGeometry::from_clearance(0.010, 0.2e-3, 0.016).unwrap();
     let law = NormalModel::Hertz(Hertz::new(1e16, 1.5).unwrap());
-    let (mut world, mut set) = pendulum(Clearance::new(geometry, law), 1);
+    let (mut world, mut set) = pendulum(HingeDesign::new(geometry, law), 1);
     let control = StepControl::adaptive(1e-3, 0.0075).min_dt(1e-6);
     let e = run_until_error(&mut world, &mut set, control, 0.1);
     let m = e.to_string();

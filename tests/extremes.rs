@@ -204,7 +204,7 @@ fn api_pendulum() -> (
             )),
     );
     let joint =
-        clearance_joint::rapier::hinge::convert::Clearance::steel_improved_liu(0.01, 2e-4, 0.016)
+        clearance_joint::rapier::hinge::design::HingeDesign::steel_improved_liu(0.01, 2e-4, 0.016)
             .unwrap()
             .joint(
                 Vector::ZERO,

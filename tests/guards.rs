@@ -10,7 +10,7 @@ use clearance_joint::scene::runner::{RunOptions, Simulation};
 use rapier3d_f64::prelude::*;
 
 /// A 2 kg arm on a steel pin (R = 10 mm, c = 0.2 mm), dry friction, released horizontal.
-fn arm(clearance: Clearance) -> (PhysicsWorld, ClearanceJointSet, ClearanceJointHandle) {
+fn arm(clearance: HingeDesign) -> (PhysicsWorld, ClearanceJointSet, ClearanceJointHandle) {
     let mut world = PhysicsWorld::new();
     world.gravity = Vector::new(0.0, -9.81, 0.0);
     world.integration_parameters.num_solver_iterations = 1;
@@ -60,7 +60,7 @@ fn track(slot: &mut (f64, f64, f64, u64), ratio: f64, value: f64, t: f64) {
 }
 
 fn run_arm(
-    clearance: Clearance,
+    clearance: HingeDesign,
     control: StepControl,
     end: f64,
 ) -> (Stepper, Tracked, ClearanceJointHandle) {
@@ -83,7 +83,7 @@ fn run_arm(
 #[test]
 fn penetration_guard_reports_the_worst_depth_when_and_how_often() {
     // A validity limit of 0.2 um: the first impact passes it by far.
-    let clearance = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
+    let clearance = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
         .max_valid_penetration(0.2e-6);
     let (stepper, seen, pin) = run_arm(clearance, StepControl::adaptive(1e-3, 0.02), 0.1);
@@ -105,7 +105,7 @@ fn penetration_guard_reports_the_worst_depth_when_and_how_often() {
         "{m}"
     );
     // Under strict the run fails at the first violating state, naming it.
-    let clearance = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
+    let clearance = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
         .max_valid_penetration(0.2e-6);
     let (mut world, mut joints, _) = arm(clearance);
@@ -126,7 +126,7 @@ fn penetration_guard_reports_the_worst_depth_when_and_how_often() {
 
 #[test]
 fn friction_guard_reports_the_worst_ratio_of_a_fixed_step_too_long() {
-    let clearance = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
+    let clearance = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
         .friction(clearance_joint::model::laws::FrictionModel::Bai(
             clearance_joint::model::laws::Bai::DRY,
@@ -250,7 +250,7 @@ fn the_validity_limit_is_checked_with_its_field() {
             "{bad}: {err}"
         );
     }
-    let c = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016).unwrap();
+    let c = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016).unwrap();
     for bad in [0.0, f64::NAN, 1.0] {
         let err = c
             .clone()

@@ -2,7 +2,7 @@
 //! handle valid, a removed joint's handle finds nothing (also after its slot is reused), and the
 //! sets visit their joints in insertion order.
 
-use clearance_joint::rapier::hinge::convert::Clearance;
+use clearance_joint::rapier::hinge::design::HingeDesign;
 use clearance_joint::rapier::joint::ClearanceJointSet;
 use clearance_joint::rapier::large_step::LargeStepJointSet;
 use rapier3d_f64::prelude::*;
@@ -27,8 +27,8 @@ fn world(n: usize) -> (PhysicsWorld, RigidBodyHandle, Vec<RigidBodyHandle>) {
     (world, base, arms)
 }
 
-fn clearance(name: &str) -> Clearance {
-    Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
+fn clearance(name: &str) -> HingeDesign {
+    HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
         .name(name)
 }

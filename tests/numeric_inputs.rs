@@ -293,9 +293,9 @@ proptest! {
             .min_impact_speed(b)
             .build();
         refuses_non_finite(&[&vectors[..], &[a, b]].concat(), &r)?;
-        let r = clearance_joint::rapier::hinge::convert::Clearance::steel_improved_liu(a, b, 0.016);
+        let r = clearance_joint::rapier::hinge::design::HingeDesign::steel_improved_liu(a, b, 0.016);
         refuses_non_finite(&[a, b], &r)?;
-        if let Ok(c) = clearance_joint::rapier::hinge::convert::Clearance::steel_improved_liu(0.01, 2e-4, 0.016) {
+        if let Ok(c) = clearance_joint::rapier::hinge::design::HingeDesign::steel_improved_liu(0.01, 2e-4, 0.016) {
             let c = c.min_impact_speed(a).restitution(b);
             let r = c.joint(anchor, anchor, axis, axis);
             refuses_non_finite(&[&vectors[..], &[a]].concat(), &r)?;

@@ -18,7 +18,7 @@ fn every_prelude_name_resolves_next_to_rapiers_prelude() {
     }
     let names = [
         std::any::type_name::<BearingSide>(),
-        std::any::type_name::<Clearance>(),
+        std::any::type_name::<HingeDesign>(),
         std::any::type_name::<ClearanceModel>(),
         converts::<ClearanceJointSet>(),
         converts::<LargeStepJointSet>(),
@@ -114,8 +114,8 @@ fn a_hinge_in_a_rapier_loop_with_both_preludes() -> Result<(), clearance_joint::
     let revolute = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0));
     let hinge = world.impulse_joints.insert(base, arm, revolute, true);
     let mut clearance = ClearanceJointSet::new();
-    let play =
-        Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?.friction(FrictionModel::Bai(Bai::DRY));
+    let play = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)?
+        .friction(FrictionModel::Bai(Bai::DRY));
     let hinge =
         clearance.convert_revolute(hinge, BearingSide::Body1, play, &mut world.impulse_joints)?;
     let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.0075));

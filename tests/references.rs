@@ -242,8 +242,8 @@ fn empty_world(run: Stepping) -> ClearanceWorld {
 }
 
 /// The clearance of `law` in a bearing of radius `r_b`, radial clearance `c` and width 16 mm.
-fn clearance(law: NormalModel, r_b: f64, c: f64) -> Clearance {
-    Clearance::new(
+fn clearance(law: NormalModel, r_b: f64, c: f64) -> HingeDesign {
+    HingeDesign::new(
         BearingGeometry::new(r_b, r_b - c, 0.016).expect("a valid bearing"),
         law,
     )

@@ -9,7 +9,7 @@
 use clearance_joint::model::laws::{
     Ambrosio, BearingGeometry, FrictionModel, LankaraniNikravesh, Material, NormalModel,
 };
-use clearance_joint::rapier::hinge::convert::Clearance;
+use clearance_joint::rapier::hinge::design::HingeDesign;
 use clearance_joint::rapier::joint::ClearanceJointSet;
 use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
 use clearance_joint::{Error, Result};
@@ -40,7 +40,7 @@ fn double_pendulum() -> (PhysicsWorld, ClearanceJointSet, RigidBodyHandle) {
     let k =
         LankaraniNikravesh::stiffness_from_geometry(&geometry, &Material::STEEL, &Material::STEEL);
     let law = LankaraniNikravesh::new(k, LankaraniNikravesh::EXPONENT, 0.9).unwrap();
-    let elbow = Clearance::new(geometry, NormalModel::LankaraniNikravesh(law))
+    let elbow = HingeDesign::new(geometry, NormalModel::LankaraniNikravesh(law))
         .friction(FrictionModel::Ambrosio(
             Ambrosio::new(0.01, 1e-4, 1e-2).unwrap(),
         ))

@@ -46,8 +46,8 @@ fn body(mass: f64, inertia: f64) -> RigidBodyBuilder {
 }
 
 /// Steel improved-Liu bore, steel shoulders.
-fn steel_spatial() -> Clearance {
-    Clearance::steel_improved_liu(R, C, L)
+fn steel_spatial() -> HingeDesign {
+    HingeDesign::steel_improved_liu(R, C, L)
         .unwrap()
         .model(ClearanceModel::Spatial(SpatialModel::steel(PLAY, COLLAR)))
 }
@@ -55,7 +55,7 @@ fn steel_spatial() -> Clearance {
 /// A fixed bearing at the origin and a free journal (0.5 kg, 1e-4 kg m^2) centred in it, hinge
 /// along z, in a world without gravity.
 fn fixed_bearing(
-    clearance: &Clearance,
+    clearance: &HingeDesign,
     control: StepControl,
 ) -> (ClearanceWorld, RigidBodyHandle, ClearanceJointHandle) {
     let mut world = ClearanceWorld::new(empty_world(), control);
@@ -135,7 +135,7 @@ fn off_centre_load_spreads_as_winkler() {
     // 1e8 N/m over the whole width; its damping makes the radial mode critically damped
     // (0.5 kg) and the tilt's a third of that.
     let law = NormalModel::KelvinVoigt(KelvinVoigt::new(1e8, 1.4e4).unwrap());
-    let clearance = Clearance::new(
+    let clearance = HingeDesign::new(
         clearance_joint::model::laws::BearingGeometry::from_clearance(R, C, L).unwrap(),
         law,
     )
@@ -246,7 +246,7 @@ fn free_floating_pair_conserves_momentum() {
 #[test]
 fn axial_knock_restitution_is_the_face_law_s() {
     let model = SpatialModel::steel(PLAY, COLLAR);
-    let clearance = Clearance::steel_improved_liu(R, C, L)
+    let clearance = HingeDesign::steel_improved_liu(R, C, L)
         .unwrap()
         .model(ClearanceModel::Spatial(model));
     let (mut world, pin, h) = fixed_bearing(&clearance, StepControl::adaptive(1e-3, 0.005));
@@ -277,7 +277,7 @@ fn axial_knock_restitution_is_the_face_law_s() {
 }
 
 /// The shared arm (`tests/support/arm.rs`) with friction on its pin, ready to run.
-fn arm(clearance: Clearance, offset: f64, control: StepControl) -> ArmRun {
+fn arm(clearance: HingeDesign, offset: f64, control: StepControl) -> ArmRun {
     let (world, arm, pin) = support::arm(clearance, offset, control);
     ArmRun { world, arm, pin }
 }
@@ -353,7 +353,7 @@ impl ArmRun {
 #[test]
 fn aligned_spatial_joint_is_the_planar_joint() {
     let control = StepControl::adaptive(1e-3, 0.0075);
-    let steel = || Clearance::steel_improved_liu(R, C, L).unwrap();
+    let steel = || HingeDesign::steel_improved_liu(R, C, L).unwrap();
     let model = ClearanceModel::Spatial(SpatialModel::steel(PLAY, COLLAR));
     let until = 0.3;
     let spatial = arm(steel().model(model), 0.0, control).run(until);
@@ -390,7 +390,7 @@ fn aligned_spatial_joint_is_the_planar_joint() {
 #[test]
 fn aligned_spatial_joint_with_friction_stays_planar() {
     let steel = || {
-        Clearance::steel_improved_liu(R, C, L)
+        HingeDesign::steel_improved_liu(R, C, L)
             .unwrap()
             .friction(FrictionModel::Bai(Bai::DRY))
     };
@@ -415,7 +415,7 @@ fn aligned_spatial_joint_with_friction_stays_planar() {
 /// its weight makes a moment across the hinge, the journal tilts and loads the bore's edges.
 /// Metrics at `tolerance` over `until` s.
 fn tilted_arm(tolerance: f64, until: f64) -> ArmResult {
-    let clearance = Clearance::steel_improved_liu(R, C, L)
+    let clearance = HingeDesign::steel_improved_liu(R, C, L)
         .unwrap()
         .friction(FrictionModel::Bai(Bai::DRY))
         .model(ClearanceModel::Spatial(SpatialModel::steel(PLAY, COLLAR)));
@@ -475,7 +475,7 @@ fn soft_face_trips_the_penetration_guard() {
         stiffness: 1e3,
         restitution: 0.9,
     });
-    let clearance = Clearance::steel_improved_liu(R, C, L)
+    let clearance = HingeDesign::steel_improved_liu(R, C, L)
         .unwrap()
         .model(ClearanceModel::Spatial(model))
         .name("soft faces");
@@ -499,7 +499,7 @@ fn soft_face_trips_the_penetration_guard() {
 #[ignore]
 fn tilted_arm_tolerance_table() {
     let run = |tol: f64| {
-        let clearance = Clearance::steel_improved_liu(R, C, L)
+        let clearance = HingeDesign::steel_improved_liu(R, C, L)
             .unwrap()
             .friction(FrictionModel::Bai(Bai::DRY))
             .model(ClearanceModel::Spatial(SpatialModel::steel(PLAY, COLLAR)));

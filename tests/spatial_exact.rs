@@ -60,8 +60,8 @@ fn linear() -> r::PowerLaw {
 
 /// The crate's spatial pin with the linear bore law (damping `damping`, N s/m, for the whole
 /// width), no friction, the default face law (`SpatialModel::steel`).
-fn linear_pin(damping: f64) -> Clearance {
-    Clearance::new(
+fn linear_pin(damping: f64) -> HingeDesign {
+    HingeDesign::new(
         BearingGeometry::from_clearance(R_B, C, L).unwrap(),
         NormalModel::KelvinVoigt(KelvinVoigt::new(K, damping).unwrap()),
     )
@@ -677,7 +677,7 @@ fn undamped_door_drift(tolerance: f64) -> (f64, f64) {
         stiffness: model.face.stiffness,
         restitution: 1.0,
     });
-    let pin = Clearance::new(
+    let pin = HingeDesign::new(
         BearingGeometry::from_clearance(R_B, C, L).unwrap(),
         NormalModel::Hertz(Hertz::new(law.stiffness, law.exponent).unwrap()),
     )
@@ -868,7 +868,7 @@ fn rim_strike(turn: Turn, angle: f64, restitution: f64) -> (f64, u64, f64) {
         stiffness: model.face.stiffness,
         restitution,
     });
-    let pin = Clearance::steel_improved_liu(R_B, C, L)
+    let pin = HingeDesign::steel_improved_liu(R_B, C, L)
         .unwrap()
         .model(ClearanceModel::Spatial(model));
     let mut rapier = PhysicsWorld::new();

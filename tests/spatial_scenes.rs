@@ -5,7 +5,7 @@
 
 use clearance_joint::model::laws::{Material, effective_modulus};
 use clearance_joint::model::spatial::{FaceLaw, SpatialModel};
-use clearance_joint::rapier::hinge::convert::ClearanceModel;
+use clearance_joint::rapier::hinge::design::ClearanceModel;
 use clearance_joint::rapier::observers::metrics::SpatialMetrics;
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::report::TwinSummary;

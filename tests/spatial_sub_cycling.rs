@@ -45,7 +45,7 @@ fn door_world(
             ))
             .can_sleep(false),
     );
-    let pin = Clearance::steel_improved_liu(R_B, C, WIDTH)
+    let pin = HingeDesign::steel_improved_liu(R_B, C, WIDTH)
         .unwrap()
         .friction(friction)
         .model(ClearanceModel::Spatial(SpatialModel::steel(0.3e-3, 0.010)))

@@ -98,7 +98,7 @@ fn journal_in_bearing(
     let k =
         LankaraniNikravesh::stiffness_from_geometry(&geometry, &Material::STEEL, &Material::STEEL);
     let law = LankaraniNikravesh::new(k, LankaraniNikravesh::EXPONENT, 0.9).unwrap();
-    let pin = Clearance::new(geometry, NormalModel::LankaraniNikravesh(law))
+    let pin = HingeDesign::new(geometry, NormalModel::LankaraniNikravesh(law))
         .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
         .unwrap();
     let mut joints = ClearanceJointSet::new();

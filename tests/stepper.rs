@@ -4,7 +4,7 @@
 
 use clearance_joint::error::Error;
 use clearance_joint::model::laws::{BearingGeometry, Hertz, NormalModel};
-use clearance_joint::rapier::hinge::convert::Clearance;
+use clearance_joint::rapier::hinge::design::HingeDesign;
 use clearance_joint::rapier::joint::ClearanceJointSet;
 use clearance_joint::rapier::observers::reaction::{
     IdealRevolute, ReactionSolver, prepare_mass_properties,
@@ -220,7 +220,7 @@ fn a_fixed_step_never_passes_the_end_and_its_last_step_is_checked() {
 /// The mechanism: a crank (kinematic, 5000 rpm, 50 mm) drives a rod (0.2 m, 0.5 kg) whose
 /// far end sits in a clearance joint (0.5 mm radial play, steel) on a slider (0.5 kg) guided by
 /// a prismatic joint; no gravity. Returns the world, the clearance set and the slider.
-fn crank_mechanism(clearance: Clearance) -> (PhysicsWorld, ClearanceJointSet, RigidBodyHandle) {
+fn crank_mechanism(clearance: HingeDesign) -> (PhysicsWorld, ClearanceJointSet, RigidBodyHandle) {
     let (omega, r, l) = (5000.0 * std::f64::consts::TAU / 60.0, 0.05, 0.2);
     let mut world = PhysicsWorld::new();
     world.gravity = Vector::ZERO;
@@ -285,7 +285,7 @@ struct CrankRun {
 
 fn crank_run(control: StepControl, end: f64) -> clearance_joint::Result<CrankRun> {
     let (mut world, mut joints, _) =
-        crank_mechanism(Clearance::steel_improved_liu(0.010, 0.5e-3, 0.016)?);
+        crank_mechanism(HingeDesign::steel_improved_liu(0.010, 0.5e-3, 0.016)?);
     let mut stepper = Stepper::new(control);
     let (mut first, mut contacts, mut onset_ratio) = (0.0f64, 0u32, 0.0f64);
     let (mut onset_depth, mut peak, mut fast) = (0.0, 0.0f64, false);
@@ -384,7 +384,7 @@ fn a_contact_no_step_can_resolve_stops_with_a_named_error() {
     // stable only far below the floor, so no step resolves it.
     let geometry = BearingGeometry::from_clearance(0.010, 0.5e-3, 0.016).unwrap();
     let law = NormalModel::Hertz(Hertz::new(1e16, 1.5).unwrap());
-    let (mut world, mut joints, _) = crank_mechanism(Clearance::new(geometry, law));
+    let (mut world, mut joints, _) = crank_mechanism(HingeDesign::new(geometry, law));
     let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.0075).min_dt(1e-6));
     let e = loop {
         match stepper.step(&mut world, &mut [&mut joints], 0.05) {

@@ -54,7 +54,7 @@ fn held_journal(
 ) -> clearance_joint::Result<(ClearanceWorld, ClearanceJointHandle)> {
     let (mut world, base, journal) = journal_world(control, iterations);
     world.rapier.bodies[journal].add_torque(Vector::new(0.0, 0.0, torque), true);
-    let pin = Clearance::steel_improved_liu(R_B, C, 0.016)
+    let pin = HingeDesign::steel_improved_liu(R_B, C, 0.016)
         .unwrap()
         .friction(FrictionModel::Coulomb(Coulomb::new(MU, V_EPS).unwrap()))
         .integration(integration)
@@ -155,7 +155,7 @@ fn an_elastic_bounce_under_gravity_keeps_its_height_at_any_step() {
         let control = StepControl::fixed(dt).with_tolerance(0.0075);
         let (mut world, base, journal) = journal_world(control, 1);
         let hertz = NormalModel::Hertz(Hertz::new(1e10, 1.5).unwrap());
-        let pin = Clearance::new(BearingGeometry::new(R_B, R_B - C, 0.016).unwrap(), hertz)
+        let pin = HingeDesign::new(BearingGeometry::new(R_B, R_B - C, 0.016).unwrap(), hertz)
             .integration(ContactIntegration::SubCycled)
             .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
             .unwrap();
@@ -198,7 +198,7 @@ fn a_resting_sub_cycled_journal_bounds_the_world_step_by_its_contact_period() {
         let control = StepControl::adaptive(1e-3, tol);
         let (mut world, base, journal) = journal_world(control, 1);
         let hertz = NormalModel::Hertz(Hertz::new(k_hertz, 1.5).unwrap());
-        let pin = Clearance::new(BearingGeometry::new(R_B, R_B - C, 0.016).unwrap(), hertz)
+        let pin = HingeDesign::new(BearingGeometry::new(R_B, R_B - C, 0.016).unwrap(), hertz)
             .integration(ContactIntegration::SubCycled)
             .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
             .unwrap();
@@ -257,7 +257,7 @@ fn a_pin_on_a_turning_arm_ends_each_step_where_its_sub_cycle_put_it() {
     let lower = link(&mut world, 1.0, 0.3, 0.4);
     let pivot = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(-0.2, 0.0, 0.0));
     world.rapier.impulse_joints.insert(base, upper, pivot, true);
-    let pin = Clearance::steel_improved_liu(0.006, 0.1e-3, 0.012)
+    let pin = HingeDesign::steel_improved_liu(0.006, 0.1e-3, 0.012)
         .unwrap()
         .integration(ContactIntegration::SubCycled)
         .joint(

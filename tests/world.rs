@@ -24,7 +24,7 @@ fn arm_world(iterations: usize) -> (PhysicsWorld, RigidBodyHandle, RigidBodyHand
 
 /// The arm's compliant pin: steel, bearing radius 10 mm, clearance 0.2 mm, width 16 mm.
 fn compliant_pin() -> ClearanceJoint {
-    Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
+    HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
         .joint(
             Vector::ZERO,
@@ -463,7 +463,7 @@ fn a_spatial_journal_out_of_its_bore_is_refused_naming_the_axis() {
     use clearance_joint::model::spatial::SpatialModel;
     // Free tilt 2c/L = 0.4 mm / 16 mm = 25 mrad.
     let spatial = |axis2: Vector| {
-        Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
+        HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
             .unwrap()
             .model(ClearanceModel::Spatial(SpatialModel::steel(0.3e-3, 0.015)))
             .joint(Vector::ZERO, Vector::new(-0.3, 0.0, 0.0), Vector::Z, axis2)

@@ -35,7 +35,7 @@ pub fn run(end: f64) -> clearance_joint::Result<Recording> {
     let hinge = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0));
     let hinge = world.impulse_joints.insert(base, arm, hinge, true);
     let mut clearance = ClearanceJointSet::new();
-    let play = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?;
+    let play = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)?;
     let hinge =
         clearance.convert_revolute(hinge, BearingSide::Body1, play, &mut world.impulse_joints)?;
 

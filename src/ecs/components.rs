@@ -4,7 +4,7 @@
 use crate::error::{Error, Result, unit_vector};
 use crate::model::angle::HingeAngle;
 use crate::model::kinematics::ContactMode;
-use crate::rapier::hinge::convert::Clearance;
+use crate::rapier::hinge::design::HingeDesign;
 use bevy_ecs::prelude::*;
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::{RevoluteJoint, RigidBody, RigidBodyHandle};
@@ -141,16 +141,16 @@ impl Hinge {
 pub struct IdealHinge;
 
 /// Makes a [`Hinge`] a clearance joint with these laws (takes precedence over [`IdealHinge`]).
-/// [`Clearance::model`] chooses the model: the compliant contact law (the default; it needs small
+/// [`HingeDesign::model`] chooses the model: the compliant contact law (the default; it needs small
 /// steps and a world with `num_solver_iterations = 1`, which you set: a world with more is
 /// refused, see the [module docs](super)) or the large-step constraint,
-/// `ClearanceHinge(Clearance::steel_improved_liu(..)?.model(ClearanceModel::LargeStep))`, for 1/60 s or 1 kHz
+/// `ClearanceHinge(HingeDesign::steel_improved_liu(..)?.model(ClearanceModel::LargeStep))`, for 1/60 s or 1 kHz
 /// worlds with any number of solver iterations. The spatial model,
 /// `.model(ClearanceModel::Spatial(SpatialModel::steel(axial_play, collar_radius)))`, frees the
 /// journal's tilt and axial slide (no lock joint; [`HingeState::spatial`] reports them); it steps
 /// as the compliant model does.
 #[derive(Component, Clone, Debug, PartialEq)]
-pub struct ClearanceHinge(pub Clearance);
+pub struct ClearanceHinge(pub HingeDesign);
 
 /// A torsion spring `T = T0 - k theta` on the [`Hinge`] of the same entity: `+T` on body 2 and
 /// `-T` on body 1 about the hinge axis; `theta` is zero where the drive starts.
@@ -187,7 +187,7 @@ pub enum HingeMode {
     /// A clearance joint.
     Clearance,
     /// A large-step clearance joint
-    /// ([`ClearanceModel::LargeStep`](crate::rapier::hinge::convert::ClearanceModel::LargeStep)).
+    /// ([`ClearanceModel::LargeStep`](crate::rapier::hinge::design::ClearanceModel::LargeStep)).
     LargeStep,
 }
 
@@ -259,7 +259,7 @@ pub struct HingeState {
     /// step; `false` for the other modes).
     pub under_resolved: bool,
     /// A spatial hinge's tilt, axial offset and forces by contact kind over the last step
-    /// ([`ClearanceModel::Spatial`](crate::rapier::hinge::convert::ClearanceModel::Spatial)); `None`
+    /// ([`ClearanceModel::Spatial`](crate::rapier::hinge::design::ClearanceModel::Spatial)); `None`
     /// for the other models and for ideal hinges. For a spatial hinge, `penetration`,
     /// `eccentricity` and `contact` are its deepest station's (a bore station or, when
     /// [`governed_by_face`](crate::rapier::joint::SpatialReport::governed_by_face), a face's).

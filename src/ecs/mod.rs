@@ -21,8 +21,8 @@
 //!   the last frame and its peak: [`run_frame`] runs one frame of a game loop).
 //!
 //! A `ClearanceHinge` builds the compliant model unless its
-//! [`Clearance::model`](crate::rapier::hinge::convert::Clearance::model) is
-//! [`ClearanceModel::LargeStep`](crate::rapier::hinge::convert::ClearanceModel::LargeStep): the one-line
+//! [`HingeDesign::model`](crate::rapier::hinge::design::HingeDesign::model) is
+//! [`ClearanceModel::LargeStep`](crate::rapier::hinge::design::ClearanceModel::LargeStep): the one-line
 //! choice of the large-step model (see [`large_step`](crate::rapier::large_step)), stepped by the
 //! same schedule.
 //!
@@ -51,7 +51,7 @@
 //!
 //! ```
 //! use bevy_ecs::prelude::*;
-//! use clearance_joint::rapier::hinge::convert::Clearance;
+//! use clearance_joint::rapier::hinge::design::HingeDesign;
 //! use clearance_joint::ecs::*;
 //! use rapier3d_f64::math::Vector;
 //! use rapier3d_f64::prelude::{MassProperties, RigidBodyBuilder};
@@ -74,7 +74,7 @@
 //!     .spawn((
 //!         Hinge::new(base, arm, Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0)),
 //!         // Was: IdealHinge,
-//!         ClearanceHinge(Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?),
+//!         ClearanceHinge(HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)?),
 //!     ))
 //!     .id();
 //! let mut schedule = physics_schedule();
@@ -97,7 +97,7 @@
 //!
 //! ```
 //! use bevy_ecs::prelude::*;
-//! use clearance_joint::rapier::hinge::convert::{Clearance, ClearanceModel};
+//! use clearance_joint::rapier::hinge::design::{HingeDesign, ClearanceModel};
 //! use clearance_joint::ecs::*;
 //! use rapier3d_f64::math::Vector;
 //! use rapier3d_f64::prelude::{MassProperties, PhysicsWorld, RigidBodyBuilder};
@@ -115,7 +115,7 @@
 //!     world.spawn(Body::from_handle(post)).id(),
 //!     world.spawn(Body::from_handle(sign)).id(),
 //! );
-//! let clearance = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?;
+//! let clearance = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)?;
 //! let hinge = world
 //!     .spawn((
 //!         Hinge::new(post, sign, Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0)),

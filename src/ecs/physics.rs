@@ -4,7 +4,8 @@
 
 use super::components::{Drive, Hinge};
 use crate::error::{Error, Result};
-use crate::rapier::hinge::convert::{BearingSide, Clearance, ClearanceModel, ConvertRevolute};
+use crate::rapier::hinge::convert::{BearingSide, ConvertRevolute};
+use crate::rapier::hinge::design::{ClearanceModel, HingeDesign};
 use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle, ClearanceJointSet};
 use crate::rapier::large_step::{LargeStepJoint, LargeStepJointHandle, LargeStepJointSet};
 use crate::rapier::observers::reaction::{IdealJoint, IdealRevolute, ReactionSolver};
@@ -35,7 +36,7 @@ struct RealizedHinge {
     joint: HingeJoint,
     bodies: BodyPair,
     frame: Hinge,
-    clearance: Option<Clearance>,
+    clearance: Option<HingeDesign>,
 }
 
 #[derive(Clone, Debug)]
@@ -143,7 +144,7 @@ impl Physics {
     }
 
     /// The large-step clearance joints (read-only: they follow the
-    /// [`ClearanceHinge`](super::ClearanceHinge) components whose [`Clearance::model`] is
+    /// [`ClearanceHinge`](super::ClearanceHinge) components whose [`HingeDesign::model`] is
     /// [`ClearanceModel::LargeStep`]).
     pub fn large_step(&self) -> &LargeStepJointSet {
         &self.world.large_step
@@ -345,7 +346,7 @@ impl Physics {
         &mut self,
         entity: Entity,
         frame: &Hinge,
-        desired: Option<Option<&Clearance>>,
+        desired: Option<Option<&HingeDesign>>,
         bodies: BodyPair,
     ) -> Result<()> {
         let context = |e: Error| e.within(&format!("hinge {entity}"));
@@ -621,7 +622,7 @@ impl Physics {
 /// Refuses a compliant clearance hinge in a world whose settings cannot step it, naming what it
 /// needs and why; the world's settings are the user's and stay as they are. A sub-cycled hinge
 /// takes any number of iterations.
-fn check_compliant(world: &PhysicsWorld, entity: Entity, c: &Clearance) -> Result<()> {
+fn check_compliant(world: &PhysicsWorld, entity: Entity, c: &HingeDesign) -> Result<()> {
     let n = world.integration_parameters.num_solver_iterations;
     let sub_cycled = c.integration == crate::rapier::joint::ContactIntegration::SubCycled;
     if n == 1 || sub_cycled {
@@ -638,15 +639,15 @@ fn check_compliant(world: &PhysicsWorld, entity: Entity, c: &Clearance) -> Resul
              contact force is evaluated once per step and held over it, and Rapier's substeps \
              would make every impact gain energy. Set it to 1 (every body of the world then gets \
              one iteration: stacks of resting bodies soften), sub-cycle the hinge's \
-             contact (`Clearance::integration(ContactIntegration::SubCycled)`), or give the hinge \
-             the large-step model{alternative}, `Clearance::model(ClearanceModel::LargeStep)`, \
+             contact (`HingeDesign::integration(ContactIntegration::SubCycled)`), or give the hinge \
+             the large-step model{alternative}, `HingeDesign::model(ClearanceModel::LargeStep)`, \
              which work with any number of iterations"
         ),
     ))
 }
 
 /// `c` with the entity as its name unless it has one.
-fn named(c: &Clearance, entity: Entity) -> Clearance {
+fn named(c: &HingeDesign, entity: Entity) -> HingeDesign {
     let mut c = c.clone();
     if c.name.is_none() {
         c.name = Some(format!("hinge {entity}"));

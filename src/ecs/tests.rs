@@ -5,15 +5,15 @@ use super::*;
 use crate::error::{Error, Result};
 use crate::model::kinematics::ContactMode;
 use crate::model::laws::{Bai, FrictionModel};
-use crate::rapier::hinge::convert::{Clearance, ClearanceModel};
+use crate::rapier::hinge::design::{ClearanceModel, HingeDesign};
 use crate::rapier::observers::metrics::{ContactObservation, ImpactRecorder};
 use crate::rapier::pipeline::stepper::StepControl;
 use bevy_ecs::prelude::*;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{MassProperties, PhysicsWorld, RigidBodyBuilder};
 
-fn clearance() -> Clearance {
-    Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
+fn clearance() -> HingeDesign {
+    HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
         .friction(FrictionModel::Bai(Bai::DRY))
 }

@@ -10,7 +10,7 @@ use rapier3d_f64::prelude::{MassProperties, PhysicsWorld, RigidBodyBuilder, Rigi
 /// iteration (the compliant joints need it) stepped by `control`. Returns the world, the arm and
 /// the pin.
 pub fn arm(
-    clearance: Clearance,
+    clearance: HingeDesign,
     offset: f64,
     control: StepControl,
 ) -> (ClearanceWorld, RigidBodyHandle, ClearanceJointHandle) {

@@ -52,7 +52,7 @@ pub struct Job {
     /// The grid point.
     pub point: Point,
     /// The scene with the base and point overrides applied, checked once (it carries the
-    /// hinges' built `Clearance`s the run uses).
+    /// hinges' built `HingeDesign`s the run uses).
     pub scene: ValidatedScene,
     /// The point's folder.
     pub dir: PathBuf,

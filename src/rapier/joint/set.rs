@@ -337,7 +337,7 @@ impl ClearanceJointSet {
                      `integration_parameters.num_solver_iterations = 1` (every body of the world \
                      then gets one iteration: stacks of resting bodies soften), or build the \
                      hinges with the large-step model, \
-                     `Clearance::model(ClearanceModel::LargeStep)` into a LargeStepJointSet, which \
+                     `HingeDesign::model(ClearanceModel::LargeStep)` into a LargeStepJointSet, which \
                      works with any number of iterations and steps as long as 1/60 s",
                     params.num_solver_iterations
                 ),

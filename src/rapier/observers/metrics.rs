@@ -51,7 +51,7 @@
 //! let revolute = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0));
 //! let pivot = world.impulse_joints.insert(base, arm, revolute, true);
 //! let mut clearance = ClearanceJointSet::new();
-//! let clear = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?;
+//! let clear = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)?;
 //! let pivot = clearance.convert_revolute(pivot, BearingSide::Body1, clear, &mut world.impulse_joints)?;
 //!
 //! let mut stepper = Stepper::new(StepControl::fixed(2e-5));

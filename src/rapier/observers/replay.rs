@@ -40,7 +40,7 @@
 //! let hinge = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0));
 //! let hinge = world.impulse_joints.insert(base, arm, hinge, true);
 //! let mut clearance = ClearanceJointSet::new();
-//! let play = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?;
+//! let play = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)?;
 //! let hinge = clearance.convert_revolute(hinge, BearingSide::Body1, play, &mut world.impulse_joints)?;
 //!
 //! // Mass properties now (Rapier computes them in the first step): the arm's box comes from them.
@@ -825,7 +825,7 @@ mod tests {
                 ))
                 .can_sleep(false),
         );
-        let pin = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)
+        let pin = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
             .unwrap()
             .integration(ContactIntegration::SubCycled)
             .joint(
@@ -893,7 +893,7 @@ mod tests {
                     Vector::splat(0.02),
                 )),
         );
-        let pin = Clearance::steel_improved_liu(0.006, 0.1e-3, 0.020)
+        let pin = HingeDesign::steel_improved_liu(0.006, 0.1e-3, 0.020)
             .unwrap()
             .model(ClearanceModel::Spatial(SpatialModel::steel(0.3e-3, 0.010)))
             .joint(

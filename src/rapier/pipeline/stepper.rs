@@ -61,7 +61,7 @@
 //! );
 //! let mut joints = ClearanceJointSet::new();
 //! // Improved Liu law, steel on steel: bearing radius 10 mm, clearance 0.2 mm, width 16 mm.
-//! let pin = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?.joint(
+//! let pin = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)?.joint(
 //!     Vector::ZERO,
 //!     Vector::new(-0.3, 0.0, 0.0),
 //!     Vector::Z,

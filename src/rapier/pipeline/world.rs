@@ -21,7 +21,7 @@
 //!         .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02)))
 //!         .can_sleep(false),
 //! );
-//! let pin = Clearance::steel_improved_liu(0.010, 0.2e-3, 0.016)?.joint(
+//! let pin = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)?.joint(
 //!     Vector::ZERO,
 //!     Vector::new(-0.3, 0.0, 0.0),
 //!     Vector::Z,

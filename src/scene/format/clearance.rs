@@ -8,7 +8,7 @@ use crate::model::laws::{
     LiuEtAl, Material, MaxDamping, NormalModel, Threlfall, effective_modulus,
 };
 use crate::model::spatial::{FaceLaw, SpatialGeometry, SpatialModel};
-use crate::rapier::hinge::convert::{Clearance, ClearanceModel};
+use crate::rapier::hinge::design::{ClearanceModel, HingeDesign};
 use crate::rapier::joint::OutOfPlaneLock;
 use serde::{Deserialize, Serialize};
 
@@ -306,11 +306,11 @@ pub enum FrictionSpec {
 }
 
 impl ClearanceSpec {
-    /// The [`Clearance`] this spec describes, in SI units, validated (errors name the field
+    /// The [`HingeDesign`] this spec describes, in SI units, validated (errors name the field
     /// relative to this spec, e.g. `contact.eta_s`): geometry, laws, impact-speed floor, impact
     /// separation, validity limit, lock, model and restitution. The hinge's name is the
-    /// caller's to set ([`Clearance::name`]).
-    pub fn clearance(&self) -> Result<Clearance> {
+    /// caller's to set ([`HingeDesign::name`]).
+    pub fn clearance(&self) -> Result<HingeDesign> {
         let geometry = self.geometry()?;
         let normal = self.normal_law(&geometry)?;
         let friction = self.friction_law()?;
@@ -328,7 +328,7 @@ impl ClearanceSpec {
                 &self.journal_material,
             )?),
         };
-        let mut clearance = Clearance::new(geometry, normal)
+        let mut clearance = HingeDesign::new(geometry, normal)
             .friction(friction)
             .min_impact_speed(min_impact_speed)
             .min_separation(min_separation)
@@ -604,7 +604,7 @@ mod tests {
         );
         assert_eq!(
             c.normal,
-            Clearance::steel_improved_liu(0.010, 0.5e-3, 0.016)
+            HingeDesign::steel_improved_liu(0.010, 0.5e-3, 0.016)
                 .unwrap()
                 .normal
         );

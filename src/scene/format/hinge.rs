@@ -3,7 +3,7 @@
 use super::limits::*;
 use super::{ClearanceSpec, FrictionSpec, ModelSpec, Scene};
 use crate::error::{Error, Result, sig4};
-use crate::rapier::hinge::convert::Clearance;
+use crate::rapier::hinge::design::HingeDesign;
 use crate::rapier::joint::OutOfPlaneLock;
 use rapier3d_f64::math::Vector;
 use serde::{Deserialize, Serialize};
@@ -48,12 +48,12 @@ impl HingeSpec {
 }
 
 impl Scene {
-    /// The hinges' fields and clearance specs (names into `names`): each hinge's [`Clearance`]
+    /// The hinges' fields and clearance specs (names into `names`): each hinge's [`HingeDesign`]
     /// (named after the hinge), `None` for an ideal hinge.
     pub(super) fn validate_hinges<'a>(
         &'a self,
         names: &mut std::collections::HashSet<&'a str>,
-    ) -> Result<Vec<Option<Clearance>>> {
+    ) -> Result<Vec<Option<HingeDesign>>> {
         let mut clearances = Vec::with_capacity(self.hinges.len());
         for h in &self.hinges {
             let p = format!("hinges[{}]", h.name);
@@ -97,8 +97,8 @@ impl Scene {
         Ok(clearances)
     }
 
-    /// The [`Clearance`] of the hinge at path `p`, its errors under `p.clearance`.
-    fn hinge_clearance(c: &ClearanceSpec, p: &str) -> Result<Clearance> {
+    /// The [`HingeDesign`] of the hinge at path `p`, its errors under `p.clearance`.
+    fn hinge_clearance(c: &ClearanceSpec, p: &str) -> Result<HingeDesign> {
         let clearance = c
             .clearance()
             .map_err(|e| e.within(&format!("{p}.clearance")))?;
@@ -116,7 +116,7 @@ impl Scene {
 /// The journal's starting offset of hinge `h` (at path `p`) with its clearance settings: finite,
 /// only on a clearance hinge, radially within the clearance, axially only on a spatial hinge and
 /// within half its axial play.
-fn journal_offset(h: &HingeSpec, clearance: Option<&Clearance>, p: &str) -> Result<()> {
+fn journal_offset(h: &HingeSpec, clearance: Option<&HingeDesign>, p: &str) -> Result<()> {
     let field = format!("{p}.journal_offset_mm");
     for (i, x) in h.journal_offset_mm.iter().enumerate() {
         crate::error::finite(&format!("{field}[{i}]"), *x)?;
@@ -148,7 +148,7 @@ fn journal_offset(h: &HingeSpec, clearance: Option<&Clearance>, p: &str) -> Resu
         ));
     }
     let play = match c.model {
-        crate::rapier::hinge::convert::ClearanceModel::Spatial(m) => m.geometry.axial_play,
+        crate::rapier::hinge::design::ClearanceModel::Spatial(m) => m.geometry.axial_play,
         _ => 0.0,
     };
     if axial.abs() > 0.5 * play * (1.0 + 1e-12) {

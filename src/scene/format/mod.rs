@@ -114,8 +114,8 @@ impl Scene {
     }
 
     /// The one check of a scene: every field, the error naming the first invalid one; returns
-    /// each hinge's [`Clearance`](crate::rapier::hinge::convert::Clearance) (`None` for an ideal hinge).
-    fn check(&self) -> Result<Vec<Option<crate::rapier::hinge::convert::Clearance>>> {
+    /// each hinge's [`HingeDesign`](crate::rapier::hinge::design::HingeDesign) (`None` for an ideal hinge).
+    fn check(&self) -> Result<Vec<Option<crate::rapier::hinge::design::HingeDesign>>> {
         if !is_plain_name(&self.name) {
             return Err(Error::invalid(
                 "name",

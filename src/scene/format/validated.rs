@@ -1,13 +1,13 @@
-//! A scene checked once, carrying what the check built: each clearance hinge's [`Clearance`].
+//! A scene checked once, carrying what the check built: each clearance hinge's [`HingeDesign`].
 
 use super::Scene;
 use crate::error::Result;
-use crate::rapier::hinge::convert::Clearance;
+use crate::rapier::hinge::design::HingeDesign;
 use std::path::Path;
 
 /// A [`Scene`] whose every field was checked, with each clearance hinge's settings built into a
-/// [`Clearance`] (named after its hinge): the one route from a hinge's
-/// [`ClearanceSpec`](super::ClearanceSpec) to its joint ([`Clearance::joint`]).
+/// [`HingeDesign`] (named after its hinge): the one route from a hinge's
+/// [`ClearanceSpec`](super::ClearanceSpec) to its joint ([`HingeDesign::joint`]).
 ///
 /// Built by [`Scene::validated`] (or loaded checked, [`ValidatedScene::load`]); read-only (it
 /// derefs to its [`Scene`]): a changed scene is a new [`Scene`], checked again.
@@ -25,12 +25,12 @@ use std::path::Path;
 pub struct ValidatedScene {
     scene: Scene,
     /// Per hinge, in scene order: its clearance settings, `None` for an ideal hinge.
-    clearances: Vec<Option<Clearance>>,
+    clearances: Vec<Option<HingeDesign>>,
 }
 
 impl ValidatedScene {
     /// Only [`Scene::validated`] builds one: `clearances` are what its check built.
-    pub(super) fn new(scene: Scene, clearances: Vec<Option<Clearance>>) -> Self {
+    pub(super) fn new(scene: Scene, clearances: Vec<Option<HingeDesign>>) -> Self {
         ValidatedScene { scene, clearances }
     }
 
@@ -69,7 +69,7 @@ impl ValidatedScene {
 
     /// The clearance settings of hinge `hinge` (index in [`Scene::hinges`]), `None` for an ideal
     /// hinge or an index past the last.
-    pub fn clearance(&self, hinge: usize) -> Option<&Clearance> {
+    pub fn clearance(&self, hinge: usize) -> Option<&HingeDesign> {
         self.clearances.get(hinge)?.as_ref()
     }
 }

@@ -115,7 +115,7 @@ impl Simulation {
     }
 
     /// Builds the world for a checked scene: its hinges' joints from the
-    /// [`Clearance`](crate::rapier::hinge::convert::Clearance)s its check built.
+    /// [`HingeDesign`](crate::rapier::hinge::design::HingeDesign)s its check built.
     pub fn from_validated(scene: &ValidatedScene, options: RunOptions) -> Result<Simulation> {
         let control = scene.run.step_control();
         control.validate().map_err(|e| e.within("run"))?;

@@ -4,7 +4,7 @@
 use super::{BodyTrack, ContactSample, HingeJoint, HingeTrack, SPATIAL_COLUMNS, Twin, TwinKind};
 use crate::error::Result;
 use crate::model::angle::{HingeAngle, UnwrappedAngle};
-use crate::rapier::hinge::convert::ClearanceModel;
+use crate::rapier::hinge::design::ClearanceModel;
 use crate::rapier::observers::metrics::ImpactRecorder;
 use crate::rapier::observers::reaction::{
     IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, ReactionSolver,
@@ -22,7 +22,7 @@ use rapier3d_f64::prelude::*;
 
 impl Twin {
     /// Builds the twin `kind` of `scene` into `world`: its bodies, hinges (clearance joints
-    /// from the scene's [`Clearance`](crate::rapier::hinge::convert::Clearance)s in a clearance twin),
+    /// from the scene's [`HingeDesign`](crate::rapier::hinge::design::HingeDesign)s in a clearance twin),
     /// drives, the scene's other joints, and its table's columns.
     pub(in crate::scene::runner) fn build(
         scene: &ValidatedScene,
@@ -194,7 +194,7 @@ fn free_or_fixed_body(b: &BodySpec, com: Vector) -> RigidBody {
 }
 
 /// The scene's hinges in `world`: in a clearance twin, a hinge with clearance is a clearance
-/// joint (in the world's clearance set) built by its [`Clearance`](crate::rapier::hinge::convert::Clearance) (the validated scene's,
+/// joint (in the world's clearance set) built by its [`HingeDesign`](crate::rapier::hinge::design::HingeDesign) (the validated scene's,
 /// the one route from settings to joint); every other hinge is Rapier's revolute joint.
 fn build_hinges(
     scene: &ValidatedScene,
@@ -624,7 +624,7 @@ fn motor_of(spec: Option<&MotorSpec>) -> Option<Motor> {
 
 #[cfg(test)]
 mod tests {
-    use crate::rapier::hinge::convert::ClearanceModel;
+    use crate::rapier::hinge::design::ClearanceModel;
     use crate::scene::Scene;
     use crate::scene::runner::{RunOptions, Simulation, Twins};
 

@@ -27,11 +27,8 @@ mod set;
 mod spatial;
 mod step_policy;
 mod subcycle;
+use builder::DEFAULT_VALID_STRAIN;
 pub(crate) use builder::validate_max_valid_penetration;
-pub use builder::{
-    ClearanceJointBuilder, DEFAULT_MIN_IMPACT_SPEED, DEFAULT_MIN_SEPARATION, OutOfPlaneLock,
-    default_max_valid_penetration,
-};
 use effective_mass::Mechanism;
 use history::{ContactHistory, Onset};
 use rapier3d_f64::math::Vector;
@@ -41,12 +38,58 @@ use rapier3d_f64::prelude::{
 };
 pub use report::ClearanceReport;
 pub use set::{ClearanceJointHandle, ClearanceJointSet};
-pub use spatial::{Region, SpatialPoint, SpatialReport};
+pub use spatial::report::{Region, SpatialPoint, SpatialReport};
 use spatial::{SpatialMemory, SpatialParts};
 use step_policy::ContactAhead;
 pub use step_policy::{CONTACT_PERIODS_PER_TOLERANCE, flight_step};
 pub use subcycle::{ContactIntegration, SubStep};
 use subcycle::{PairStart, SubCycle};
+
+/// What holds the degrees of freedom the contact law does not (axial translation and the two tilts).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum OutOfPlaneLock {
+    /// A Rapier `GenericJoint` locking the axial translation and the two tilts, relative to the
+    /// bodies (works for any axis and any body motion). The default.
+    #[default]
+    Joint,
+    /// Nothing: the caller guarantees planar motion (e.g. with `LockedAxes` on the bodies).
+    None,
+}
+
+/// Builds a [`ClearanceJoint`] with chained setters, like Rapier's `RevoluteJointBuilder`.
+/// Body 1 carries the bearing (hole), body 2 the journal (pin).
+///
+/// ```
+/// use clearance_joint::model::laws::{Bai, BearingGeometry, FrictionModel, ImprovedLiu, MaxDamping, NormalModel};
+/// use clearance_joint::prelude::*;
+/// let geometry = BearingGeometry::from_clearance(0.010, 0.5e-3, 0.016).unwrap();
+/// let law = ImprovedLiu::new(1.137e11, 0.016, 0.5e-3, 1.0, 1e-4, MaxDamping::Eta(0.01)).unwrap();
+/// let joint = ClearanceJointBuilder::new(Vector::new(0.0, -1.0, 0.0), geometry, NormalModel::ImprovedLiu(law))
+///     .local_anchor1(Vector::new(0.4, 0.0, 0.4))
+///     .local_anchor2(Vector::new(0.0, 0.0, 0.4))
+///     .friction(FrictionModel::Bai(Bai::DRY))
+///     .build()
+///     .unwrap();
+/// assert!((joint.geometry().clearance() - 0.5e-3).abs() < 1e-15);
+/// ```
+#[derive(Clone, Debug)]
+pub struct ClearanceJointBuilder {
+    joint: ClearanceJoint,
+    spatial: Option<crate::model::spatial::SpatialModel>,
+}
+
+/// Default of [`ClearanceJointBuilder::min_impact_speed`], m/s.
+pub const DEFAULT_MIN_IMPACT_SPEED: f64 = 1e-4;
+
+/// Default of [`ClearanceJointBuilder::min_separation`], m.
+pub const DEFAULT_MIN_SEPARATION: f64 = 1e-7;
+
+/// The default validity limit of a joint's penetration, m: 1 % of the journal radius (95 um
+/// for a 10 mm bearing with 0.5 mm of clearance), a nominal compressive strain `delta/R_j` of
+/// 1 %, within the small strain of the linear elastic laws (docs/MODEL.md, "Validity").
+pub fn default_max_valid_penetration(geometry: &BearingGeometry) -> f64 {
+    DEFAULT_VALID_STRAIN * geometry.journal_radius()
+}
 
 /// A revolute hinge with radial clearance between two Rapier rigid bodies.
 #[derive(Clone, Debug)]

@@ -1,40 +1,6 @@
-//! Building a clearance joint: [`ClearanceJointBuilder`], what holds the out-of-plane degrees of
-//! freedom ([`OutOfPlaneLock`]) and the builder's defaults.
+//! Building a clearance joint: [`ClearanceJointBuilder`]'s setters and checks.
 
 use super::*;
-
-/// What holds the degrees of freedom the contact law does not (axial translation and the two tilts).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum OutOfPlaneLock {
-    /// A Rapier `GenericJoint` locking the axial translation and the two tilts, relative to the
-    /// bodies (works for any axis and any body motion). The default.
-    #[default]
-    Joint,
-    /// Nothing: the caller guarantees planar motion (e.g. with `LockedAxes` on the bodies).
-    None,
-}
-
-/// Builds a [`ClearanceJoint`] with chained setters, like Rapier's `RevoluteJointBuilder`.
-/// Body 1 carries the bearing (hole), body 2 the journal (pin).
-///
-/// ```
-/// use clearance_joint::model::laws::{Bai, BearingGeometry, FrictionModel, ImprovedLiu, MaxDamping, NormalModel};
-/// use clearance_joint::prelude::*;
-/// let geometry = BearingGeometry::from_clearance(0.010, 0.5e-3, 0.016).unwrap();
-/// let law = ImprovedLiu::new(1.137e11, 0.016, 0.5e-3, 1.0, 1e-4, MaxDamping::Eta(0.01)).unwrap();
-/// let joint = ClearanceJointBuilder::new(Vector::new(0.0, -1.0, 0.0), geometry, NormalModel::ImprovedLiu(law))
-///     .local_anchor1(Vector::new(0.4, 0.0, 0.4))
-///     .local_anchor2(Vector::new(0.0, 0.0, 0.4))
-///     .friction(FrictionModel::Bai(Bai::DRY))
-///     .build()
-///     .unwrap();
-/// assert!((joint.geometry().clearance() - 0.5e-3).abs() < 1e-15);
-/// ```
-#[derive(Clone, Debug)]
-pub struct ClearanceJointBuilder {
-    joint: ClearanceJoint,
-    spatial: Option<crate::model::spatial::SpatialModel>,
-}
 
 impl ClearanceJointBuilder {
     /// A joint about `axis` (in body 1's frame; also used for body 2 unless
@@ -171,25 +137,12 @@ impl ClearanceJointBuilder {
     }
 }
 
-/// Default of [`ClearanceJointBuilder::min_impact_speed`], m/s.
-pub const DEFAULT_MIN_IMPACT_SPEED: f64 = 1e-4;
-
-/// Default of [`ClearanceJointBuilder::min_separation`], m.
-pub const DEFAULT_MIN_SEPARATION: f64 = 1e-7;
-
 /// The nominal compressive strain `delta/R_j` up to which the contact laws are trusted by
 /// default: 1 %. Every law here is linear elastic (small strain); at a strain `e` the
 /// Green-Lagrange strain `e + e^2/2` differs from the linear one by `e/2`, 0.5 % at 1 %, and
 /// the approach `delta` spreads over a depth of the order of the journal radius `R_j`.
 /// docs/MODEL.md ("Validity") gives the argument and what it does not cover.
 pub(crate) const DEFAULT_VALID_STRAIN: f64 = 0.01;
-
-/// The default validity limit of a joint's penetration, m: 1 % of the journal radius (95 um
-/// for a 10 mm bearing with 0.5 mm of clearance), a nominal compressive strain `delta/R_j` of
-/// 1 %, within the small strain of the linear elastic laws (docs/MODEL.md, "Validity").
-pub fn default_max_valid_penetration(geometry: &BearingGeometry) -> f64 {
-    DEFAULT_VALID_STRAIN * geometry.journal_radius()
-}
 
 /// Checks a validity limit `depth` (m) for `field`: positive, finite, and at most the journal
 /// radius (a deeper "penetration" is no contact of two cylinders).

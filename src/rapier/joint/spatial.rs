@@ -16,10 +16,10 @@ use rapier3d_f64::math::{AngularInertia, Vector};
 use rapier3d_f64::prelude::{RigidBody, RigidBodySet};
 
 mod evaluate;
-mod report;
+pub(super) mod report;
 pub(super) mod subcycle;
 use evaluate::{Totals, apply_region};
-pub use report::{Region, SpatialPoint, SpatialReport};
+use report::{Region, SpatialPoint, SpatialReport};
 
 /// One region's memory between steps.
 #[derive(Clone, Copy, Debug)]

@@ -1,18 +1,7 @@
-//! Building a large-step joint: [`LargeStepJointBuilder`] and the restitution of its impacts.
+//! Building a large-step joint: [`LargeStepJointBuilder`]'s setters and checks, and the
+//! restitution of its impacts.
 
 use super::*;
-
-/// The coefficient of restitution of the journal's impacts.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Restitution {
-    /// A fixed coefficient in [0, 1].
-    Coefficient(f64),
-    /// The restitution this compliant law gives each impact, at its approach speed and the
-    /// effective mass of the two bodies along the normal
-    /// ([`impact_restitution`]): the large-step model bounces as
-    /// the compliant model would.
-    Law(NormalModel),
-}
 
 impl Restitution {
     /// The coefficient for one impact of `approach_speed` (m/s) between bodies of
@@ -23,29 +12,6 @@ impl Restitution {
             Restitution::Law(law) => impact_restitution(law, effective_mass, approach_speed),
         }
     }
-}
-
-/// Builds a [`LargeStepJoint`] with chained setters, like Rapier's `RevoluteJointBuilder`.
-/// Body 1 carries the bearing (hole), body 2 the journal (pin).
-///
-/// ```
-/// use clearance_joint::rapier::large_step::LargeStepJointBuilder;
-/// use clearance_joint::model::laws::BearingGeometry;
-/// use rapier3d_f64::math::Vector;
-/// let geometry = BearingGeometry::from_clearance(0.010, 0.5e-3, 0.016).unwrap();
-/// let joint = LargeStepJointBuilder::new(Vector::Z, geometry)
-///     .local_anchor1(Vector::new(0.4, 0.0, 0.4))
-///     .restitution(0.6)
-///     .friction(0.25)
-///     .name("door hinge")
-///     .build()
-///     .unwrap();
-/// assert_eq!(joint.friction(), 0.25);
-/// assert!((joint.clearance() - 0.5e-3).abs() < 1e-15);
-/// ```
-#[derive(Clone, Debug)]
-pub struct LargeStepJointBuilder {
-    joint: LargeStepJoint,
 }
 
 impl LargeStepJointBuilder {

@@ -207,8 +207,8 @@ pub struct HingeMetrics {
     pub rms_force_n: f64,
     /// Largest apparent restitution of an impact, the separation speed over the approach speed
     /// (from the first state out of and into contact), over impacts that approached faster than
-    /// [`RESTITUTION_MIN_SPEED`]; above 1 a contact gave back more than it took (0 without such
-    /// an impact).
+    /// 1 mm/s (a grazing approach's separation speed is set by the other forces, not by the
+    /// contact); above 1 a contact gave back more than it took (0 without such an impact).
     pub max_restitution: f64,
     /// Final relative angle, deg (set by the scene runner; 0 from a bare recorder).
     pub final_angle_deg: f64,

@@ -111,7 +111,7 @@ pub fn clearance_joint_from_revolute(
 /// The large-step clearance joint equivalent to the revolute `joint` (same anchors and axes),
 /// with the geometry and laws of `clearance` (see [`HingeDesign::large_step_joint`]). Refuses what
 /// [`clearance_joint_from_revolute`] refuses.
-pub fn large_step_joint_from_revolute(
+pub(crate) fn large_step_joint_from_revolute(
     joint: &GenericJoint,
     clearance: &HingeDesign,
 ) -> Result<LargeStepJoint> {
@@ -168,7 +168,7 @@ fn revolute_frames(joint: &GenericJoint) -> Result<[Vector; 4]> {
 /// The ideal revolute joint with the anchors and axes of `joint`. Contacts between the two
 /// bodies are disabled, as by the clearance joint's own out-of-plane lock (re-enable them with
 /// `GenericJoint::set_contacts_enabled` if your colliders need them).
-pub fn revolute_from_clearance(joint: &ClearanceJoint) -> RevoluteJoint {
+pub(crate) fn revolute_from_clearance(joint: &ClearanceJoint) -> RevoluteJoint {
     revolute_joint([
         joint.local_anchor1(),
         joint.local_anchor2(),
@@ -179,7 +179,7 @@ pub fn revolute_from_clearance(joint: &ClearanceJoint) -> RevoluteJoint {
 
 /// The ideal revolute joint with the anchors and axes of the large-step `joint` (contacts
 /// between the bodies disabled, as in [`revolute_from_clearance`]).
-pub fn revolute_from_large_step(joint: &LargeStepJoint) -> RevoluteJoint {
+pub(crate) fn revolute_from_large_step(joint: &LargeStepJoint) -> RevoluteJoint {
     revolute_joint([
         joint.local_anchor1(),
         joint.local_anchor2(),
@@ -191,7 +191,7 @@ pub fn revolute_from_large_step(joint: &LargeStepJoint) -> RevoluteJoint {
 /// The ideal revolute joint through `anchor1` / `anchor2` about `axis1` / `axis2` (body frames;
 /// axes as given), with contacts between the two bodies disabled: the joint a clearance joint
 /// converts back to, and the ECS layer's ideal hinge.
-pub fn revolute_joint([anchor1, anchor2, axis1, axis2]: [Vector; 4]) -> RevoluteJoint {
+pub(crate) fn revolute_joint([anchor1, anchor2, axis1, axis2]: [Vector; 4]) -> RevoluteJoint {
     let data = GenericJointBuilder::new(JointAxesMask::LOCKED_REVOLUTE_AXES)
         .local_axis1(axis1)
         .local_axis2(axis2)
@@ -247,8 +247,8 @@ pub fn revolute_to_clearance(
 }
 
 /// Replaces the clearance joint `handle` of `set` by an ideal revolute joint in
-/// `impulse_joints` with the same bodies, anchors and axes (see [`revolute_from_clearance`]);
-/// the clearance joint's forces are taken back from the bodies and its out-of-plane lock is
+/// `impulse_joints` with the same bodies, anchors and axes (contacts between the two bodies
+/// disabled, as by the clearance joint's own out-of-plane lock); the clearance joint's forces are taken back from the bodies and its out-of-plane lock is
 /// removed.
 ///
 /// **Energy.** The anchors are apart by the journal's eccentricity `e` (up to `c`) when it
@@ -285,7 +285,7 @@ pub fn clearance_to_revolute(
 /// the geometry and laws of `clearance` (its [`model`](HingeDesign::model) is not consulted: the
 /// set is the choice; but a [`ClearanceModel::Spatial`](crate::rapier::hinge::design::ClearanceModel::Spatial) one is refused, naming `model`, since the
 /// large-step joint is planar). Nothing changes when it fails.
-pub fn revolute_to_large_step(
+pub(crate) fn revolute_to_large_step(
     set: &mut LargeStepJointSet,
     revolute: ImpulseJointHandle,
     clearance: HingeDesign,
@@ -302,7 +302,7 @@ pub fn revolute_to_large_step(
 /// bodies, anchors and axes; the bodies get their substep settings back. The other handles of
 /// `set` stay valid. As with [`clearance_to_revolute`], the revolute re-centres the journal: a
 /// body hanging on the bearing wall is lifted by `c` and gains `m g c` of energy.
-pub fn large_step_to_revolute(
+pub(crate) fn large_step_to_revolute(
     set: &mut LargeStepJointSet,
     handle: LargeStepJointHandle,
     bodies: &mut RigidBodySet,
@@ -328,8 +328,10 @@ pub trait ConvertRevolute {
     /// The set's joint handle.
     type Handle;
 
-    /// See [`revolute_to_clearance`] and [`revolute_to_large_step`]: `bearing` says which body
-    /// of the revolute carries the bearing.
+    /// See [`revolute_to_clearance`]: `bearing` says which body of the revolute carries the
+    /// bearing. A [`LargeStepJointSet`] builds a large-step joint with the same anchors and axes
+    /// and refuses a [`ClearanceModel::Spatial`](crate::rapier::hinge::design::ClearanceModel::Spatial)
+    /// design, naming `model` (the large-step joint is planar).
     fn convert_revolute(
         &mut self,
         revolute: ImpulseJointHandle,
@@ -338,7 +340,8 @@ pub trait ConvertRevolute {
         impulse_joints: &mut ImpulseJointSet,
     ) -> Result<Self::Handle>;
 
-    /// See [`clearance_to_revolute`] and [`large_step_to_revolute`]. The revolute re-centres
+    /// See [`clearance_to_revolute`] (a [`LargeStepJointSet`] also gives the bodies their substep
+    /// settings back). The revolute re-centres
     /// the journal: a body hanging on the bearing wall is lifted by the clearance `c` and gains
     /// `m g c` of energy (see [`clearance_to_revolute`]).
     fn revert_to_revolute(

@@ -77,6 +77,7 @@
 //! # Ok::<(), clearance_joint::Error>(())
 //! ```
 
+mod builder;
 pub mod resolution;
 mod set;
 pub use set::{LargeStepJointHandle, LargeStepJointSet};
@@ -99,8 +100,6 @@ use std::collections::BTreeMap;
 
 /// Default of [`LargeStepJointBuilder::max_substeps`].
 pub const DEFAULT_MAX_SUBSTEPS: usize = 64;
-/// Default of [`LargeStepJointBuilder::min_impact_speed`], m/s.
-pub const DEFAULT_MIN_IMPACT_SPEED: f64 = 1e-4;
 /// A journal within this fraction of `c` from the wall counts as touching it.
 const CONTACT_TOLERANCE: f64 = 1e-3;
 /// Damping of the friction motor: large enough that the motor is a hard velocity constraint
@@ -119,17 +118,6 @@ pub enum Restitution {
     /// ([`impact_restitution`]): the large-step model bounces as
     /// the compliant model would.
     Law(NormalModel),
-}
-
-impl Restitution {
-    /// The coefficient for one impact of `approach_speed` (m/s) between bodies of
-    /// `effective_mass` (kg) along the normal.
-    pub fn coefficient(&self, effective_mass: f64, approach_speed: f64) -> f64 {
-        match self {
-            Restitution::Coefficient(e) => *e,
-            Restitution::Law(law) => impact_restitution(law, effective_mass, approach_speed),
-        }
-    }
 }
 
 /// Builds a [`LargeStepJoint`] with chained setters, like Rapier's `RevoluteJointBuilder`.
@@ -153,110 +141,6 @@ impl Restitution {
 #[derive(Clone, Debug)]
 pub struct LargeStepJointBuilder {
     joint: LargeStepJoint,
-}
-
-impl LargeStepJointBuilder {
-    /// A joint about `axis` (in body 1's frame; also body 2's unless
-    /// [`local_axis2`](Self::local_axis2) is set) with the radial geometry `geometry` (its clearance
-    /// is the play; its journal radius is the friction moment's arm), anchors at both bodies'
-    /// origins, inelastic (restitution 0) and frictionless.
-    pub fn new(axis: Vector, geometry: BearingGeometry) -> Self {
-        LargeStepJointBuilder {
-            joint: LargeStepJoint {
-                name: String::from("large-step clearance joint"),
-                local_axis1: axis,
-                local_axis2: axis,
-                local_anchor1: Vector::ZERO,
-                local_anchor2: Vector::ZERO,
-                geometry,
-                restitution: Restitution::Coefficient(0.0),
-                friction: 0.0,
-                min_impact_speed: DEFAULT_MIN_IMPACT_SPEED,
-                max_substeps: DEFAULT_MAX_SUBSTEPS,
-                body1: RigidBodyHandle::invalid(),
-                body2: RigidBodyHandle::invalid(),
-                handle: None,
-                state: JointState::default(),
-                report: LargeStepReport::default(),
-            },
-        }
-    }
-    /// Bearing centre in body 1's frame.
-    pub fn local_anchor1(mut self, anchor: Vector) -> Self {
-        self.joint.local_anchor1 = anchor;
-        self
-    }
-    /// Journal centre in body 2's frame.
-    pub fn local_anchor2(mut self, anchor: Vector) -> Self {
-        self.joint.local_anchor2 = anchor;
-        self
-    }
-    /// Hinge axis in body 2's frame (defaults to the axis given to [`new`](Self::new)).
-    pub fn local_axis2(mut self, axis: Vector) -> Self {
-        self.joint.local_axis2 = axis;
-        self
-    }
-    /// A fixed coefficient of restitution in [0, 1] (default 0: onsets do not rebound).
-    pub fn restitution(mut self, coefficient: f64) -> Self {
-        self.joint.restitution = Restitution::Coefficient(coefficient);
-        self
-    }
-    /// Bounce as the compliant law `law` would at each impact (see [`Restitution::Law`]).
-    pub fn restitution_law(mut self, law: NormalModel) -> Self {
-        self.joint.restitution = Restitution::Law(law);
-        self
-    }
-    /// Coulomb friction coefficient `mu >= 0` of the bearing surface (default 0): the hinge
-    /// sticks below the friction moment `mu N R_j` and slides at it.
-    pub fn friction(mut self, mu: f64) -> Self {
-        self.joint.friction = mu;
-        self
-    }
-    /// Approach speed below which a contact onset does not bounce, m/s (default 1e-4).
-    pub fn min_impact_speed(mut self, speed: f64) -> Self {
-        self.joint.min_impact_speed = speed;
-        self
-    }
-    /// Most substeps per step the joint may ask Rapier for, at least `num_solver_iterations`
-    /// (default 64). A step that needs more is taken anyway and reported under-resolved.
-    pub fn max_substeps(mut self, substeps: usize) -> Self {
-        self.joint.max_substeps = substeps;
-        self
-    }
-    /// A name used in error messages and outputs.
-    pub fn name(mut self, name: impl Into<String>) -> Self {
-        self.joint.name = name.into();
-        self
-    }
-    /// Validates and returns the joint.
-    pub fn build(mut self) -> Result<LargeStepJoint> {
-        let j = &mut self.joint;
-        j.local_axis1 = unit_vector("local_axis1", j.local_axis1)?;
-        j.local_axis2 = unit_vector("local_axis2", j.local_axis2)?;
-        for (field, v) in [
-            ("local_anchor1", j.local_anchor1),
-            ("local_anchor2", j.local_anchor2),
-        ] {
-            if !v.is_finite() {
-                return Err(Error::invalid(field, format!("must be finite (got {v:?})")));
-            }
-        }
-        if let Restitution::Coefficient(e) = j.restitution {
-            non_negative("restitution", e)?;
-            if e > 1.0 {
-                return Err(Error::invalid(
-                    "restitution",
-                    format!("must be in [0, 1] (got {e}): above 1 an impact would create energy"),
-                ));
-            }
-        }
-        non_negative("friction", j.friction)?;
-        positive("min_impact_speed", j.min_impact_speed)?;
-        if j.max_substeps == 0 {
-            return Err(Error::invalid("max_substeps", "must be at least 1 (got 0)"));
-        }
-        Ok(self.joint)
-    }
 }
 
 /// What the joint did over the last step (all zero before the first).
@@ -449,7 +333,7 @@ impl LargeStepJoint {
     /// radial axes coupled with the limit `[0, c]` on their norm, and (with friction) a velocity
     /// motor on the rotation whose largest torque the hook sets every step. Contacts between the
     /// two bodies are disabled, as for Rapier's own revolute joints in this crate.
-    pub fn rapier_joint(&self) -> GenericJoint {
+    pub(crate) fn rapier_joint(&self) -> GenericJoint {
         let mut b = GenericJointBuilder::new(
             JointAxesMask::LIN_X | JointAxesMask::ANG_Y | JointAxesMask::ANG_Z,
         )

@@ -193,10 +193,9 @@ impl ReactionSolver {
         self.solve_with(bodies, joints, gravity, &[])
     }
 
-    /// [`solve`](Self::solve) with further applied wrenches on the bodies: those of the force
-    /// sources the [`Stepper`](crate::rapier::pipeline::stepper::Stepper) adds during its steps only (drives,
-    /// clearance contacts), which the bodies' user forces do not hold between steps.
-    pub fn solve_with(
+    /// [`solve`](Self::solve) with further applied wrenches on the bodies (see
+    /// [`solve_joints_with`](Self::solve_joints_with)).
+    fn solve_with(
         &mut self,
         bodies: &RigidBodySet,
         joints: &[IdealRevolute],
@@ -213,8 +212,10 @@ impl ReactionSolver {
         if ok { Some(&self.forces) } else { None }
     }
 
-    /// [`solve_joints`](Self::solve_joints) with further applied wrenches, as in
-    /// [`solve_with`](Self::solve_with).
+    /// [`solve_joints`](Self::solve_joints) with further applied wrenches on the bodies: those of
+    /// the force sources the [`Stepper`](crate::rapier::pipeline::stepper::Stepper) adds during
+    /// its steps only (drives, clearance contacts), which the bodies' user forces do not hold
+    /// between steps.
     pub fn solve_joints_with(
         &mut self,
         bodies: &RigidBodySet,

@@ -1,0 +1,307 @@
+//! The recorder's thinning: which states a replay keeps, and its cap on frames.
+
+use super::frames::*;
+use super::*;
+
+impl ReplayRecorder {
+    /// A recorder keeping a state per `interval` s in free flight and per `contact_interval`
+    /// s while a journal is in contact (`0 < contact_interval <= interval`).
+    pub fn new(interval: f64, contact_interval: f64) -> Result<Self> {
+        if !(interval.is_finite() && interval > 0.0) {
+            return Err(Error::invalid("interval", "must be a positive time, s"));
+        }
+        if !(contact_interval.is_finite() && contact_interval > 0.0 && contact_interval <= interval)
+        {
+            return Err(Error::invalid(
+                "contact_interval",
+                "must be a positive time no longer than `interval`, s",
+            ));
+        }
+        Ok(ReplayRecorder {
+            recording: Recording {
+                interval_s: interval,
+                contact_interval_s: contact_interval,
+                ..Recording::default()
+            },
+            handles: Vec::new(),
+            joints: Vec::new(),
+            pending: None,
+            peak: None,
+            in_contact: false,
+            onset: f64::NEG_INFINITY,
+            last_kept: f64::NEG_INFINITY,
+            max_frames: usize::MAX,
+        })
+    }
+
+    /// The recorder keeping at most `max_frames` frames (at least 4), halving its frames and
+    /// doubling its intervals whenever it reaches them (see the module docs' cap).
+    pub fn with_max_frames(mut self, max_frames: usize) -> Self {
+        self.max_frames = max_frames.max(4);
+        self
+    }
+
+    /// Tracks a body (in group `group`), its shapes from its colliders or its mass properties
+    /// (see [`ReplayBody::shapes`]; call after the mass properties are known: Rapier computes
+    /// them in the first step,
+    /// [`prepare_mass_properties`](crate::rapier::observers::reaction::prepare_mass_properties) before it).
+    /// Returns its index.
+    pub fn track_body(
+        &mut self,
+        name: &str,
+        group: &str,
+        handle: RigidBodyHandle,
+        bodies: &RigidBodySet,
+        colliders: &ColliderSet,
+    ) -> usize {
+        let shapes = bodies
+            .get(handle)
+            .map(|rb| body_shapes(rb, colliders))
+            .unwrap_or_default();
+        self.recording.bodies.push(ReplayBody {
+            name: name.into(),
+            group: group.into(),
+            shapes,
+        });
+        self.handles.push(handle);
+        self.handles.len() - 1
+    }
+
+    /// The index of a tracked body, by handle.
+    fn body_index(&self, handle: RigidBodyHandle, field: &str) -> Result<usize> {
+        self.handles
+            .iter()
+            .position(|&h| h == handle)
+            .ok_or_else(|| Error::invalid(field, "its body is not tracked: track it first"))
+    }
+
+    /// Tracks clearance joint `handle` of `set`, the set passed `set_index`-th to
+    /// [`record`](Self::record). Its two bodies must be tracked already.
+    pub fn track_journal(
+        &mut self,
+        name: &str,
+        group: &str,
+        set_index: usize,
+        handle: ClearanceJointHandle,
+        set: &ClearanceJointSet,
+    ) -> Result<()> {
+        let joint = set
+            .get(handle)
+            .ok_or_else(|| Error::invalid(name, "no such clearance joint in this set"))?;
+        let g = joint.geometry();
+        let axis1 = joint.local_axis1();
+        let u1 = in_plane_u(axis1);
+        self.recording.journals.push(ReplayJournal {
+            name: name.into(),
+            group: group.into(),
+            bearing: self.body_index(joint.body1(), name)?,
+            journal: self.body_index(joint.body2(), name)?,
+            anchor1_m: joint.local_anchor1().to_array(),
+            anchor2_m: joint.local_anchor2().to_array(),
+            axis1: axis1.to_array(),
+            u1: u1.to_array(),
+            clearance_m: g.clearance(),
+            bearing_radius_m: g.bearing_radius(),
+            width_m: g.length(),
+            axial_play_m: joint.spatial_model().map(|m| m.geometry.axial_play),
+        });
+        self.joints.push((set_index, handle));
+        Ok(())
+    }
+
+    /// Tracks an ideal hinge between two tracked bodies, drawn as a pin.
+    pub fn track_pin(
+        &mut self,
+        name: &str,
+        group: &str,
+        body1: RigidBodyHandle,
+        body2: RigidBodyHandle,
+        anchor1: Vector,
+        axis1: Vector,
+    ) -> Result<()> {
+        let pin = ReplayPin {
+            name: name.into(),
+            group: group.into(),
+            body1: self.body_index(body1, name)?,
+            body2: self.body_index(body2, name)?,
+            anchor1_m: anchor1.to_array(),
+            axis1: axis1.normalize_or_zero().to_array(),
+        };
+        self.recording.pins.push(pin);
+        Ok(())
+    }
+
+    /// Records the state at time `t` (call after each step; `sets` as given to
+    /// [`track_journal`](Self::track_journal)). Keeps it or not by the thinning rule.
+    pub fn record(&mut self, t: f64, bodies: &RigidBodySet, sets: &[&ClearanceJointSet]) {
+        let frame = self.frame(t, bodies, sets);
+        for inside in self.inside_frames(&frame, bodies, sets) {
+            self.record_frame(inside);
+        }
+        self.record_frame(frame);
+    }
+
+    /// Records one state (thinned as [`record`](Self::record) says).
+    fn record_frame(&mut self, frame: ReplayFrame) {
+        let t = frame.t;
+        let contact = frame.journals.iter().any(|j| j.contact);
+        let onset = contact && !self.in_contact;
+        if onset {
+            self.onset = t;
+        }
+        let dense = t - self.onset <= DENSE_FRAMES * self.recording.contact_interval_s;
+        let spacing = if (contact || self.in_contact) && dense {
+            self.recording.contact_interval_s
+        } else {
+            self.recording.interval_s
+        };
+        let keep = onset || t - self.last_kept >= spacing * (1.0 - 1e-9);
+        if onset && let Some(before) = self.pending.take() {
+            self.push_after_peak(before);
+        }
+        self.in_contact = contact;
+        if keep {
+            self.pending = None;
+            self.push_after_peak(frame);
+        } else {
+            if self.peak.as_ref().is_none_or(|p| force(&frame) > force(p)) {
+                self.peak = Some(frame.clone());
+            }
+            self.pending = Some(frame);
+        }
+    }
+
+    /// Keeps `frame`, after the state of largest force skipped since the last kept one when
+    /// that force exceeds both neighbours' (a peak between kept states: so the recording's
+    /// largest force is the run's, whatever the thinning).
+    fn push_after_peak(&mut self, frame: ReplayFrame) {
+        if let Some(peak) = self.peak.take() {
+            let before = self.recording.frames.last().map_or(0.0, force);
+            if peak.t < frame.t && force(&peak) > before.max(force(&frame)) {
+                self.push(peak);
+            }
+        }
+        self.push(frame);
+    }
+
+    fn push(&mut self, frame: ReplayFrame) {
+        self.last_kept = frame.t;
+        self.recording.frames.push(frame);
+        if self.recording.frames.len() > self.max_frames {
+            self.halve();
+        }
+    }
+
+    /// Halves the frames kept (see the module docs' cap): the first and last stay, each pair
+    /// between keeps its frame of larger force, with the other's impact flags.
+    fn halve(&mut self) {
+        let frames = std::mem::take(&mut self.recording.frames);
+        let n = frames.len();
+        let mut kept = Vec::with_capacity(n / 2 + 2);
+        let mut it = frames.into_iter();
+        kept.extend(it.next());
+        let last = it.next_back();
+        while let Some(a) = it.next() {
+            kept.push(match it.next() {
+                Some(b) => merge_pair(a, b),
+                None => a,
+            });
+        }
+        kept.extend(last);
+        self.recording.frames = kept;
+        self.recording.interval_s *= 2.0;
+        self.recording.contact_interval_s *= 2.0;
+    }
+
+    fn frame(&self, t: f64, bodies: &RigidBodySet, sets: &[&ClearanceJointSet]) -> ReplayFrame {
+        let poses = self
+            .handles
+            .iter()
+            .map(|&h| match bodies.get(h) {
+                Some(rb) => {
+                    let (p, q) = (rb.translation(), *rb.rotation());
+                    [p.x, p.y, p.z, q.x, q.y, q.z, q.w]
+                }
+                None => [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
+            })
+            .collect();
+        let journals = self
+            .joints
+            .iter()
+            .zip(&self.recording.journals)
+            .map(|(&(set, h), track)| {
+                let Some(joint) = sets.get(set).and_then(|s| s.get(h)) else {
+                    return JournalFrame::default();
+                };
+                journal_frame(joint, bodies, track)
+            })
+            .collect();
+        ReplayFrame { t, poses, journals }
+    }
+
+    /// The states inside the step that led to `end` of the sub-cycled joints
+    /// ([`ClearanceJoint::substeps`]), in time order: each such joint at its sub-step, the other
+    /// journals as at the step's end (or at their own latest sub-step before), the bodies drawn
+    /// at the step's end (they move little within a step against the journal in its play).
+    fn inside_frames(
+        &self,
+        end: &ReplayFrame,
+        bodies: &RigidBodySet,
+        sets: &[&ClearanceJointSet],
+    ) -> Vec<ReplayFrame> {
+        let joint = |&(set, h): &(usize, ClearanceJointHandle)| sets.get(set)?.get(h);
+        let mut times: Vec<f64> = Vec::new();
+        for j in self.joints.iter().filter_map(joint) {
+            if let Some((last, inside)) = j.substeps().split_last() {
+                let start = end.t - last.t;
+                times.extend(inside.iter().map(|s| start + s.t));
+            }
+        }
+        if times.is_empty() {
+            return Vec::new();
+        }
+        times.sort_by(f64::total_cmp);
+        times.dedup();
+        let rotation = |j: &ClearanceJoint| -> Rotation {
+            bodies
+                .get(j.body1())
+                .map(|rb| *rb.rotation())
+                .unwrap_or_default()
+        };
+        times
+            .into_iter()
+            .map(|t| {
+                let mut frame = ReplayFrame {
+                    t,
+                    poses: end.poses.clone(),
+                    journals: end.journals.clone(),
+                };
+                for ((k, id), track) in self.joints.iter().enumerate().zip(&self.recording.journals)
+                {
+                    let Some(j) = joint(id) else { continue };
+                    let Some(last) = j.substeps().last() else {
+                        continue;
+                    };
+                    let start = end.t - last.t;
+                    if let Some(s) = j.substeps().iter().rev().find(|s| start + s.t <= t) {
+                        frame.journals[k] = substep_frame(s, rotation(j), track);
+                    }
+                }
+                frame
+            })
+            .collect()
+    }
+
+    /// The frames kept so far.
+    pub fn frames(&self) -> &[ReplayFrame] {
+        &self.recording.frames
+    }
+
+    /// The recording, with the last state recorded kept.
+    pub fn finish(mut self) -> Recording {
+        if let Some(last) = self.pending.take() {
+            self.push_after_peak(last);
+        }
+        self.recording
+    }
+}

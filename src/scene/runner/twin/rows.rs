@@ -1,0 +1,131 @@
+//! A twin's table rows: the values of the current state, and the row written between two states.
+
+use super::*;
+
+impl Twin {
+    /// The row values of the current state into `row_cur`.
+    pub(super) fn fill_row(&mut self, t: f64, world: &ClearanceWorld) {
+        let bodies = &world.rapier.bodies;
+        let axis_ref = self.reference_axis;
+        let v = &mut self.row_cur;
+        v.clear();
+        v.push(t);
+        for b in &self.bodies {
+            let rb = &bodies[b.handle];
+            v.push(b.angle.value().to_degrees());
+            v.push(rb.angvel().dot(axis_ref).to_degrees());
+        }
+        if self.body_motion {
+            for b in self.bodies.iter().filter(|b| b.moves) {
+                let rb = &bodies[b.handle];
+                let p = *rb.position() * b.local_com;
+                let r = *rb.rotation() * b.local_com;
+                // The centre of mass's velocity and acceleration at the state: a dynamic body's
+                // from the constrained solve (`solve_ideal_reactions`); a tabulated drive's from
+                // its table; a steady drive's those of its spin (its frame turns about its
+                // origin, so its centre of mass moves with `w x r`).
+                let (vel, acc) = match (b.table, b.fixed) {
+                    (Some(k), _) => {
+                        let (v0, a, w, alpha) = world.prescribed.motions[k].rates(t);
+                        (v0 + w.cross(r), a + alpha.cross(r) + w.cross(w.cross(r)))
+                    }
+                    (None, true) => {
+                        let w = rb.angvel();
+                        (rb.linvel() + w.cross(r), w.cross(w.cross(r)))
+                    }
+                    (None, false) => {
+                        let (vel, _) = self.reactions.velocity(b.handle).unwrap_or_default();
+                        let (acc, _) = self.reactions.acceleration(b.handle).unwrap_or_default();
+                        (vel, acc)
+                    }
+                };
+                v.extend_from_slice(&[p.x, p.y, p.z, vel.x, vel.y, vel.z, acc.x, acc.y, acc.z]);
+            }
+        }
+        for h in &self.hinges {
+            let (r1, r2) = (
+                &bodies[self.bodies[h.bearing].handle],
+                &bodies[self.bodies[h.journal].handle],
+            );
+            let axis = *r1.rotation() * h.local_axis1;
+            v.push(h.angle.value().to_degrees());
+            v.push((r2.angvel() - r1.angvel()).dot(axis).to_degrees());
+            v.push(h.force);
+            match h.joint {
+                HingeJoint::Clearance(c) => {
+                    let j = world.clearance.get(c).expect("handle of this twin");
+                    let r = j.report();
+                    let (u, v_axis) = (*r1.rotation() * h.local_u1, *r1.rotation() * h.local_v1);
+                    let pose = r.spatial.map(|_| j.spatial_pose(r1, r2, u));
+                    // A spatial joint's eccentricity at the bearing's mid-plane (its report's
+                    // state is the deepest station's, which may be a face's).
+                    let e = pose.map_or(r.state.eccentricity, |p| p.mid_plane_eccentricity());
+                    v.push(e.dot(u) * 1e3);
+                    v.push(e.dot(v_axis) * 1e3);
+                    v.push(r.state.penetration.max(0.0) * 1e6);
+                    v.push(if r.state.penetration > 0.0 { 1.0 } else { 0.0 });
+                    if let (Some(p), Some(s)) = (pose, r.spatial) {
+                        let [tu, tv] = p.tilt();
+                        v.extend_from_slice(&[
+                            tu.to_degrees(),
+                            tv.to_degrees(),
+                            p.axial_offset() * 1e3,
+                            s.bore_force,
+                            s.edge_force[0],
+                            s.edge_force[1],
+                            s.face_force[0],
+                            s.face_force[1],
+                        ]);
+                        // Where each edge region's resultant acts, from the bearing's centre
+                        // along the axis (0 while it carries nothing).
+                        v.extend(
+                            s.edge_point
+                                .map(|at| (at - p.bearing_center).dot(p.bearing_axis) * 1e3),
+                        );
+                    }
+                }
+                HingeJoint::LargeStep(k) => {
+                    let r = world
+                        .large_step
+                        .get(k)
+                        .expect("handle of this twin")
+                        .report();
+                    let e = r.eccentricity;
+                    v.push(e.dot(*r1.rotation() * h.local_u1) * 1e3);
+                    v.push(e.dot(*r1.rotation() * h.local_v1) * 1e3);
+                    v.push(h.sample.penetration.max(0.0) * 1e6);
+                    v.push(if r.contact { 1.0 } else { 0.0 });
+                }
+                HingeJoint::Ideal => v.extend_from_slice(&[0.0, 0.0, 0.0, 0.0]),
+            }
+            if h.spatial && !matches!(h.joint, HingeJoint::Clearance(_)) {
+                v.extend_from_slice(&[0.0; SPATIAL_COLUMNS.len()]);
+            }
+        }
+        for (_, f) in &self.joints {
+            v.push(*f);
+        }
+        v.extend(self.motors.iter().flatten());
+    }
+
+    /// Appends the row at time `t`, `w` of the way from the previous state to the current one
+    /// (linear; the contact flag from the nearer state).
+    pub(in crate::scene::runner) fn write_row(&mut self, t: f64, w: f64) {
+        let contact_cols = &self.contact_columns;
+        let (prev, cur) = (&self.row_prev, &self.row_cur);
+        let v = &mut self.table.values;
+        v.push(t);
+        for (i, &b) in cur.iter().enumerate().skip(1) {
+            let a = prev.get(i).copied().unwrap_or(b);
+            v.push(if w >= 1.0 {
+                b
+            } else if w <= 0.0 {
+                a
+            } else if contact_cols.contains(&i) {
+                if w >= 0.5 { b } else { a }
+            } else {
+                a + (b - a) * w
+            });
+        }
+    }
+}

@@ -9,7 +9,7 @@ use crate::rapier::hinge::design::{ClearanceModel, HingeDesign};
 use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle, ClearanceJointSet};
 use crate::rapier::large_step::{LargeStepJoint, LargeStepJointHandle, LargeStepJointSet};
 use crate::rapier::observers::reaction::{IdealJoint, IdealRevolute, ReactionSolver};
-use crate::rapier::pipeline::stepper::{GuardReport, StepControl, StepMode};
+use crate::rapier::pipeline::stepper::{GuardReport, StepControl, StepHooks, StepMode};
 use crate::rapier::pipeline::world::ClearanceWorld;
 use crate::rapier::sources::drive::{DriveHandle, TorsionSpring};
 use bevy_ecs::prelude::*;
@@ -512,24 +512,24 @@ impl Physics {
 
     /// Evaluates the joints and drives at the current state when the stepper needs it (see
     /// [`apply_forces`](super::apply_forces)).
-    pub(super) fn prepare_forces(&mut self) -> Result<()> {
+    pub(super) fn prepare_forces(&mut self, user: &mut dyn StepHooks) -> Result<()> {
         if std::mem::take(&mut self.changed) {
             self.world.invalidate(false);
         }
         follow_dt(&mut self.world);
-        self.world.prepare()
+        self.world.prepare_with(user)
     }
 
     /// One accepted step of the world's step control, at most `integration_parameters.dt` long
     /// (and ending at most at the frame's end under [`run_frame`](super::run_frame)).
-    pub(super) fn step(&mut self) -> Result<()> {
+    pub(super) fn step(&mut self, user: &mut dyn StepHooks) -> Result<()> {
         let dt = self.world.rapier.integration_parameters.dt;
         follow_dt(&mut self.world);
         // The forces the step holds are those at its start (evaluated by `apply_forces`): read
         // them before it.
         self.start_forces = self.hinge_forces_now()?;
         let until = (self.world.time() + dt).min(self.frame_end.unwrap_or(f64::INFINITY));
-        let result = self.world.step(until);
+        let result = self.world.step_with(until, user);
         // Rapier's `dt` as the user set it (the stepper sets it per step).
         self.world.rapier.integration_parameters.dt = dt;
         result.map(|_| ()).map_err(|e| {

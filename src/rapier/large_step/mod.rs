@@ -83,24 +83,21 @@ pub use set::{LargeStepJointHandle, LargeStepJointSet};
 
 use crate::error::{Error, Result, non_negative, positive, unit_vector};
 use crate::model::laws::{BearingGeometry, NormalModel, impact_restitution};
-use crate::rapier::pipeline::arena::OrderedArena;
 use crate::rapier::pipeline::ledger::{
     Wrench, ensure_mass_properties, inverse_mass_along, world_center_of_mass,
 };
-use rapier3d_f64::data::Index;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     GenericJoint, GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, IntegrationParameters,
-    JointAxesMask, JointAxis, PhysicsWorld, RigidBody, RigidBodyHandle, RigidBodySet,
-    RigidBodyType,
+    JointAxesMask, JointAxis, RigidBody, RigidBodyHandle, RigidBodySet, RigidBodyType,
 };
 use resolution::{quantized_substeps, rocking_frequency, substeps_needed};
 use std::collections::BTreeMap;
 
 /// Default of [`LargeStepJointBuilder::max_substeps`].
 pub const DEFAULT_MAX_SUBSTEPS: usize = 64;
-/// Default of [`LargeStepJointBuilder::min_impact_speed`], m/s.
-pub const DEFAULT_MIN_IMPACT_SPEED: f64 = 1e-4;
+/// Default of [`LargeStepJointBuilder::min_impact_speed`], m/s: the compliant joint's.
+pub use crate::rapier::joint::DEFAULT_MIN_IMPACT_SPEED;
 /// A journal within this fraction of `c` from the wall counts as touching it.
 const CONTACT_TOLERANCE: f64 = 1e-3;
 /// Damping of the friction motor: large enough that the motor is a hard velocity constraint

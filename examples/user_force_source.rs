@@ -80,6 +80,7 @@ impl StepHooks for SpringDamper {
 fn main() -> Result<(), clearance_joint::Error> {
     let mut rapier = PhysicsWorld::new();
     rapier.gravity = Vector::ZERO;
+    rapier.integration_parameters.num_solver_iterations = 1; // the spring's force once a step
     let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(0.05, 0.01));
     let base = world.rapier.bodies.insert(RigidBodyBuilder::fixed());
     // A 1 kg body released 0.1 m beyond the spring's rest length of 0.5 m.

@@ -213,7 +213,6 @@ pub mod prelude {
         IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, KinematicState,
         ReactionSolver,
     };
-    pub use crate::rapier::pipeline::element_set::{ElementHandle, ElementSet};
     pub use crate::rapier::pipeline::protocol::{GuardKind, GuardReport, Violation, Wrench};
     pub use crate::rapier::pipeline::step_hooks::{EvaluateContext, StepContext, StepHooks};
     pub use crate::rapier::pipeline::stepper::{StepControl, StepInfo, Stepper};

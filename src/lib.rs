@@ -208,13 +208,14 @@ pub mod prelude {
     pub use crate::rapier::large_step::{
         LargeStepJoint, LargeStepJointBuilder, LargeStepJointHandle, LargeStepJointSet, Restitution,
     };
-    pub use crate::rapier::observers::guards::GuardReport;
     pub use crate::rapier::observers::metrics::{ContactObservation, ImpactRecorder};
     pub use crate::rapier::observers::reaction::{
         IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, KinematicState,
         ReactionSolver,
     };
-    pub use crate::rapier::pipeline::stepper::{StepControl, StepHooks, StepInfo, Stepper};
+    pub use crate::rapier::pipeline::protocol::{GuardKind, GuardReport, Violation, Wrench};
+    pub use crate::rapier::pipeline::step_hooks::{EvaluateContext, StepContext, StepHooks};
+    pub use crate::rapier::pipeline::stepper::{StepControl, StepInfo, Stepper};
     pub use crate::rapier::pipeline::world::ClearanceWorld;
     pub use crate::rapier::sources::drive::{DriveHandle, DriveSet, TorsionSpring};
     /// The same item as Rapier's (`rapier3d_f64::math::Vector`), so no clash with its prelude.

@@ -352,6 +352,8 @@ fn example_binaries_run_headless_and_print_the_comparison() {
             "robot_backlash",
             "--example",
             "slider_crank",
+            "--example",
+            "user_force_source",
         ])
         .output()
         .unwrap();
@@ -376,6 +378,10 @@ fn example_binaries_run_headless_and_print_the_comparison() {
         (
             "slider_crank",
             &["ideal slider acceleration", "closed form", "first impact"][..],
+        ),
+        (
+            "user_force_source",
+            &["steps", "closed form", "guard: the spring"][..],
         ),
     ] {
         if name == "ecs" && !cfg!(feature = "ecs") {

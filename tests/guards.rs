@@ -90,7 +90,7 @@ fn penetration_guard_reports_the_worst_depth_when_and_how_often() {
     let g = stepper.guards();
     let v = g.worst(GuardKind::Penetration).expect("the guard fires");
     assert_eq!(v.joint.as_deref(), Some("pin"));
-    assert_eq!(v.handle, Some(pin));
+    assert_eq!(v.handle, Some(pin.id()));
     assert_eq!(v.limit, 0.2e-6);
     assert_eq!((v.worst, v.t_s, v.first_t_s, v.count), seen.pen);
     // The worst, not the first: far deeper than the limit, later than the first violation.

@@ -14,6 +14,8 @@
 //!   [`IdealHinge`] (Rapier's revolute joint) or [`ClearanceHinge`] (radial clearance, contact and
 //!   friction laws). A hinge with neither joins nothing. When both are present, the clearance wins.
 //! - [`Drive`]: a torsion spring `T = T0 - k theta` on a hinge (on the hinge's entity).
+//! - [`UserHooks`] (resource, optional): a force source of your own
+//!   ([`StepHooks`](crate::rapier::pipeline::step_hooks::StepHooks)) stepped with the world's.
 //! - [`HingeState`] and [`BodyState`] (added automatically): what the last step did (a hinge's
 //!   force, eccentricity and `|e|/c`, contact, impulse, the substeps of a large-step hinge;
 //!   the counts of onsets and impacts, see the
@@ -158,4 +160,4 @@ pub use components::{
 };
 pub use physics::{HingeJoint, Physics};
 pub use schedule::{PhysicsSet, add_physics_systems, physics_schedule, run_frame, run_step};
-pub use systems::{apply_forces, record, step_physics, sync_bodies, sync_hinges};
+pub use systems::{UserHooks, apply_forces, record, step_physics, sync_bodies, sync_hinges};

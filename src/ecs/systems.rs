@@ -11,6 +11,7 @@ use super::components::{
 use super::physics::{HingeJoint, Physics};
 use crate::error::Error;
 use crate::model::kinematics::ContactMode;
+use crate::rapier::pipeline::step_hooks::StepHooks;
 use bevy_ecs::prelude::*;
 use rapier3d_f64::math::Vector;
 use std::collections::BTreeSet;
@@ -137,14 +138,34 @@ pub fn sync_hinges(
     physics.remove_hinges_except(&seen);
 }
 
+/// Your own participant in the physics steps (a resource; optional): a force source of your
+/// own, or anything else that implements [`StepHooks`], stepped by [`apply_forces`] and
+/// [`step_physics`] after the world's own joints and drives, as
+/// [`ClearanceWorld::step_with`](crate::rapier::pipeline::world::ClearanceWorld::step_with)
+/// steps it. Several sources go in one type of your own (a tuple struct that forwards).
+#[derive(Resource)]
+pub struct UserHooks(pub Box<dyn StepHooks + Send + Sync>);
+
+impl UserHooks {
+    /// Boxes `hooks`.
+    pub fn new(hooks: impl StepHooks + Send + Sync + 'static) -> Self {
+        UserHooks(Box::new(hooks))
+    }
+}
+
 /// Evaluates the force sources (torsion springs, the clearance force hook) at the current state
 /// when the stepper needs it: before the first step and after the sync systems changed
 /// something. Otherwise the stepper already evaluated them at the end of the last step.
-pub fn apply_forces(mut physics: ResMut<Physics>) {
+pub fn apply_forces(mut physics: ResMut<Physics>, user: Option<ResMut<UserHooks>>) {
     if physics.error().is_some() {
         return;
     }
-    if let Err(e) = physics.prepare_forces() {
+    let mut none = ();
+    let user: &mut dyn StepHooks = match user {
+        Some(hooks) => hooks.into_inner().0.as_mut(),
+        None => &mut none,
+    };
+    if let Err(e) = physics.prepare_forces(user) {
         physics.fail(e);
     }
 }
@@ -153,11 +174,16 @@ pub fn apply_forces(mut physics: ResMut<Physics>) {
 /// of `world.rapier.integration_parameters.dt` unless [`Physics::set_step_control`] chose otherwise):
 /// variable-step consistent kicks, step acceptance, guards. An error stops the systems where the
 /// state was last valid.
-pub fn step_physics(mut physics: ResMut<Physics>) {
+pub fn step_physics(mut physics: ResMut<Physics>, user: Option<ResMut<UserHooks>>) {
     if physics.error().is_some() {
         return;
     }
-    if let Err(e) = physics.step() {
+    let mut none = ();
+    let user: &mut dyn StepHooks = match user {
+        Some(hooks) => hooks.into_inner().0.as_mut(),
+        None => &mut none,
+    };
+    if let Err(e) = physics.step(user) {
         physics.fail(e);
     }
 }

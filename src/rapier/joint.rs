@@ -10,13 +10,9 @@ use crate::model::laws::{
     BearingGeometry, FrictionLaw, FrictionModel, NormalContact, NormalForceLaw, NormalModel,
     crossing_fraction, loaded_impact_rate, penetration_for_energy, speed_at_crossing,
 };
-use crate::rapier::observers::guards::{GuardKind, GuardReport, Violation};
-use crate::rapier::observers::stall::StalledContact;
-use crate::rapier::pipeline::arena::OrderedArena;
 use crate::rapier::pipeline::ledger::{
     ForceLedger, Wrench, ensure_mass_properties, inverse_mass_along, world_center_of_mass,
 };
-use rapier3d_f64::data::Index;
 use std::sync::OnceLock;
 
 mod builder;

@@ -2,36 +2,21 @@
 //! per-step force hook and their part in the step protocol.
 
 use super::*;
+use crate::rapier::pipeline::element_set::{ElementHandle, ElementSet};
+use crate::rapier::pipeline::protocol::{
+    BodyShare, GuardKind, GuardReport, StalledContact, Violation,
+};
+use crate::rapier::pipeline::step_hooks::{EvaluateContext, StepContext, StepHooks, StepPass};
 /// Handle of a joint in a [`ClearanceJointSet`], returned by its
-/// [`insert`](ClearanceJointSet::insert): generational, as Rapier's `ImpulseJointHandle`.
-/// Removing a joint never changes another joint's handle, and the handle of a removed joint
-/// finds nothing ever after (a later joint that reuses its slot gets a new generation). Handles
-/// order by slot, not by insertion: iterate the set for the insertion order.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct ClearanceJointHandle(Index);
-
-impl ClearanceJointHandle {
-    /// A handle from its slot and generation, for the crate's unit tests (users get handles
-    /// from [`ClearanceJointSet::insert`] only).
-    #[cfg(test)]
-    pub(crate) fn from_raw_parts(slot: u32, generation: u32) -> Self {
-        ClearanceJointHandle(Index::from_raw_parts(slot, generation))
-    }
-}
-
-/// `slot`v`generation`, as bevy's `Entity`.
-impl std::fmt::Display for ClearanceJointHandle {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let (slot, generation) = self.0.into_raw_parts();
-        write!(f, "{slot}v{generation}")
-    }
-}
+/// [`insert`](ClearanceJointSet::insert): generational, as Rapier's `ImpulseJointHandle`
+/// ([`ElementHandle`]).
+pub type ClearanceJointHandle = ElementHandle<ClearanceJoint>;
 
 /// All clearance joints of a world, and the per-step force hook. The joints are visited (their
 /// forces evaluated and added, [`iter`](Self::iter)) in insertion order.
 #[derive(Clone, Debug, Default)]
 pub struct ClearanceJointSet {
-    joints: OrderedArena<ClearanceJoint>,
+    joints: ElementSet<ClearanceJoint>,
     ledger: ForceLedger,
     /// The forces at the state (every joint's).
     wrenches: Vec<Wrench>,
@@ -99,7 +84,7 @@ impl ClearanceJointSet {
             .build();
             joint.lock_handle = Some(impulse_joints.insert(body1, body2, lock, true));
         }
-        ClearanceJointHandle(self.joints.insert(joint))
+        self.joints.insert(joint)
     }
 
     /// Removes the joint's forces from its bodies (and its lock joint from `impulse_joints`) and
@@ -111,7 +96,7 @@ impl ClearanceJointSet {
         bodies: &mut RigidBodySet,
         impulse_joints: &mut ImpulseJointSet,
     ) -> Option<ClearanceJoint> {
-        let mut joint = self.joints.remove(handle.0)?;
+        let mut joint = self.joints.remove(handle)?;
         if let Some(lock) = joint.lock_handle.take() {
             impulse_joints.remove(lock, true);
         }
@@ -139,24 +124,29 @@ impl ClearanceJointSet {
 
     /// Whether `handle` is a joint of this set.
     pub fn contains(&self, handle: ClearanceJointHandle) -> bool {
-        self.joints.contains(handle.0)
+        self.joints.contains(handle)
     }
 
     /// The joint behind `handle` (`None` once it was removed).
     pub fn get(&self, handle: ClearanceJointHandle) -> Option<&ClearanceJoint> {
-        self.joints.get(handle.0)
+        self.joints.get(handle)
     }
 
-    /// The joint behind `handle`, mutably (`None` once it was removed).
+    /// The joint behind `handle`, mutably (`None` once it was removed); raises the
+    /// [`revision`](Self::revision).
     pub fn get_mut(&mut self, handle: ClearanceJointHandle) -> Option<&mut ClearanceJoint> {
-        self.joints.get_mut(handle.0)
+        self.joints.get_mut(handle)
     }
 
     /// All joints with their handles, in insertion order.
     pub fn iter(&self) -> impl Iterator<Item = (ClearanceJointHandle, &ClearanceJoint)> {
-        self.joints
-            .iter()
-            .map(|(i, j)| (ClearanceJointHandle(i), j))
+        self.joints.iter()
+    }
+
+    /// A count that every insert, remove and [`get_mut`](Self::get_mut) raises: two equal
+    /// readings mean the same joints, unedited ([`ElementSet::revision`]).
+    pub fn revision(&self) -> u64 {
+        self.joints.revision()
     }
 
     /// Number of joints.
@@ -289,7 +279,7 @@ impl ClearanceJointSet {
     pub(crate) fn resolve_step(
         &mut self,
         bodies: &RigidBodySet,
-        pass: &crate::rapier::pipeline::step_hooks::StepPass,
+        pass: &StepPass,
         iterations: usize,
     ) -> bool {
         if pass.pass > 0 {
@@ -390,9 +380,8 @@ impl ClearanceJointSet {
 
     /// Restores what [`save_state`](Self::save_state) saved.
     pub(crate) fn restore_state(&mut self) {
-        for (j, d) in self.joints.values_mut().zip(&self.saved) {
-            j.set_dynamics(d);
-        }
+        self.joints
+            .restore_from(&self.saved, |j, d| j.set_dynamics(d));
         self.wrenches.clone_from(&self.saved_wrenches);
         self.applied.clone_from(&self.saved_applied);
         if self.retaking {
@@ -438,9 +427,10 @@ impl ClearanceJointSet {
 
 /// The clearance joints take part in the stepper's steps: their contact forces, step limits,
 /// acceptance and guards ([`crate::rapier::pipeline::step_hooks`]).
-impl crate::rapier::pipeline::step_hooks::StepHooks for ClearanceJointSet {
-    fn evaluate(&mut self, bodies: &mut RigidBodySet, impulse_joints: &ImpulseJointSet) {
-        ClearanceJointSet::evaluate(self, bodies, impulse_joints);
+impl StepHooks for ClearanceJointSet {
+    fn evaluate(&mut self, context: EvaluateContext<'_>) {
+        self.set_last_step(context.last_step);
+        ClearanceJointSet::evaluate(self, context.bodies, context.impulse_joints);
     }
     /// What the stepper applies: the explicit joints' forces at the state, and in a step's
     /// pass 1 the sub-cycled joints' deliveries ([`ClearanceJointSet::wrenches`] holds every
@@ -452,7 +442,7 @@ impl crate::rapier::pipeline::step_hooks::StepHooks for ClearanceJointSet {
     fn resolve_step(
         &mut self,
         world: &rapier3d_f64::prelude::PhysicsWorld,
-        pass: &crate::rapier::pipeline::step_hooks::StepPass,
+        pass: &StepPass,
     ) -> bool {
         let iterations = world.integration_parameters.num_solver_iterations;
         ClearanceJointSet::resolve_step(self, &world.bodies, pass, iterations)
@@ -466,25 +456,23 @@ impl crate::rapier::pipeline::step_hooks::StepHooks for ClearanceJointSet {
     fn check_world(&self, params: &IntegrationParameters) -> Result<()> {
         self.check_substeps(params)
     }
-    fn set_last_step(&mut self, dt: f64) {
-        ClearanceJointSet::set_last_step(self, dt);
+    fn step_limit(&self, step: &StepContext) -> f64 {
+        self.adaptive_step(step.tolerance, step.last_dt)
     }
-    fn step_limit(&self, tolerance: f64, last_dt: f64) -> f64 {
-        self.adaptive_step(tolerance, last_dt)
+    fn check_step(&self, step: &StepContext) -> Result<()> {
+        ClearanceJointSet::check_step(self, step.dt)
     }
-    fn check_step(&self, dt: f64) -> Result<()> {
-        ClearanceJointSet::check_step(self, dt)
+    fn judge_step(&self, step: &StepContext) -> Option<f64> {
+        ClearanceJointSet::judge_step(self, step.dt, step.tolerance)
     }
-    fn judge_step(&self, dt: f64, tolerance: f64) -> Option<f64> {
-        ClearanceJointSet::judge_step(self, dt, tolerance)
-    }
-    fn record_guards(&self, guards: &mut GuardReport, t: f64, dt: f64, fixed: bool) {
+    fn record_guards(&self, step: &StepContext, guards: &mut GuardReport) {
+        let (t, dt, fixed) = (step.t, step.dt, step.fixed);
         for (handle, j) in self.iter() {
             let limit = j.report().friction_stable_dt;
             if fixed && dt > limit && !j.sub_cycled() {
                 guards.record(
                     Violation::new(GuardKind::Friction, dt / limit, 1.0, t)
-                        .joint(j.name(), Some(handle))
+                        .joint(j.name(), Some(handle.id()))
                         .note(format!(
                             "step {} s, friction's limit {} s",
                             crate::error::sig4(dt),
@@ -500,7 +488,7 @@ impl crate::rapier::pipeline::step_hooks::StepHooks for ClearanceJointSet {
                         f64::from(subcycle::MAX_SUBSTEPS),
                         t,
                     )
-                    .joint(j.name(), Some(handle)),
+                    .joint(j.name(), Some(handle.id())),
                 );
             }
             let (depth, valid) = (j.deepest_in_step(), j.max_valid_penetration());
@@ -511,13 +499,21 @@ impl crate::rapier::pipeline::step_hooks::StepHooks for ClearanceJointSet {
             if ratio > 1.0 {
                 guards.record(
                     Violation::new(GuardKind::Penetration, depth, valid, t)
-                        .joint(j.name(), Some(handle)),
+                        .joint(j.name(), Some(handle.id())),
                 );
             }
         }
     }
     fn stalled_contact(&self, bodies: &RigidBodySet) -> Option<StalledContact> {
-        crate::rapier::observers::stall::stalled_contact([self], bodies)
+        self.iter()
+            .filter(|(_, j)| j.report().state.penetration > 0.0)
+            .min_by(|(_, a), (_, b)| {
+                let limit = |j: &ClearanceJoint| {
+                    j.report().max_stable_dt.min(j.report().friction_stable_dt)
+                };
+                limit(a).total_cmp(&limit(b))
+            })
+            .map(|(h, j)| stalled_contact_of(h, j, bodies))
     }
     fn joints_of(&self, body: RigidBodyHandle, names: &mut Vec<String>) {
         for (_, j) in self.iter() {
@@ -536,5 +532,68 @@ impl crate::rapier::pipeline::step_hooks::StepHooks for ClearanceJointSet {
             )?;
         }
         Ok(())
+    }
+}
+
+/// The numbers of `joint` (with handle `handle`) in `bodies` at its last evaluation, for a
+/// stall's diagnosis.
+fn stalled_contact_of(
+    handle: ClearanceJointHandle,
+    joint: &ClearanceJoint,
+    bodies: &RigidBodySet,
+) -> StalledContact {
+    let r = joint.report();
+    let s = &r.state;
+    let law = joint.governing_law();
+    let m = r.effective_mass;
+    let shares = [joint.body1(), joint.body2()]
+        .into_iter()
+        .filter_map(|h| {
+            let rb = bodies.get(h).filter(|rb| rb.is_dynamic())?;
+            let mp = &rb.mass_properties().local_mprops;
+            let rn = (s.contact_point - world_center_of_mass(rb)).cross(s.normal);
+            let p = mp.principal_inertia();
+            Some(BodyShare {
+                handle: h,
+                mass: mp.mass(),
+                inertia: p.x.min(p.y).min(p.z),
+                rotational_inverse_mass: rn.dot(mp.world_inv_inertia(rb.rotation()) * rn),
+            })
+        })
+        .collect();
+    let energy =
+        0.5 * m * s.penetration_rate.max(0.0).powi(2) + law.elastic_energy(s.penetration.max(0.0));
+    let reach = penetration_for_energy(law, energy, 1e-6).max(s.penetration);
+    let valid = joint.max_valid_penetration();
+    let at_valid = NormalContact {
+        penetration: valid,
+        penetration_rate: s.penetration_rate.max(0.0),
+        impact_rate: r.impact_rate.max(joint.min_impact_speed_floor()),
+    };
+    let (stable_dt_at_valid, _, _) = stable_step(
+        law.tangent_stiffness(valid),
+        law.damping_coefficient(&at_valid),
+        m,
+    );
+    StalledContact {
+        joint: joint.name().to_string(),
+        handle: Some(handle.id()),
+        law: law.kind(),
+        penetration: s.penetration,
+        rate: s.penetration_rate,
+        impact_rate: r.impact_rate,
+        min_impact_speed: joint.min_impact_speed_floor(),
+        zeta: r.zeta,
+        omega: r.omega,
+        elastic_stiffness: law.tangent_stiffness(s.penetration),
+        face: r.spatial.is_some_and(|sp| sp.governed_by_face),
+        stable_dt: r.max_stable_dt,
+        friction_dt: r.friction_stable_dt,
+        normal_force: r.force.normal_force,
+        effective_mass: m,
+        bodies: shares,
+        max_valid_penetration: valid,
+        reachable_penetration: reach,
+        stable_dt_at_valid,
     }
 }

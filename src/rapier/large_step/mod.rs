@@ -84,16 +84,13 @@ pub use set::{LargeStepJointHandle, LargeStepJointSet};
 
 use crate::error::{Error, Result, non_negative, positive, unit_vector};
 use crate::model::laws::{BearingGeometry, NormalModel, impact_restitution};
-use crate::rapier::pipeline::arena::OrderedArena;
 use crate::rapier::pipeline::ledger::{
     Wrench, ensure_mass_properties, inverse_mass_along, world_center_of_mass,
 };
-use rapier3d_f64::data::Index;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     GenericJoint, GenericJointBuilder, ImpulseJointHandle, ImpulseJointSet, IntegrationParameters,
-    JointAxesMask, JointAxis, PhysicsWorld, RigidBody, RigidBodyHandle, RigidBodySet,
-    RigidBodyType,
+    JointAxesMask, JointAxis, RigidBody, RigidBodyHandle, RigidBodySet, RigidBodyType,
 };
 use resolution::{quantized_substeps, rocking_frequency, substeps_needed};
 use std::collections::BTreeMap;

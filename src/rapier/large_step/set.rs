@@ -2,21 +2,12 @@
 //! hooks around each Rapier step and their part in the step protocol.
 
 use super::*;
+use crate::rapier::pipeline::element_set::{ElementHandle, ElementSet};
+use crate::rapier::pipeline::step_hooks::{RapierStepContext, StepHooks};
 /// Handle of a joint in a [`LargeStepJointSet`], returned by its
-/// [`insert`](LargeStepJointSet::insert): generational, as Rapier's `ImpulseJointHandle`.
-/// Removing a joint never changes another joint's handle, and the handle of a removed joint
-/// finds nothing ever after (a later joint that reuses its slot gets a new generation). Handles
-/// order by slot, not by insertion: iterate the set for the insertion order.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct LargeStepJointHandle(Index);
-
-/// `slot`v`generation`, as bevy's `Entity`.
-impl std::fmt::Display for LargeStepJointHandle {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        let (slot, generation) = self.0.into_raw_parts();
-        write!(f, "{slot}v{generation}")
-    }
-}
+/// [`insert`](LargeStepJointSet::insert): generational, as Rapier's `ImpulseJointHandle`
+/// ([`ElementHandle`]).
+pub type LargeStepJointHandle = ElementHandle<LargeStepJoint>;
 
 /// All large-step clearance joints of a world, and the per-step hooks.
 ///
@@ -29,7 +20,7 @@ impl std::fmt::Display for LargeStepJointHandle {
 /// for more. The joints are visited ([`iter`](Self::iter), the hooks) in insertion order.
 #[derive(Clone, Debug, Default)]
 pub struct LargeStepJointSet {
-    joints: OrderedArena<LargeStepJoint>,
+    joints: ElementSet<LargeStepJoint>,
     /// `additional_solver_iterations` of each managed body before the set touched it.
     base_extra: BTreeMap<(u32, u32), usize>,
     /// Group of each joint, in the joints' order (joints sharing a dynamic body), rebuilt after
@@ -88,7 +79,7 @@ impl LargeStepJointSet {
         joint.report = LargeStepReport::default();
         joint.handle = Some(impulse_joints.insert(body1, body2, joint.rapier_joint(), true));
         self.groups_valid = false;
-        LargeStepJointHandle(self.joints.insert(joint))
+        self.joints.insert(joint)
     }
 
     /// Removes the joint (and its Rapier joint) and returns it (`None` for a handle of no joint
@@ -101,7 +92,7 @@ impl LargeStepJointSet {
         bodies: &mut RigidBodySet,
         impulse_joints: &mut ImpulseJointSet,
     ) -> Option<LargeStepJoint> {
-        let mut joint = self.joints.remove(handle.0)?;
+        let mut joint = self.joints.remove(handle)?;
         self.groups_valid = false;
         // A saved state is by position: it no longer matches the joints.
         self.saved.clear();
@@ -123,24 +114,29 @@ impl LargeStepJointSet {
 
     /// Whether `handle` is a joint of this set.
     pub fn contains(&self, handle: LargeStepJointHandle) -> bool {
-        self.joints.contains(handle.0)
+        self.joints.contains(handle)
     }
 
     /// The joint behind `handle` (`None` once it was removed).
     pub fn get(&self, handle: LargeStepJointHandle) -> Option<&LargeStepJoint> {
-        self.joints.get(handle.0)
+        self.joints.get(handle)
     }
 
-    /// The joint behind `handle`, mutably (`None` once it was removed).
+    /// The joint behind `handle`, mutably (`None` once it was removed); raises the
+    /// [`revision`](Self::revision).
     pub fn get_mut(&mut self, handle: LargeStepJointHandle) -> Option<&mut LargeStepJoint> {
-        self.joints.get_mut(handle.0)
+        self.joints.get_mut(handle)
     }
 
     /// All joints with their handles, in insertion order.
     pub fn iter(&self) -> impl Iterator<Item = (LargeStepJointHandle, &LargeStepJoint)> {
-        self.joints
-            .iter()
-            .map(|(i, j)| (LargeStepJointHandle(i), j))
+        self.joints.iter()
+    }
+
+    /// A count that every insert, remove and [`get_mut`](Self::get_mut) raises: two equal
+    /// readings mean the same joints, unedited ([`ElementSet::revision`]).
+    pub fn revision(&self) -> u64 {
+        self.joints.revision()
     }
 
     /// Number of joints.
@@ -348,26 +344,27 @@ impl LargeStepJointSet {
 /// rejected step ([`crate::rapier::pipeline::step_hooks`]). Under a
 /// [`Stepper`](crate::rapier::pipeline::stepper::Stepper) or a
 /// [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld) no hook can be forgotten.
-impl crate::rapier::pipeline::step_hooks::StepHooks for LargeStepJointSet {
+impl StepHooks for LargeStepJointSet {
     fn save_state(&mut self) {
-        self.saved.clear();
-        self.saved
-            .extend(self.joints.values().map(|j| (j.state, j.report)));
+        self.joints
+            .save_into(&mut self.saved, |j| (j.state, j.report));
     }
     fn restore_state(&mut self) {
-        for (j, (state, report)) in self.joints.values_mut().zip(&self.saved) {
+        self.joints.restore_from(&self.saved, |j, (state, report)| {
             j.state = *state;
             j.report = *report;
-        }
+        });
     }
-    fn before_rapier_step(&mut self, world: &mut PhysicsWorld, _t0: f64, _dt: f64) {
+    fn before_rapier_step(&mut self, context: RapierStepContext<'_>) {
+        let world = context.world;
         self.before_step(
             &mut world.bodies,
             &mut world.impulse_joints,
             &world.integration_parameters,
         );
     }
-    fn after_rapier_step(&mut self, world: &mut PhysicsWorld) {
+    fn after_rapier_step(&mut self, context: RapierStepContext<'_>) {
+        let world = context.world;
         self.after_step(&mut world.bodies, &world.impulse_joints);
     }
     fn joints_of(&self, body: RigidBodyHandle, names: &mut Vec<String>) {

@@ -6,7 +6,9 @@
 //! - [`reaction`]: exact ideal-joint reactions from the constrained equations.
 //! - [`replay`]: bodies' poses and journals' states, thinned by time, for a replay of a run.
 
-pub mod guards;
+/// The run-time guards' report, part of the step protocol's vocabulary
+/// ([`crate::rapier::pipeline::protocol::guards`]).
+pub use crate::rapier::pipeline::protocol::guards;
 pub mod metrics;
 pub mod reaction;
 pub mod replay;

@@ -12,72 +12,9 @@
 //! 6. a stiffness too high for the bodies' masses.
 
 use crate::error::sig4;
-use crate::model::kinematics::stable_step;
-use crate::model::laws::{LawKind, NormalContact, NormalForceLaw, penetration_for_energy};
-use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle};
-use crate::rapier::pipeline::ledger::world_center_of_mass;
-use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
-
-/// One body's share of the inverse effective mass along the contact normal.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct BodyShare {
-    /// The body.
-    pub handle: RigidBodyHandle,
-    /// Its mass, kg.
-    pub mass: f64,
-    /// Its smallest principal moment of inertia, kg m^2.
-    pub inertia: f64,
-    /// `(r x n) . I^-1 (r x n)`, 1/kg: the rotational part of its inverse mass at the contact.
-    pub rotational_inverse_mass: f64,
-}
-
-/// The numbers of the contact the step control could not resolve.
-#[derive(Clone, Debug, PartialEq)]
-pub struct StalledContact {
-    /// The joint's name.
-    pub joint: String,
-    /// Its handle in its set.
-    pub handle: ClearanceJointHandle,
-    /// The normal law.
-    pub law: LawKind,
-    /// Penetration, m (negative: a gap).
-    pub penetration: f64,
-    /// Penetration rate, m/s.
-    pub rate: f64,
-    /// The approach speed the hysteresis laws divide by, `delta_dot0`, m/s (0 in free flight).
-    pub impact_rate: f64,
-    /// The joint's floor on it, m/s.
-    pub min_impact_speed: f64,
-    /// Linearised damping ratio.
-    pub zeta: f64,
-    /// Linearised natural frequency, rad/s: from `dF/d delta`, the spring's tangent stiffness
-    /// plus the slope of a hysteresis law's damping times the rate.
-    pub omega: f64,
-    /// The spring's own tangent stiffness at the penetration, N/m (the law without its
-    /// damping): against `omega^2 m` it tells a stiff spring from a steep damping.
-    pub elastic_stiffness: f64,
-    /// Whether the contact is a shoulder on a bearing face (the spatial joint's face law), not
-    /// the journal on the bore.
-    pub face: bool,
-    /// Damped stability limit of the step, s.
-    pub stable_dt: f64,
-    /// Friction's step limit, s.
-    pub friction_dt: f64,
-    /// Normal force, N.
-    pub normal_force: f64,
-    /// Effective mass along the normal, kg.
-    pub effective_mass: f64,
-    /// Each movable body's share (fixed and kinematic bodies have none).
-    pub bodies: Vec<BodyShare>,
-    /// The law's validity limit, m.
-    pub max_valid_penetration: f64,
-    /// The deepest penetration the contact can reach from its state (elastic energy plus the
-    /// kinetic energy of the approach), m.
-    pub reachable_penetration: f64,
-    /// The stable step of the contact at the validity limit, s (what a contact that stays valid
-    /// needs).
-    pub stable_dt_at_valid: f64,
-}
+use crate::model::laws::LawKind;
+use crate::rapier::pipeline::protocol::{BodyShare, StalledContact};
+use rapier3d_f64::prelude::RigidBodyHandle;
 
 /// The cause [`diagnose`] finds.
 #[derive(Clone, Debug, PartialEq)]
@@ -195,88 +132,6 @@ impl std::fmt::Display for Stall {
             }
         }
         f.write_str(&text)
-    }
-}
-
-impl StalledContact {
-    /// The numbers of `joint` (with handle `handle`) in `bodies` at its last evaluation.
-    pub fn of(handle: ClearanceJointHandle, joint: &ClearanceJoint, bodies: &RigidBodySet) -> Self {
-        let r = joint.report();
-        let s = &r.state;
-        let law = joint.governing_law();
-        let m = r.effective_mass;
-        let shares = [joint.body1(), joint.body2()]
-            .into_iter()
-            .filter_map(|h| {
-                let rb = bodies.get(h).filter(|rb| rb.is_dynamic())?;
-                let mp = &rb.mass_properties().local_mprops;
-                let rn = (s.contact_point - world_center_of_mass(rb)).cross(s.normal);
-                let p = mp.principal_inertia();
-                Some(BodyShare {
-                    handle: h,
-                    mass: mp.mass(),
-                    inertia: p.x.min(p.y).min(p.z),
-                    rotational_inverse_mass: rn.dot(mp.world_inv_inertia(rb.rotation()) * rn),
-                })
-            })
-            .collect();
-        let energy = 0.5 * m * s.penetration_rate.max(0.0).powi(2)
-            + law.elastic_energy(s.penetration.max(0.0));
-        let reach = penetration_for_energy(law, energy, 1e-6).max(s.penetration);
-        let valid = joint.max_valid_penetration();
-        let at_valid = NormalContact {
-            penetration: valid,
-            penetration_rate: s.penetration_rate.max(0.0),
-            impact_rate: r.impact_rate.max(joint.min_impact_speed_floor()),
-        };
-        let (stable_dt_at_valid, _, _) = stable_step(
-            law.tangent_stiffness(valid),
-            law.damping_coefficient(&at_valid),
-            m,
-        );
-        StalledContact {
-            joint: joint.name().to_string(),
-            handle,
-            law: law.kind(),
-            penetration: s.penetration,
-            rate: s.penetration_rate,
-            impact_rate: r.impact_rate,
-            min_impact_speed: joint.min_impact_speed_floor(),
-            zeta: r.zeta,
-            omega: r.omega,
-            elastic_stiffness: law.tangent_stiffness(s.penetration),
-            face: r.spatial.is_some_and(|sp| sp.governed_by_face),
-            stable_dt: r.max_stable_dt,
-            friction_dt: r.friction_stable_dt,
-            normal_force: r.force.normal_force,
-            effective_mass: m,
-            bodies: shares,
-            max_valid_penetration: valid,
-            reachable_penetration: reach,
-            stable_dt_at_valid,
-        }
-    }
-
-    /// The contact state in words.
-    pub fn state(&self) -> String {
-        let place = if self.face {
-            ", a shoulder on a bearing face"
-        } else {
-            ""
-        };
-        format!(
-            "joint `{}` (handle {}){place}: penetration {} um, rate {} m/s, delta_dot0 {} m/s, damping ratio \
-             {}, stable step {} s (friction's {} s), effective mass {} kg",
-            self.joint,
-            self.handle,
-            sig4(self.penetration * 1e6),
-            sig4(self.rate),
-            sig4(self.impact_rate),
-            sig4(self.zeta),
-            sig4(self.stable_dt),
-            sig4(self.friction_dt),
-            sig4(self.effective_mass)
-        )
     }
 }
 
@@ -472,23 +327,6 @@ fn damping_field(law: LawKind, face: bool) -> &'static str {
     }
 }
 
-/// The joint of `sets` in contact whose step limit is the shortest (the one that stops the
-/// step control), with its numbers; `None` when no joint is in contact.
-pub fn stalled_contact<'a>(
-    sets: impl IntoIterator<Item = &'a crate::rapier::joint::ClearanceJointSet>,
-    bodies: &RigidBodySet,
-) -> Option<StalledContact> {
-    sets.into_iter()
-        .flat_map(|s| s.iter())
-        .filter(|(_, j)| j.report().state.penetration > 0.0)
-        .min_by(|(_, a), (_, b)| {
-            let limit =
-                |j: &ClearanceJoint| j.report().max_stable_dt.min(j.report().friction_stable_dt);
-            limit(a).total_cmp(&limit(b))
-        })
-        .map(|(h, j)| StalledContact::of(h, j, bodies))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -496,7 +334,7 @@ mod tests {
     fn contact() -> StalledContact {
         StalledContact {
             joint: "pin".into(),
-            handle: ClearanceJointHandle::from_raw_parts(0, 0),
+            handle: Some(crate::rapier::pipeline::protocol::ElementId::from_raw_parts(0, 0)),
             law: LawKind::LankaraniNikravesh,
             penetration: 1e-6,
             rate: 1e-3,

@@ -4,19 +4,9 @@
 //! untouched, every force source of this crate removes exactly what it added at the previous
 //! step before adding the new value (exact when it was the only contributor: `(0 + p) - p = 0`).
 
+pub(crate) use crate::rapier::pipeline::protocol::Wrench;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
-
-/// Force and torque (about the centre of mass) added to one body at the last application.
-#[derive(Clone, Copy, Debug)]
-pub struct Wrench {
-    /// The body.
-    pub body: RigidBodyHandle,
-    /// Force, N.
-    pub force: Vector,
-    /// Torque about the body's centre of mass, N m.
-    pub torque: Vector,
-}
 
 /// The wrenches added at the last application, to be taken back at the next one.
 #[derive(Clone, Debug, Default)]

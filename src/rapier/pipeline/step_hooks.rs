@@ -1,25 +1,28 @@
 //! The step protocol: what the [`Stepper`](crate::rapier::pipeline::stepper::Stepper) asks of everything
 //! that takes part in a step, as a hook trait with default methods (as Rapier's
-//! `PhysicsHooks`). Every joint set of this crate implements it
+//! `PhysicsHooks`), each hook given a context struct (as Rapier's `PairFilterContext`). Every
+//! joint set of this crate implements it
 //! ([`ClearanceJointSet`](crate::rapier::joint::ClearanceJointSet),
 //! [`LargeStepJointSet`](crate::rapier::large_step::LargeStepJointSet)), as do the drives
 //! ([`DriveSet`](crate::rapier::sources::drive::DriveSet)) and the prescribed motions
-//! ([`PrescribedSet`](crate::rapier::sources::prescribed::PrescribedSet)). A new joint model plugs in
-//! here: it overrides what it needs, the rest does nothing.
+//! ([`PrescribedSet`](crate::rapier::sources::prescribed::PrescribedSet)); a user's own force
+//! source implements it too and steps with them through
+//! [`ClearanceWorld::step_with`](crate::rapier::pipeline::world::ClearanceWorld::step_with). A
+//! participant overrides what it needs, the rest does nothing. Its vocabulary (wrenches,
+//! violations, stalled contacts, element ids) is in [`protocol`](crate::rapier::pipeline::protocol).
 //!
 //! One step of the stepper, in the order the hooks are called:
 //! 1. [`check_bodies`](StepHooks::check_bodies) before every step;
 //!    [`check_world`](StepHooks::check_world) once before the first step (the solver settings a
-//!    participant needs), then [`set_last_step`](StepHooks::set_last_step) and
-//!    [`evaluate`](StepHooks::evaluate) at the state before the step.
+//!    participant needs), then [`evaluate`](StepHooks::evaluate) at
+//!    the state before the step.
 //! 2. The step's length: the smallest [`step_limit`](StepHooks::step_limit) (adaptive), or a
 //!    fixed step checked by [`check_step`](StepHooks::check_step).
 //! 3. [`save_state`](StepHooks::save_state) (the step may be rejected or taken again); the
 //!    [`wrenches`](StepHooks::wrenches) are added to the bodies for this step only;
 //!    [`before_rapier_step`](StepHooks::before_rapier_step), Rapier's step,
 //!    [`after_rapier_step`](StepHooks::after_rapier_step); then
-//!    [`set_last_step`](StepHooks::set_last_step) and [`evaluate`](StepHooks::evaluate) at the
-//!    new state.
+//!    [`evaluate`](StepHooks::evaluate) at the new state.
 //!    After each Rapier pass, [`resolve_step`](StepHooks::resolve_step): a participant may ask
 //!    for the step to be taken again from its start with its new wrenches (the bodies and
 //!    every participant's state restored first).
@@ -34,9 +37,7 @@
 //! `apply`/`before_step`/`after_step` instead.
 
 use crate::error::Result;
-use crate::rapier::observers::guards::GuardReport;
-use crate::rapier::observers::stall::StalledContact;
-use crate::rapier::pipeline::ledger::Wrench;
+use crate::rapier::pipeline::protocol::{GuardReport, StalledContact, Wrench};
 use rapier3d_f64::prelude::{
     ImpulseJointSet, IntegrationParameters, PhysicsWorld, RigidBodyHandle, RigidBodySet,
 };
@@ -45,9 +46,8 @@ use rapier3d_f64::prelude::{
 /// nothing (see the [module](self) docs for the order of the calls).
 pub trait StepHooks {
     /// Evaluates at the bodies' current state, without touching their forces: the wrenches of
-    /// the next step. `impulse_joints` are the world's Rapier joints (the mechanism a force
-    /// source acts in). Default: nothing.
-    fn evaluate(&mut self, _bodies: &mut RigidBodySet, _impulse_joints: &ImpulseJointSet) {}
+    /// the next step. Default: nothing.
+    fn evaluate(&mut self, _context: EvaluateContext<'_>) {}
 
     /// The wrenches of the last evaluation, added to the bodies for the next step only.
     /// Default: none.
@@ -68,39 +68,33 @@ pub trait StepHooks {
         Ok(())
     }
 
-    /// The longest adaptive step this participant allows from the current state, s, for the
-    /// step control's `tolerance` and the last accepted step `last_dt` (0 before the first).
-    /// Default: no limit.
-    fn step_limit(&self, _tolerance: f64, _last_dt: f64) -> f64 {
+    /// The longest adaptive step this participant allows from the current state, s (the
+    /// context's `tolerance`, `last_dt` and `t`; its `dt` is 0). Default: no limit.
+    fn step_limit(&self, _step: &StepContext) -> f64 {
         f64::INFINITY
     }
 
-    /// Whether a fixed step `dt` is within the stability limit of this participant's state (before
-    /// the step, and again at the state the step ended in): an
+    /// Whether a fixed step `step.dt` is within the stability limit of this participant's state
+    /// (before the step, and again at the state the step ended in): an
     /// [`Error::StepTooLarge`](crate::Error::StepTooLarge) if not. Default: any step.
-    fn check_step(&self, _dt: f64) -> Result<()> {
+    fn check_step(&self, _step: &StepContext) -> Result<()> {
         Ok(())
     }
 
-    /// Judges an adaptive step `dt` just taken (evaluated at its end): `Some(shorter)` rejects
-    /// it, to be retried at most `shorter` long. Default: accepted.
-    fn judge_step(&self, _dt: f64, _tolerance: f64) -> Option<f64> {
+    /// Judges an adaptive step `step.dt` just taken (evaluated at its end, `step.t`):
+    /// `Some(shorter)` rejects it, to be retried at most `shorter` long. Default: accepted.
+    fn judge_step(&self, _step: &StepContext) -> Option<f64> {
         None
     }
 
     /// Right before each Rapier step (a retried one included), with the step's start `t0` and
-    /// length `dt`, s (`world.integration_parameters.dt` is set to it): e.g. the next poses of
+    /// length `dt` (`world.integration_parameters.dt` is set to it): e.g. the next poses of
     /// prescribed kinematic bodies, or the substeps of large-step joints. Default: nothing.
-    fn before_rapier_step(&mut self, _world: &mut PhysicsWorld, _t0: f64, _dt: f64) {}
-    /// The length of the step that led to the state the next [`evaluate`](Self::evaluate) sees,
-    /// s: 0 before the first step (and after a restart, when the velocities are the state's own).
-    /// Rapier's velocities are the mean over that step; a source that reads rates can carry them
-    /// to the state.
-    fn set_last_step(&mut self, _dt: f64) {}
+    fn before_rapier_step(&mut self, _context: RapierStepContext<'_>) {}
 
     /// Right after each Rapier step, before [`evaluate`](Self::evaluate): e.g. reading the
     /// constraint forces of large-step joints and bouncing their impacts. Default: nothing.
-    fn after_rapier_step(&mut self, _world: &mut PhysicsWorld) {}
+    fn after_rapier_step(&mut self, _context: RapierStepContext<'_>) {}
 
     /// After each Rapier pass of a step (after [`after_rapier_step`](Self::after_rapier_step)):
     /// whether the step must be taken again from its start, as long, with this participant's
@@ -113,10 +107,11 @@ pub trait StepHooks {
         false
     }
 
-    /// Records, after an accepted step of `dt` (s) ending at `t`, what the run-time guards must
-    /// know of this participant's state (penetrations beyond a law's validity, a fixed step
-    /// beyond friction's limit, when `fixed`). Default: nothing.
-    fn record_guards(&self, _guards: &mut GuardReport, _t: f64, _dt: f64, _fixed: bool) {}
+    /// Records in `guards`, after an accepted step `step.dt` ending at `step.t`, what the
+    /// run-time guards must know of this participant's state (penetrations beyond a law's
+    /// validity, a fixed step beyond friction's limit when `step.fixed`, a spring stretched too
+    /// far). Default: nothing.
+    fn record_guards(&self, _step: &StepContext, _guards: &mut GuardReport) {}
 
     /// The contact of this participant whose step limit is the shortest, with its numbers, for a
     /// stall's diagnosis; `None` when none is in contact. Default: none.
@@ -133,6 +128,54 @@ pub trait StepHooks {
     fn check_bodies(&self, _bodies: &RigidBodySet) -> Result<()> {
         Ok(())
     }
+}
+
+/// No participant: what [`ClearanceWorld::step`](crate::rapier::pipeline::world::ClearanceWorld::step)
+/// steps with beside its own sets.
+impl StepHooks for () {}
+
+/// What [`StepHooks::evaluate`] sees: the bodies at the state to evaluate and the world's
+/// Rapier joints (the mechanism a force source acts in).
+#[non_exhaustive]
+pub struct EvaluateContext<'a> {
+    /// The bodies (mutable only to compute mass properties Rapier has not yet).
+    pub bodies: &'a mut RigidBodySet,
+    /// The world's Rapier joints.
+    pub impulse_joints: &'a ImpulseJointSet,
+    /// The length of the step that led to this state, s: 0 before the first step (and after a
+    /// restart, when the velocities are the state's own). Rapier's velocities are the mean over
+    /// that step; a source that reads rates can carry them to the state.
+    pub last_step: f64,
+}
+
+/// The step a hook is asked about ([`StepHooks::step_limit`], [`StepHooks::check_step`],
+/// [`StepHooks::judge_step`], [`StepHooks::record_guards`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct StepContext {
+    /// The time of the state the participant was last evaluated at, s: the step's start before
+    /// it is taken, its end after.
+    pub t: f64,
+    /// The step, s (0 when it is still to be chosen, in [`StepHooks::step_limit`]).
+    pub dt: f64,
+    /// The last accepted step, s (0 before the first).
+    pub last_dt: f64,
+    /// The step control's tolerance.
+    pub tolerance: f64,
+    /// Whether the steps are fixed (no step is rejected or retried).
+    pub fixed: bool,
+}
+
+/// The world around one Rapier step ([`StepHooks::before_rapier_step`],
+/// [`StepHooks::after_rapier_step`]).
+#[non_exhaustive]
+pub struct RapierStepContext<'a> {
+    /// The Rapier world; `integration_parameters.dt` is the step.
+    pub world: &'a mut PhysicsWorld,
+    /// The step's start, s.
+    pub t0: f64,
+    /// The step, s.
+    pub dt: f64,
 }
 
 /// One Rapier pass of a step, as [`StepHooks::resolve_step`] sees it.

@@ -51,7 +51,7 @@ use crate::error::Result;
 use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle, ClearanceJointSet};
 use crate::rapier::large_step::{LargeStepJoint, LargeStepJointHandle, LargeStepJointSet};
 use crate::rapier::observers::reaction::{IdealJoint, KinematicState, ReactionSolver};
-use crate::rapier::pipeline::ledger::Wrench;
+use crate::rapier::pipeline::protocol::Wrench;
 use crate::rapier::pipeline::step_hooks::StepHooks;
 use crate::rapier::pipeline::stepper::{GuardReport, StepControl, StepInfo, Stepper};
 use crate::rapier::sources::drive::{DriveHandle, DriveSet, TorsionSpring};
@@ -63,9 +63,14 @@ use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle};
 /// [`Stepper`]. The sets are public fields, as in Rapier's `PhysicsWorld`: read them freely;
 /// add and remove joints, drives and motions with the `insert_*`/`remove_*` methods (which also
 /// add their Rapier parts and tell the step control when forces must be evaluated again). A
-/// compliant joint or a drive added or removed through the fields is noticed at the next step;
+/// compliant joint or a drive added, removed or edited through the fields is noticed at the
+/// next step (by the sets' revisions, [`ElementSet::revision`](crate::rapier::pipeline::element_set::ElementSet::revision));
 /// after moving bodies or setting velocities by hand between steps, call
 /// [`invalidate`](Self::invalidate).
+///
+/// Force sources of your own take part in the steps through
+/// [`step_with`](Self::step_with): any type that implements [`StepHooks`] (its wrenches, step
+/// limit, acceptance, saved state and guards), run after the world's own sets.
 pub struct ClearanceWorld {
     /// The Rapier world: bodies, colliders, Rapier's own joints, gravity, integration parameters.
     pub rapier: PhysicsWorld,
@@ -78,9 +83,10 @@ pub struct ClearanceWorld {
     /// The tabulated (prescribed) motions of kinematic bodies.
     pub prescribed: PrescribedSet,
     stepper: Stepper,
-    /// The sizes of the compliant joint set and the drive set at the last step: a change means
-    /// their forces must be evaluated again before the next step.
-    counts: [usize; 2],
+    /// The revisions of the compliant joint set and the drive set at the last step (`None`
+    /// before the first): a change means their forces must be evaluated again before the next
+    /// step.
+    revisions: Option<[u64; 2]>,
     /// Scratch: the sources' wrenches for a reaction solve.
     wrenches: Vec<Wrench>,
 }
@@ -96,7 +102,7 @@ impl ClearanceWorld {
             drives: DriveSet::new(),
             prescribed: PrescribedSet::default(),
             stepper: Stepper::new(control),
-            counts: [usize::MAX; 2],
+            revisions: None,
             wrenches: Vec::new(),
         }
     }
@@ -182,7 +188,22 @@ impl ClearanceWorld {
     /// motions' hooks in their order). Call it in place of Rapier's `PhysicsWorld::step`.
     /// `until` must be finite, after the current time and within what the clock can reach (a
     /// step of `max_dt` must change the time there); else it is refused, naming `until`.
+    /// The same as [`step_with`](Self::step_with) with no hooks of your own (`&mut ()`).
     pub fn step(&mut self, until: f64) -> Result<StepInfo> {
+        self.step_with(until, &mut ())
+    }
+
+    /// [`step`](Self::step) with your own participant `user` in the step, after the world's
+    /// own (drives, compliant joints, large-step joints, prescribed motions, in that order):
+    /// its [`StepHooks`] are called as theirs, so its wrenches act over the step, its
+    /// [`step_limit`](StepHooks::step_limit) bounds the adaptive step, its
+    /// [`judge_step`](StepHooks::judge_step) may reject it (its
+    /// [`save_state`](StepHooks::save_state)/[`restore_state`](StepHooks::restore_state) then
+    /// undo it) and its [`record_guards`](StepHooks::record_guards) fill
+    /// [`guards`](Self::guards). Pass the same participant at every step (a tuple or a struct of
+    /// your own holds several); after changing it between steps, call
+    /// [`invalidate`](Self::invalidate).
+    pub fn step_with(&mut self, until: f64, user: &mut dyn StepHooks) -> Result<StepInfo> {
         if !until.is_finite() {
             return Err(crate::Error::invalid(
                 "until",
@@ -190,13 +211,19 @@ impl ClearanceWorld {
             ));
         }
         self.follow_changes();
-        let (stepper, physics, mut hooks) = self.parts();
+        let (stepper, physics, mut hooks) = self.parts(user);
         stepper.step(physics, &mut hooks, until)
     }
 
     /// Steps until the clock reaches `until` (s, finite; at or before the current time nothing is
     /// done); returns the number of accepted steps taken.
     pub fn step_to(&mut self, until: f64) -> Result<u64> {
+        self.step_to_with(until, &mut ())
+    }
+
+    /// [`step_to`](Self::step_to) with your own participant `user` in every step
+    /// ([`step_with`](Self::step_with)).
+    pub fn step_to_with(&mut self, until: f64, user: &mut dyn StepHooks) -> Result<u64> {
         if !until.is_finite() {
             return Err(crate::Error::invalid(
                 "until",
@@ -205,7 +232,7 @@ impl ClearanceWorld {
         }
         let start = self.stepper.steps();
         while self.time() < until {
-            self.step(until)?;
+            self.step_with(until, user)?;
         }
         Ok(self.stepper.steps() - start)
     }
@@ -214,8 +241,14 @@ impl ClearanceWorld {
     /// (done by [`step`](Self::step) on its own; call it to read the joints' forces at the
     /// initial state before the first step). Also checks the world's settings.
     pub fn prepare(&mut self) -> Result<()> {
+        self.prepare_with(&mut ())
+    }
+
+    /// [`prepare`](Self::prepare) with your own participant `user`
+    /// ([`step_with`](Self::step_with)).
+    pub fn prepare_with(&mut self, user: &mut dyn StepHooks) -> Result<()> {
         self.follow_changes();
-        let (stepper, physics, mut hooks) = self.parts();
+        let (stepper, physics, mut hooks) = self.parts(user);
         stepper.prepare(physics, &mut hooks)
     }
 
@@ -226,8 +259,19 @@ impl ClearanceWorld {
         dt: f64,
         read: impl FnOnce(&PhysicsWorld, &StepInfo) -> R,
     ) -> Result<R> {
+        self.peek_with(dt, &mut (), read)
+    }
+
+    /// [`peek`](Self::peek) with your own participant `user` ([`step_with`](Self::step_with)),
+    /// whose state is restored with the world's.
+    pub fn peek_with<R>(
+        &mut self,
+        dt: f64,
+        user: &mut dyn StepHooks,
+        read: impl FnOnce(&PhysicsWorld, &StepInfo) -> R,
+    ) -> Result<R> {
         self.follow_changes();
-        let (stepper, physics, mut hooks) = self.parts();
+        let (stepper, physics, mut hooks) = self.parts(user);
         stepper.peek(physics, &mut hooks, dt, read)
     }
 
@@ -316,9 +360,16 @@ impl ClearanceWorld {
     // ----- Internals -----
 
     /// The stepper, the Rapier world and the hooks in their order: drives, compliant joints,
-    /// large-step joints, prescribed motions (the drives' and joints' forces are added to a body
-    /// in that order).
-    fn parts(&mut self) -> (&mut Stepper, &mut PhysicsWorld, [&mut dyn StepHooks; 4]) {
+    /// large-step joints, prescribed motions, the user's (the forces are added to a body in that
+    /// order).
+    fn parts<'a>(
+        &'a mut self,
+        user: &'a mut dyn StepHooks,
+    ) -> (
+        &'a mut Stepper,
+        &'a mut PhysicsWorld,
+        [&'a mut dyn StepHooks; 5],
+    ) {
         (
             &mut self.stepper,
             &mut self.rapier,
@@ -327,21 +378,23 @@ impl ClearanceWorld {
                 &mut self.clearance,
                 &mut self.large_step,
                 &mut self.prescribed,
+                user,
             ],
         )
     }
 
     /// A force source edited through its public field since the last step (a compliant joint or
-    /// a drive added or removed): its forces are evaluated again before the next step. Only
-    /// these: an evaluation at the same state again is not free (the joints' reports would lose
-    /// the onset they flagged), and the other sets carry no forces to evaluate.
+    /// a drive added, removed or edited, seen by the sets' revisions): its forces are evaluated
+    /// again before the next step. Only these: an evaluation at the same state again is not free
+    /// (the joints' reports would lose the onset they flagged), and the other sets carry no
+    /// forces to evaluate.
     fn follow_changes(&mut self) {
-        let counts = [self.clearance.len(), self.drives.len()];
-        if counts != self.counts {
-            if self.counts[0] != usize::MAX {
+        let revisions = [self.clearance.revision(), self.drives.revision()];
+        if self.revisions != Some(revisions) {
+            if self.revisions.is_some() {
                 self.stepper.invalidate(false);
             }
-            self.counts = counts;
+            self.revisions = Some(revisions);
         }
     }
 }

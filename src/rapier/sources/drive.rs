@@ -2,10 +2,10 @@
 
 use crate::error::{Result, in_range, unit_vector};
 use crate::model::angle::HingeAngle;
-use crate::rapier::pipeline::arena::OrderedArena;
-use crate::rapier::pipeline::ledger::{ForceLedger, Wrench};
-use crate::rapier::pipeline::step_hooks::StepHooks;
-use rapier3d_f64::data::Index;
+use crate::rapier::pipeline::element_set::{ElementHandle, ElementSet};
+use crate::rapier::pipeline::ledger::ForceLedger;
+use crate::rapier::pipeline::protocol::Wrench;
+use crate::rapier::pipeline::step_hooks::{EvaluateContext, StepHooks};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
 
@@ -106,10 +106,8 @@ impl TorsionSpring {
 }
 
 /// Handle of a drive in a [`DriveSet`], returned by its [`insert`](DriveSet::insert):
-/// generational, as the joint sets' handles (removing a drive never changes another's handle;
-/// the handle of a removed drive finds nothing ever after).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct DriveHandle(Index);
+/// generational, as the joint sets' handles.
+pub type DriveHandle = ElementHandle<TorsionSpring>;
 
 /// All drives of a world, visited in insertion order. Under the
 /// [`Stepper`](crate::rapier::pipeline::stepper::Stepper) (or a
@@ -117,7 +115,7 @@ pub struct DriveHandle(Index);
 /// only; a loop that calls `world.step()` itself calls [`DriveSet::apply`] before every step.
 #[derive(Clone, Debug, Default)]
 pub struct DriveSet {
-    drives: OrderedArena<TorsionSpring>,
+    drives: ElementSet<TorsionSpring>,
     ledger: ForceLedger,
     wrenches: Vec<Wrench>,
     saved: Vec<(HingeAngle, f64)>,
@@ -131,24 +129,29 @@ impl DriveSet {
     }
     /// Adds a drive; returns its handle.
     pub fn insert(&mut self, drive: TorsionSpring) -> DriveHandle {
-        DriveHandle(self.drives.insert(drive))
+        self.drives.insert(drive)
     }
     /// Removes the drive and returns it (`None` for a handle of no drive of this set); the others
     /// keep their handles and order. Its torque leaves the next evaluation (a loop that applies
     /// the torques itself calls [`apply`](Self::apply) or [`take_back`](Self::take_back)).
     pub fn remove(&mut self, handle: DriveHandle) -> Option<TorsionSpring> {
-        let d = self.drives.remove(handle.0)?;
+        let d = self.drives.remove(handle)?;
         // A saved state is by position: it no longer matches the drives.
         self.saved.clear();
         Some(d)
     }
     /// The drive behind `handle` (`None` once it was removed).
     pub fn get(&self, handle: DriveHandle) -> Option<&TorsionSpring> {
-        self.drives.get(handle.0)
+        self.drives.get(handle)
     }
     /// The drives with their handles, in insertion order.
     pub fn iter(&self) -> impl Iterator<Item = (DriveHandle, &TorsionSpring)> {
-        self.drives.iter().map(|(i, d)| (DriveHandle(i), d))
+        self.drives.iter()
+    }
+    /// A count that every insert and remove raises: two equal readings mean the same drives
+    /// ([`ElementSet::revision`]).
+    pub fn revision(&self) -> u64 {
+        self.drives.revision()
     }
     /// Number of drives.
     pub fn len(&self) -> usize {
@@ -191,18 +194,18 @@ impl DriveSet {
 
     /// Saves the angle trackers and applied torques (before a step that may be rejected).
     pub(crate) fn save_state(&mut self) {
-        self.saved.clear();
-        self.saved
-            .extend(self.drives.values().map(|d| (d.angle, d.last_torque)));
+        self.drives
+            .save_into(&mut self.saved, |d| (d.angle, d.last_torque));
         self.saved_wrenches.clone_from(&self.wrenches);
     }
 
     /// Restores what [`save_state`](Self::save_state) saved.
     pub(crate) fn restore_state(&mut self) {
-        for (d, &(angle, torque)) in self.drives.values_mut().zip(&self.saved) {
-            d.angle = angle;
-            d.last_torque = torque;
-        }
+        self.drives
+            .restore_from(&self.saved, |d, &(angle, torque)| {
+                d.angle = angle;
+                d.last_torque = torque;
+            });
         self.wrenches.clone_from(&self.saved_wrenches);
     }
 
@@ -218,12 +221,8 @@ impl DriveSet {
 /// The drives take part in the stepper's steps: their torques, saved and restored with a rejected
 /// step ([`crate::rapier::pipeline::step_hooks`]).
 impl StepHooks for DriveSet {
-    fn evaluate(
-        &mut self,
-        bodies: &mut RigidBodySet,
-        _impulse_joints: &rapier3d_f64::prelude::ImpulseJointSet,
-    ) {
-        DriveSet::evaluate(self, bodies);
+    fn evaluate(&mut self, context: EvaluateContext<'_>) {
+        DriveSet::evaluate(self, context.bodies);
     }
     fn wrenches(&self) -> &[Wrench] {
         DriveSet::wrenches(self)

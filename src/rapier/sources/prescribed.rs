@@ -9,9 +9,9 @@
 //! state, whatever the step.
 
 use crate::error::{Error, Result};
-use crate::rapier::pipeline::step_hooks::StepHooks;
+use crate::rapier::pipeline::step_hooks::{RapierStepContext, StepHooks};
 use rapier3d_f64::math::{Pose, Rotation, Vector};
-use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle, RigidBodySet, RigidBodyType};
+use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet, RigidBodyType};
 
 /// `v` normalised; an error naming `field` when it has no direction (zero or not finite).
 fn unit(field: &str, v: Vector) -> Result<Vector> {
@@ -302,10 +302,10 @@ impl StepHooks for PrescribedSet {
         Ok(())
     }
 
-    fn before_rapier_step(&mut self, world: &mut PhysicsWorld, t0: f64, dt: f64) {
+    fn before_rapier_step(&mut self, context: RapierStepContext<'_>) {
         for m in &self.motions {
-            if let Some(rb) = world.bodies.get_mut(m.body) {
-                rb.set_next_kinematic_position(m.pose(t0 + dt));
+            if let Some(rb) = context.world.bodies.get_mut(m.body) {
+                rb.set_next_kinematic_position(m.pose(context.t0 + context.dt));
             }
         }
     }

@@ -2,8 +2,8 @@
 //! worst value seen, when, and how many states violated (not the first: a run whose first
 //! violation is 1 % over its limit may reach 6 times it later).
 
+use super::ElementId;
 use crate::error::sig4;
-use crate::rapier::joint::ClearanceJointHandle;
 use serde::{Serialize, Serializer};
 
 /// Which guard a [`Violation`] is of. What `worst` and `limit` measure depends on it.
@@ -41,13 +41,13 @@ pub enum GuardKind {
 pub struct Violation {
     /// The guard.
     pub kind: GuardKind,
-    /// The clearance joint's name (in the scene layer, the hinge's name in the scene; for a
-    /// velocity motor, the motor's joint), if the guard concerns one.
+    /// The name of the joint or element the guard concerns, if one (in the scene layer, the
+    /// hinge's name in the scene; for a velocity motor, the motor's joint).
     pub joint: Option<String>,
-    /// The clearance joint's handle in its [`ClearanceJointSet`](crate::rapier::joint::ClearanceJointSet)
-    /// (the plain API's way to name it), if the guard concerns one.
+    /// Its handle in its set ([`ElementHandle::id`](crate::rapier::pipeline::element_set::ElementHandle::id):
+    /// the plain API's way to name it), if it has one.
     #[serde(skip)]
-    pub handle: Option<ClearanceJointHandle>,
+    pub handle: Option<ElementId>,
     /// The twin (`ideal`, `clearance`) for guards the scene runner records.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub twin: Option<String>,
@@ -91,8 +91,8 @@ impl Violation {
         }
     }
 
-    /// Names the clearance joint (and its handle in the API).
-    pub fn joint(mut self, name: &str, handle: Option<ClearanceJointHandle>) -> Self {
+    /// Names the joint or element the violation concerns (and its handle in its set).
+    pub fn joint(mut self, name: &str, handle: Option<ElementId>) -> Self {
         self.joint = Some(name.to_string());
         self.handle = handle;
         self
@@ -344,7 +344,7 @@ mod tests {
 
     fn pen(depth: f64, t: f64) -> Violation {
         Violation::new(GuardKind::Penetration, depth, 50e-6, t)
-            .joint("pin", Some(ClearanceJointHandle::from_raw_parts(0, 0)))
+            .joint("pin", Some(ElementId::from_raw_parts(0, 0)))
     }
 
     #[test]
@@ -376,7 +376,7 @@ mod tests {
         g.record(pen(60e-6, 0.001));
         g.record(
             Violation::new(GuardKind::Penetration, 70e-6, 50e-6, 0.002)
-                .joint("other", Some(ClearanceJointHandle::from_raw_parts(1, 0))),
+                .joint("other", Some(ElementId::from_raw_parts(1, 0))),
         );
         g.record(Violation::new(GuardKind::Energy, 0.05, 0.01, 0.3).twin("ideal"));
         g.violation("mine", || "my own guard".into());

@@ -1,0 +1,295 @@
+//! The step control's checks and diagnoses: the world's and bodies' state before a step, the
+//! guards after it, and the words of a divergence or a stall.
+
+use super::{GuardKind, STALL_STEPS, StepMode, Stepper, Violation};
+use crate::error::{Error, Result};
+use crate::rapier::observers::stall::{Stall, StallCause};
+use crate::rapier::pipeline::step_hooks::{StepContext, StepHooks};
+use rapier3d_f64::prelude::PhysicsWorld;
+
+impl Stepper {
+    /// The stall message for `seen`: the contact that stops the steps, its state and its cause
+    /// ([`crate::rapier::observers::stall`]).
+    pub(super) fn stall_reason(
+        &self,
+        world: &PhysicsWorld,
+        sources: &[&mut dyn StepHooks],
+        seen: &str,
+    ) -> Box<Stall> {
+        if let Some(turn) = self.turn_stall(world) {
+            return Box::new(Stall::turn_bound(seen.into(), self.control.min_dt, turn));
+        }
+        // The contact whose step limit is the shortest stops the step control.
+        let limit =
+            |c: &crate::rapier::pipeline::protocol::StalledContact| c.stable_dt.min(c.friction_dt);
+        let contact = sources
+            .iter()
+            .filter_map(|s| s.stalled_contact(&world.bodies))
+            .min_by(|a, b| limit(a).total_cmp(&limit(b)));
+        Box::new(Stall::at_contact(seen.into(), contact, self.control.min_dt))
+    }
+
+    /// The turn bound in words when it alone asks for steps at the floor: the fastest-turning
+    /// movable body may turn `tolerance/8` rad a step.
+    fn turn_stall(&self, world: &PhysicsWorld) -> Option<StallCause> {
+        let per_step =
+            crate::rapier::pipeline::motion_step::TURN_PER_TOLERANCE * self.control.tolerance;
+        let (handle, rb) = world
+            .bodies
+            .iter()
+            .filter(|(_, rb)| !rb.is_fixed())
+            .max_by(|a, b| a.1.angvel().length().total_cmp(&b.1.angvel().length()))?;
+        let w = rb.angvel().length();
+        let step = crate::rapier::pipeline::motion_step::turn_step(per_step, w);
+        (step <= 2.0 * self.control.min_dt).then_some(StallCause::TurnBound {
+            body: handle,
+            rate: w,
+            per_step,
+            step,
+        })
+    }
+
+    pub(super) fn count_floor(
+        &mut self,
+        world: &PhysicsWorld,
+        sources: &[&mut dyn StepHooks],
+        dt: f64,
+    ) -> Result<()> {
+        if self.control.mode == StepMode::Adaptive && dt <= self.control.min_dt * (1.0 + 1e-9) {
+            self.guards.floor_steps += 1;
+            self.floor_run += 1;
+            // One state counted; the worst is the longest run in a row (closest to a stall).
+            let v = Violation::new(
+                GuardKind::Floor,
+                self.floor_run as f64,
+                STALL_STEPS as f64,
+                self.t,
+            )
+            .note(format!("{} s", crate::error::sig4(self.control.min_dt)));
+            self.guards.record(v);
+            if self.floor_run >= STALL_STEPS {
+                let seen = format!("{} steps in a row at the floor", self.floor_run);
+                return Err(Error::Stalled {
+                    t: self.t,
+                    stall: self.stall_reason(world, sources, &seen),
+                });
+            }
+        } else {
+            self.floor_run = 0;
+        }
+        Ok(())
+    }
+
+    /// Non-physical bodies are errors; penetrations beyond validity are recorded.
+    pub(super) fn check_health(
+        &mut self,
+        world: &PhysicsWorld,
+        sources: &[&mut dyn StepHooks],
+        dt: f64,
+    ) -> Result<()> {
+        for b in &self.saved {
+            if let Some(rb) = world.bodies.get(b.handle)
+                && let Some(speed) = left_physical_range(rb, &world.integration_parameters)
+            {
+                return Err(Error::Diverged {
+                    t: self.t,
+                    reason: diverged_body(
+                        world,
+                        sources,
+                        b.handle,
+                        speed,
+                        self.control.joint_correction,
+                    ),
+                });
+            }
+        }
+        let step = self.step_context(self.t, dt);
+        for s in sources {
+            s.record_guards(&step, &mut self.guards);
+        }
+        if self.control.strict && !self.guards.is_clean() {
+            return Err(Error::Guard {
+                t: self.t,
+                violations: self.guards.violations.clone(),
+            });
+        }
+        Ok(())
+    }
+
+    /// The step context of a step `dt` (s) whose participants are evaluated at time `t` (s).
+    pub(super) fn step_context(&self, t: f64, dt: f64) -> StepContext {
+        StepContext {
+            t,
+            dt,
+            last_dt: self.last_dt,
+            tolerance: self.control.tolerance,
+            fixed: self.control.mode == StepMode::Fixed,
+        }
+    }
+
+    /// Adds the time, the step mode and the parameter that set the step to a step-limit error
+    /// (the joints know none of them).
+    pub(super) fn locate(&self, mut e: Error) -> Error {
+        if let Error::StepTooLarge(limit) = &mut e {
+            limit.t = Some(self.t);
+            limit.field = "StepControl::max_dt".into();
+        }
+        e.with_step_mode(self.control.mode == StepMode::Adaptive)
+    }
+}
+
+/// The world's gravity must be finite (a NaN one would only show as a body leaving the
+/// physical range), and within what the speed guard lets a step take: a free body falling for
+/// one step of `max_dt` must stay below the guard, half Rapier's `max_linear_velocity` (beyond
+/// it the first step leaves the physical range, or Rapier's clamps leave the bodies still).
+pub(super) fn check_gravity(world: &PhysicsWorld, max_dt: f64) -> Result<()> {
+    let g = world.gravity;
+    if !g.is_finite() {
+        return Err(Error::invalid(
+            "gravity",
+            format!("the world's gravity must be finite (got {g:?})"),
+        ));
+    }
+    let guard = 0.5 * world.integration_parameters.max_linear_velocity();
+    let bound = guard / max_dt;
+    if g.length() > bound {
+        return Err(Error::invalid(
+            "gravity",
+            format!(
+                "{} m/s^2 would take a free body past the speed guard ({} m/s, half \
+                 `integration_parameters.max_linear_velocity()`) within one step of max_dt = {} \
+                 s: give a gravity of at most {} m/s^2 (or a shorter max_dt)",
+                crate::error::sig4(g.length()),
+                crate::error::sig4(guard),
+                crate::error::sig4(max_dt),
+                crate::error::sig4(bound)
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Every body's pose and velocities are finite before a step: a NaN set by hand would otherwise
+/// show only as a body leaving the physical range after it, with nothing to say why.
+pub(super) fn check_body_states(world: &PhysicsWorld) -> Result<()> {
+    for (handle, rb) in world.bodies.iter() {
+        let bad = [
+            (
+                "position",
+                rb.translation().is_finite() && rb.rotation().is_finite(),
+            ),
+            ("linvel", rb.linvel().is_finite()),
+            ("angvel", rb.angvel().is_finite()),
+        ]
+        .into_iter()
+        .find(|(_, ok)| !ok);
+        if let Some((field, _)) = bad {
+            return Err(Error::invalid(
+                field,
+                format!(
+                    "body {:?} has a non-finite {field} before the step (position {:?}, linvel \
+                     {:?}, angvel {:?}): set finite values",
+                    handle.into_raw_parts(),
+                    rb.translation(),
+                    rb.linvel(),
+                    rb.angvel()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Every impulse joint (Rapier's own, a clearance joint's lock, a large-step joint's) and every
+/// participant's joint joins bodies of the world: Rapier's step panics on one whose body is gone.
+pub(super) fn check_joint_bodies(
+    world: &PhysicsWorld,
+    sources: &[&mut dyn StepHooks],
+) -> Result<()> {
+    for (handle, joint) in world.impulse_joints.iter() {
+        crate::rapier::pipeline::step_hooks::joint_bodies(
+            &world.bodies,
+            || format!("impulse joint {:?}", handle.into_raw_parts()),
+            joint.body1(),
+            joint.body2(),
+        )?;
+    }
+    for s in sources {
+        s.check_bodies(&world.bodies)?;
+    }
+    Ok(())
+}
+
+/// What a divergence says of `body`: its handle, what joins it (Rapier's impulse joints, the
+/// sources' clearance joints), its speed and the likely cause.
+fn diverged_body(
+    world: &PhysicsWorld,
+    sources: &[&mut dyn StepHooks],
+    body: rapier3d_f64::prelude::RigidBodyHandle,
+    speed: f64,
+    joint_correction: bool,
+) -> String {
+    let mut joined: Vec<String> = world
+        .impulse_joints
+        .attached_joints(body)
+        .map(|(_, _, h, _)| format!("impulse joint {:?}", h.into_raw_parts()))
+        .collect();
+    // Rapier's joints: the ones whose drift correction can make it diverge.
+    let jointed = !joined.is_empty();
+    for s in sources {
+        s.joints_of(body, &mut joined);
+    }
+    let joined = if joined.is_empty() {
+        String::new()
+    } else {
+        format!(", joined by {}", joined.join(", "))
+    };
+    let speed = state_in_words(world.bodies.get(body), speed);
+    let correction = if jointed && !joint_correction {
+        "; with the joint correction off (`StepControl::joint_correction`), also Rapier's joint \
+         drift correction under changing steps, which makes a chain of slender bodies tilt out of \
+         its plane"
+    } else {
+        ""
+    };
+    format!(
+        "body {:?}{joined} left the physical range ({speed}, the guard being {} m/s); likely \
+         cause: a motor, drive or prescribed motion that moves it too fast, a contact too stiff \
+         for the step, or a non-finite input (gravity, a force, a mass){correction}",
+        body.into_raw_parts(),
+        crate::error::sig4(0.5 * world.integration_parameters.max_linear_velocity())
+    )
+}
+
+/// What is out of range in a diverged body's state: its pose, its velocities, Rapier's quarantine,
+/// or its `speed` (m/s).
+fn state_in_words(rb: Option<&rapier3d_f64::prelude::RigidBody>, speed: f64) -> String {
+    let Some(rb) = rb else {
+        return "it is no longer in the world".into();
+    };
+    if !(rb.translation().is_finite() && rb.rotation().is_finite()) {
+        format!("its position is not finite: {:?}", rb.translation())
+    } else if !(rb.linvel().is_finite() && rb.angvel().is_finite()) {
+        format!(
+            "its velocity is not finite: linvel {:?}, angvel {:?}",
+            rb.linvel(),
+            rb.angvel()
+        )
+    } else if !rb.is_enabled() {
+        "Rapier disabled it".into()
+    } else {
+        format!("speed {} m/s", crate::error::sig4(speed))
+    }
+}
+
+/// `Some(speed)` when `rb` has left the physical range: disabled by Rapier's quarantine,
+/// non-finite, or faster than half Rapier's speed clamp (Rapier clamps a blown-up body instead of
+/// producing NaN, so a clamped speed is the sign of a silent blow-up).
+pub fn left_physical_range(
+    rb: &rapier3d_f64::prelude::RigidBody,
+    params: &rapier3d_f64::prelude::IntegrationParameters,
+) -> Option<f64> {
+    let (v, w) = (rb.linvel(), rb.angvel());
+    let bad = !rb.is_enabled() || !rb.translation().is_finite() || !v.is_finite() || !w.is_finite();
+    (bad || v.length() > 0.5 * params.max_linear_velocity()).then(|| v.length())
+}

@@ -325,6 +325,12 @@ pub(crate) struct SubCycle {
     pub(crate) mean: Pair12,
     /// The pair's velocity at the step's end.
     pub(crate) end_velocity: Pair12,
+    /// The displacement held by the last finished step, `E` (impulse times time: the pair
+    /// stands at Rapier's poses moved by `P E`), with the impulse held beside it, by which a
+    /// step retaken from a restored state finds it ([`SubCycle::held_shift`]).
+    pub(crate) shift: HeldShift,
+    /// The displacement this step leaves held, `E'`, taken as `shift` when the step finishes.
+    pub(crate) shift_next: Pair12,
     pub(crate) history: ContactHistory,
     pub(crate) samples: Vec<SubStep>,
     /// The normal's effective mass at the end, kg.
@@ -337,12 +343,35 @@ pub(crate) struct SubCycle {
     pub(crate) dissipated: f64,
 }
 
+/// The displacements held by the last two finished steps, each with the impulse held beside it
+/// (newest first): a step the stepper rejects restores the impulse held before it, and with
+/// it the displacement held before it.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct HeldShift {
+    last: [(Pair12, Pair12); 2],
+}
+
+impl SubCycle {
+    /// The displacement held with the impulse `held` (zero when neither of the last two
+    /// finished steps held that impulse: a first step, or a state restored from further back).
+    fn held_shift(&self, held: &Pair12) -> Pair12 {
+        self.shift
+            .last
+            .iter()
+            .find(|(h, _)| h == held)
+            .map_or([0.0; 12], |(_, e)| *e)
+    }
+}
+
 /// What a sub-cycle integrates over one world step of `h` (s), from the pair's state `start`
 /// with the velocity `u0` at the state, under the rest of the world's acceleration `a_free`.
 pub(crate) struct Cycle<'a> {
     pub(crate) joint: &'a ClearanceJoint,
     pub(crate) start: &'a PairStart,
     pub(crate) u0: Pair12,
+    /// Where the pair stands beyond Rapier's poses at the start (the held displacement moved
+    /// through the mobilities): shifts, then turns, as [`Pair12`].
+    pub(crate) offset: Pair12,
     pub(crate) a_free: Pair12,
     /// [`PairStart::stabilisation`]: shifts, then turns.
     pub(crate) stabilisation: [[Vector; 2]; 2],
@@ -588,8 +617,9 @@ impl Group<'_> {
             .zip(&self.memory)
             .map(|(c, (history, before))| {
                 let m = Motion {
+                    shift: [part(&c.offset, 0), part(&c.offset, 2)],
+                    turn: [part(&c.offset, 1), part(&c.offset, 3)],
                     v: c.u0,
-                    ..Motion::default()
                 };
                 let here = c.here(&m);
                 Lane {
@@ -793,6 +823,9 @@ fn plan_group(
         .map(|j| j.cycle.start.expect("a planned joint has a start"))
         .collect();
     let held: Vec<Pair12> = members.iter().map(|j| j.cycle.held).collect();
+    let shift: Vec<Pair12> = (0..group.len())
+        .map(|a| runs[a].held_shift(&held[a]))
+        .collect();
     let cross: Vec<Vec<(usize, [f64; 144])>> = members
         .iter()
         .enumerate()
@@ -830,6 +863,7 @@ fn plan_group(
                 joint,
                 start: &starts[a],
                 u0,
+                offset: moved(a, &shift),
                 a_free,
                 stabilisation,
                 h,
@@ -849,9 +883,9 @@ fn plan_group(
     .run(&mut runs);
     let deliver: Vec<Pair12> = (0..group.len())
         .map(|a| {
-            let mut d = held[a];
-            axpy(&mut d, 1.0, &runs[a].mean);
-            d.map(|q| q / c_n)
+            let (d, shift_next) = delivery_plan(&held[a], &shift[a], &runs[a], h, c_n);
+            runs[a].shift_next = shift_next;
+            d
         })
         .collect();
     // The state's velocity beyond the Verlet reading of Rapier's velocities around it,
@@ -878,10 +912,53 @@ fn plan_group(
     }
 }
 
+/// The impulse Rapier's pass 1 delivers over a step of `h` (`Q kick`, as a constant wrench
+/// through `N` substeps: `c_n = (N + 1)/(2 N)`), after a sub-cycle `run` that began with the
+/// impulse `held` and the displacement `shift` held, and the displacement it leaves held.
+///
+/// A constant wrench through Rapier's substeps moves the pair by `c_n h P Q kick` and changes
+/// its velocity by `P Q kick`; the sub-cycle moved it by `P (h H + Pi)` and changed its velocity
+/// by `P Gamma` beyond the held `H`. With one substep (`c_n = 1`) the move is met exactly,
+/// `Q kick = H + Pi/h`, and the rest of the impulse, `H + Gamma - Q kick` (between 0 and
+/// `Gamma`), is held to the next step. With more, meeting the move every step holds
+/// `H' = (1 - 1/c_n) H + ...`: an impulse that changes sign at every step (-0.6 of itself at four
+/// substeps), in Rapier's velocities between the steps, where every velocity-dependent force
+/// of the world (a controller's damping, a motor) reads it: the SCARA arm's shoulder fed it back
+/// through its PD controller into impacts 4 times the reference's. Here instead the move and
+/// the impulse are met over two steps, without sign changes: `E0 = E + h H + Pi - c_n h (H +
+/// Gamma)` is what the velocity-matching delivery `H + Gamma` leaves of the move, the delivery
+/// is `H + Gamma + E0/h`, and the step leaves `H' = -E0/h` held and `E' = (1 - c_n) E0` in
+/// place (the pair stands at Rapier's poses moved by `P E'`, where the next sub-cycle starts);
+/// a step without contact after it delivers both exactly (`E0' = 0`).
+fn delivery_plan(
+    held: &Pair12,
+    shift: &Pair12,
+    run: &SubCycle,
+    h: f64,
+    c_n: f64,
+) -> (Pair12, Pair12) {
+    let mut d = *held;
+    if c_n == 1.0 {
+        axpy(&mut d, 1.0, &run.mean);
+        return (d, [0.0; 12]);
+    }
+    // `E0/h`, with the velocity-matching delivery `H + Gamma` in `d`.
+    let mut e0 = *shift;
+    e0.iter_mut().for_each(|e| *e /= h);
+    axpy(&mut e0, 1.0 - c_n, held);
+    axpy(&mut e0, 1.0, &run.mean);
+    axpy(&mut e0, -c_n, &run.impulse);
+    axpy(&mut d, 1.0, &run.impulse);
+    axpy(&mut d, 1.0, &e0);
+    (d, e0.map(|e| (1.0 - c_n) * h * e))
+}
+
 impl super::CycleState {
     /// Takes the step's sub-cycle as the last step's: the impulse left `held`, and what the
     /// step did (its velocity correction, dissipation, impulse and sub-steps), for the readers.
     pub(crate) fn adopt_run(&mut self, held: Pair12) {
+        let run = &mut self.run;
+        run.shift.last = [(held, run.shift_next), run.shift.last[0]];
         self.held = held;
         self.start_correction = self.run.start_correction;
         self.dissipated = self.run.dissipated;

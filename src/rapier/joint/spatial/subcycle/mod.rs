@@ -1,0 +1,246 @@
+//! Sub-cycled contact of the spatial joint
+//! ([`ContactIntegration::SubCycled`](crate::rapier::joint::ContactIntegration::SubCycled)).
+//!
+//! The planar sub-cycle's frame is kept (`super::super::subcycle`): Rapier's pass 0 gives the
+//! rest of the world's acceleration `a` of the pair's 12 velocities, the joint integrates the
+//! pair over the world step on its own clock through the pair's mobility `P`, and pass 1
+//! delivers the constant wrench that puts the bodies where the sub-steps did, the impulse
+//! Rapier's mean velocities do not hold carried to the next step.
+//!
+//! **What is integrated.** The state is the contact's impulse on the pair so far, `Gamma(t)`,
+//! and its time integral `Pi(t)` (24 numbers): the pair's position increments and velocities
+//! follow from them exactly, `x = u0 t + a t^2/2 + P Pi`, `v = u0 + a t + P Gamma`, and
+//! `dPi/dt = Gamma`, `dGamma/dt = L(x, v)`, `L` the four regions' load on the pair (every
+//! quadrature point's normal and friction force, as the explicit joint's). The delivery needs
+//! `Gamma(h)` and `Pi(h)`: they are the state, not a quadrature beside it, so the bodies land
+//! where the sub-steps put them.
+//!
+//! **How.** A linearly implicit Rosenbrock method, ROS2 (Verwer et al. 1999: L-stable, second
+//! order for any Jacobian), with the linearly implicit Euler step as its embedded first-order
+//! estimate. The Jacobian `dL/dx P`, `dL/dv P` is taken by forward differences along the
+//! coordinates the pair can move. The stiff terms (the loaded edges' and faces' stiffness, the
+//! damping, friction's slope near zero slip) are then integrated implicitly: at rest the
+//! sub-steps grow to the whole world step, and the tolerance, not stability, sets them. The
+//! sub-step follows the error estimate against the tolerance: positions against
+//! [`POSITION_SCALE`] of the clearance (angles against that over the journal's lever), velocities
+//! relative to themselves plus [`VELOCITY_SCALE`]. A contact's onset makes the force bend; the
+//! estimate grows there and the sub-steps shrink onto it.
+//!
+//! **Memory.** Each region's contact history (onset, `delta_dot0` at the crossing) advances at
+//! every accepted sub-step, as the joint's own (the deepest region's). A region in contact keeps
+//! its impact rate over the step (raised to its loaded rate at the evaluation before it, as the
+//! explicit joint's); a region a trial state presses without a history takes its own approach
+//! speed.
+
+use super::super::subcycle::{MAX_SUBSTEPS, PairStart, SubCycle, SubStep};
+use super::super::{ClearanceJoint, ContactHistory, Mechanism, motion};
+use super::{Mobility, Pair, SpatialParts, Totals, apply_region, deepest_state, region_points};
+use crate::model::kinematics::{BodyMotion, ForcePair, JournalState};
+use crate::model::spatial::SpatialPose;
+use crate::rapier::pipeline::ledger::{Wrench, world_center_of_mass};
+use crate::rapier::pipeline::step_hooks::StepPass;
+use rapier3d_f64::math::{Rotation, Vector};
+use rapier3d_f64::prelude::{RigidBody, RigidBodySet};
+
+/// A 12-vector over the pair's coordinates: the bearing's linear and angular, then the
+/// journal's.
+type Pair12 = [f64; 12];
+/// A 12 x 12 matrix over the pair's coordinates, row-major.
+type Square = [f64; 144];
+
+/// The fraction of the clearance the tolerance is applied to for the sub-steps' position error:
+/// a contact's depth is a small fraction of the clearance (the door's edges: 1 %), and its
+/// force follows its depth.
+pub(crate) const POSITION_SCALE: f64 = 0.01;
+
+/// The speed, per metre of clearance and per second, below which a velocity error is judged
+/// absolutely (`tolerance x VELOCITY_SCALE x clearance`): the rate at which the position scale
+/// is covered in a millisecond. A resting pair's velocities are near zero; their error then
+/// counts against this floor.
+pub(crate) const VELOCITY_SCALE: f64 = POSITION_SCALE * 1e3;
+
+/// Accepted sub-steps a Jacobian serves at most (ROS2 keeps its order with any Jacobian; a
+/// stale one costs accuracy per sub-step and the error estimate sees it). It is also retaken
+/// when a region starts or stops touching, and when a sub-step is rejected.
+const JACOBIAN_AGE: u32 = 8;
+
+/// Which regions touch at `eval`.
+fn contact_set(eval: &Eval) -> [bool; 4] {
+    eval.states.map(|s| s.penetration > 0.0)
+}
+
+/// Whether the load moved from `then` (where the Jacobian was taken) by more than
+/// [`JACOBIAN_DRIFT`] of its size: the contact's stiffness has moved with it.
+fn changed(now: &Pair12, then: &Pair12) -> bool {
+    let norm = |x: &Pair12| x.iter().map(|a| a * a).sum::<f64>().sqrt();
+    let diff: Pair12 = std::array::from_fn(|i| now[i] - then[i]);
+    norm(&diff) > JACOBIAN_DRIFT * norm(then)
+}
+
+/// The load's relative change after which the Jacobian is retaken.
+const JACOBIAN_DRIFT: f64 = 0.02;
+
+/// ROS2's `gamma = 1 + 1/sqrt(2)` (L-stable).
+const GAMMA: f64 = 1.0 + std::f64::consts::FRAC_1_SQRT_2;
+
+fn part(x: &Pair12, k: usize) -> Vector {
+    Vector::new(x[3 * k], x[3 * k + 1], x[3 * k + 2])
+}
+
+fn put(x: &mut Pair12, k: usize, v: Vector) {
+    x[3 * k..3 * k + 3].copy_from_slice(&[v.x, v.y, v.z]);
+}
+
+fn axpy(y: &mut Pair12, s: f64, x: &Pair12) {
+    for (y, x) in y.iter_mut().zip(x) {
+        *y += s * x;
+    }
+}
+
+fn mul(p: &Square, x: &Pair12) -> Pair12 {
+    std::array::from_fn(|r| (0..12).map(|c| p[r * 12 + c] * x[c]).sum())
+}
+
+fn rotate(turn: Vector, r: Vector) -> Vector {
+    if turn == Vector::ZERO {
+        r
+    } else {
+        Rotation::from_scaled_axis(turn) * r
+    }
+}
+
+/// The pair of a spatial joint at the start of a step.
+#[derive(Clone, Copy, Debug)]
+pub(in crate::rapier::joint) struct SpatialStart {
+    com: [Vector; 2],
+    /// Bearing centre and journal centre, from each centre of mass.
+    anchor: [Vector; 2],
+    bearing_axis: Vector,
+    transverse: Vector,
+    journal_axis: Vector,
+    /// Rapier's velocities at the start (the mean over the step before).
+    velocity: Pair12,
+    mobility: Square,
+}
+
+impl SpatialStart {
+    /// The pair of `joint` (spatial) at the bodies' state, its mobility through `mechanism`.
+    fn of(joint: &ClearanceJoint, bodies: &RigidBodySet, mechanism: &Mechanism) -> Option<Self> {
+        let parts = joint.spatial.as_ref()?;
+        let rb: [&RigidBody; 2] = [bodies.get(joint.body1)?, bodies.get(joint.body2)?];
+        let com = rb.map(world_center_of_mass);
+        let velocity = PairStart::velocity_now(joint, bodies)?;
+        Some(SpatialStart {
+            com,
+            anchor: [
+                *rb[0].position() * joint.local_anchor1 - com[0],
+                *rb[1].position() * joint.local_anchor2 - com[1],
+            ],
+            bearing_axis: *rb[0].rotation() * joint.local_axis1,
+            transverse: *rb[0].rotation() * parts.local_transverse1,
+            journal_axis: *rb[1].rotation() * joint.local_axis2,
+            velocity,
+            mobility: mechanism.pair_mobility(),
+        })
+    }
+}
+
+mod integrator;
+
+use integrator::{Eval, RegionClock, SpatialCycle};
+
+impl ClearanceJoint {
+    /// Takes a spatial sub-cycled joint's pair before the next step (at each evaluation).
+    pub(in crate::rapier::joint) fn take_spatial_start(
+        &mut self,
+        bodies: &RigidBodySet,
+        mechanism: &Mechanism,
+    ) {
+        self.cycle.spatial_start = if self.sub_cycled() && self.spatial.is_some() {
+            SpatialStart::of(self, bodies, mechanism)
+        } else {
+            None
+        };
+    }
+
+    /// The planar joints' `subcycle::plan_cycles` for the spatial joint: after Rapier's pass 0,
+    /// the rest of the world's acceleration, the sub-cycle, and the impulse pass 1 delivers.
+    pub(in crate::rapier::joint) fn plan_spatial_cycle(
+        &mut self,
+        bodies: &RigidBodySet,
+        pass: &StepPass,
+        iterations: usize,
+    ) -> Option<Pair12> {
+        let start = self.cycle.spatial_start?;
+        let now = PairStart::velocity_now(self, bodies)?;
+        let (h, kick) = (pass.dt, pass.kick);
+        let c_n = (iterations as f64 + 1.0) / (2.0 * iterations.max(1) as f64);
+        let a_free: Pair12 = std::array::from_fn(|i| (now[i] - start.velocity[i]) / kick);
+        let mut u0 = start.velocity;
+        axpy(&mut u0, c_n * kick - 0.5 * h, &a_free);
+        axpy(&mut u0, 1.0, &mul(&start.mobility, &self.cycle.held));
+        let mut parts = self.spatial.take()?;
+        let mut clocks = parts.patches.map(|p| RegionClock {
+            history: p.contact,
+            state: p.state,
+            impact_rate: p.impact_rate,
+        });
+        let mut run = std::mem::take(&mut self.cycle.run);
+        let cycle = SpatialCycle::new(self, &start, (u0, a_free), h, pass.tolerance);
+        let before = (self.contact, &self.report.state);
+        let guess = self.cycle.substep_guess;
+        let last = cycle.run(&mut parts, before, &mut clocks, guess, &mut run);
+        for (patch, clock) in parts.patches.iter_mut().zip(clocks) {
+            patch.contact = clock.history;
+            patch.state = clock.state;
+            patch.impact_rate = clock.impact_rate;
+        }
+        self.spatial = Some(parts);
+        self.cycle.substep_guess = last;
+        let mut deliver = self.cycle.held;
+        axpy(&mut deliver, 1.0, &run.mean);
+        deliver.iter_mut().for_each(|q| *q /= c_n);
+        let mut held = self.cycle.held;
+        axpy(&mut held, 1.0, &run.impulse);
+        axpy(&mut held, -1.0, &deliver);
+        // The state's velocity beyond the Verlet reading of Rapier's velocities around it (as
+        // the planar sub-cycle's).
+        let w = (2.0 * kick - h) / (2.0 * kick);
+        let mut beyond = self.cycle.held;
+        axpy(&mut beyond, -w, &deliver);
+        run.start_correction = mul(&start.mobility, &beyond);
+        self.cycle.run = run;
+        self.cycle.pending = Some(held);
+        deliver.iter().any(|q| *q != 0.0).then_some(deliver)
+    }
+
+    /// [`finish_cycle`](ClearanceJoint::finish_cycle) for the spatial joint: the regions
+    /// evaluated at the bodies' poses with the sub-cycle's end velocity (their histories are the
+    /// sub-cycle's), the states inside the step, the impulse left held.
+    pub(in crate::rapier::joint) fn finish_spatial_cycle(
+        &mut self,
+        bodies: &RigidBodySet,
+        mechanism: &Mechanism,
+    ) -> Option<(Wrench, Wrench)> {
+        let held = self.cycle.pending.take()?;
+        let end = *self.cycle.run.samples.last()?;
+        let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
+        let v = self.cycle.run.end_velocity;
+        let (mut m1, mut m2) = (motion(rb1), motion(rb2));
+        (m1.linvel, m1.angvel, m2.linvel, m2.angvel) =
+            (part(&v, 0), part(&v, 1), part(&v, 2), part(&v, 3));
+        let pair = Pair([Mobility::of(rb1), Mobility::of(rb2)], mechanism);
+        let mut parts = self.spatial.take()?;
+        let transverse = *rb1.rotation() * parts.local_transverse1;
+        let pose = self.spatial_pose(rb1, rb2, transverse);
+        self.contact = self.cycle.run.history;
+        self.report.state = end.state;
+        let result = self.evaluate_regions(&mut parts, &pose, [&m1, &m2], &pair, [0.0, 0.0]);
+        self.spatial = Some(parts);
+        self.report.max_stable_dt = f64::INFINITY;
+        self.report.friction_stable_dt = f64::INFINITY;
+        self.elastic = std::sync::OnceLock::new();
+        self.cycle.adopt_run(held);
+        result
+    }
+}

@@ -1,0 +1,383 @@
+//! One joint's sub-steps: the contact at a position of the sub-cycle ([`Here`]), the kick
+//! (the law's elastic force at the position, damping and friction implicit), the sub-step's
+//! length, and what a sub-cycle hands back ([`SubCycle`]).
+
+use super::pair::{Motion, Pair12, PairStart, axpy, dot, load, mul, part, rotate, row};
+use super::{APPROACH_FRACTION, MAX_SUBSTEPS, STABLE_FRACTION_PER_TOLERANCE, SubStep};
+use crate::model::kinematics::{BodyMotion, JournalState, journal_state};
+use crate::model::laws::{FrictionLaw, NormalContact, NormalForceLaw, loaded_impact_rate};
+use crate::rapier::joint::{ClearanceJoint, ContactAhead, ContactHistory};
+use rapier3d_f64::math::Vector;
+
+/// The contact at one position of the sub-cycle, linearised for the kick.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Here {
+    pub(super) state: JournalState,
+    /// The bearing's and the journal's centres, and the hinge's axis.
+    pub(super) centres: [Vector; 2],
+    pub(super) axis: Vector,
+    /// The acceleration of the journal's centre relative to the bearing's in the plane, from the
+    /// rest of the world's accelerations (with the bodies' centripetal terms), m/s².
+    pub(super) centre_acceleration: Vector,
+    pub(super) com: [Vector; 2],
+    pub(super) tangent: Vector,
+    /// Rows reading the penetration rate and the slip along `tangent`.
+    pub(super) rows: [Pair12; 2],
+    /// Loads of a unit normal force (pushing the journal out, along `-n`) and a unit force along
+    /// `tangent`, and the pair's velocity change per unit of each.
+    pub(super) loads: [Pair12; 2],
+    pub(super) moves: [Pair12; 2],
+    /// `w[r][c]`: the rate read by row `r` per unit of load `c`.
+    pub(super) w: [[f64; 2]; 2],
+}
+
+impl Here {
+    /// The state here with its rates at the pair's velocity `v`.
+    pub(super) fn rates_at(&self, v: &Pair12) -> JournalState {
+        let [p_i, p_j] = self.centres;
+        let centre =
+            |k: usize, p: Vector| part(v, 2 * k) + part(v, 2 * k + 1).cross(p - self.com[k]);
+        let centres = centre(1, p_j) - centre(0, p_i);
+        JournalState {
+            penetration_rate: dot(&self.rows[0], v),
+            slip: dot(&self.rows[1], v) * self.tangent,
+            eccentricity_rate: centres - centres.dot(self.axis) * self.axis,
+            ..self.state
+        }
+    }
+
+    /// Effective mass along the normal, kg (infinite when nothing moves along it).
+    pub(super) fn mass(&self) -> f64 {
+        if self.w[0][0] < 0.0 {
+            -1.0 / self.w[0][0]
+        } else {
+            f64::INFINITY
+        }
+    }
+}
+
+/// The outcome of one sub-cycle.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SubCycle {
+    /// The contact's impulse over the step, `Gamma(h)`.
+    pub(crate) impulse: Pair12,
+    /// `Pi/h`: the mean over the step of the impulse accumulated by each sub-step's start.
+    pub(crate) mean: Pair12,
+    /// The pair's velocity at the step's end.
+    pub(crate) end_velocity: Pair12,
+    /// The displacement held by the last finished step, `E` (impulse times time: the pair
+    /// stands at Rapier's poses moved by `P E`), with the impulse held beside it, by which a
+    /// step retaken from a restored state finds it ([`SubCycle::held_shift`]).
+    pub(crate) shift: HeldShift,
+    /// The displacement this step leaves held, `E'`, taken as `shift` when the step finishes.
+    pub(crate) shift_next: Pair12,
+    pub(crate) history: ContactHistory,
+    pub(crate) samples: Vec<SubStep>,
+    /// The normal's effective mass at the end, kg.
+    pub(crate) end_mass: f64,
+    pub(crate) substeps: u32,
+    /// The pair's velocity at the step's start beyond the Verlet reading of Rapier's
+    /// velocities around it ([`ClearanceJoint::start_velocity_correction`]).
+    pub(crate) start_correction: Pair12,
+    /// The energy the damping and friction took over the step, J.
+    pub(crate) dissipated: f64,
+}
+
+/// The displacements held by the last two finished steps, each with the impulse held beside it
+/// (newest first): a step the stepper rejects restores the impulse held before it, and with
+/// it the displacement held before it.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct HeldShift {
+    pub(super) last: [(Pair12, Pair12); 2],
+}
+
+impl SubCycle {
+    /// The displacement held with the impulse `held` (zero when neither of the last two
+    /// finished steps held that impulse: a first step, or a state restored from further back).
+    pub(super) fn held_shift(&self, held: &Pair12) -> Pair12 {
+        self.shift
+            .last
+            .iter()
+            .find(|(h, _)| h == held)
+            .map_or([0.0; 12], |(_, e)| *e)
+    }
+}
+
+/// What a sub-cycle integrates over one world step of `h` (s), from the pair's state `start`
+/// with the velocity `u0` at the state, under the rest of the world's acceleration `a_free`.
+pub(crate) struct Cycle<'a> {
+    pub(crate) joint: &'a ClearanceJoint,
+    pub(crate) start: &'a PairStart,
+    pub(crate) u0: Pair12,
+    /// Where the pair stands beyond Rapier's poses at the start (the held displacement moved
+    /// through the mobilities): shifts, then turns, as [`Pair12`].
+    pub(crate) offset: Pair12,
+    pub(crate) a_free: Pair12,
+    /// [`PairStart::stabilisation`]: shifts, then turns.
+    pub(crate) stabilisation: [[Vector; 2]; 2],
+    pub(crate) h: f64,
+    pub(crate) tolerance: f64,
+}
+
+impl Cycle<'_> {
+    pub(super) fn here(&self, m: &Motion) -> Here {
+        let s = self.start;
+        let com = [s.com[0] + m.shift[0], s.com[1] + m.shift[1]];
+        let p_i = com[0] + rotate(m.turn[0], s.anchor[0]);
+        let p_j = com[1] + rotate(m.turn[1], s.anchor[1]);
+        let axis = rotate(m.turn[0], s.axis);
+        let motion = |k: usize| BodyMotion {
+            center_of_mass: com[k],
+            linvel: part(&m.v, 2 * k),
+            angvel: part(&m.v, 2 * k + 1),
+        };
+        let g = &self.joint.geometry;
+        let state = journal_state(g, p_i, p_j, axis, &motion(0), &motion(1));
+        let n = state.normal;
+        let tangent = axis.cross(n);
+        let q_i = p_i + g.bearing_radius() * n;
+        let q_j = p_j + g.journal_radius() * n;
+        let rows = [row(&com, q_i, q_j, n), row(&com, q_i, q_j, tangent)];
+        let loads = [
+            load(&com, state.contact_point, -n),
+            load(&com, state.contact_point, tangent),
+        ];
+        let moves = loads.map(|l| mul(&s.mobility, &l));
+        let w = [0, 1].map(|r| [0, 1].map(|c| dot(&rows[r], &moves[c])));
+        let point_acceleration = |k: usize, p: Vector| {
+            let (w, r) = (part(&m.v, 2 * k + 1), p - com[k]);
+            part(&self.a_free, 2 * k) + part(&self.a_free, 2 * k + 1).cross(r) + w.cross(w.cross(r))
+        };
+        let relative = point_acceleration(1, p_j) - point_acceleration(0, p_i);
+        Here {
+            state,
+            centres: [p_i, p_j],
+            axis,
+            centre_acceleration: relative - relative.dot(axis) * axis,
+            com,
+            tangent,
+            rows,
+            loads,
+            moves,
+            w,
+        }
+    }
+
+    /// `delta_dot0` for the law in the contact of `history` at `here` (as the explicit joint's).
+    pub(super) fn impact_rate(&self, history: &ContactHistory, here: &Here) -> f64 {
+        let law = &self.joint.normal_law;
+        if history.in_contact && law.uses_impact_rate() {
+            let elastic = law.elastic_energy(here.state.penetration);
+            history
+                .impact_rate
+                .max(loaded_impact_rate(elastic, here.mass()))
+        } else {
+            history.impact_rate
+        }
+    }
+
+    /// The next sub-step from `here` (velocity `v` read there), at most `left` (s).
+    pub(super) fn substep(&self, here: &Here, history: &ContactHistory, left: f64) -> f64 {
+        let j = self.joint;
+        let st = &here.state;
+        let mass = here.mass();
+        let ahead = |speed: f64, depth: f64| {
+            let contact = ContactAhead {
+                mass,
+                approach_speed: speed,
+                depth,
+                impact_rate: history.in_contact.then_some(history.impact_rate),
+                min_impact_speed: j.min_impact_speed,
+            };
+            let elastic = j.normal_law.elastic_energy(depth);
+            let stable = STABLE_FRACTION_PER_TOLERANCE * self.tolerance;
+            contact.resolving_step(&j.normal_law, elastic, self.tolerance, stable)
+        };
+        let s = if st.penetration > 0.0 {
+            ahead(st.penetration_rate.abs(), st.penetration)
+        } else {
+            let c = j.geometry.clearance();
+            let (e, v, a) = (
+                st.eccentricity,
+                st.eccentricity_rate,
+                here.centre_acceleration,
+            );
+            // The wall is predicted from the centre's path as a parabola: a free sub-step
+            // moves it by at most `tolerance` of the clearance (the world step's own journal
+            // path bound), so a turning body's path meets the wall where the parabola says.
+            let path = crate::rapier::joint::flight_step(self.tolerance, c, v.length());
+            match time_to_wall(e, v, a, c, left.min(path)) {
+                None => left.min(path),
+                Some(t) => {
+                    let n = (e + v * t + 0.5 * a * t * t).normalize_or_zero();
+                    let speed = (v + a * t).dot(n).max(0.0);
+                    let own = ahead(speed, 0.0);
+                    if t <= own {
+                        // Onto the wall: the contact begins at a sub-step's end, where a law
+                        // whose force jumps at the onset (Kelvin-Voigt's damping) starts whole.
+                        t * (1.0 + 1e-9) + 1e-15 * self.h
+                    } else {
+                        (APPROACH_FRACTION * t).max(own)
+                    }
+                }
+            }
+        };
+        let s = s.max(1e-9 * self.h);
+        // No sliver of a last sub-step.
+        if s >= 0.95 * left { left } else { s }
+    }
+
+    /// The sub-step after one of `s` that left `left` (s) of the step, from `here`: 0 when that
+    /// was the last, the rest of the step beyond [`MAX_SUBSTEPS`].
+    pub(super) fn next_substep(
+        &self,
+        here: &Here,
+        history: &ContactHistory,
+        left: f64,
+        count: u32,
+    ) -> f64 {
+        if left <= 0.0 {
+            0.0
+        } else if count >= MAX_SUBSTEPS {
+            left
+        } else {
+            self.substep(here, history, left)
+        }
+    }
+
+    /// A kick at `here`: `v += sigma a + sigma_c P F`, the rest of the world acting over `sigma`
+    /// (s) and the contact over `sigma_c` (s; shorter at an onset, where it acts from the
+    /// crossing on), its force taken at the state's velocity `(1 - beta) v_before + beta v_after`
+    /// (implicit for `beta > 0`). Returns the force (normal, along the tangent), the impulse and
+    /// the energy the damping and friction took over the span (J).
+    pub(super) fn kick(
+        &self,
+        here: &Here,
+        v: &mut Pair12,
+        (sigma, sigma_c): (f64, f64),
+        beta: f64,
+        impact_rate: f64,
+    ) -> ([f64; 2], Pair12, f64) {
+        let c_a = [dot(&here.rows[0], v), dot(&here.rows[1], v)];
+        // The rates the rest of the world brings over the span.
+        let a = [
+            sigma * dot(&here.rows[0], &self.a_free),
+            sigma * dot(&here.rows[1], &self.a_free),
+        ];
+        let delta = here.state.penetration;
+        let mut f = [0.0, 0.0];
+        let mut dissipated = 0.0;
+        if delta > 0.0 {
+            let law = &self.joint.normal_law;
+            let contact = NormalContact {
+                penetration: delta,
+                penetration_rate: 0.0,
+                impact_rate,
+            };
+            let elastic = law.elastic_force(delta);
+            let damping = law.damping_coefficient(&contact);
+            let w = &here.w;
+            let bs = beta * sigma_c;
+            for _ in 0..50 {
+                // The normal force is affine in the rate (every law here): solved exactly.
+                let c0n = c_a[0] + beta * a[0] + bs * w[0][1] * f[1];
+                let f_n = ((elastic + damping * c0n) / (1.0 - damping * bs * w[0][0])).max(0.0);
+                let c0t = c_a[1] + beta * a[1] + bs * w[1][0] * f_n;
+                let k = bs * w[1][1] * f_n;
+                let slip = implicit_slip(&self.joint.friction_law, c0t, k);
+                let f_t = -self.joint.friction_law.coefficient(slip.abs()) * f_n * slip.signum();
+                let change = (f_n - f[0]).abs() + (f_t - f[1]).abs();
+                f = [f_n, if slip == 0.0 { 0.0 } else { f_t }];
+                if change <= 1e-13 * (f_n + 1e-300) {
+                    break;
+                }
+            }
+            // The rates at the state, with the force found: the damping's share of the normal
+            // force and the friction work against them.
+            let c_m = [0, 1].map(|r| c_a[r] + beta * a[r] + bs * (w[r][0] * f[0] + w[r][1] * f[1]));
+            if f[0] > 0.0 {
+                dissipated = sigma_c * ((f[0] - elastic) * c_m[0] - f[1] * c_m[1]);
+            }
+        }
+        axpy(v, sigma, &self.a_free);
+        axpy(v, sigma_c * f[0], &here.moves[0]);
+        axpy(v, sigma_c * f[1], &here.moves[1]);
+        let mut impulse = [0.0; 12];
+        axpy(&mut impulse, sigma_c * f[0], &here.loads[0]);
+        axpy(&mut impulse, sigma_c * f[1], &here.loads[1]);
+        (f, impulse, dissipated)
+    }
+}
+
+/// The first time within `left` (s) at which the eccentricity `e + v t + a t^2/2` (m, m/s,
+/// m/s²) can reach the clearance `c` (m), `None` when it stays inside. Marched by safe steps:
+/// from each point the gap cannot close faster than the path's speed and acceleration allow,
+/// so no contact is stepped over, and a path straight at the wall lands on it in one step.
+pub(super) fn time_to_wall(e: Vector, v: Vector, a: Vector, c: f64, left: f64) -> Option<f64> {
+    let acc = a.length();
+    let mut t = 0.0;
+    for _ in 0..200 {
+        let gap = c - (e + v * t + 0.5 * a * t * t).length();
+        if gap <= 0.0 {
+            return Some(t);
+        }
+        let speed = (v + a * t).length();
+        // The earliest the gap can close: speed dt + acc dt^2/2 = gap.
+        let dt = if acc > 0.0 {
+            2.0 * gap / (speed + (speed * speed + 2.0 * acc * gap).sqrt())
+        } else if speed > 0.0 {
+            gap / speed
+        } else {
+            return None;
+        };
+        t += dt;
+        if t >= left {
+            return None;
+        }
+        if dt <= 1e-12 * t {
+            return Some(t);
+        }
+    }
+    Some(t)
+}
+
+/// The slip `x` at the state with friction taken there: `x = c0 - k mu(|x|) sign(x)`, `c0` the
+/// slip without this sub-step's friction, `k >= 0` the slip friction's full coefficient removes.
+/// A root lies between 0 and `c0` (friction opposes the slip and never reverses it alone);
+/// bracketed by bisection with a secant guess, as the law may fall with speed (Stribeck).
+pub(super) fn implicit_slip(law: &impl FrictionLaw, c0: f64, k: f64) -> f64 {
+    if c0 == 0.0 || !(k > 0.0) {
+        return c0;
+    }
+    let sign = c0.signum();
+    let target = c0.abs();
+    // g(x) = x + k mu(x) - target over [0, target]: g(0) <= 0 <= g(target).
+    let g = |x: f64| x + k * law.coefficient(x) - target;
+    let (mut lo, mut hi) = (0.0, target);
+    let (mut g_lo, mut g_hi) = (g(lo), g(hi));
+    if g_lo >= 0.0 {
+        return 0.0;
+    }
+    for _ in 0..200 {
+        let secant = lo - g_lo * (hi - lo) / (g_hi - g_lo);
+        let mid = 0.5 * (lo + hi);
+        // The secant when it falls well inside the bracket, else the midpoint.
+        let x = if secant > lo + 0.01 * (hi - lo) && secant < hi - 0.01 * (hi - lo) {
+            secant
+        } else {
+            mid
+        };
+        let gx = g(x);
+        if gx <= 0.0 {
+            lo = x;
+            g_lo = gx;
+        } else {
+            hi = x;
+            g_hi = gx;
+        }
+        if hi - lo <= 1e-14 * target + 1e-300 {
+            break;
+        }
+    }
+    sign * 0.5 * (lo + hi)
+}

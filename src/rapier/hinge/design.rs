@@ -91,7 +91,7 @@ pub struct HingeDesign {
     pub min_separation: f64,
     /// The deepest penetration at which the contact law is trusted, m; deeper contacts are guard
     /// violations ([`ClearanceJointBuilder::max_valid_penetration`]). `None` (the default): 1 % of
-    /// the journal radius ([`crate::rapier::joint::default_max_valid_penetration`]).
+    /// the journal radius.
     pub max_valid_penetration: Option<f64>,
     /// What holds the out-of-plane degrees of freedom (default [`OutOfPlaneLock::Joint`]);
     /// ignored by [`ClearanceModel::Spatial`], which locks nothing.

@@ -26,13 +26,13 @@ pub struct TorsionSpring {
 impl TorsionSpring {
     /// The largest preload, N m: a torque beyond it drives any body of a mechanism past the
     /// speed guard within a step.
-    pub const MAX_TORQUE: f64 = 1e9;
+    pub(crate) const MAX_TORQUE: f64 = 1e9;
 
     /// The largest stiffness, N m/rad.
-    pub const MAX_STIFFNESS: f64 = 1e12;
+    pub(crate) const MAX_STIFFNESS: f64 = 1e12;
 
-    /// Preload `torque0` (N m, at most [`MAX_TORQUE`](Self::MAX_TORQUE) either way) and
-    /// `stiffness` (N m/rad, from 0 to [`MAX_STIFFNESS`](Self::MAX_STIFFNESS)), about
+    /// Preload `torque0` (N m, at most 1e9 either way) and `stiffness` (N m/rad, from 0 to
+    /// 1e12), about
     /// `local_axis1` (body 1's frame); errors name `torque0`, `stiffness` or `axis`.
     pub fn new(
         body1: RigidBodyHandle,

@@ -182,7 +182,7 @@ impl ClearanceJointSet {
     }
 
     /// Sets the length of the step that led to the bodies' current state, s, for the next
-    /// [`evaluate`](Self::evaluate) or [`apply_forces`](Self::apply_forces).
+    /// [`evaluate`](StepHooks::evaluate) or [`apply_forces`](Self::apply_forces).
     ///
     /// Rapier's velocities after a step are the mean over it (a Verlet step), half a step behind
     /// the state; a contact's damping read from them is wrong by a first-order error in the step
@@ -214,7 +214,7 @@ impl ClearanceJointSet {
     /// `impulse_joints` are the world's Rapier joints: the contact's effective mass is taken
     /// through the ideal joints that hold its bodies (an arm's pivot, a slider's guide), which
     /// set how hard a journal strikes its wall (the laws' damping, the step bounds).
-    pub fn evaluate(&mut self, bodies: &mut RigidBodySet, impulse_joints: &ImpulseJointSet) {
+    pub(crate) fn evaluate(&mut self, bodies: &mut RigidBodySet, impulse_joints: &ImpulseJointSet) {
         self.wrenches.clear();
         self.applied.clear();
         self.retaking = false;

@@ -98,7 +98,7 @@ impl Stall {
     /// Names body `handle` `label` in the message (a scene's `` body `crank` ``): the step
     /// control knows only Rapier's handles, `body (0, 0)`. The first label given for a handle
     /// is used.
-    pub fn name_body(&mut self, handle: RigidBodyHandle, label: impl Into<String>) {
+    pub(crate) fn name_body(&mut self, handle: RigidBodyHandle, label: impl Into<String>) {
         self.body_names.push((handle, label.into()));
     }
 }

@@ -163,7 +163,7 @@ impl DriveSet {
     }
     /// Replaces the torques applied at the previous call by the current ones (for a loop that
     /// calls `world.step()` itself; the [`Stepper`](crate::rapier::pipeline::stepper::Stepper) uses
-    /// [`evaluate`](Self::evaluate) and adds the torques for its step only).
+    /// [`evaluate`](StepHooks::evaluate) and adds the torques for its step only).
     pub fn apply(&mut self, bodies: &mut RigidBodySet) {
         self.evaluate(bodies);
         self.ledger.replace(bodies, self.wrenches.iter().copied());
@@ -171,7 +171,7 @@ impl DriveSet {
 
     /// Measures the angles and computes the torques of [`wrenches`](Self::wrenches), without
     /// touching the bodies' forces.
-    pub fn evaluate(&mut self, bodies: &RigidBodySet) {
+    pub(crate) fn evaluate(&mut self, bodies: &RigidBodySet) {
         self.wrenches.clear();
         for d in self.drives.values_mut() {
             if let Some((w1, w2)) = d.evaluate(bodies) {

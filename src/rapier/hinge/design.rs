@@ -97,7 +97,7 @@ pub struct HingeDesign {
     /// ignored by [`ClearanceModel::Spatial`], which locks nothing.
     pub(crate) lock: OutOfPlaneLock,
     /// Name used in errors and reports (default: the builder's default name).
-    pub(crate) name: Option<String>,
+    pub name: Option<String>,
     /// Which model to build (default [`ClearanceModel::Compliant`]).
     pub model: ClearanceModel,
     /// Coefficient of restitution of the large-step model's bounces; `None` (the default): the

@@ -182,7 +182,7 @@ impl DriveSet {
     }
 
     /// The torques of the last evaluation, two per drive.
-    pub fn wrenches(&self) -> &[Wrench] {
+    pub(crate) fn wrenches(&self) -> &[Wrench] {
         &self.wrenches
     }
     /// Takes back, exactly, every torque this set applied at its last [`apply`](Self::apply)

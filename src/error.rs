@@ -1,7 +1,7 @@
 //! Errors as values: every failure names the field or file it concerns and says why.
 
-use crate::rapier::observers::guards::Violation;
 use crate::rapier::observers::stall::Stall;
+use crate::rapier::pipeline::protocol::Violation;
 use std::path::PathBuf;
 
 /// Everything that can go wrong in this crate. Nothing here panics on bad input.

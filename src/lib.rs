@@ -53,7 +53,7 @@
 //! force hook), [`LargeStepJointSet`](rapier::large_step::LargeStepJointSet) (the play as a
 //! constraint, for game and robot rates), [`Stepper`](rapier::pipeline::stepper::Stepper) with
 //! [`StepControl`](rapier::pipeline::stepper::StepControl) (step choice, acceptance,
-//! [`GuardReport`](rapier::pipeline::stepper::GuardReport)), the step protocol every set implements
+//! [`GuardReport`](rapier::pipeline::protocol::GuardReport)), the step protocol every set implements
 //! ([`StepHooks`](rapier::pipeline::step_hooks::StepHooks)), and
 //! [`ClearanceJointBuilder`](rapier::joint::ClearanceJointBuilder) for a joint built from scratch.
 //! [`ClearanceWorld`](rapier::pipeline::world::ClearanceWorld) bundles them; the scene runner and the

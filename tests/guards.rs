@@ -4,7 +4,8 @@
 
 use clearance_joint::Error;
 use clearance_joint::prelude::*;
-use clearance_joint::rapier::pipeline::stepper::{GuardKind, StepControl, Stepper};
+use clearance_joint::rapier::pipeline::protocol::GuardKind;
+use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::runner::{RunOptions, Simulation};
 use rapier3d_f64::prelude::*;

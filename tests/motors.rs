@@ -3,8 +3,8 @@
 //! applied, the energy balance with the motors' work, the motor fields' validation, and the
 //! motor-driven four-bar under adaptive steps against a fine fixed-step run.
 
-use clearance_joint::rapier::observers::guards::Violation;
-use clearance_joint::rapier::pipeline::stepper::GuardKind;
+use clearance_joint::rapier::pipeline::protocol::GuardKind;
+use clearance_joint::rapier::pipeline::protocol::Violation;
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::runner::{RunOptions, Simulation, TwinKind, Twins};
 use rapier3d_f64::prelude::{JointAxesMask, JointAxis};

@@ -14,9 +14,6 @@ use clearance_joint::model::kinematics::{BodyMotion, contact_force, journal_stat
 use clearance_joint::model::laws::*;
 use clearance_joint::rapier::joint::ClearanceJointBuilder;
 use clearance_joint::rapier::large_step::LargeStepJointBuilder;
-use clearance_joint::rapier::large_step::resolution::{
-    quantized_substeps, rocking_frequency, substeps_needed,
-};
 use clearance_joint::rapier::observers::metrics::{
     ContactObservation, Impact, ImpactRecorder, per_period,
 };
@@ -177,13 +174,6 @@ proptest! {
         }
         let (dt, omega, zeta) = stable_step(x, x0, h0);
         prop_assert!(!dt.is_nan() && dt >= 0.0, "stable_step({x}, {x0}, {h0}) = {dt}, {omega}, {zeta}");
-        let r = rocking_frequency(x, x0, h0);
-        let n = substeps_needed(x, x0, h0, x1, h1);
-        prop_assert!(!n.is_nan() && n >= 1.0, "substeps_needed = {n}");
-        let q = quantized_substeps(n, 1, 64);
-        prop_assert!((1..=64).contains(&q), "quantized_substeps({n}) = {q}");
-        let q = quantized_substeps(r, 4, 4096);
-        prop_assert!((4..=4096).contains(&q), "quantized_substeps({r}) = {q}");
         let m = SoftMotor::force_based(x, x0, h0.abs(), h1.abs());
         let f = m.force(x1, h0, h1);
         prop_assert!(f.is_nan() || (-m.max_force..=m.max_force).contains(&f));

@@ -11,7 +11,7 @@ use clearance_joint::model::laws::{
 use clearance_joint::model::spatial::{End, FaceLaw, SpatialModel};
 use clearance_joint::prelude::*;
 use clearance_joint::rapier::joint::Region;
-use clearance_joint::rapier::observers::guards::GuardKind;
+use clearance_joint::rapier::pipeline::protocol::GuardKind;
 use rapier3d_f64::prelude::*;
 
 #[path = "support/arm.rs"]

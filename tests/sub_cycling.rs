@@ -121,7 +121,7 @@ fn a_friction_held_journal_rests_at_game_and_robot_steps_with_its_static_balance
 /// a strict step control an error; at the default tolerance the same run is clean.
 #[test]
 fn a_sub_cycle_beyond_its_sub_step_cap_is_a_guard_violation() {
-    use clearance_joint::rapier::observers::guards::GuardKind;
+    use clearance_joint::rapier::pipeline::protocol::GuardKind;
     let sub_cycled = ContactIntegration::SubCycled;
     let control = StepControl::fixed(1.0 / 60.0).with_tolerance(1e-6);
     let (world, _) = held_journal(0.0, control, 1, 0.05, sub_cycled).unwrap();

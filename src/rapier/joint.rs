@@ -37,7 +37,7 @@ pub use set::{ClearanceJointHandle, ClearanceJointSet};
 pub use spatial::report::{Region, SpatialPoint, SpatialReport};
 use spatial::{SpatialMemory, SpatialParts};
 use step_policy::ContactAhead;
-pub use step_policy::{CONTACT_PERIODS_PER_TOLERANCE, flight_step};
+pub(crate) use step_policy::flight_step;
 pub use subcycle::{ContactIntegration, SubStep};
 use subcycle::{PairStart, SubCycle};
 
@@ -75,15 +75,15 @@ pub struct ClearanceJointBuilder {
 }
 
 /// Default of [`ClearanceJointBuilder::min_impact_speed`], m/s.
-pub const DEFAULT_MIN_IMPACT_SPEED: f64 = 1e-4;
+pub(crate) const DEFAULT_MIN_IMPACT_SPEED: f64 = 1e-4;
 
 /// Default of [`ClearanceJointBuilder::min_separation`], m.
-pub const DEFAULT_MIN_SEPARATION: f64 = 1e-7;
+pub(crate) const DEFAULT_MIN_SEPARATION: f64 = 1e-7;
 
 /// The default validity limit of a joint's penetration, m: 1 % of the journal radius (95 um
 /// for a 10 mm bearing with 0.5 mm of clearance), a nominal compressive strain `delta/R_j` of
 /// 1 %, within the small strain of the linear elastic laws (docs/MODEL.md, "Validity").
-pub fn default_max_valid_penetration(geometry: &BearingGeometry) -> f64 {
+pub(crate) fn default_max_valid_penetration(geometry: &BearingGeometry) -> f64 {
     DEFAULT_VALID_STRAIN * geometry.journal_radius()
 }
 
@@ -277,8 +277,7 @@ impl ClearanceJoint {
     }
 
     /// The deepest penetration at which the contact law is trusted, m
-    /// ([`ClearanceJointBuilder::max_valid_penetration`]; default
-    /// [`default_max_valid_penetration`]).
+    /// ([`ClearanceJointBuilder::max_valid_penetration`]; default 1 % of the journal radius).
     pub fn max_valid_penetration(&self) -> f64 {
         self.max_valid_penetration
             .unwrap_or_else(|| default_max_valid_penetration(&self.geometry))

@@ -35,7 +35,7 @@ pub struct Summary {
     pub stepping: String,
     /// What the run-time guards saw: rejected steps, the deepest penetration against its law's
     /// validity, steps at the floor, and violations in words (empty when the run stayed valid).
-    pub guards: crate::rapier::pipeline::stepper::GuardReport,
+    pub guards: crate::rapier::pipeline::protocol::GuardReport,
     /// The convergence check's verdict: which metrics converged against a run at half the
     /// tolerance, which did not, and what the check cost; or why none was made
     /// ([`ConvergenceVerdict`]).

@@ -8,7 +8,7 @@
 #![allow(dead_code)] // the test uses a part of it
 
 use clearance_joint::rapier::observers::metrics::Impact;
-use clearance_joint::rapier::pipeline::stepper::Violation;
+use clearance_joint::rapier::pipeline::protocol::Violation;
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::runner::{RunOptions, Simulation, TwinKind, Twins};
 use std::path::{Path, PathBuf};

@@ -82,20 +82,20 @@ pub struct HingeDesign {
     /// Normal contact law.
     pub normal: NormalModel,
     /// Friction law (default none).
-    pub friction: FrictionModel,
+    pub(crate) friction: FrictionModel,
     /// Floor on the impact velocity of the hysteresis laws, m/s (default 1e-4).
-    pub min_impact_speed: f64,
+    pub(crate) min_impact_speed: f64,
     /// Gap a free flight must open for the next onset to count as an
     /// [impact](crate::rapier::observers::metrics#onsets-impacts-and-chatter), m (default 0.1 um; the
     /// large-step model does not count impacts and ignores it).
-    pub min_separation: f64,
+    pub(crate) min_separation: f64,
     /// The deepest penetration at which the contact law is trusted, m; deeper contacts are guard
     /// violations ([`ClearanceJointBuilder::max_valid_penetration`]). `None` (the default): 1 % of
-    /// the journal radius ([`crate::rapier::joint::default_max_valid_penetration`]).
-    pub max_valid_penetration: Option<f64>,
+    /// the journal radius.
+    pub(crate) max_valid_penetration: Option<f64>,
     /// What holds the out-of-plane degrees of freedom (default [`OutOfPlaneLock::Joint`]);
     /// ignored by [`ClearanceModel::Spatial`], which locks nothing.
-    pub lock: OutOfPlaneLock,
+    pub(crate) lock: OutOfPlaneLock,
     /// Name used in errors and reports (default: the builder's default name).
     pub name: Option<String>,
     /// Which model to build (default [`ClearanceModel::Compliant`]).
@@ -104,10 +104,10 @@ pub struct HingeDesign {
     /// normal law's own restitution at each bounce ([`crate::rapier::large_step::Restitution::Law`]).
     /// The compliant and spatial models take their restitution from their laws:
     /// [`joint`](Self::joint) refuses a set one, naming `restitution`.
-    pub restitution: Option<f64>,
+    pub(crate) restitution: Option<f64>,
     /// How the compliant planar joint integrates its contact (default
     /// [`ContactIntegration::Explicit`](crate::rapier::joint::ContactIntegration::Explicit)).
-    pub integration: crate::rapier::joint::ContactIntegration,
+    pub(crate) integration: crate::rapier::joint::ContactIntegration,
 }
 
 impl HingeDesign {

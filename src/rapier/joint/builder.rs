@@ -79,8 +79,8 @@ impl ClearanceJointBuilder {
         self
     }
     /// The deepest penetration at which the contact law is still trusted, m (default 1 % of the
-    /// journal radius, see [`default_max_valid_penetration`]). A journal pressed deeper is outside the model; the
-    /// steppers report it as a guard violation ([`crate::rapier::pipeline::stepper::GuardReport`]), with
+    /// journal radius, a nominal strain of 1 %). A journal pressed deeper is outside the model; the
+    /// steppers report it as a guard violation ([`crate::rapier::pipeline::protocol::GuardReport`]), with
     /// the worst depth, when and how often. It is not a force limit.
     pub fn max_valid_penetration(mut self, depth: f64) -> Self {
         self.joint.max_valid_penetration = Some(depth);

@@ -47,7 +47,7 @@ impl ClearanceJointSet {
     /// [`OutOfPlaneLock::Joint`] it also inserts into `impulse_joints` the Rapier joint that locks
     /// the axial translation and the two tilts. Refused, naming `body1` or `body2`, unless both
     /// are in `bodies` and not the same body, and naming `local_axis2` when a spatial joint's
-    /// journal does not lie in its bore ([`ClearanceJoint::check_start`]); nothing is added then.
+    /// journal does not lie in its bore; nothing is added then.
     pub fn insert(
         &mut self,
         body1: RigidBodyHandle,
@@ -182,7 +182,7 @@ impl ClearanceJointSet {
     }
 
     /// Sets the length of the step that led to the bodies' current state, s, for the next
-    /// [`evaluate`](Self::evaluate) or [`apply_forces`](Self::apply_forces).
+    /// [`evaluate`](StepHooks::evaluate) or [`apply_forces`](Self::apply_forces).
     ///
     /// Rapier's velocities after a step are the mean over it (a Verlet step), half a step behind
     /// the state; a contact's damping read from them is wrong by a first-order error in the step
@@ -198,8 +198,8 @@ impl ClearanceJointSet {
     }
 
     /// The force evaluation of [`apply`](Self::apply) without its checks, for callers that choose
-    /// the step after seeing the contact state (adaptive stepping) and then call
-    /// [`check_step`](Self::check_step) themselves.
+    /// the step after seeing the contact state (adaptive stepping) and then check it themselves
+    /// ([`StepHooks::check_step`]).
     pub fn apply_forces(&mut self, bodies: &mut RigidBodySet, impulse_joints: &ImpulseJointSet) {
         self.evaluate(bodies, impulse_joints);
         self.ledger.replace(bodies, self.wrenches.iter().copied());
@@ -214,7 +214,7 @@ impl ClearanceJointSet {
     /// `impulse_joints` are the world's Rapier joints: the contact's effective mass is taken
     /// through the ideal joints that hold its bodies (an arm's pivot, a slider's guide), which
     /// set how hard a journal strikes its wall (the laws' damping, the step bounds).
-    pub fn evaluate(&mut self, bodies: &mut RigidBodySet, impulse_joints: &ImpulseJointSet) {
+    pub(crate) fn evaluate(&mut self, bodies: &mut RigidBodySet, impulse_joints: &ImpulseJointSet) {
         self.wrenches.clear();
         self.applied.clear();
         self.retaking = false;
@@ -315,7 +315,7 @@ impl ClearanceJointSet {
 
     /// Refuses Rapier substeps (`num_solver_iterations != 1`) when the set holds joints that
     /// are not sub-cycled (a sub-cycled joint delivers its impulse through any number).
-    pub fn check_substeps(&self, params: &IntegrationParameters) -> Result<()> {
+    pub(crate) fn check_substeps(&self, params: &IntegrationParameters) -> Result<()> {
         let explicit = self.joints.values().any(|j| !j.sub_cycled());
         if params.num_solver_iterations != 1 && explicit {
             return Err(Error::invalid(
@@ -337,7 +337,7 @@ impl ClearanceJointSet {
     }
 
     /// Checks `dt` against every joint's current stability limit.
-    pub fn check_step(&self, dt: f64) -> Result<()> {
+    pub(crate) fn check_step(&self, dt: f64) -> Result<()> {
         for j in self.joints.values() {
             if j.prepared && j.last_wrenches.is_none() {
                 return Err(Error::invalid(
@@ -408,19 +408,10 @@ impl ClearanceJointSet {
     }
 
     /// Smallest [`ClearanceJoint::adaptive_step`] over all joints (infinite without joints).
-    pub fn adaptive_step(&self, tolerance: f64, last_dt: f64) -> f64 {
+    pub(crate) fn adaptive_step(&self, tolerance: f64, last_dt: f64) -> f64 {
         self.joints
             .values()
             .map(|j| j.adaptive_step(tolerance, last_dt))
-            .fold(f64::INFINITY, f64::min)
-    }
-
-    /// Smallest stability limit over all joints at the last application (infinite when no
-    /// joint is in contact), s.
-    pub fn max_stable_dt(&self) -> f64 {
-        self.joints
-            .values()
-            .map(|j| j.report.max_stable_dt)
             .fold(f64::INFINITY, f64::min)
     }
 }

@@ -182,7 +182,7 @@ impl ClearanceJoint {
     /// Whether a spatial joint can start from the bodies' poses: its journal's axis must lie in
     /// its bore (a tilt whose edges alone would press past the law's validity is refused, naming
     /// `local_axis2`). Planar joints pass: their lock aligns the axes.
-    pub fn check_start(&self, rb1: &RigidBody, rb2: &RigidBody) -> crate::error::Result<()> {
+    pub(crate) fn check_start(&self, rb1: &RigidBody, rb2: &RigidBody) -> crate::error::Result<()> {
         if self.spatial.is_none() {
             return Ok(());
         }

@@ -103,13 +103,13 @@ impl ClearanceJoint {
     /// of the last application. `last_dt` is the step taken before it (to estimate the gap's
     /// acceleration).
     ///
-    /// - In contact: twice `tolerance` ([`CONTACT_PERIODS_PER_TOLERANCE`]) of the contact's
+    /// - In contact: twice `tolerance` of the contact's
     ///   natural period `2 pi/omega`, with `omega` at the deepest point the contact's energy
     ///   reaches (its elastic energy plus the kinetic energy of its normal motion, in or out), and
     ///   within the damped stability limit there. The step follows the contact's energy, not the
     ///   phase of its oscillation.
     /// - In free flight: the journal's centre moves at most `tolerance` times the clearance
-    ///   relative to the bearing's in one step ([`flight_step`]: its path across the gap decides
+    ///   relative to the bearing's in one step (its path across the gap decides
     ///   where and how fast the next impact comes), and the contact ahead is predicted from the
     ///   gap, closing speed and acceleration; a step covers at most half the time to it, and no
     ///   less than the step that contact will need.
@@ -192,9 +192,9 @@ impl ClearanceJoint {
     }
 
     /// The step that resolves a contact now `depth` deep (m) whose journal moves at
-    /// `approach_speed` (m/s) along the normal to `2 tolerance` of its natural period
-    /// ([`CONTACT_PERIODS_PER_TOLERANCE`]), taken at the deepest point the contact can reach (its
-    /// elastic energy plus that kinetic energy), and within the damped stability limit there. A
+    /// `approach_speed` (m/s) along the normal to `2 tolerance` of its natural period, taken at
+    /// the deepest point the contact can reach (its elastic energy plus that kinetic energy), and
+    /// within the damped stability limit there. A
     /// spatial joint's contact carries the governing law's
     /// [`contact_share`](spatial::SpatialParts::contact_share): a tilted journal pressed at its
     /// edge is as stiff as the few stations that touch, not the whole width.

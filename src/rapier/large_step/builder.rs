@@ -71,9 +71,8 @@ impl LargeStepJointBuilder {
         self.joint.friction = mu;
         self
     }
-    /// Approach speed below which a contact onset does not bounce, m/s (default
-    /// [`DEFAULT_MIN_IMPACT_SPEED`](crate::rapier::joint::DEFAULT_MIN_IMPACT_SPEED), 1e-4, as
-    /// the compliant joint's).
+    /// Approach speed below which a contact onset does not bounce, m/s (default 1e-4, as the
+    /// compliant joint's).
     pub fn min_impact_speed(mut self, speed: f64) -> Self {
         self.joint.min_impact_speed = speed;
         self

@@ -25,7 +25,9 @@
 //!   journal centre (it shifts the contact along the wall by at most `atan(mu)`) is left out.
 //! - **Resolution, set from the clearance.** Rapier 0.36's coupled limit has no slop term
 //!   (`normalized_allowed_linear_error` only feeds continuous collision detection). What a small
-//!   clearance does need is a fine enough substep; see [`resolution`]. Before each step the joint
+//!   clearance does need is a fine enough substep: one whose rotation drift and sliding along the
+//!   curved wall each stay within 5 % of `c`, and on which the journal's rocking on the wall
+//!   (`sqrt(N/(m_t c))`) stays stable (`omega_r h <= 1`). Before each step the joint
 //!   asks for `base 2^k` substeps (`base = num_solver_iterations`) through the
 //!   `additional_solver_iterations` of its dynamic bodies, only as many as the rotation drift and
 //!   the journal's rocking on the wall need, at most
@@ -78,7 +80,7 @@
 //! ```
 
 mod builder;
-pub mod resolution;
+pub(crate) mod resolution;
 mod set;
 pub use set::{LargeStepJointHandle, LargeStepJointSet};
 
@@ -148,7 +150,7 @@ pub struct LargeStepReport {
     pub eccentricity: Vector,
     /// `|e|/c`: 1 on the wall up to the step's position error. The substeps are chosen, from
     /// the state before the step, to hold the last substep's rotation drift and the sliding
-    /// error along the curved wall to [`DRIFT_FRACTION`](resolution::DRIFT_FRACTION) (5 %) of
+    /// error along the curved wall to 5 % of
     /// `c` each: a step not flagged [`under_resolved`](Self::under_resolved) ends at most 10 %
     /// outside the circle (measured: 1.053 on a swinging arm at 1/60 s, 1.085 on the cobbled
     /// sign of `examples/game_rate.rs` capped at four substeps; a step that ends further out is
@@ -189,7 +191,7 @@ pub struct LargeStepReport {
     pub friction_limit: f64,
     /// Substeps Rapier took for the joint's bodies in this step.
     pub substeps: usize,
-    /// Substeps the step needed (unrounded; see [`resolution`]).
+    /// Substeps the step needed (unrounded; the resolution criteria of [`large_step`](crate::rapier::large_step)).
     pub substeps_needed: f64,
     /// Whether the step was not resolved: it needed more substeps than
     /// [`max_substeps`](LargeStepJointBuilder::max_substeps) allowed (judged from the state

@@ -111,4 +111,41 @@ mod tests {
         assert_eq!(quantized_substeps(3.0, 1, 64), 4);
         assert_eq!(quantized_substeps(5.0, 4, 2), 4, "never below the base");
     }
+
+    #[test]
+    fn any_numbers_give_a_count() {
+        // Every input from the awkward values (non-finite, zero, negative, tiny, huge) gives a
+        // frequency that is not NaN, at least one substep, and a count within the bounds.
+        let values = [
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+            0.0,
+            -1.0,
+            1e-300,
+            0.5e-3,
+            1e300,
+        ];
+        for &x in &values {
+            for &x0 in &values {
+                for &h0 in &values {
+                    let r = rocking_frequency(x, x0, h0);
+                    assert!(
+                        !r.is_nan() && r >= 0.0,
+                        "rocking_frequency({x}, {x0}, {h0}) = {r}"
+                    );
+                    let q = quantized_substeps(r, 4, 4096);
+                    assert!((4..=4096).contains(&q), "quantized_substeps({r}) = {q}");
+                    for &x1 in &values {
+                        for &h1 in &values {
+                            let n = substeps_needed(x, x0, h0, x1, h1);
+                            assert!(!n.is_nan() && n >= 1.0, "substeps_needed = {n}");
+                            let q = quantized_substeps(n, 1, 64);
+                            assert!((1..=64).contains(&q), "quantized_substeps({n}) = {q}");
+                        }
+                    }
+                }
+            }
+        }
+    }
 }

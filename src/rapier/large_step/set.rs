@@ -283,7 +283,7 @@ impl LargeStepJointSet {
     /// joints, which are no ideal joints. Not the step protocol's
     /// [`wrenches`](crate::rapier::pipeline::step_hooks::StepHooks::wrenches): Rapier's solver applies these
     /// forces itself.
-    pub fn constraint_wrenches(&self, bodies: &RigidBodySet, out: &mut Vec<Wrench>) {
+    pub(crate) fn constraint_wrenches(&self, bodies: &RigidBodySet, out: &mut Vec<Wrench>) {
         for j in self.joints.values() {
             let (Some(rb1), Some(rb2)) = (bodies.get(j.body1), bodies.get(j.body2)) else {
                 continue;

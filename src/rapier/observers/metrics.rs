@@ -13,7 +13,7 @@
 //!   Every contact begins with one.
 //! - **Impact**: an onset after a free flight that opened a gap of at least the joint's
 //!   `min_separation` ([`ClearanceJointBuilder::min_separation`](crate::rapier::joint::ClearanceJointBuilder::min_separation),
-//!   [`DEFAULT_MIN_SEPARATION`](crate::rapier::joint::DEFAULT_MIN_SEPARATION) = 0.1 um); the
+//!   0.1 um by default); the
 //!   first contact of a joint is always one
 //!   ([`ClearanceReport::impact`](crate::rapier::joint::ClearanceReport::impact)).
 //! - **Chatter**: the onsets that are not impacts: a journal following the wall that lifts off

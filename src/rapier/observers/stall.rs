@@ -1,7 +1,7 @@
 //! Why the step control stalled, read from the numbers of the contact that stopped it: the
 //! message of [`Error::Stalled`](crate::Error::Stalled) names the joint, its contact state
 //! (penetration, approach speed `delta_dot0`, damping ratio, stable step) and the cause, chosen by
-//! [`diagnose`] from those numbers rather than guessed:
+//! from those numbers rather than guessed:
 //!
 //! 1. a body whose inertia makes the effective mass at the contact tiny;
 //! 2. an approach speed that presses the contact past its law's validity;
@@ -16,7 +16,7 @@ use crate::model::laws::LawKind;
 use crate::rapier::pipeline::protocol::{BodyShare, StalledContact};
 use rapier3d_f64::prelude::RigidBodyHandle;
 
-/// The cause [`diagnose`] finds.
+/// The cause read from the numbers of a stalled contact.
 #[derive(Clone, Debug, PartialEq)]
 #[non_exhaustive]
 pub enum StallCause {
@@ -60,7 +60,7 @@ pub struct Stall {
     /// The contact that stopped the step control, with its numbers; `None` when no clearance
     /// joint was in contact, or the turn bound stopped it.
     pub contact: Option<StalledContact>,
-    /// The cause: [`diagnose`]d from the contact's numbers, [`StallCause::NoContact`] without a
+    /// The cause: read from the contact's numbers, [`StallCause::NoContact`] without a
     /// contact, or [`StallCause::TurnBound`].
     pub cause: StallCause,
     /// Bodies named in the message, by handle (see [`name_body`](Self::name_body)).
@@ -69,8 +69,8 @@ pub struct Stall {
 
 impl Stall {
     /// A stall seen as `seen` under the step floor `min_dt` (s) at `contact`, its cause
-    /// [`diagnose`]d from the contact's numbers.
-    pub fn at_contact(seen: String, contact: Option<StalledContact>, min_dt: f64) -> Stall {
+    /// read from the contact's numbers.
+    pub(crate) fn at_contact(seen: String, contact: Option<StalledContact>, min_dt: f64) -> Stall {
         let cause = contact
             .as_ref()
             .map_or(StallCause::NoContact, |c| diagnose(c, min_dt));
@@ -85,7 +85,7 @@ impl Stall {
 
     /// A stall seen as `seen` under the step floor `min_dt` (s) that the turn bound explains
     /// (`cause` a [`StallCause::TurnBound`]).
-    pub fn turn_bound(seen: String, min_dt: f64, cause: StallCause) -> Stall {
+    pub(crate) fn turn_bound(seen: String, min_dt: f64, cause: StallCause) -> Stall {
         Stall {
             seen,
             min_dt,
@@ -98,7 +98,7 @@ impl Stall {
     /// Names body `handle` `label` in the message (a scene's `` body `crank` ``): the step
     /// control knows only Rapier's handles, `body (0, 0)`. The first label given for a handle
     /// is used.
-    pub fn name_body(&mut self, handle: RigidBodyHandle, label: impl Into<String>) {
+    pub(crate) fn name_body(&mut self, handle: RigidBodyHandle, label: impl Into<String>) {
         self.body_names.push((handle, label.into()));
     }
 }
@@ -141,7 +141,7 @@ const TINY_MASS_FRACTION: f64 = 1e-3;
 
 /// The cause of a stall at contact `c` under the step floor `min_dt` (s), from its numbers (see
 /// the module docs for the order).
-pub fn diagnose(c: &StalledContact, min_dt: f64) -> StallCause {
+pub(crate) fn diagnose(c: &StalledContact, min_dt: f64) -> StallCause {
     if !(c.penetration > 0.0) {
         return StallCause::NoContact;
     }

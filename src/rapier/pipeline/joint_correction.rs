@@ -52,6 +52,7 @@ impl JointCorrection {
     }
 
     /// The current span, s (0 before the first step).
+    #[cfg(test)]
     pub fn span(&self) -> f64 {
         self.span
     }

@@ -124,7 +124,7 @@ pub trait StepHooks {
     fn joints_of(&self, _body: RigidBodyHandle, _names: &mut Vec<String>) {}
 
     /// Checks that this participant's joints join bodies of `bodies` (before every step; an error
-    /// names `body1` or `body2`, as [`joint_bodies`] words it). Default: nothing to check.
+    /// names `body1` or `body2`, as this crate's joint sets word it). Default: nothing to check.
     fn check_bodies(&self, _bodies: &RigidBodySet) -> Result<()> {
         Ok(())
     }
@@ -195,7 +195,7 @@ pub struct StepPass {
 
 /// `Ok` when `body1` and `body2` are both in `bodies`; else an error naming the one missing
 /// (`body1` or `body2`), with `joint()` (in words, formed only then) the joint that holds it.
-pub fn joint_bodies(
+pub(crate) fn joint_bodies(
     bodies: &RigidBodySet,
     joint: impl FnOnce() -> String,
     body1: RigidBodyHandle,
@@ -220,7 +220,7 @@ pub fn joint_bodies(
 
 /// A new joint's two bodies: both in `bodies` ([`joint_bodies`]) and not the same body, naming
 /// `body1` or `body2` as the sets' `insert` methods name them.
-pub fn joint_pair(
+pub(crate) fn joint_pair(
     bodies: &RigidBodySet,
     body1: RigidBodyHandle,
     body2: RigidBodyHandle,

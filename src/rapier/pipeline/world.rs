@@ -112,7 +112,7 @@ impl ClearanceWorld {
     /// Adds a compliant clearance joint between `body1` (bearing) and `body2` (journal), with its
     /// Rapier lock. Refused, naming `body1` or `body2`, unless both are bodies of
     /// `self.rapier.bodies` and not the same body, and naming `local_axis2` when a spatial
-    /// joint's journal does not lie in its bore ([`ClearanceJoint::check_start`]); nothing is
+    /// joint's journal does not lie in its bore; nothing is
     /// added then.
     pub fn insert_clearance(
         &mut self,

@@ -26,13 +26,13 @@ pub struct TorsionSpring {
 impl TorsionSpring {
     /// The largest preload, N m: a torque beyond it drives any body of a mechanism past the
     /// speed guard within a step.
-    pub const MAX_TORQUE: f64 = 1e9;
+    pub(crate) const MAX_TORQUE: f64 = 1e9;
 
     /// The largest stiffness, N m/rad.
-    pub const MAX_STIFFNESS: f64 = 1e12;
+    pub(crate) const MAX_STIFFNESS: f64 = 1e12;
 
-    /// Preload `torque0` (N m, at most [`MAX_TORQUE`](Self::MAX_TORQUE) either way) and
-    /// `stiffness` (N m/rad, from 0 to [`MAX_STIFFNESS`](Self::MAX_STIFFNESS)), about
+    /// Preload `torque0` (N m, at most 1e9 either way) and `stiffness` (N m/rad, from 0 to
+    /// 1e12), about
     /// `local_axis1` (body 1's frame); errors name `torque0`, `stiffness` or `axis`.
     pub fn new(
         body1: RigidBodyHandle,
@@ -163,7 +163,7 @@ impl DriveSet {
     }
     /// Replaces the torques applied at the previous call by the current ones (for a loop that
     /// calls `world.step()` itself; the [`Stepper`](crate::rapier::pipeline::stepper::Stepper) uses
-    /// [`evaluate`](Self::evaluate) and adds the torques for its step only).
+    /// [`evaluate`](StepHooks::evaluate) and adds the torques for its step only).
     pub fn apply(&mut self, bodies: &mut RigidBodySet) {
         self.evaluate(bodies);
         self.ledger.replace(bodies, self.wrenches.iter().copied());
@@ -171,7 +171,7 @@ impl DriveSet {
 
     /// Measures the angles and computes the torques of [`wrenches`](Self::wrenches), without
     /// touching the bodies' forces.
-    pub fn evaluate(&mut self, bodies: &RigidBodySet) {
+    pub(crate) fn evaluate(&mut self, bodies: &RigidBodySet) {
         self.wrenches.clear();
         for d in self.drives.values_mut() {
             if let Some((w1, w2)) = d.evaluate(bodies) {
@@ -182,7 +182,7 @@ impl DriveSet {
     }
 
     /// The torques of the last evaluation, two per drive.
-    pub fn wrenches(&self) -> &[Wrench] {
+    pub(crate) fn wrenches(&self) -> &[Wrench] {
         &self.wrenches
     }
     /// Takes back, exactly, every torque this set applied at its last [`apply`](Self::apply)

@@ -219,7 +219,7 @@ impl PrescribedMotion {
     /// Whether this motion can be honoured in `bodies`: its body is there and kinematic
     /// position-based (Rapier moves no other kind to a pose), its axis or direction a unit vector
     /// (else the pose's rotation is not one). Errors name `motions[index]` and the field.
-    pub fn check(&self, index: usize, bodies: &RigidBodySet) -> Result<()> {
+    pub(crate) fn check(&self, index: usize, bodies: &RigidBodySet) -> Result<()> {
         let at = |field: &str| format!("motions[{index}].{field}");
         let Some(rb) = bodies.get(self.body) else {
             return Err(Error::invalid(

@@ -64,7 +64,7 @@ pub struct Simulation {
     last_read: f64,
 }
 
-pub use crate::rapier::pipeline::stepper::left_physical_range;
+use crate::rapier::pipeline::stepper::left_physical_range;
 
 /// Where a run is, passed to the callback of [`Simulation::run_with_progress`].
 #[derive(Clone, Copy, Debug)]

@@ -18,7 +18,7 @@ pub enum GuardKind {
     /// the step to that limit, `limit` 1.
     Friction,
     /// Steps at the adaptive floor `min_dt`: `worst` the longest run of them in a row, `limit`
-    /// the run that stalls ([`crate::rapier::pipeline::stepper::STALL_STEPS`]); `count` all of them.
+    /// the run that stalls (100,000); `count` all of them.
     Floor,
     /// Energy gained (recorded by the scene runner): `worst` the largest growth of the energy
     /// balance over the energy scale, `limit` the allowed growth; judged once over the run.

@@ -4,7 +4,7 @@
 //! a stall is diagnosed from, and the [`ElementId`] that names an element of a set in them. It
 //! imports nothing of the joint models, the sources or the observers, so each of them can use it.
 
-pub mod guards;
+mod guards;
 
 pub use guards::{GuardKind, GuardReport, Violation};
 

@@ -11,7 +11,7 @@ pub enum StepMode {
     /// A constant step (the paper's way); the last step is shortened to land on the end.
     Fixed,
     /// The step changes between Rapier steps: no body turns more than `tolerance/8` rad in a step
-    /// ([`motion_step`](crate::rapier::pipeline::motion_step::motion_step)), shorter as a contact approaches and inside it (twice `tolerance` of the
+    /// (the bodies' own motion), shorter as a contact approaches and inside it (twice `tolerance` of the
     /// contact's natural period, at most `50 tolerance` of its damped stability limit, within
     /// friction's), at most the
     /// largest step (a safety cap), with rejected steps retried. The default.
@@ -21,7 +21,7 @@ pub enum StepMode {
 
 /// Steps at or below this many floors in a row, with no progress in simulated time, stop the
 /// run with [`Error::Stalled`](crate::Error::Stalled).
-pub const STALL_STEPS: u64 = 100_000;
+pub(crate) const STALL_STEPS: u64 = 100_000;
 
 /// The step control of a [`Stepper`](super::Stepper), built with chained setters.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -32,12 +32,12 @@ pub struct StepControl {
     pub max_dt: f64,
     /// Adaptive: the local error each bound of the step holds to: a step covers at most twice
     /// this fraction of a contact's natural period
-    /// ([`CONTACT_PERIODS_PER_TOLERANCE`](crate::rapier::joint::CONTACT_PERIODS_PER_TOLERANCE)),
-    /// turns no body by more than an eighth of it in rad
-    /// ([`TURN_PER_TOLERANCE`](crate::rapier::pipeline::motion_step::TURN_PER_TOLERANCE)), and moves a
+    /// (a tolerance of 0.05 is a tenth of a period), turns no body by more than an eighth of it
+    /// in rad, and moves a
     /// journal's centre relative to its bearing's by at most this fraction of the clearance.
     pub tolerance: f64,
-    /// Adaptive: the smallest step, s (the floor; see [`STALL_STEPS`]).
+    /// Adaptive: the smallest step, s (the floor; 100,000 steps at it in a row
+    /// without progress stall the run).
     pub min_dt: f64,
     /// Adaptive: the largest ratio of a step to the one before it. Steps that change abruptly
     /// make Rapier's constrained velocities (which it evaluates at the step's start) disagree
@@ -48,7 +48,7 @@ pub struct StepControl {
     /// [`Error::Guard`](crate::Error::Guard) instead of only being recorded.
     pub strict: bool,
     /// Whether Rapier's joints correct their drift at the rate of the longest recent step
-    /// ([`joint_correction`](crate::rapier::pipeline::joint_correction)), not within each step whatever
+    /// (the span decays by 0.1 % per step), not within each step whatever
     /// its length. On by default: without it a jointed chain of slender bodies can diverge when
     /// the step changes.
     pub joint_correction: bool,
@@ -58,12 +58,12 @@ impl StepControl {
     /// The shortest step, s (fixed, or an adaptive control's largest; also the default floor
     /// `min_dt`): Rapier's solver divides by the step, and a step of 1e-300 s ends in
     /// non-finite states.
-    pub const SMALLEST_STEP: f64 = 1e-10;
+    pub(crate) const SMALLEST_STEP: f64 = 1e-10;
 
     /// The smallest adaptive tolerance: a step covers twice it of a contact period and a body
     /// turns at most an eighth of it in rad, so below it a body turning at 1,000 rad/s needs
     /// steps under the default floor `min_dt` (1e-10 s).
-    pub const SMALLEST_TOLERANCE: f64 = 1e-6;
+    pub(crate) const SMALLEST_TOLERANCE: f64 = 1e-6;
 
     /// Constant steps of `dt` seconds.
     pub fn fixed(dt: f64) -> Self {
@@ -122,8 +122,8 @@ impl StepControl {
         self
     }
 
-    /// Checks the fields: finite steps of at least [`SMALLEST_STEP`](Self::SMALLEST_STEP), a
-    /// tolerance from [`SMALLEST_TOLERANCE`](Self::SMALLEST_TOLERANCE) to 1, growth above 1.
+    /// Checks the fields: finite steps of at least 1e-10 s, a tolerance from 1e-6 to 1, growth
+    /// above 1.
     pub fn validate(&self) -> Result<()> {
         let ok = |v: f64| v.is_finite() && v > 0.0;
         let step = match self.mode {

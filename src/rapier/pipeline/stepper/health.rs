@@ -285,7 +285,7 @@ fn state_in_words(rb: Option<&rapier3d_f64::prelude::RigidBody>, speed: f64) -> 
 /// `Some(speed)` when `rb` has left the physical range: disabled by Rapier's quarantine,
 /// non-finite, or faster than half Rapier's speed clamp (Rapier clamps a blown-up body instead of
 /// producing NaN, so a clamped speed is the sign of a silent blow-up).
-pub fn left_physical_range(
+pub(crate) fn left_physical_range(
     rb: &rapier3d_f64::prelude::RigidBody,
     params: &rapier3d_f64::prelude::IntegrationParameters,
 ) -> Option<f64> {

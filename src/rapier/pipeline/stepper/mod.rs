@@ -18,9 +18,9 @@
 //!   velocity; on slender bodies that makes the locked tilt grow at each change of the step. The
 //!   stepper gives the joints (those with Rapier's default softness, for the step only) the
 //!   correction rate of the longest recent step
-//!   ([`joint_correction`](crate::rapier::pipeline::joint_correction); [`StepControl::joint_correction`]).
+//!   ([`StepControl::joint_correction`]).
 //! - **Step choice** ([`StepControl`]): fixed, or adaptive from the motion (no body turns more
-//!   than `tolerance/8` rad in a step: [`motion_step`](crate::rapier::pipeline::motion_step)) and the
+//!   than `tolerance/8` rad in a step) and the
 //!   contacts (the joints'
 //!   [`adaptive_step`](crate::rapier::joint::ClearanceJoint::adaptive_step)), growing by at most
 //!   [`StepControl::max_growth`] per step and landing exactly on the time given to
@@ -40,7 +40,7 @@
 //! - **Guards** ([`GuardReport`]): a body that left the physical range is an error
 //!   ([`Error::Diverged`]); a contact deeper than its law's validity and runs of steps at the step
 //!   floor are recorded (and fail the run under [`StepControl::strict`]); a step control that
-//!   cannot make progress (no accepted step above the floor for [`STALL_STEPS`] steps) is an
+//!   cannot make progress (no accepted step above the floor for 100,000 steps) is an
 //!   [`Error::Stalled`].
 //!
 //! ```
@@ -90,12 +90,13 @@ use health::{check_body_states, check_gravity, check_joint_bodies};
 use pass::{BodySnapshot, snapshot_bodies};
 use rapier3d_f64::prelude::PhysicsWorld;
 
-pub use control::{STALL_STEPS, StepControl, StepMode};
-pub use health::left_physical_range;
+pub(crate) use control::STALL_STEPS;
+pub use control::{StepControl, StepMode};
+pub(crate) use health::left_physical_range;
 
-pub use crate::rapier::pipeline::protocol::{GuardKind, GuardReport, Violation};
+pub(crate) use crate::rapier::pipeline::protocol::{GuardKind, GuardReport, Violation};
 use crate::rapier::pipeline::step_hooks::EvaluateContext;
-pub use crate::rapier::pipeline::step_hooks::{StepHooks, StepPass};
+pub(crate) use crate::rapier::pipeline::step_hooks::StepHooks;
 
 /// Passes after the first that one step may take ([`StepHooks::resolve_step`]): a sub-cycled
 /// joint takes one.
@@ -155,7 +156,7 @@ impl Stepper {
     }
 
     /// Changes the step control (e.g. the ECS layer follows `integration_parameters.dt`).
-    pub fn set_control(&mut self, control: StepControl) {
+    pub(crate) fn set_control(&mut self, control: StepControl) {
         self.control = control;
     }
 

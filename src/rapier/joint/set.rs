@@ -13,7 +13,7 @@ use crate::rapier::pipeline::step_hooks::{EvaluateContext, StepContext, StepHook
 pub type ClearanceJointHandle = ElementHandle<ClearanceJoint>;
 
 /// All clearance joints of a world, and the per-step force hook. The joints are visited (their
-/// forces evaluated and added, [`iter`](Self::iter)) in insertion order.
+/// forces evaluated and added, [`iter`](ElementSet::iter)) in insertion order.
 #[derive(Clone, Debug, Default)]
 pub struct ClearanceJointSet {
     joints: ElementSet<ClearanceJoint>,
@@ -122,41 +122,10 @@ impl ClearanceJointSet {
         Some(joint)
     }
 
-    /// Whether `handle` is a joint of this set.
-    pub fn contains(&self, handle: ClearanceJointHandle) -> bool {
-        self.joints.contains(handle)
-    }
-
-    /// The joint behind `handle` (`None` once it was removed).
-    pub fn get(&self, handle: ClearanceJointHandle) -> Option<&ClearanceJoint> {
-        self.joints.get(handle)
-    }
-
     /// The joint behind `handle`, mutably (`None` once it was removed); raises the
-    /// [`revision`](Self::revision).
+    /// [`revision`](ElementSet::revision).
     pub fn get_mut(&mut self, handle: ClearanceJointHandle) -> Option<&mut ClearanceJoint> {
         self.joints.get_mut(handle)
-    }
-
-    /// All joints with their handles, in insertion order.
-    pub fn iter(&self) -> impl Iterator<Item = (ClearanceJointHandle, &ClearanceJoint)> {
-        self.joints.iter()
-    }
-
-    /// A count that every insert, remove and [`get_mut`](Self::get_mut) raises: two equal
-    /// readings mean the same joints, unedited ([`ElementSet::revision`]).
-    pub fn revision(&self) -> u64 {
-        self.joints.revision()
-    }
-
-    /// Number of joints.
-    pub fn len(&self) -> usize {
-        self.joints.len()
-    }
-
-    /// Whether the set is empty.
-    pub fn is_empty(&self) -> bool {
-        self.joints.is_empty()
     }
 
     /// The force hook: call before every `PhysicsPipeline::step`. It evaluates every joint from
@@ -418,6 +387,18 @@ impl ClearanceJointSet {
 
 /// The clearance joints take part in the stepper's steps: their contact forces, step limits,
 /// acceptance and guards ([`crate::rapier::pipeline::step_hooks`]).
+/// Reading the set is reading its [`ElementSet`]: [`get`](ElementSet::get),
+/// [`contains`](ElementSet::contains), [`iter`](ElementSet::iter) (insertion order),
+/// [`len`](ElementSet::len), [`revision`](ElementSet::revision). Adding and removing go through
+/// the set's own methods, which also keep the Rapier side and the forces in step.
+impl std::ops::Deref for ClearanceJointSet {
+    type Target = ElementSet<ClearanceJoint>;
+
+    fn deref(&self) -> &Self::Target {
+        &self.joints
+    }
+}
+
 impl StepHooks for ClearanceJointSet {
     fn evaluate(&mut self, context: EvaluateContext<'_>) {
         self.set_last_step(context.last_step);

@@ -17,7 +17,7 @@ pub type LargeStepJointHandle = ElementHandle<LargeStepJoint>;
 /// a body had when its first joint was inserted, and restores that value when the body's last
 /// joint is removed. Joints that share a dynamic body share one substep count (Rapier substeps a
 /// connected component together); the force readout assumes no other body in that component asks
-/// for more. The joints are visited ([`iter`](Self::iter), the hooks) in insertion order.
+/// for more. The joints are visited ([`iter`](ElementSet::iter), the hooks) in insertion order.
 #[derive(Clone, Debug, Default)]
 pub struct LargeStepJointSet {
     joints: ElementSet<LargeStepJoint>,
@@ -112,41 +112,10 @@ impl LargeStepJointSet {
         Some(joint)
     }
 
-    /// Whether `handle` is a joint of this set.
-    pub fn contains(&self, handle: LargeStepJointHandle) -> bool {
-        self.joints.contains(handle)
-    }
-
-    /// The joint behind `handle` (`None` once it was removed).
-    pub fn get(&self, handle: LargeStepJointHandle) -> Option<&LargeStepJoint> {
-        self.joints.get(handle)
-    }
-
     /// The joint behind `handle`, mutably (`None` once it was removed); raises the
-    /// [`revision`](Self::revision).
+    /// [`revision`](ElementSet::revision).
     pub fn get_mut(&mut self, handle: LargeStepJointHandle) -> Option<&mut LargeStepJoint> {
         self.joints.get_mut(handle)
-    }
-
-    /// All joints with their handles, in insertion order.
-    pub fn iter(&self) -> impl Iterator<Item = (LargeStepJointHandle, &LargeStepJoint)> {
-        self.joints.iter()
-    }
-
-    /// A count that every insert, remove and [`get_mut`](Self::get_mut) raises: two equal
-    /// readings mean the same joints, unedited ([`ElementSet::revision`]).
-    pub fn revision(&self) -> u64 {
-        self.joints.revision()
-    }
-
-    /// Number of joints.
-    pub fn len(&self) -> usize {
-        self.joints.len()
-    }
-
-    /// Whether the set is empty.
-    pub fn is_empty(&self) -> bool {
-        self.joints.is_empty()
     }
 
     /// Prepares the coming step (call right before `PhysicsPipeline::step`, after setting `dt`):
@@ -344,6 +313,18 @@ impl LargeStepJointSet {
 /// rejected step ([`crate::rapier::pipeline::step_hooks`]). Under a
 /// [`Stepper`](crate::rapier::pipeline::stepper::Stepper) or a
 /// [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld) no hook can be forgotten.
+/// Reading the set is reading its [`ElementSet`]: [`get`](ElementSet::get),
+/// [`contains`](ElementSet::contains), [`iter`](ElementSet::iter) (insertion order),
+/// [`len`](ElementSet::len), [`revision`](ElementSet::revision). Adding and removing go through
+/// the set's own methods, which also keep the Rapier side and the forces in step.
+impl std::ops::Deref for LargeStepJointSet {
+    type Target = ElementSet<LargeStepJoint>;
+
+    fn deref(&self) -> &Self::Target {
+        &self.joints
+    }
+}
+
 impl StepHooks for LargeStepJointSet {
     fn save_state(&mut self) {
         self.joints

@@ -140,27 +140,6 @@ impl DriveSet {
         self.saved.clear();
         Some(d)
     }
-    /// The drive behind `handle` (`None` once it was removed).
-    pub fn get(&self, handle: DriveHandle) -> Option<&TorsionSpring> {
-        self.drives.get(handle)
-    }
-    /// The drives with their handles, in insertion order.
-    pub fn iter(&self) -> impl Iterator<Item = (DriveHandle, &TorsionSpring)> {
-        self.drives.iter()
-    }
-    /// A count that every insert and remove raises: two equal readings mean the same drives
-    /// ([`ElementSet::revision`]).
-    pub fn revision(&self) -> u64 {
-        self.drives.revision()
-    }
-    /// Number of drives.
-    pub fn len(&self) -> usize {
-        self.drives.len()
-    }
-    /// Whether the set is empty.
-    pub fn is_empty(&self) -> bool {
-        self.drives.is_empty()
-    }
     /// Replaces the torques applied at the previous call by the current ones (for a loop that
     /// calls `world.step()` itself; the [`Stepper`](crate::rapier::pipeline::stepper::Stepper) uses
     /// [`evaluate`](StepHooks::evaluate) and adds the torques for its step only).
@@ -220,6 +199,18 @@ impl DriveSet {
 
 /// The drives take part in the stepper's steps: their torques, saved and restored with a rejected
 /// step ([`crate::rapier::pipeline::step_hooks`]).
+/// Reading the set is reading its [`ElementSet`]: [`get`](ElementSet::get),
+/// [`contains`](ElementSet::contains), [`iter`](ElementSet::iter) (insertion order),
+/// [`len`](ElementSet::len), [`revision`](ElementSet::revision). Adding and removing go through
+/// the set's own methods, which also keep the Rapier side and the forces in step.
+impl std::ops::Deref for DriveSet {
+    type Target = ElementSet<TorsionSpring>;
+
+    fn deref(&self) -> &Self::Target {
+        &self.drives
+    }
+}
+
 impl StepHooks for DriveSet {
     fn evaluate(&mut self, context: EvaluateContext<'_>) {
         DriveSet::evaluate(self, context.bodies);

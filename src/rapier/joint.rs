@@ -132,6 +132,9 @@ struct CycleState {
     start: Option<PairStart>,
     /// The impulse of the steps so far that Rapier's velocities do not hold yet, `H`.
     held: [f64; 12],
+    /// The displacement held beside it, `E`: the pair stands at Rapier's poses moved by `P E`
+    /// (zero with one solver iteration).
+    shift: [f64; 12],
     /// The states inside the last step.
     substeps: Vec<SubStep>,
     /// The step's sub-cycle, and the impulse it leaves held, between Rapier's pass 0 and the
@@ -167,6 +170,7 @@ struct JointDynamics {
     prepared: bool,
     spatial: Option<SpatialMemory>,
     held: [f64; 12],
+    shift: [f64; 12],
     substeps: Vec<SubStep>,
 }
 
@@ -327,6 +331,7 @@ impl ClearanceJoint {
         d.last_wrenches = self.last_wrenches;
         d.prepared = self.prepared;
         d.held = self.cycle.held;
+        d.shift = self.cycle.shift;
         d.substeps.clone_from(&self.cycle.substeps);
         match (&self.spatial, &mut d.spatial) {
             (Some(parts), Some(memory)) => parts.save_into(memory),
@@ -344,6 +349,7 @@ impl ClearanceJoint {
         self.last_wrenches = d.last_wrenches;
         self.prepared = d.prepared;
         self.cycle.held = d.held;
+        self.cycle.shift = d.shift;
         self.cycle.substeps.clone_from(&d.substeps);
         if let (Some(parts), Some(memory)) = (&mut self.spatial, &d.spatial) {
             parts.restore(memory);

@@ -209,6 +209,7 @@ impl ClearanceJointSet {
             if finished.is_none() {
                 // Explicit, or a sub-cycled joint's first evaluation (velocities its own).
                 joint.cycle.held = [0.0; 12];
+                joint.cycle.shift = [0.0; 12];
                 joint.cycle.start_correction = [0.0; 12];
                 joint.cycle.substep_count = 0;
                 joint.cycle.substeps.clear();

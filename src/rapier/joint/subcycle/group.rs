@@ -270,9 +270,7 @@ pub(super) fn plan_group(
         .map(|j| j.cycle.start.expect("a planned joint has a start"))
         .collect();
     let held: Vec<Pair12> = members.iter().map(|j| j.cycle.held).collect();
-    let shift: Vec<Pair12> = (0..group.len())
-        .map(|a| runs[a].held_shift(&held[a]))
-        .collect();
+    let shift: Vec<Pair12> = members.iter().map(|j| j.cycle.shift).collect();
     let cross: Vec<Vec<(usize, [f64; 144])>> = members
         .iter()
         .enumerate()
@@ -404,9 +402,8 @@ impl crate::rapier::joint::CycleState {
     /// Takes the step's sub-cycle as the last step's: the impulse left `held`, and what the
     /// step did (its velocity correction, dissipation, impulse and sub-steps), for the readers.
     pub(crate) fn adopt_run(&mut self, held: Pair12) {
-        let run = &mut self.run;
-        run.shift.last = [(held, run.shift_next), run.shift.last[0]];
         self.held = held;
+        self.shift = self.run.shift_next;
         self.start_correction = self.run.start_correction;
         self.dissipated = self.run.dissipated;
         self.impulse = self.run.impulse;

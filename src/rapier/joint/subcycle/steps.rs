@@ -65,11 +65,8 @@ pub(crate) struct SubCycle {
     pub(crate) mean: Pair12,
     /// The pair's velocity at the step's end.
     pub(crate) end_velocity: Pair12,
-    /// The displacement held by the last finished step, `E` (impulse times time: the pair
-    /// stands at Rapier's poses moved by `P E`), with the impulse held beside it, by which a
-    /// step retaken from a restored state finds it ([`SubCycle::held_shift`]).
-    pub(crate) shift: HeldShift,
-    /// The displacement this step leaves held, `E'`, taken as `shift` when the step finishes.
+    /// The displacement this step leaves held, `E'`, the joint's held displacement once the
+    /// step finishes.
     pub(crate) shift_next: Pair12,
     pub(crate) history: ContactHistory,
     pub(crate) samples: Vec<SubStep>,
@@ -81,26 +78,6 @@ pub(crate) struct SubCycle {
     pub(crate) start_correction: Pair12,
     /// The energy the damping and friction took over the step, J.
     pub(crate) dissipated: f64,
-}
-
-/// The displacements held by the last two finished steps, each with the impulse held beside it
-/// (newest first): a step the stepper rejects restores the impulse held before it, and with
-/// it the displacement held before it.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct HeldShift {
-    pub(super) last: [(Pair12, Pair12); 2],
-}
-
-impl SubCycle {
-    /// The displacement held with the impulse `held` (zero when neither of the last two
-    /// finished steps held that impulse: a first step, or a state restored from further back).
-    pub(super) fn held_shift(&self, held: &Pair12) -> Pair12 {
-        self.shift
-            .last
-            .iter()
-            .find(|(h, _)| h == held)
-            .map_or([0.0; 12], |(_, e)| *e)
-    }
 }
 
 /// What a sub-cycle integrates over one world step of `h` (s), from the pair's state `start`

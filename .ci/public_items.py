@@ -10,7 +10,9 @@ Counts, under a module (default `rapier`, or `crate` for the whole library):
 Also prints `listing`: every `pub use` counted as an item beside its target, the rule used before the
 split into definitions and second paths.
 """
-import json, sys, collections
+import collections, json, signal, sys
+
+signal.signal(signal.SIGPIPE, signal.SIG_DFL)  # `| head` closes the pipe early
 
 d = json.load(open(sys.argv[1]))
 which = sys.argv[2] if len(sys.argv) > 2 else "rapier"

@@ -27,7 +27,7 @@ use clearance_joint::rapier::observers::metrics::{
     ContactObservation, HingeMetrics, ImpactRecorder,
 };
 use clearance_joint::rapier::observers::reaction::{
-    IdealJoint, IdealPrismatic, IdealRevolute, ReactionSolver, prepare_mass_properties,
+    IdealJoint, ReactionSolver, prepare_mass_properties,
 };
 use clearance_joint::rapier::pipeline::stepper::StepControl;
 use clearance_joint::rapier::pipeline::world::ClearanceWorld;
@@ -126,7 +126,7 @@ pub fn build(clearance: Option<HingeDesign>, control: StepControl) -> Result<Mec
     let slider_at = Vector::new(r + l, 0.0, 0.0);
     let crank_pin_at = Vector::new(r, 0.0, 0.0);
     let crank_pin = (crank_pin_at, crank_pin_at - rod_at);
-    world.impulse_joints.insert(
+    let crank_joint = world.impulse_joints.insert(
         crank,
         rod,
         RevoluteJointBuilder::new(Vector::Z)
@@ -146,13 +146,7 @@ pub fn build(clearance: Option<HingeDesign>, control: StepControl) -> Result<Mec
             .contacts_enabled(false),
         true,
     );
-    let mut ideal = vec![IdealJoint::Revolute(IdealRevolute {
-        body1: crank,
-        body2: rod,
-        local_anchor1: crank_pin.0,
-        local_anchor2: crank_pin.1,
-        local_axis1: Vector::Z,
-    })];
+    let mut ideal = vec![IdealJoint::from_rapier(&world.impulse_joints, crank_joint)?];
     let mut world = ClearanceWorld::new(world, control);
     let pin = match clearance {
         Some(c) => Some(world.clearance.convert_revolute(
@@ -162,17 +156,14 @@ pub fn build(clearance: Option<HingeDesign>, control: StepControl) -> Result<Mec
             &mut world.rapier.impulse_joints,
         )?),
         None => {
-            ideal.push(IdealJoint::Revolute(IdealRevolute {
-                body1: slider,
-                body2: rod,
-                local_anchor1: slider_pin.0,
-                local_anchor2: slider_pin.1,
-                local_axis1: Vector::Z,
-            }));
+            ideal.push(IdealJoint::from_rapier(
+                &world.rapier.impulse_joints,
+                pin_joint,
+            )?);
             None
         }
     };
-    world.rapier.impulse_joints.insert(
+    let slide = world.rapier.impulse_joints.insert(
         ground,
         slider,
         PrismaticJointBuilder::new(Vector::X)
@@ -180,13 +171,10 @@ pub fn build(clearance: Option<HingeDesign>, control: StepControl) -> Result<Mec
             .contacts_enabled(false),
         true,
     );
-    ideal.push(IdealJoint::Prismatic(IdealPrismatic {
-        body1: ground,
-        body2: slider,
-        local_anchor1: slider_at,
-        local_anchor2: Vector::ZERO,
-        local_axis1: Vector::X,
-    }));
+    ideal.push(IdealJoint::from_rapier(
+        &world.rapier.impulse_joints,
+        slide,
+    )?);
     prepare_mass_properties(&mut world.rapier.bodies);
     Ok(Mechanism {
         world,

@@ -14,7 +14,7 @@ use clearance_joint::model::laws::{
 };
 use clearance_joint::rapier::joint::{ClearanceJointBuilder, ClearanceJointHandle};
 use clearance_joint::rapier::observers::reaction::{
-    IdealJoint, IdealRevolute, ReactionSolver, prepare_mass_properties,
+    IdealJoint, ReactionSolver, prepare_mass_properties,
 };
 use clearance_joint::rapier::pipeline::stepper::StepControl;
 use clearance_joint::rapier::pipeline::world::ClearanceWorld;
@@ -42,6 +42,8 @@ struct Twin {
     satellite: RigidBodyHandle,
     panel: RigidBodyHandle,
     clearance: Option<ClearanceJointHandle>,
+    /// The ideal twin's revolute.
+    revolute: Option<rapier3d_f64::prelude::ImpulseJointHandle>,
 }
 
 /// What one twin measured over every step.
@@ -91,6 +93,7 @@ fn add_twin(world: &mut ClearanceWorld, with_clearance: bool) -> Result<Twin> {
     let panel = body(world, PANEL);
     let h = Vector::from(HINGE_POINT);
     let (a1, a2) = (h - Vector::from(SATELLITE.2), h - Vector::from(PANEL.2));
+    let mut revolute_handle = None;
     let clearance = if with_clearance {
         // Table 2: 20 mm bearing, 16 mm wide, steel on steel, c = 0.5 mm; eta = 1 %; table 3: dry.
         let (radius, c, width) = (0.010, 0.5e-3, 0.016);
@@ -112,10 +115,12 @@ fn add_twin(world: &mut ClearanceWorld, with_clearance: bool) -> Result<Twin> {
             .local_anchor1(a1)
             .local_anchor2(a2)
             .contacts_enabled(false);
-        world
-            .rapier
-            .impulse_joints
-            .insert(satellite, panel, revolute, true);
+        revolute_handle = Some(
+            world
+                .rapier
+                .impulse_joints
+                .insert(satellite, panel, revolute, true),
+        );
         None
     };
     world.insert_drive(TorsionSpring::new(
@@ -129,6 +134,7 @@ fn add_twin(world: &mut ClearanceWorld, with_clearance: bool) -> Result<Twin> {
         satellite,
         panel,
         clearance,
+        revolute: revolute_handle,
     })
 }
 
@@ -162,14 +168,13 @@ pub fn run() -> Result<(Outcome, Outcome)> {
     let [ideal, clear] = [add_twin(&mut world, false)?, add_twin(&mut world, true)?];
     // The ideal hinge's exact reaction at each state (not a momentum difference over a step).
     prepare_mass_properties(&mut world.rapier.bodies);
-    let h = Vector::from(HINGE_POINT);
-    let ideal_hinge = [IdealJoint::Revolute(IdealRevolute {
-        body1: ideal.satellite,
-        body2: ideal.panel,
-        local_anchor1: h - Vector::from(SATELLITE.2),
-        local_anchor2: h - Vector::from(PANEL.2),
-        local_axis1: AXIS,
-    })];
+    let hinge = ideal
+        .revolute
+        .expect("the ideal twin's hinge is a revolute");
+    let ideal_hinge = [IdealJoint::from_rapier(
+        &world.rapier.impulse_joints,
+        hinge,
+    )?];
     let mut reactions = ReactionSolver::default();
     world.prepare()?;
     let mut out = [Outcome::default(), Outcome::default()];

@@ -209,10 +209,7 @@ pub mod prelude {
         LargeStepJoint, LargeStepJointBuilder, LargeStepJointHandle, LargeStepJointSet, Restitution,
     };
     pub use crate::rapier::observers::metrics::{ContactObservation, ImpactRecorder};
-    pub use crate::rapier::observers::reaction::{
-        IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, KinematicState,
-        ReactionSolver,
-    };
+    pub use crate::rapier::observers::reaction::{IdealJoint, KinematicState, ReactionSolver};
     pub use crate::rapier::pipeline::protocol::{GuardKind, GuardReport, Violation, Wrench};
     pub use crate::rapier::pipeline::step_hooks::{EvaluateContext, StepContext, StepHooks};
     pub use crate::rapier::pipeline::stepper::{StepControl, StepInfo, Stepper};

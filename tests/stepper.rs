@@ -7,7 +7,7 @@ use clearance_joint::model::laws::{BearingGeometry, Hertz, NormalModel};
 use clearance_joint::rapier::hinge::design::HingeDesign;
 use clearance_joint::rapier::joint::ClearanceJointSet;
 use clearance_joint::rapier::observers::reaction::{
-    IdealRevolute, ReactionSolver, prepare_mass_properties,
+    IdealJoint, ReactionSolver, prepare_mass_properties,
 };
 use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
 use clearance_joint::scene::Scene;
@@ -415,13 +415,10 @@ fn the_reaction_solver_matches_a_hand_computed_static_load() {
             )),
     );
     prepare_mass_properties(&mut bodies);
-    let j = IdealRevolute {
-        body1: base,
-        body2: arm,
-        local_anchor1: Vector::ZERO,
-        local_anchor2: Vector::new(0.0, 0.3, 0.0),
-        local_axis1: Vector::Z,
-    };
+    let mut joints = ImpulseJointSet::new();
+    let pivot = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0));
+    let pivot = joints.insert(base, arm, pivot, true);
+    let j = IdealJoint::from_rapier(&joints, pivot).unwrap();
     let f = ReactionSolver::default()
         .solve(&bodies, &[j], Vector::new(0.0, -9.81, 0.0))
         .unwrap()[0];

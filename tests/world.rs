@@ -148,7 +148,7 @@ fn reactions_see_the_large_step_joints() {
         .local_anchor1(Vector::new(0.0, -0.2, 0.0))
         .local_anchor2(Vector::new(0.0, 0.2, 0.0))
         .contacts_enabled(false);
-    rapier.impulse_joints.insert(upper, lower, elbow, true);
+    let elbow = rapier.impulse_joints.insert(upper, lower, elbow, true);
     let mut world = ClearanceWorld::new(rapier, StepControl::fixed(1.0 / 60.0));
     let geometry = BearingGeometry::from_clearance(0.010, 1e-3, 0.016).unwrap();
     let pin = LargeStepJointBuilder::new(Vector::Z, geometry)
@@ -158,13 +158,7 @@ fn reactions_see_the_large_step_joints() {
         .unwrap();
     world.insert_large_step(base, upper, pin).unwrap();
     world.step_to(5.0).unwrap();
-    let joints = [IdealJoint::Revolute(IdealRevolute {
-        body1: upper,
-        body2: lower,
-        local_anchor1: Vector::new(0.0, -0.2, 0.0),
-        local_anchor2: Vector::new(0.0, 0.2, 0.0),
-        local_axis1: Vector::Z,
-    })];
+    let joints = [IdealJoint::from_rapier(&world.rapier.impulse_joints, elbow).unwrap()];
     let mut solver = ReactionSolver::default();
     let f = world.solve_reactions(&mut solver, &joints).unwrap()[0];
     let weight = 3.0 * 9.81;

@@ -3,7 +3,7 @@
 
 use super::{HingeJoint, Physics};
 use crate::error::{Error, Result};
-use crate::rapier::observers::reaction::{IdealJoint, IdealRevolute};
+use crate::rapier::observers::reaction::{IdealJoint, IdealRevolute, JointModel};
 use crate::rapier::pipeline::stepper::{StepHooks, StepMode};
 use crate::rapier::pipeline::world::ClearanceWorld;
 use bevy_ecs::prelude::Entity;
@@ -87,13 +87,14 @@ impl Physics {
         let mut ideal_entities = Vec::new();
         for (e, r) in &self.hinges {
             if let HingeJoint::Ideal(_) = r.joint {
-                self.ideal_joints.push(IdealJoint::Revolute(IdealRevolute {
-                    body1: r.bodies.0,
-                    body2: r.bodies.1,
-                    local_anchor1: r.frame.local_anchor1,
-                    local_anchor2: r.frame.local_anchor2,
-                    local_axis1: r.frame.unit_axis1(),
-                }));
+                self.ideal_joints
+                    .push(IdealJoint(JointModel::Revolute(IdealRevolute {
+                        body1: r.bodies.0,
+                        body2: r.bodies.1,
+                        local_anchor1: r.frame.local_anchor1,
+                        local_anchor2: r.frame.local_anchor2,
+                        local_axis1: r.frame.unit_axis1(),
+                    })));
                 ideal_entities.push(*e);
             }
         }

@@ -320,7 +320,7 @@ impl ClearanceWorld {
     // ----- Reactions -----
 
     /// The force on each ideal joint's body 2 at the current state (N, world frame, in the order
-    /// of `joints`; [`ReactionSolver::solve_joints_with`]), with what the step loop knows and a
+    /// of `joints`; [`ReactionSolver::solve`]), with what the step loop knows and a
     /// bare solve would not: the joints' and drives' wrenches (they act during the steps only;
     /// a large-step joint's, its constraint's force over the last step),
     /// the prescribed motions' rates at this time, and the stored velocities' lag of half the
@@ -349,7 +349,7 @@ impl ClearanceWorld {
         // The large-step joints' constraint forces of the last step (no ideal joints to solve).
         self.large_step
             .constraint_wrenches(&self.rapier.bodies, &mut self.wrenches);
-        solver.solve_joints_with(
+        solver.solve_with(
             &self.rapier.bodies,
             joints,
             self.rapier.gravity,

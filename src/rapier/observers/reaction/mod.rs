@@ -24,11 +24,15 @@
 //! motion is fully prescribed (a driven crank) then gets its exact velocities from the
 //! projection, whatever the step.
 //!
-//! **Motors.** A velocity motor that holds its speed ([`IdealJoint::MotorRevolute`],
-//! [`IdealJoint::MotorPrismatic`]) is one more constraint row (`d(speed)/dt = 0`), its multiplier
-//! the motor torque or force. A soft motor ([`SoftMotor`]: Rapier's spring-damper
-//! `k (x_target - x) + c (v_target - v)`, times the row's effective mass in Rapier's
-//! acceleration-based model) is an applied wrench computed from the state.
+//! **Joints.** [`IdealJoint::from_rapier`] reads each joint from Rapier's description (kind from
+//! its locked axes, anchors and axis from its frames, the motor on its free axis), so the solve
+//! and the simulation hold the same joint.
+//!
+//! **Motors.** A soft motor (Rapier's spring-damper `k (x_target - x) + c (v_target - v)`,
+//! clamped to its `max_force`, times the row's effective mass in Rapier's acceleration-based
+//! model) is an applied wrench computed from the state. A velocity motor that holds its speed
+//! ([`IdealJoint::held_motor`]) is one more constraint row (`d(speed)/dt = 0`), its multiplier
+//! the motor torque or force.
 //!
 //! The solve works before the first step, when Rapier has not computed the bodies' mass
 //! properties yet: the solver computes those of a body without colliders from its builder's
@@ -40,7 +44,7 @@
 //! All a user needs, nothing hidden:
 //!
 //! ```
-//! use clearance_joint::rapier::observers::reaction::{IdealRevolute, ReactionSolver};
+//! use clearance_joint::rapier::observers::reaction::{IdealJoint, ReactionSolver};
 //! use rapier3d_f64::prelude::*;
 //! use rapier3d_f64::math::Vector;
 //!
@@ -52,19 +56,17 @@
 //!         .translation(Vector::new(0.0, -0.3, 0.0))
 //!         .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02))),
 //! );
-//! let joint = IdealRevolute {
-//!     body1: base,
-//!     body2: arm,
-//!     local_anchor1: Vector::ZERO,
-//!     local_anchor2: Vector::new(0.0, 0.3, 0.0),
-//!     local_axis1: Vector::Z,
-//! };
+//! let mut joints = ImpulseJointSet::new();
+//! let pivot = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0));
+//! let pivot = joints.insert(base, arm, pivot, true);
+//! let joint = IdealJoint::from_rapier(&joints, pivot)?;
 //! let mut solver = ReactionSolver::default();
 //! let forces = solver.solve(&bodies, &[joint], Vector::new(0.0, -9.81, 0.0)).unwrap();
 //! assert!((forces[0] - Vector::new(0.0, 2.0 * 9.81, 0.0)).length() < 1e-9);
 //! // At rest, held: no acceleration.
 //! let (a, alpha) = solver.acceleration(arm).unwrap();
 //! assert!(a.length() < 1e-12 && alpha.length() < 1e-12);
+//! # Ok::<(), clearance_joint::Error>(())
 //! ```
 
 mod body;
@@ -77,8 +79,9 @@ mod solve;
 mod tests;
 
 pub use body::KinematicState;
-pub use joints::{IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical};
-pub use motor::SoftMotor;
+pub use joints::IdealJoint;
+pub(crate) use joints::{IdealFixed, IdealPrismatic, IdealRevolute, IdealSpherical, JointModel};
+pub(crate) use motor::SoftMotor;
 
 use crate::rapier::pipeline::ledger::Wrench;
 use body::Entry;
@@ -128,7 +131,6 @@ pub struct ReactionSolver {
     motors: Vec<Option<f64>>,
     /// Per joint with a motor: the relative speed along its axis at the state.
     motor_rates: Vec<f64>,
-    revolutes: Vec<IdealJoint>,
     extra: Vec<Wrench>,
     /// Why the last solve returned `None`.
     failure: Option<ReactionFailure>,
@@ -173,50 +175,36 @@ impl std::fmt::Display for ReactionFailure {
 impl std::error::Error for ReactionFailure {}
 
 impl ReactionSolver {
-    /// The force on each joint's body 2 (N, world frame), in the order of `joints`, at the bodies'
-    /// current state under their user forces and torques and `gravity`. Redundant constraints (a
-    /// closed loop, whose reactions rigid dynamics alone do not determine) get a least-norm
-    /// share through a relative regularisation of 1e-12, used only when the system is singular.
-    /// A joint between two bodies that no force moves (fixed or kinematic on both sides) carries
-    /// no unknown: its force is zero (their supports take the load) and it does not affect the
-    /// others. Works before the first step (see the [module](self) docs). `None`, never a
-    /// made-up force, when a body is missing, a body with colliders has no mass properties yet,
-    /// or the system cannot be solved (a non-finite state or mass): [`failure`](Self::failure)
-    /// says which. Only the listed joints are constraints: contacts with colliders are not part
-    /// of the solve.
+    /// The force on each joint's body 2 at its anchor (N, world frame), in the order of
+    /// `joints`, at the bodies' current state under their user forces and torques and `gravity`:
+    /// for a prismatic joint the part normal to the axis, the only one an ideal slide carries; a
+    /// motor's torque or force is [`motor`](Self::motor). Every ideal joint of the mechanism must
+    /// be listed: a joint left out is a free motion to the solver. Kinematic bodies are taken to
+    /// move at constant velocity (their accelerations are those of a rigid rotation at their
+    /// angular velocity) unless [`kinematic`](Self::kinematic) prescribes them. Redundant
+    /// constraints (a closed loop, whose reactions rigid dynamics alone do not determine) get a
+    /// least-norm share through a relative regularisation of 1e-12, used only when the system is
+    /// singular. A joint between two bodies that no force moves (fixed or kinematic on both
+    /// sides) carries no unknown: its force is zero (their supports take the load) and it does
+    /// not affect the others. Works before the first step (see the [module](self) docs). `None`,
+    /// never a made-up force, when a body is missing, a body with colliders has no mass
+    /// properties yet, or the system cannot be solved (a non-finite state or mass):
+    /// [`failure`](Self::failure) says which. Only the listed joints are constraints: contacts
+    /// with colliders are not part of the solve.
     pub fn solve(
         &mut self,
         bodies: &RigidBodySet,
-        joints: &[IdealRevolute],
+        joints: &[IdealJoint],
         gravity: Vector,
     ) -> Option<&[Vector]> {
         self.solve_with(bodies, joints, gravity, &[])
     }
 
-    /// [`solve`](Self::solve) with further applied wrenches on the bodies (see
-    /// [`solve_joints_with`](Self::solve_joints_with)).
-    fn solve_with(
-        &mut self,
-        bodies: &RigidBodySet,
-        joints: &[IdealRevolute],
-        gravity: Vector,
-        extra: &[Wrench],
-    ) -> Option<&[Vector]> {
-        let mut all = std::mem::take(&mut self.revolutes);
-        all.clear();
-        all.extend(joints.iter().map(|&j| IdealJoint::Revolute(j)));
-        let ok = self
-            .solve_joints_with(bodies, &all, gravity, extra)
-            .is_some();
-        self.revolutes = all;
-        if ok { Some(&self.forces) } else { None }
-    }
-
-    /// [`solve_joints`](Self::solve_joints) with further applied wrenches on the bodies: those of
-    /// the force sources the [`Stepper`](crate::rapier::pipeline::stepper::Stepper) adds during
-    /// its steps only (drives, clearance contacts), which the bodies' user forces do not hold
-    /// between steps.
-    pub fn solve_joints_with(
+    /// [`solve`](Self::solve) with further applied wrenches on the bodies: those of the force
+    /// sources the step loop adds during its steps only (drives, clearance contacts), which the
+    /// bodies' user forces do not hold between steps
+    /// ([`ClearanceWorld::solve_reactions`](crate::rapier::pipeline::world::ClearanceWorld::solve_reactions)).
+    pub(crate) fn solve_with(
         &mut self,
         bodies: &RigidBodySet,
         joints: &[IdealJoint],
@@ -228,22 +216,6 @@ impl ReactionSolver {
         let r = self.solve_joints_inner(bodies, joints, gravity).is_some();
         self.extra.clear();
         if r { Some(&self.forces) } else { None }
-    }
-
-    /// [`solve`](Self::solve) for any mix of revolute, prismatic, fixed and spherical joints, with
-    /// or without motors: the force on each joint's body 2 at its anchor (N, world frame; for a
-    /// prismatic joint the part normal to the axis, the only one an ideal slide carries; a
-    /// motor's torque or force is [`motor`](Self::motor)). Every ideal joint of the mechanism
-    /// must be listed: a joint left out is a free motion to the solver. Kinematic bodies are
-    /// taken to move at constant velocity (their accelerations are those of a rigid rotation at
-    /// their angular velocity) unless [`kinematic`](Self::kinematic) prescribes them.
-    pub fn solve_joints(
-        &mut self,
-        bodies: &RigidBodySet,
-        joints: &[IdealJoint],
-        gravity: Vector,
-    ) -> Option<&[Vector]> {
-        self.solve_joints_with(bodies, joints, gravity, &[])
     }
 
     /// The motor torque (N m about the axis, revolute) or force (N along the axis, prismatic) on

@@ -1,6 +1,7 @@
 //! Joint motors: the soft motor's law at a state, and the motors' torques and forces in the solve.
 
 use super::body::Entry;
+use super::joints::JointModel;
 use super::{IdealJoint, ReactionSolver};
 use rapier3d_f64::math::{Rotation, Vector};
 use rapier3d_f64::prelude::{JointMotor, MotorModel};
@@ -100,13 +101,13 @@ impl ReactionSolver {
         }
         self.motors.clear();
         self.motor_rates.clear();
-        for (j, &(i1, i2)) in joints.iter().zip(pairs) {
+        for (j, &(i1, i2)) in joints.iter().map(|j| &j.0).zip(pairs) {
             let (e1, e2) = (self.entries[i1], self.entries[i2]);
             self.motor_rates.push(match j {
-                IdealJoint::MotorRevolute(j) | IdealJoint::SoftMotorRevolute(j, _) => {
+                JointModel::MotorRevolute(j) | JointModel::SoftMotorRevolute(j, _) => {
                     (e1.rot * j.local_axis1).normalize().dot(e2.w - e1.w)
                 }
-                IdealJoint::MotorPrismatic(j) | IdealJoint::SoftMotorPrismatic(j, _) => {
+                JointModel::MotorPrismatic(j) | JointModel::SoftMotorPrismatic(j, _) => {
                     let axis = (e1.rot * j.local_axis1).normalize();
                     let p2 = e2.pose * j.local_anchor2;
                     axis.dot((e2.v + e2.w.cross(p2 - e2.com)) - (e1.v + e1.w.cross(p2 - e1.com)))
@@ -114,7 +115,7 @@ impl ReactionSolver {
                 _ => 0.0,
             });
             let motor = match j {
-                IdealJoint::SoftMotorRevolute(j, m) => {
+                JointModel::SoftMotorRevolute(j, m) => {
                     let axis = (e1.rot * j.local_axis1).normalize();
                     let angle = rapier_angle(e1.rot, e2.rot, j.local_axis1);
                     let rate = axis.dot(e2.w - e1.w);
@@ -131,7 +132,7 @@ impl ReactionSolver {
                     self.entries[i1].t -= tau * axis;
                     Some(tau)
                 }
-                IdealJoint::SoftMotorPrismatic(j, m) => {
+                JointModel::SoftMotorPrismatic(j, m) => {
                     let p1 = e1.pose * j.local_anchor1;
                     let p2 = e2.pose * j.local_anchor2;
                     let axis = (e1.rot * j.local_axis1).normalize();
@@ -155,7 +156,7 @@ impl ReactionSolver {
                     Some(f.dot(axis))
                 }
                 // The held motors' multipliers come with the solve.
-                IdealJoint::MotorRevolute(_) | IdealJoint::MotorPrismatic(_) => Some(0.0),
+                JointModel::MotorRevolute(_) | JointModel::MotorPrismatic(_) => Some(0.0),
                 _ => None,
             };
             self.motors.push(motor);

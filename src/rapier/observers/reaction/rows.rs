@@ -1,5 +1,6 @@
 //! The constraint rows of each joint kind (Jacobian, velocity-product terms) and `J M^-1 J^T`.
 
+use super::joints::JointModel;
 use super::{IdealJoint, ReactionSolver};
 use rapier3d_f64::math::Vector;
 
@@ -45,13 +46,13 @@ impl ReactionSolver {
     pub(super) fn build_rows(&mut self, joints: &[IdealJoint], pairs: &[(usize, usize)]) {
         self.rows.clear();
         self.starts.clear();
-        for (j, &(i1, i2)) in joints.iter().zip(pairs) {
+        for (j, &(i1, i2)) in joints.iter().map(|j| &j.0).zip(pairs) {
             self.starts.push(self.rows.len());
             let (e1, e2) = (&self.entries[i1], &self.entries[i2]);
             let (v1, v2, w1, w2) = (e1.v, e2.v, e1.w, e2.w);
             let held = matches!(
                 j,
-                IdealJoint::MotorRevolute(_) | IdealJoint::MotorPrismatic(_)
+                JointModel::MotorRevolute(_) | JointModel::MotorPrismatic(_)
             );
             let mut push = |jac: [Vector; 4], c: f64, position: bool| {
                 self.rows.push(Row {
@@ -78,9 +79,9 @@ impl ReactionSolver {
                 }
             };
             match j {
-                IdealJoint::Revolute(j)
-                | IdealJoint::MotorRevolute(j)
-                | IdealJoint::SoftMotorRevolute(j, _) => {
+                JointModel::Revolute(j)
+                | JointModel::MotorRevolute(j)
+                | JointModel::SoftMotorRevolute(j, _) => {
                     let r1 = e1.pose * j.local_anchor1 - e1.com;
                     let r2 = e2.pose * j.local_anchor2 - e2.com;
                     let axis = (e1.rot * j.local_axis1).normalize();
@@ -95,9 +96,9 @@ impl ReactionSolver {
                         push([Vector::ZERO, -axis, Vector::ZERO, axis], ang(axis), false);
                     }
                 }
-                IdealJoint::Prismatic(j)
-                | IdealJoint::MotorPrismatic(j)
-                | IdealJoint::SoftMotorPrismatic(j, _) => {
+                JointModel::Prismatic(j)
+                | JointModel::MotorPrismatic(j)
+                | JointModel::SoftMotorPrismatic(j, _) => {
                     let p1 = e1.pose * j.local_anchor1;
                     let p2 = e2.pose * j.local_anchor2;
                     let (r1, r2) = (p1 - e1.com, p2 - e2.com);
@@ -128,12 +129,12 @@ impl ReactionSolver {
                         push(jac, c, false);
                     }
                 }
-                IdealJoint::Spherical(j) => {
+                JointModel::Spherical(j) => {
                     let r1 = e1.pose * j.local_anchor1 - e1.com;
                     let r2 = e2.pose * j.local_anchor2 - e2.com;
                     point_rows(&mut push, r1, r2);
                 }
-                IdealJoint::Fixed(j) => {
+                JointModel::Fixed(j) => {
                     let r1 = e1.pose * j.local_anchor1 - e1.com;
                     let r2 = e2.pose * j.local_anchor2 - e2.com;
                     point_rows(&mut push, r1, r2);

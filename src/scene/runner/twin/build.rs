@@ -7,8 +7,8 @@ use crate::model::angle::{HingeAngle, UnwrappedAngle};
 use crate::rapier::hinge::design::ClearanceModel;
 use crate::rapier::observers::metrics::ImpactRecorder;
 use crate::rapier::observers::reaction::{
-    IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, ReactionSolver,
-    SoftMotor,
+    IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, JointModel,
+    ReactionSolver, SoftMotor,
 };
 use crate::rapier::observers::replay::in_plane_u;
 use crate::rapier::pipeline::world::ClearanceWorld;

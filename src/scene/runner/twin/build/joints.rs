@@ -12,13 +12,13 @@ pub(super) fn ideal_hinge_joints(
     for (i, h) in hinges.iter().enumerate() {
         if let HingeJoint::Ideal = h.joint {
             let (a1, a2) = anchors(scene, scene.hinges[i].point_m, h.bearing, h.journal);
-            ideal_joints.push(IdealJoint::Revolute(IdealRevolute {
+            ideal_joints.push(IdealJoint(JointModel::Revolute(IdealRevolute {
                 body1: bodies[h.bearing].handle,
                 body2: bodies[h.journal].handle,
                 local_anchor1: a1,
                 local_anchor2: a2,
                 local_axis1: h.local_axis1,
-            }));
+            })));
             ideal_hinges.push(i);
         }
     }
@@ -119,12 +119,12 @@ pub(super) fn build_joint(
                 .local_anchor2(a2)
                 .contacts_enabled(false)
                 .into(),
-            IdealJoint::Fixed(IdealFixed {
+            IdealJoint(JointModel::Fixed(IdealFixed {
                 body1: b1,
                 body2: b2,
                 local_anchor1: a1,
                 local_anchor2: a2,
-            }),
+            })),
         ),
         JointKindSpec::Spherical => (
             SphericalJointBuilder::new()
@@ -132,12 +132,12 @@ pub(super) fn build_joint(
                 .local_anchor2(a2)
                 .contacts_enabled(false)
                 .into(),
-            IdealJoint::Spherical(IdealSpherical {
+            IdealJoint(JointModel::Spherical(IdealSpherical {
                 body1: b1,
                 body2: b2,
                 local_anchor1: a1,
                 local_anchor2: a2,
-            }),
+            })),
         ),
     };
     let handle = world.rapier.impulse_joints.insert(b1, b2, rapier, true);
@@ -171,15 +171,15 @@ pub(super) fn prismatic(
     let ideal = match motor {
         Some(Motor::Held { target, factor }) => {
             rj = rj.motor_velocity(target, factor);
-            IdealJoint::MotorPrismatic(ideal)
+            IdealJoint(JointModel::MotorPrismatic(ideal))
         }
         Some(Motor::Soft(m)) => {
             rj = rj
                 .set_motor(m.target_pos, m.target_vel, m.stiffness, m.damping)
                 .motor_model(MotorModel::ForceBased);
-            IdealJoint::SoftMotorPrismatic(ideal, m)
+            IdealJoint(JointModel::SoftMotorPrismatic(ideal, m))
         }
-        None => IdealJoint::Prismatic(ideal),
+        None => IdealJoint(JointModel::Prismatic(ideal)),
     };
     (rj.into(), ideal)
 }
@@ -207,15 +207,15 @@ pub(super) fn revolute(
     let ideal = match motor {
         Some(Motor::Held { target, factor }) => {
             rj = rj.motor_velocity(target, factor);
-            IdealJoint::MotorRevolute(ideal)
+            IdealJoint(JointModel::MotorRevolute(ideal))
         }
         Some(Motor::Soft(m)) => {
             rj = rj
                 .motor(m.target_pos, m.target_vel, m.stiffness, m.damping)
                 .motor_model(MotorModel::ForceBased);
-            IdealJoint::SoftMotorRevolute(ideal, m)
+            IdealJoint(JointModel::SoftMotorRevolute(ideal, m))
         }
-        None => IdealJoint::Revolute(ideal),
+        None => IdealJoint(JointModel::Revolute(ideal)),
     };
     (rj.into(), ideal)
 }

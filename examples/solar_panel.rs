@@ -12,7 +12,8 @@ use clearance_joint::model::laws::{
     Bai, BearingGeometry, FrictionModel, ImprovedLiu, Material, MaxDamping, NormalModel,
     effective_modulus,
 };
-use clearance_joint::rapier::joint::{ClearanceJointBuilder, ClearanceJointHandle};
+use clearance_joint::rapier::hinge::design::HingeDesign;
+use clearance_joint::rapier::joint::ClearanceJointHandle;
 use clearance_joint::rapier::observers::reaction::{
     IdealJoint, ReactionSolver, prepare_mass_properties,
 };
@@ -99,16 +100,13 @@ fn add_twin(world: &mut ClearanceWorld, with_clearance: bool) -> Result<Twin> {
         let (radius, c, width) = (0.010, 0.5e-3, 0.016);
         let e_star = effective_modulus(&Material::STEEL, &Material::STEEL);
         let law = ImprovedLiu::new(e_star, width, c, 1.0, 1e-4, MaxDamping::Eta(0.01))?;
-        let joint = ClearanceJointBuilder::new(
-            AXIS,
+        let joint = HingeDesign::new(
             BearingGeometry::from_clearance(radius, c, width)?,
             NormalModel::ImprovedLiu(law),
         )
-        .local_anchor1(a1)
-        .local_anchor2(a2)
         .friction(FrictionModel::Bai(Bai::DRY))
         .name("hinge")
-        .build()?;
+        .joint(a1, a2, AXIS, AXIS)?;
         Some(world.insert_clearance(satellite, panel, joint)?)
     } else {
         let revolute = RevoluteJointBuilder::new(AXIS)

@@ -55,7 +55,7 @@
 //! [`StepControl`](rapier::pipeline::stepper::StepControl) (step choice, acceptance,
 //! [`GuardReport`](rapier::pipeline::protocol::GuardReport)), the step protocol every set implements
 //! ([`StepHooks`](rapier::pipeline::step_hooks::StepHooks)), and
-//! [`ClearanceJointBuilder`](rapier::joint::ClearanceJointBuilder) for a joint built from scratch.
+//! [`HingeDesign::joint`](rapier::hinge::design::HingeDesign::joint) for a joint built from scratch.
 //! [`ClearanceWorld`](rapier::pipeline::world::ClearanceWorld) bundles them; the scene runner and the
 //! bevy_ecs layer are built on it.
 //!
@@ -202,8 +202,7 @@ pub mod prelude {
     pub use crate::rapier::hinge::convert::{BearingSide, ConvertRevolute};
     pub use crate::rapier::hinge::design::{ClearanceModel, HingeDesign};
     pub use crate::rapier::joint::{
-        ClearanceJoint, ClearanceJointBuilder, ClearanceJointHandle, ClearanceJointSet,
-        ContactIntegration, OutOfPlaneLock,
+        ClearanceJoint, ClearanceJointHandle, ClearanceJointSet, ContactIntegration, OutOfPlaneLock,
     };
     pub use crate::rapier::large_step::{
         LargeStepJoint, LargeStepJointBuilder, LargeStepJointHandle, LargeStepJointSet, Restitution,

@@ -12,7 +12,7 @@
 use clearance_joint::model::angle::{HingeAngle, UnwrappedAngle, twist_angle};
 use clearance_joint::model::kinematics::{BodyMotion, contact_force, journal_state, stable_step};
 use clearance_joint::model::laws::*;
-use clearance_joint::rapier::joint::ClearanceJointBuilder;
+use clearance_joint::rapier::hinge::design::HingeDesign;
 use clearance_joint::rapier::large_step::LargeStepJointBuilder;
 use clearance_joint::rapier::observers::metrics::{
     ContactObservation, Impact, ImpactRecorder, per_period,
@@ -260,14 +260,11 @@ proptest! {
     ) {
         let geometry = BearingGeometry::from_clearance(0.01, 2e-4, 0.016).unwrap();
         let law = laws().pop().unwrap();
-        let r = ClearanceJointBuilder::new(axis, geometry, law)
-            .local_anchor1(anchor)
-            .local_anchor2(anchor)
-            .local_axis2(axis)
+        let r = HingeDesign::new(geometry, law)
             .min_impact_speed(a)
             .min_separation(b)
             .max_valid_penetration(a)
-            .build();
+            .joint(anchor, anchor, axis, axis);
         let vectors = [axis.x, axis.y, axis.z, anchor.x, anchor.y, anchor.z];
         refuses_non_finite(&[&vectors[..], &[a, b]].concat(), &r)?;
         let r = LargeStepJointBuilder::new(axis, geometry)

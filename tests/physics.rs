@@ -269,9 +269,9 @@ fn ln_impact(dt: f64) -> (PhysicsWorld, ClearanceJointSet, ClearanceJointHandle)
     let k =
         LankaraniNikravesh::stiffness_from_geometry(&geometry, &Material::STEEL, &Material::STEEL);
     let law = NormalModel::LankaraniNikravesh(LankaraniNikravesh::new(k, 1.5, 0.9).unwrap());
-    let joint = ClearanceJointBuilder::new(Vector::Z, geometry, law)
+    let joint = HingeDesign::new(geometry, law)
         .lock(OutOfPlaneLock::None)
-        .build()
+        .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
         .unwrap();
     let mut set = ClearanceJointSet::new();
     let pin = set

@@ -33,7 +33,6 @@ fn every_prelude_name_resolves_next_to_rapiers_prelude() {
         std::any::type_name::<EvaluateContext>(),
         std::any::type_name::<StepContext>(),
         std::any::type_name::<ClearanceJoint>(),
-        std::any::type_name::<ClearanceJointBuilder>(),
         std::any::type_name::<ClearanceJointHandle>(),
         std::any::type_name::<OutOfPlaneLock>(),
         std::any::type_name::<ContactIntegration>(),

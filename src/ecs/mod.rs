@@ -30,9 +30,10 @@
 //!
 //! Swapping an entity's `IdealHinge` for a `ClearanceHinge` is the whole change, at spawn or
 //! while running: the sync system converts the Rapier revolute joint into a clearance joint with
-//! [`revolute_to_clearance`](crate::rapier::hinge::convert::revolute_to_clearance) (and back with
-//! [`clearance_to_revolute`](crate::rapier::hinge::convert::clearance_to_revolute) when the `ClearanceHinge`
-//! is removed again).
+//! [`ConvertRevolute::convert_revolute`](crate::rapier::hinge::convert::ConvertRevolute::convert_revolute)
+//! (and back with
+//! [`revert_to_revolute`](crate::rapier::hinge::convert::ConvertRevolute::revert_to_revolute)
+//! when the `ClearanceHinge` is removed again).
 //!
 //! # The world's settings are yours
 //!

@@ -52,32 +52,18 @@ pub enum OutOfPlaneLock {
     None,
 }
 
-/// Builds a [`ClearanceJoint`] with chained setters, like Rapier's `RevoluteJointBuilder`.
-/// Body 1 carries the bearing (hole), body 2 the journal (pin).
-///
-/// ```
-/// use clearance_joint::model::laws::{Bai, BearingGeometry, FrictionModel, ImprovedLiu, MaxDamping, NormalModel};
-/// use clearance_joint::prelude::*;
-/// let geometry = BearingGeometry::from_clearance(0.010, 0.5e-3, 0.016).unwrap();
-/// let law = ImprovedLiu::new(1.137e11, 0.016, 0.5e-3, 1.0, 1e-4, MaxDamping::Eta(0.01)).unwrap();
-/// let joint = ClearanceJointBuilder::new(Vector::new(0.0, -1.0, 0.0), geometry, NormalModel::ImprovedLiu(law))
-///     .local_anchor1(Vector::new(0.4, 0.0, 0.4))
-///     .local_anchor2(Vector::new(0.0, 0.0, 0.4))
-///     .friction(FrictionModel::Bai(Bai::DRY))
-///     .build()
-///     .unwrap();
-/// assert!((joint.geometry().clearance() - 0.5e-3).abs() < 1e-15);
-/// ```
+/// Builds a [`ClearanceJoint`] from a [`HingeDesign`](crate::rapier::hinge::design::HingeDesign)
+/// and its placement. Body 1 carries the bearing (hole), body 2 the journal (pin).
 #[derive(Clone, Debug)]
-pub struct ClearanceJointBuilder {
+pub(crate) struct ClearanceJointBuilder {
     joint: ClearanceJoint,
     spatial: Option<crate::model::spatial::SpatialModel>,
 }
 
-/// Default of [`ClearanceJointBuilder::min_impact_speed`], m/s.
+/// Default of [`HingeDesign::min_impact_speed`](crate::rapier::hinge::design::HingeDesign::min_impact_speed), m/s.
 pub(crate) const DEFAULT_MIN_IMPACT_SPEED: f64 = 1e-4;
 
-/// Default of [`ClearanceJointBuilder::min_separation`], m.
+/// Default of [`HingeDesign::min_separation`](crate::rapier::hinge::design::HingeDesign::min_separation), m.
 pub(crate) const DEFAULT_MIN_SEPARATION: f64 = 1e-7;
 
 /// The default validity limit of a joint's penetration, m: 1 % of the journal radius (95 um
@@ -281,13 +267,14 @@ impl ClearanceJoint {
     }
 
     /// The deepest penetration at which the contact law is trusted, m
-    /// ([`ClearanceJointBuilder::max_valid_penetration`]; default 1 % of the journal radius).
+    /// ([`HingeDesign::max_valid_penetration`](crate::rapier::hinge::design::HingeDesign::max_valid_penetration);
+    /// default 1 % of the journal radius).
     pub fn max_valid_penetration(&self) -> f64 {
         self.max_valid_penetration
             .unwrap_or_else(|| default_max_valid_penetration(&self.geometry))
     }
     /// The floor on the impact velocity `delta_dot0` of the hysteresis laws, m/s
-    /// ([`ClearanceJointBuilder::min_impact_speed`]).
+    /// ([`HingeDesign::min_impact_speed`](crate::rapier::hinge::design::HingeDesign::min_impact_speed)).
     pub(crate) fn min_impact_speed_floor(&self) -> f64 {
         self.min_impact_speed
     }

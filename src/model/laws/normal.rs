@@ -20,7 +20,7 @@ pub struct NormalContact {
     /// Penetration rate `delta_dot`, m/s (positive while the surfaces approach).
     pub penetration_rate: f64,
     /// Penetration rate when the current contact began, `delta_dot0`, m/s, already floored to a
-    /// positive minimum by the joint (see `ClearanceJointBuilder::min_impact_speed`).
+    /// positive minimum by the joint (see `HingeDesign::min_impact_speed`).
     pub impact_rate: f64,
 }
 

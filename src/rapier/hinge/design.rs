@@ -90,7 +90,7 @@ pub struct HingeDesign {
     /// large-step model does not count impacts and ignores it).
     pub(crate) min_separation: f64,
     /// The deepest penetration at which the contact law is trusted, m; deeper contacts are guard
-    /// violations ([`ClearanceJointBuilder::max_valid_penetration`]). `None` (the default): 1 % of
+    /// violations ([`max_valid_penetration`](Self::max_valid_penetration)). `None` (the default): 1 % of
     /// the journal radius.
     pub(crate) max_valid_penetration: Option<f64>,
     /// What holds the out-of-plane degrees of freedom (default [`OutOfPlaneLock::Joint`]);
@@ -165,28 +165,35 @@ impl HingeDesign {
         )
     }
 
-    /// Sets the friction law.
+    /// Sets the friction law (default: none).
     pub fn friction(mut self, friction: FrictionModel) -> Self {
         self.friction = friction;
         self
     }
 
-    /// Sets the floor on the impact velocity of the hysteresis laws, m/s.
+    /// Sets the floor on the impact velocity `delta_dot0` of the hysteresis laws, m/s (default
+    /// 1e-4): a contact that begins at a vanishing speed would otherwise get unbounded damping.
     pub fn min_impact_speed(mut self, speed: f64) -> Self {
         self.min_impact_speed = speed;
         self
     }
 
     /// Sets the gap a free flight must open for the next onset to count as an
-    /// [impact](crate::rapier::observers::metrics#onsets-impacts-and-chatter), m (checked when the joint is
+    /// [impact](crate::rapier::observers::metrics#onsets-impacts-and-chatter), m (default 0.1 um,
+    /// about 8 times the resting penetration of the paper's hinge load: onsets after smaller
+    /// separations are the chatter of a journal following the wall; checked when the joint is
     /// built: not negative).
     pub fn min_separation(mut self, gap: f64) -> Self {
         self.min_separation = gap;
         self
     }
 
-    /// Sets the deepest penetration at which the contact law is trusted, m (checked when the
-    /// joint is built: positive, at most the journal radius).
+    /// Sets the deepest penetration at which the contact law is trusted, m (default 1 % of the
+    /// journal radius, a nominal strain of 1 %; checked when the joint is built: positive, at
+    /// most the journal radius). A journal pressed deeper is outside the model; the step loop
+    /// reports it as a guard violation
+    /// ([`GuardReport`](crate::rapier::pipeline::protocol::GuardReport)), with the worst depth,
+    /// when and how often. It is not a force limit.
     pub fn max_valid_penetration(mut self, depth: f64) -> Self {
         self.max_valid_penetration = Some(depth);
         self
@@ -227,7 +234,25 @@ impl HingeDesign {
     }
 
     /// A validated clearance joint with these laws, about `local_axis1` / `local_axis2` through
-    /// `local_anchor1` / `local_anchor2` (body frames; body 1 carries the bearing).
+    /// `local_anchor1` / `local_anchor2` (body frames; body 1 carries the bearing, body 2 the
+    /// journal): unit axes, finite anchors, a normal law that holds a clearance (Liu's family)
+    /// built for the geometry's ([`NormalModel::check_clearance`]), the floors and the validity
+    /// limit. Without a revolute joint to convert
+    /// ([`ConvertRevolute`](crate::rapier::hinge::convert::ConvertRevolute)), this builds one from
+    /// scratch:
+    ///
+    /// ```
+    /// use clearance_joint::model::laws::{Bai, BearingGeometry, FrictionModel, ImprovedLiu, MaxDamping, NormalModel};
+    /// use clearance_joint::prelude::*;
+    /// let geometry = BearingGeometry::from_clearance(0.010, 0.5e-3, 0.016)?;
+    /// let law = ImprovedLiu::new(1.137e11, 0.016, 0.5e-3, 1.0, 1e-4, MaxDamping::Eta(0.01))?;
+    /// let axis = Vector::new(0.0, -1.0, 0.0);
+    /// let joint = HingeDesign::new(geometry, NormalModel::ImprovedLiu(law))
+    ///     .friction(FrictionModel::Bai(Bai::DRY))
+    ///     .joint(Vector::new(0.4, 0.0, 0.4), Vector::new(0.0, 0.0, 0.4), axis, axis)?;
+    /// assert!((joint.geometry().clearance() - 0.5e-3).abs() < 1e-15);
+    /// # Ok::<(), clearance_joint::Error>(())
+    /// ```
     pub fn joint(
         &self,
         local_anchor1: Vector,

@@ -6,7 +6,7 @@ impl ClearanceJointBuilder {
     /// A joint about `axis` (in body 1's frame; also used for body 2 unless
     /// [`local_axis2`](Self::local_axis2) is set) with the given geometry and normal law,
     /// frictionless, anchors at both bodies' origins.
-    pub fn new(axis: Vector, geometry: BearingGeometry, normal_law: NormalModel) -> Self {
+    pub(crate) fn new(axis: Vector, geometry: BearingGeometry, normal_law: NormalModel) -> Self {
         ClearanceJointBuilder {
             joint: ClearanceJoint {
                 name: String::from("clearance joint"),
@@ -39,34 +39,34 @@ impl ClearanceJointBuilder {
         }
     }
     /// Bearing centre in body 1's frame.
-    pub fn local_anchor1(mut self, anchor: Vector) -> Self {
+    pub(crate) fn local_anchor1(mut self, anchor: Vector) -> Self {
         self.joint.local_anchor1 = anchor;
         self
     }
     /// Journal centre in body 2's frame.
-    pub fn local_anchor2(mut self, anchor: Vector) -> Self {
+    pub(crate) fn local_anchor2(mut self, anchor: Vector) -> Self {
         self.joint.local_anchor2 = anchor;
         self
     }
     /// How the contact is integrated over a step ([`ContactIntegration`]; default
     /// [`ContactIntegration::Explicit`]).
-    pub fn integration(mut self, integration: ContactIntegration) -> Self {
+    pub(crate) fn integration(mut self, integration: ContactIntegration) -> Self {
         self.joint.integration = integration;
         self
     }
     /// Hinge axis in body 2's frame (defaults to the axis given to [`new`](Self::new)).
-    pub fn local_axis2(mut self, axis: Vector) -> Self {
+    pub(crate) fn local_axis2(mut self, axis: Vector) -> Self {
         self.joint.local_axis2 = axis;
         self
     }
     /// The friction law (default: none).
-    pub fn friction(mut self, friction: FrictionModel) -> Self {
+    pub(crate) fn friction(mut self, friction: FrictionModel) -> Self {
         self.joint.friction_law = friction;
         self
     }
     /// Floor on the impact velocity `delta_dot0` of the hysteresis laws, m/s (default 1e-4): a
     /// contact that begins at a vanishing speed would otherwise get unbounded damping.
-    pub fn min_impact_speed(mut self, speed: f64) -> Self {
+    pub(crate) fn min_impact_speed(mut self, speed: f64) -> Self {
         self.joint.min_impact_speed = speed;
         self
     }
@@ -74,7 +74,7 @@ impl ClearanceJointBuilder {
     /// [impact](crate::rapier::observers::metrics#onsets-impacts-and-chatter), m (default 0.1 um, about 8
     /// times the resting penetration of the paper's hinge load): onsets after smaller
     /// separations are the chatter of a journal following the wall.
-    pub fn min_separation(mut self, gap: f64) -> Self {
+    pub(crate) fn min_separation(mut self, gap: f64) -> Self {
         self.joint.min_separation = gap;
         self
     }
@@ -82,31 +82,31 @@ impl ClearanceJointBuilder {
     /// journal radius, a nominal strain of 1 %). A journal pressed deeper is outside the model; the
     /// steppers report it as a guard violation ([`crate::rapier::pipeline::protocol::GuardReport`]), with
     /// the worst depth, when and how often. It is not a force limit.
-    pub fn max_valid_penetration(mut self, depth: f64) -> Self {
+    pub(crate) fn max_valid_penetration(mut self, depth: f64) -> Self {
         self.joint.max_valid_penetration = Some(depth);
         self
     }
     /// What locks the out-of-plane degrees of freedom (default [`OutOfPlaneLock::Joint`]).
-    pub fn lock(mut self, lock: OutOfPlaneLock) -> Self {
+    pub(crate) fn lock(mut self, lock: OutOfPlaneLock) -> Self {
         self.joint.lock = lock;
         self
     }
     /// A name used in error messages and outputs.
-    pub fn name(mut self, name: impl Into<String>) -> Self {
+    pub(crate) fn name(mut self, name: impl Into<String>) -> Self {
         self.joint.name = name.into();
         self
     }
     /// Makes the joint spatial ([`crate::model::spatial`]): nothing is locked, the journal
     /// tilts and slides axially, touching the bore along its width (the geometry's length) and
     /// the bearing's faces with its shoulders. The [`lock`](Self::lock) is ignored (always none).
-    pub fn spatial(mut self, model: crate::model::spatial::SpatialModel) -> Self {
+    pub(crate) fn spatial(mut self, model: crate::model::spatial::SpatialModel) -> Self {
         self.spatial = Some(model);
         self
     }
     /// Validates and returns the joint: unit axes, finite anchors, a normal law that holds a
     /// clearance (Liu's family) built for the geometry's
     /// ([`NormalModel::check_clearance`]), the floors and the validity limit.
-    pub fn build(mut self) -> Result<ClearanceJoint> {
+    pub(crate) fn build(mut self) -> Result<ClearanceJoint> {
         let j = &mut self.joint;
         j.local_axis1 = crate::error::unit_vector("local_axis1", j.local_axis1)?;
         j.local_axis2 = crate::error::unit_vector("local_axis2", j.local_axis2)?;

@@ -12,7 +12,7 @@
 //!   state out of it ([`ClearanceReport::onset`](crate::rapier::joint::ClearanceReport::onset)).
 //!   Every contact begins with one.
 //! - **Impact**: an onset after a free flight that opened a gap of at least the joint's
-//!   `min_separation` ([`ClearanceJointBuilder::min_separation`](crate::rapier::joint::ClearanceJointBuilder::min_separation),
+//!   `min_separation` ([`HingeDesign::min_separation`](crate::rapier::hinge::design::HingeDesign::min_separation),
 //!   0.1 um by default); the
 //!   first contact of a joint is always one
 //!   ([`ClearanceReport::impact`](crate::rapier::joint::ClearanceReport::impact)).

@@ -61,7 +61,7 @@ use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
 use serde::{Deserialize, Serialize};
 
 /// How a compliant clearance joint integrates its contact and friction forces over a step
-/// ([`ClearanceJointBuilder::integration`](super::ClearanceJointBuilder::integration)).
+/// ([`HingeDesign::integration`](crate::rapier::hinge::design::HingeDesign::integration)).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[non_exhaustive]
 pub enum ContactIntegration {

@@ -19,12 +19,13 @@ use clearance_joint::rapier::observers::metrics::{
 };
 use clearance_joint::rapier::observers::reaction::SoftMotor;
 use clearance_joint::rapier::pipeline::stepper::StepControl;
+use clearance_joint::rapier::pipeline::world::ClearanceWorld;
 use clearance_joint::rapier::sources::drive::TorsionSpring;
 use clearance_joint::rapier::sources::prescribed::Table;
 use clearance_joint::{Error, error};
 use proptest::prelude::*;
 use rapier3d_f64::math::{Rotation, Vector};
-use rapier3d_f64::prelude::RigidBodyHandle;
+use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle};
 
 /// The numbers that break code: NaN, the infinities, signed zeros, the extremes of the normal
 /// range, subnormals, and ordinary values of both signs over many decades.
@@ -304,11 +305,16 @@ proptest! {
     fn step_control_refuses_what_is_not_finite(
         dt in any_number(), tol in any_number(), floor in any_number(), growth in any_number(),
     ) {
-        let fixed = StepControl::fixed(dt);
-        refuses_non_finite(&[dt], &fixed.validate())?;
-        let c = StepControl::adaptive(dt, tol).with_tolerance(tol).min_dt(floor).max_growth(growth);
-        refuses_non_finite(&[dt, tol, floor, growth], &c.validate())?;
-        if c.validate().is_ok() {
+        // The world checks its control at every step (and at `prepare`).
+        let check = |c: StepControl| ClearanceWorld::new(PhysicsWorld::new(), c).prepare();
+        refuses_non_finite(&[dt], &check(StepControl::fixed(dt)))?;
+        let c = StepControl {
+            min_dt: floor,
+            max_growth: growth,
+            ..StepControl::adaptive(dt, tol)
+        };
+        refuses_non_finite(&[dt, tol, floor, growth], &check(c))?;
+        if check(c).is_ok() {
             prop_assert!(c.max_dt > 0.0 && c.min_dt <= c.max_dt);
         }
     }

@@ -39,30 +39,34 @@
 //! use clearance_joint::prelude::*;
 //! use rapier3d_f64::prelude::*;
 //!
-//! let mut world = PhysicsWorld::new(); // gravity along -y
-//! world.integration_parameters.num_solver_iterations = 1;
-//! let base = world.bodies.insert(RigidBodyBuilder::fixed());
-//! let arm = world.bodies.insert(
+//! let mut rapier = PhysicsWorld::new(); // gravity along -y
+//! rapier.integration_parameters.num_solver_iterations = 1;
+//! let mut world = ClearanceWorld::new(rapier, StepControl::fixed(2e-5));
+//! let base = world.rapier.bodies.insert(RigidBodyBuilder::fixed());
+//! let arm = world.rapier.bodies.insert(
 //!     RigidBodyBuilder::dynamic()
 //!         .translation(Vector::new(0.0, -0.3, 0.0))
 //!         .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02)))
 //!         .can_sleep(false),
 //! );
 //! let revolute = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0));
-//! let pivot = world.impulse_joints.insert(base, arm, revolute, true);
-//! let mut clearance = ClearanceJointSet::new();
+//! let pivot = world.rapier.impulse_joints.insert(base, arm, revolute, true);
 //! let clear = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)?;
-//! let pivot = clearance.convert_revolute(pivot, BearingSide::Body1, clear, &mut world.impulse_joints)?;
+//! let pivot = world.clearance.convert_revolute(
+//!     pivot,
+//!     BearingSide::Body1,
+//!     clear,
+//!     &mut world.rapier.impulse_joints,
+//! )?;
 //!
-//! let mut stepper = Stepper::new(StepControl::fixed(2e-5));
-//! stepper.prepare(&mut world, &mut [&mut clearance])?;
+//! world.prepare()?;
 //! let mut recorder = ImpactRecorder::new();
-//! while stepper.time() < 0.1 {
-//!     let before = ContactObservation::of(clearance.get(pivot).unwrap());
-//!     let info = stepper.step(&mut world, &mut [&mut clearance], 0.1)?;
+//! while world.time() < 0.1 {
+//!     let before = ContactObservation::of(world.clearance.get(pivot).unwrap());
+//!     let info = world.step(0.1)?;
 //!     recorder.record(info.t0, info.dt, &before);
 //! }
-//! recorder.finish(stepper.time(), &ContactObservation::of(clearance.get(pivot).unwrap()));
+//! recorder.finish(world.time(), &ContactObservation::of(world.clearance.get(pivot).unwrap()));
 //! // The journal drops through the 0.2 mm gap and bounces on the bearing's floor.
 //! let first = &recorder.contacts()[0];
 //! assert!(first.approach_speed_m_s > 0.01 && first.peak_force_n > 100.0);

@@ -264,10 +264,14 @@ pub fn summary_json(summary: &Summary) -> Result<String> {
     ];
     fn check(v: &serde_json::Value, key: &str, path: &str, end: f64) -> Result<()> {
         match v {
-            serde_json::Value::Null if !MAY_BE_NULL.contains(&key) => Err(Error::Diverged {
-                t: end,
-                reason: format!("non-finite value of `{path}` in the summary"),
-            }),
+            serde_json::Value::Null if !MAY_BE_NULL.contains(&key) => Err(Error::diverged(
+                end,
+                crate::error::Divergence::NonFinite {
+                    name: path.to_string(),
+                    place: "in the summary".into(),
+                    value: None,
+                },
+            )),
             serde_json::Value::Object(o) => o
                 .iter()
                 .try_for_each(|(k, c)| check(c, k, &format!("{path}.{k}"), end)),

@@ -2,7 +2,7 @@
 //! hooks, and the hinges' forces the step held.
 
 use super::{HingeJoint, Physics};
-use crate::error::{Error, Result};
+use crate::error::{Divergence, Error, Result};
 use crate::rapier::observers::reaction::{IdealJoint, IdealRevolute};
 use crate::rapier::pipeline::stepper::{StepHooks, StepMode};
 use crate::rapier::pipeline::world::ClearanceWorld;
@@ -108,12 +108,7 @@ impl Physics {
                     .map(|(e, f)| (*e, f.length()))
                     .collect()
             })
-            .ok_or_else(|| Error::Diverged {
-                t,
-                reason: "the ideal hinges' reactions cannot be solved: the state or a body's \
-                         mass is not finite"
-                    .into(),
-            })?;
+            .ok_or_else(|| Error::diverged(t, Divergence::Reactions { twin: None }))?;
         self.ideal_cache = (self.world.steps(), forces.clone());
         Ok(forces)
     }

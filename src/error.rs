@@ -66,7 +66,7 @@ pub enum Error {
     Guard {
         /// Simulated time when detected.
         t: f64,
-        /// The violations (in words: [`Violation::message`], joined by `; `).
+        /// The violations (in words: their `Display`, joined by `; `).
         violations: Vec<Violation>,
     },
     /// A convergence check found metrics that move beyond their bounds at a tighter step
@@ -408,7 +408,7 @@ pub struct ParameterNames {
 fn in_words(violations: &[Violation]) -> String {
     violations
         .iter()
-        .map(Violation::message)
+        .map(Violation::to_string)
         .collect::<Vec<_>>()
         .join("; ")
 }

@@ -64,8 +64,7 @@
 //! ([`rapier::sources::prescribed`]), torsion springs and torques ([`rapier::sources::drive`]). Around the loop, the
 //! same public pieces the scene runner uses:
 //! - [`ImpactRecorder`](rapier::observers::metrics::ImpactRecorder): the impact list (onset, approach speed,
-//!   peak force, deepest penetration, duration), contact fraction, peak and first-impact figures,
-//!   and per-turn statistics of a driven mechanism;
+//!   peak force, deepest penetration, duration), contact fraction, peak and first-impact figures;
 //! - [`ReactionSolver`](rapier::observers::reaction::ReactionSolver): the exact reactions of the ideal joints
 //!   at a state, from the constrained equations (no difference quotients);
 //! - [`StepInfo`](rapier::pipeline::stepper::StepInfo) of every step and the world's guards (penetration

@@ -135,7 +135,7 @@ fn penetration_guard_reports_the_worst_depth_when_and_how_often() {
     assert!(
         matches!(&err, Error::Guard { violations, .. } if violations.iter().any(|v| v.kind == GuardKind::Penetration
             && v.joint.as_deref() == Some("pin")
-            && v.message().contains("joint `pin` penetrated"))),
+            && v.to_string().contains("joint `pin` penetrated"))),
         "{err}"
     );
 }

@@ -137,7 +137,7 @@ fn a_sub_cycle_beyond_its_sub_step_cap_is_a_guard_violation() {
             .any(|v| v.kind == GuardKind::SubSteps && v.joint.as_deref() == Some("clearance joint")),
         "{v:?}"
     );
-    println!("{}", v[0].message());
+    println!("{}", v[0]);
     let strict = held_journal(
         0.0,
         StepControl {

@@ -283,7 +283,7 @@ fn the_source_guard_shows_in_the_world_guards() {
         .expect("the spring's guard");
     assert_eq!(v.kind, GuardKind::Other);
     assert!(v.worst > 0.099 && v.limit == 0.08 && v.count > 1, "{v:?}");
-    assert_eq!(v.message(), "the spring is stretched past its maximum");
+    assert_eq!(v.to_string(), "the spring is stretched past its maximum");
     assert!(!world.guards().is_clean());
 }
 

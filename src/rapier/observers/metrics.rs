@@ -151,7 +151,7 @@ impl ContactObservation {
     }
 
     /// Whether the surfaces are in contact (penetration above 0).
-    pub fn in_contact(&self) -> bool {
+    pub(crate) fn in_contact(&self) -> bool {
         self.penetration > 0.0
     }
 }
@@ -465,7 +465,7 @@ impl ImpactRecorder {
 
     /// The contact list as a table: `onset_t_s, approach_speed_mm_s, peak_force_n, peak_t_s,
     /// max_penetration_um, duration_s, separated` (1 for an impact, 0 for chatter).
-    pub fn contacts_table(&self) -> Table {
+    pub(crate) fn contacts_table(&self) -> Table {
         let mut t = Table::new(
             [
                 "onset_t_s",
@@ -496,7 +496,7 @@ impl ImpactRecorder {
 
 /// One period (a crank turn) of a driven mechanism's clearance joint.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct PeriodStats {
+pub(crate) struct PeriodStats {
     /// Start of the period, s.
     pub start_s: f64,
     /// Its length, s (the last period may be cut short by the end of the run).
@@ -520,7 +520,7 @@ pub struct PeriodStats {
 /// period of its onset. Empty for a period or end that is not positive (or NaN); an error when
 /// `end / period` is more than [`MAX_PERIODS`] (or infinite): the table would not fit in
 /// memory.
-pub fn per_period(impacts: &[Impact], period: f64, end: f64) -> Result<Vec<PeriodStats>> {
+pub(crate) fn per_period(impacts: &[Impact], period: f64, end: f64) -> Result<Vec<PeriodStats>> {
     if !(period > 0.0) || !(end > 0.0) {
         return Ok(Vec::new());
     }
@@ -566,7 +566,7 @@ pub fn per_period(impacts: &[Impact], period: f64, end: f64) -> Result<Vec<Perio
 }
 
 /// Most periods [`per_period`] tabulates (a table of about 50 MB).
-pub const MAX_PERIODS: usize = 1_000_000;
+pub(crate) const MAX_PERIODS: usize = 1_000_000;
 
 /// The per-period statistics as a table: `turn, start_s, onsets, separated_impacts,
 /// peak_force_n, contact_fraction` (`separated_impacts`: the [impacts](crate::rapier::observers::metrics#onsets-impacts-and-chatter)).

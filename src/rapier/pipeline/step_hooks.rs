@@ -114,7 +114,8 @@ pub trait StepHooks {
     fn record_guards(&self, _step: &StepContext, _guards: &mut GuardReport) {}
 
     /// The contact of this participant whose step limit is the shortest, with its numbers, for a
-    /// stall's diagnosis; `None` when none is in contact. Default: none.
+    /// stall's diagnosis; `None` when none is in contact. This crate's compliant joint set
+    /// reports its contacts; a participant of your own keeps the default: none.
     fn stalled_contact(&self, _bodies: &RigidBodySet) -> Option<StalledContact> {
         None
     }

@@ -118,7 +118,7 @@ fn add_twin(world: &mut ClearanceWorld, with_clearance: bool) -> Result<Twin> {
             .insert(satellite, panel, revolute, true);
         None
     };
-    world.insert_drive(TorsionSpring::new(
+    world.drives.insert(TorsionSpring::new(
         satellite,
         panel,
         AXIS,

@@ -116,9 +116,7 @@ impl Physics {
 
 /// Fixed steps follow `integration_parameters.dt` as the user sets it, between any two steps.
 fn follow_dt(world: &mut ClearanceWorld) {
-    let mut control = *world.step_control();
-    if control.mode == StepMode::Fixed {
-        control.max_dt = world.rapier.integration_parameters.dt;
-        world.set_step_control(control);
+    if world.step_control.mode == StepMode::Fixed {
+        world.step_control.max_dt = world.rapier.integration_parameters.dt;
     }
 }

@@ -54,15 +54,17 @@ use crate::rapier::observers::reaction::{IdealJoint, KinematicState, ReactionSol
 use crate::rapier::pipeline::protocol::Wrench;
 use crate::rapier::pipeline::step_hooks::StepHooks;
 use crate::rapier::pipeline::stepper::{GuardReport, StepControl, StepInfo, Stepper};
-use crate::rapier::sources::drive::{DriveHandle, DriveSet, TorsionSpring};
+use crate::rapier::sources::drive::DriveSet;
 use crate::rapier::sources::prescribed::{PrescribedMotion, PrescribedSet};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle};
 
 /// A Rapier world with clearance joints, drives and prescribed motions, stepped by one step
-/// control ([`crate::rapier::pipeline::stepper`]). The sets are public fields, as in Rapier's `PhysicsWorld`: read them freely;
-/// add and remove joints, drives and motions with the `insert_*`/`remove_*` methods (which also
-/// add their Rapier parts and tell the step control when forces must be evaluated again). A
+/// control ([`crate::rapier::pipeline::stepper`]). The sets and the step control are public
+/// fields, as in Rapier's `PhysicsWorld`: read them freely; add and remove joints and motions
+/// with the `insert_*`/`remove_*` methods (which also add their Rapier parts and tell the step
+/// control when forces must be evaluated again), drives with the drive set's own
+/// [`insert`](DriveSet::insert) and [`remove`](DriveSet::remove) (they have no Rapier part). A
 /// compliant joint or a drive added, removed or edited through the fields is noticed at the
 /// next step (by the sets' revisions, [`ElementSet::revision`](crate::rapier::pipeline::element_set::ElementSet::revision));
 /// after moving bodies or setting velocities by hand between steps, call
@@ -82,6 +84,9 @@ pub struct ClearanceWorld {
     pub drives: DriveSet,
     /// The tabulated (prescribed) motions of kinematic bodies.
     pub prescribed: PrescribedSet,
+    /// The step control: fixed or adaptive steps, their bounds, strictness. Set it between
+    /// steps; each step checks it, naming a field out of its domain.
+    pub step_control: StepControl,
     stepper: Stepper,
     /// The revisions of the compliant joint set and the drive set at the last step (`None`
     /// before the first): a change means their forces must be evaluated again before the next
@@ -101,6 +106,7 @@ impl ClearanceWorld {
             large_step: LargeStepJointSet::new(),
             drives: DriveSet::new(),
             prescribed: PrescribedSet::default(),
+            step_control: control,
             stepper: Stepper::new(control),
             revisions: None,
             wrenches: Vec::new(),
@@ -157,18 +163,6 @@ impl ClearanceWorld {
         let w = &mut self.rapier;
         self.large_step
             .remove(handle, &mut w.bodies, &mut w.impulse_joints)
-    }
-
-    /// Adds a drive.
-    pub fn insert_drive(&mut self, drive: TorsionSpring) -> DriveHandle {
-        self.stepper.invalidate(false);
-        self.drives.insert(drive)
-    }
-
-    /// Removes a drive; `None` for a handle of no drive.
-    pub fn remove_drive(&mut self, handle: DriveHandle) -> Option<TorsionSpring> {
-        self.stepper.invalidate(false);
-        self.drives.remove(handle)
     }
 
     /// Adds a prescribed motion; returns its index in [`PrescribedSet::motions`]. Refused, naming
@@ -325,16 +319,6 @@ impl ClearanceWorld {
         self.stepper.guards()
     }
 
-    /// The step control.
-    pub fn step_control(&self) -> &StepControl {
-        self.stepper.control()
-    }
-
-    /// Replaces the step control (between steps).
-    pub fn set_step_control(&mut self, control: StepControl) {
-        self.stepper.set_control(control);
-    }
-
     // ----- Reactions -----
 
     /// The force on each ideal joint's body 2 at the current state (N, world frame, in the order
@@ -388,6 +372,7 @@ impl ClearanceWorld {
         &'a mut PhysicsWorld,
         [&'a mut dyn StepHooks; 5],
     ) {
+        self.stepper.set_control(self.step_control);
         (
             &mut self.stepper,
             &mut self.rapier,

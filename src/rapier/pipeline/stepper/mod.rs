@@ -116,12 +116,7 @@ impl Stepper {
         }
     }
 
-    /// The step control.
-    pub fn control(&self) -> &StepControl {
-        &self.control
-    }
-
-    /// Changes the step control (e.g. the ECS layer follows `integration_parameters.dt`).
+    /// Changes the step control (the world's `step_control`, before each step).
     pub(crate) fn set_control(&mut self, control: StepControl) {
         self.control = control;
     }

@@ -324,7 +324,10 @@ fn main() {
                 Pins::Compliant(ContactIntegration::SubCycled),
                 c,
                 rate,
-                StepControl::fixed(tick).with_tolerance(tolerance),
+                StepControl {
+                    tolerance,
+                    ..StepControl::fixed(tick)
+                },
             );
             let reference = run(
                 Pins::Compliant(ContactIntegration::Explicit),

@@ -121,7 +121,7 @@ fn add_twin(world: &mut ClearanceWorld, with_clearance: bool) -> Result<Twin> {
         );
         None
     };
-    world.insert_drive(TorsionSpring::new(
+    world.drives.insert(TorsionSpring::new(
         satellite,
         panel,
         AXIS,

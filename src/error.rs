@@ -4,6 +4,9 @@ use crate::rapier::observers::stall::Stall;
 use crate::rapier::pipeline::protocol::Violation;
 use std::path::PathBuf;
 
+mod divergence;
+pub use divergence::Divergence;
+
 /// Everything that can go wrong in this crate. Nothing here panics on bad input.
 ///
 /// The messages speak to the caller of the layer that returns them: the plain API's errors name
@@ -39,13 +42,15 @@ pub enum Error {
     /// it knows the mode, see [`Error::with_step_mode`]); the numbers are [`StepLimit`]'s.
     #[error("{0}")]
     StepTooLarge(Box<StepLimit>),
-    /// The simulation state became non-physical (non-finite, or energy/momentum destroyed).
-    #[error("simulation diverged at t = {t:.6} s: {reason}")]
+    /// The simulation state became non-physical: a body left the physical range, reactions that
+    /// cannot be solved, a value bound for an output that is not finite. What diverged, where,
+    /// and its value are [`Divergence`]'s.
+    #[error("simulation diverged at t = {t:.6} s: {what}")]
     Diverged {
         /// Simulated time when detected.
         t: f64,
-        /// What was detected.
-        reason: String,
+        /// What diverged (in words through its `Display`).
+        what: Box<Divergence>,
     },
     /// The step control could not make progress: every step it tried was rejected, or it stayed
     /// at its floor without advancing the simulated time.
@@ -64,7 +69,7 @@ pub enum Error {
     Guard {
         /// Simulated time when detected.
         t: f64,
-        /// The violations (in words: [`Violation::message`], joined by `; `).
+        /// The violations (in words: their `Display`, joined by `; `).
         violations: Vec<Violation>,
     },
     /// A convergence check found metrics that move beyond their bounds at a tighter step
@@ -314,7 +319,7 @@ pub struct ParameterNames {
 fn in_words(violations: &[Violation]) -> String {
     violations
         .iter()
-        .map(Violation::message)
+        .map(Violation::to_string)
         .collect::<Vec<_>>()
         .join("; ")
 }

@@ -51,13 +51,12 @@
 //! The pieces: [`HingeDesign`](rapier::hinge::design::HingeDesign) (geometry and laws, any law of
 //! [`model::laws`]), [`ClearanceJointSet`](rapier::joint::ClearanceJointSet) (the joints and their
 //! force hook), [`LargeStepJointSet`](rapier::large_step::LargeStepJointSet) (the play as a
-//! constraint, for game and robot rates), [`Stepper`](rapier::pipeline::stepper::Stepper) with
-//! [`StepControl`](rapier::pipeline::stepper::StepControl) (step choice, acceptance,
-//! [`GuardReport`](rapier::pipeline::protocol::GuardReport)), the step protocol every set implements
-//! ([`StepHooks`](rapier::pipeline::step_hooks::StepHooks)), and
+//! constraint, for game and robot rates), [`StepControl`](rapier::pipeline::stepper::StepControl)
+//! (step choice, acceptance, [`GuardReport`](rapier::pipeline::protocol::GuardReport)), the step
+//! protocol every set implements ([`StepHooks`](rapier::pipeline::step_hooks::StepHooks)), and
 //! [`HingeDesign::joint`](rapier::hinge::design::HingeDesign::joint) for a joint built from scratch.
-//! [`ClearanceWorld`](rapier::pipeline::world::ClearanceWorld) bundles them; the scene runner and the
-//! bevy_ecs layer are built on it.
+//! [`ClearanceWorld`](rapier::pipeline::world::ClearanceWorld) bundles them and takes every step;
+//! the scene runner and the bevy_ecs layer are built on it.
 //!
 //! # 2. A driven mechanism, with its metrics
 //!
@@ -65,11 +64,10 @@
 //! ([`rapier::sources::prescribed`]), torsion springs and torques ([`rapier::sources::drive`]). Around the loop, the
 //! same public pieces the scene runner uses:
 //! - [`ImpactRecorder`](rapier::observers::metrics::ImpactRecorder): the impact list (onset, approach speed,
-//!   peak force, deepest penetration, duration), contact fraction, peak and first-impact figures,
-//!   and per-turn statistics of a driven mechanism;
+//!   peak force, deepest penetration, duration), contact fraction, peak and first-impact figures;
 //! - [`ReactionSolver`](rapier::observers::reaction::ReactionSolver): the exact reactions of the ideal joints
 //!   at a state, from the constrained equations (no difference quotients);
-//! - [`StepInfo`](rapier::pipeline::stepper::StepInfo) of every step and the stepper's guards (penetration
+//! - [`StepInfo`](rapier::pipeline::stepper::StepInfo) of every step and the world's guards (penetration
 //!   beyond the law's validity, energy gained, steps at the floor).
 //! - [`ReplayRecorder`](rapier::observers::replay::ReplayRecorder): the bodies' poses and each journal in its
 //!   bearing, thinned by time, for a replay of the run (the app writes it as `replay.html`).
@@ -82,7 +80,7 @@
 //! A mechanism can instead be described in a RON scene file ([`scene::Scene`]: bodies, ideal
 //! joints, hinges with or without clearance, drives, prescribed motions, run settings), validated
 //! with errors that name the field. [`scene::runner::Simulation`] builds an ideal and a clearance
-//! twin in one world, steps them with the same [`Stepper`](rapier::pipeline::stepper::Stepper), and returns
+//! twin in one [`ClearanceWorld`](rapier::pipeline::world::ClearanceWorld), steps them with the same step control, and returns
 //! their time series, impact lists, reactions, energy and momentum checks and guards;
 //! [`RunResult::write`](scene::runner::RunResult::write) writes the result set whole or not at
 //! all:
@@ -211,7 +209,7 @@ pub mod prelude {
     pub use crate::rapier::observers::reaction::{IdealJoint, KinematicState, ReactionSolver};
     pub use crate::rapier::pipeline::protocol::{GuardKind, GuardReport, Violation, Wrench};
     pub use crate::rapier::pipeline::step_hooks::{EvaluateContext, StepContext, StepHooks};
-    pub use crate::rapier::pipeline::stepper::{StepControl, StepInfo, Stepper};
+    pub use crate::rapier::pipeline::stepper::{StepControl, StepInfo};
     pub use crate::rapier::pipeline::world::ClearanceWorld;
     pub use crate::rapier::sources::drive::{DriveHandle, DriveSet, TorsionSpring};
     /// The same item as Rapier's (`rapier3d_f64::math::Vector`), so no clash with its prelude.

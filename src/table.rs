@@ -71,10 +71,14 @@ impl Table {
             line.clear();
             for (j, v) in self.row(i).iter().enumerate() {
                 if !v.is_finite() {
-                    return Err(Error::Diverged {
-                        t: self.row(i)[0],
-                        reason: format!("non-finite `{}` in output row {i}", self.columns[j]),
-                    });
+                    return Err(Error::diverged(
+                        self.row(i)[0],
+                        crate::error::Divergence::NonFinite {
+                            name: self.columns[j].clone(),
+                            place: format!("in output row {i}"),
+                            value: Some(*v),
+                        },
+                    ));
                 }
                 if j > 0 {
                     line.push(',');

@@ -1,5 +1,5 @@
 //! Issue 18, item 5: the library's errors speak to the library's caller. A plain-API caller (its
-//! own Rapier world, loop and `Stepper`) reads the API's names, never an option of the app
+//! own Rapier world and loop, stepped by a `ClearanceWorld`) reads the API's names, never an option of the app
 //! (`--dt`) nor a path of the scene format (`run.dt_s`, `hinges[NAME]...`); the same errors
 //! through the scene runner name the scene's fields (the app's options are added by the app:
 //! `app/tests/reliability.rs`).
@@ -7,7 +7,7 @@
 use clearance_joint::error::Error;
 use clearance_joint::model::laws::{BearingGeometry, Hertz, KelvinVoigt, NormalModel};
 use clearance_joint::prelude::*;
-use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
+use clearance_joint::rapier::pipeline::stepper::StepControl;
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::runner::{RunOptions, Simulation};
 use rapier3d_f64::prelude::*;
@@ -62,17 +62,24 @@ fn steel() -> HingeDesign {
     HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016).unwrap()
 }
 
+/// `world` with the joints of `set`, stepped with `control`.
+fn world_of(world: PhysicsWorld, set: ClearanceJointSet, control: StepControl) -> ClearanceWorld {
+    let mut world = ClearanceWorld::new(world, control);
+    world.clearance = set;
+    world
+}
+
 /// Steps `set`'s world with `control` until an error (or `end` s, then panics).
 fn run_until_error(
-    world: &mut PhysicsWorld,
-    set: &mut ClearanceJointSet,
+    world: PhysicsWorld,
+    set: ClearanceJointSet,
     control: StepControl,
     end: f64,
 ) -> Error {
-    let mut stepper = Stepper::new(control);
+    let mut world = world_of(world, set, control);
     loop {
-        match stepper.step(world, &mut [set], end) {
-            Ok(_) => assert!(stepper.time() < end, "no error by t = {end} s"),
+        match world.step(end) {
+            Ok(_) => assert!(world.time() < end, "no error by t = {end} s"),
             Err(e) => return e,
         }
     }
@@ -80,8 +87,8 @@ fn run_until_error(
 
 #[test]
 fn a_fixed_step_too_large_names_the_api() {
-    let (mut world, mut set) = pendulum(steel(), 1);
-    let e = run_until_error(&mut world, &mut set, StepControl::fixed(1e-3), 1.0);
+    let (world, set) = pendulum(steel(), 1);
+    let e = run_until_error(world, set, StepControl::fixed(1e-3), 1.0);
     let m = e.to_string();
     assert!(
         matches!(&e, Error::StepTooLarge(l) if l.field() == "StepControl::max_dt"
@@ -319,8 +326,8 @@ fn a_restitution_the_model_ignores_is_refused() {
 
 #[test]
 fn rapiers_default_iterations_suggest_the_large_step_model() {
-    let (mut world, mut set) = pendulum(steel(), 4);
-    let e = run_until_error(&mut world, &mut set, StepControl::fixed(1e-5), 0.01);
+    let (world, set) = pendulum(steel(), 4);
+    let e = run_until_error(world, set, StepControl::fixed(1e-5), 0.01);
     let m = e.to_string();
     assert!(
         matches!(&e, Error::Invalid { field, .. } if field == "num_solver_iterations"),
@@ -375,9 +382,12 @@ fn a_stall_names_the_api() {
     // resolves it.
     let geometry = BearingGeometry::from_clearance(0.010, 0.2e-3, 0.016).unwrap();
     let law = NormalModel::Hertz(Hertz::new(1e16, 1.5).unwrap());
-    let (mut world, mut set) = pendulum(HingeDesign::new(geometry, law), 1);
-    let control = StepControl::adaptive(1e-3, 0.0075).min_dt(1e-6);
-    let e = run_until_error(&mut world, &mut set, control, 0.1);
+    let (world, set) = pendulum(HingeDesign::new(geometry, law), 1);
+    let control = StepControl {
+        min_dt: 1e-6,
+        ..StepControl::adaptive(1e-3, 0.0075)
+    };
+    let e = run_until_error(world, set, control, 0.1);
     let m = e.to_string();
     assert!(matches!(e, Error::Stalled { .. }), "{m}");
     assert!(m.contains("joint `pin`") && m.contains("`min_dt`"), "{m}");
@@ -388,9 +398,12 @@ fn a_stall_names_the_api() {
 fn a_strict_guard_names_the_joint() {
     // A validity limit of 1 nm: the first contact passes it.
     let clearance = steel().max_valid_penetration(1e-9);
-    let (mut world, mut set) = pendulum(clearance, 1);
-    let control = StepControl::adaptive(1e-3, 0.0075).strict(true);
-    let e = run_until_error(&mut world, &mut set, control, 0.1);
+    let (world, set) = pendulum(clearance, 1);
+    let control = StepControl {
+        strict: true,
+        ..StepControl::adaptive(1e-3, 0.0075)
+    };
+    let e = run_until_error(world, set, control, 0.1);
     let m = e.to_string();
     assert!(matches!(e, Error::Guard { .. }), "{m}");
     assert!(
@@ -459,15 +472,13 @@ fn a_face_restitution_that_stalls_is_named() {
 /// naming the state (unchecked, each left the physical range as "speed 0 m/s").
 #[test]
 fn steps_torques_and_states_the_solver_cannot_take_are_named() {
-    let (mut world, mut set) = pendulum(steel(), 1);
     for (control, field) in [
         (StepControl::fixed(1e-300), "dt"),
         (StepControl::adaptive(1e-300, 0.0075), "max_dt"),
         (StepControl::adaptive(1e-3, 1e-300), "tolerance"),
     ] {
-        let e = Stepper::new(control)
-            .step(&mut world, &mut [&mut set], 0.1)
-            .unwrap_err();
+        let (world, set) = pendulum(steel(), 1);
+        let e = world_of(world, set, control).step(0.1).unwrap_err();
         let m = e.to_string();
         assert!(
             matches!(&e, Error::Invalid { field: f, .. } if f == field),
@@ -502,16 +513,16 @@ fn steps_torques_and_states_the_solver_cannot_take_are_named() {
             rb.set_translation(Vector::new(f64::NAN, 0.0, 0.0), true)
         }),
     ] {
-        let (mut world, mut set) = pendulum(steel(), 1);
-        set_bad(&mut world.bodies[arm]);
-        let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.0075));
-        let e = stepper.step(&mut world, &mut [&mut set], 0.1).unwrap_err();
+        let (world, set) = pendulum(steel(), 1);
+        let mut world = world_of(world, set, StepControl::adaptive(1e-3, 0.0075));
+        set_bad(&mut world.rapier.bodies[arm]);
+        let e = world.step(0.1).unwrap_err();
         let m = e.to_string();
         assert!(
             matches!(&e, Error::Invalid { field: f, .. } if f == field) && m.contains("non-finite"),
             "{field}: {m}"
         );
-        assert_eq!(stepper.time(), 0.0);
+        assert_eq!(world.time(), 0.0);
     }
 }
 
@@ -552,10 +563,10 @@ fn a_stall_of_the_turn_bound_names_the_tolerance() {
                 Vector::splat(0.01),
             )),
     );
-    let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 1e-6));
+    let mut world = ClearanceWorld::new(world, StepControl::adaptive(1e-3, 1e-6));
     let e = loop {
-        match stepper.step(&mut world, &mut [], 1.0) {
-            Ok(_) => assert!(stepper.steps() < 1_000_000, "no stall"),
+        match world.step(1.0) {
+            Ok(_) => assert!(world.steps() < 1_000_000, "no stall"),
             Err(e) => break e,
         }
     };

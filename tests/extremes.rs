@@ -222,13 +222,12 @@ fn api_pendulum() -> (
 
 #[test]
 fn api_refuses_a_gravity_that_is_not_finite() {
-    use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
-    let (mut world, mut joints, _) = api_pendulum();
-    world.gravity = rapier3d_f64::math::Vector::new(0.0, f64::NAN, 0.0);
-    let mut stepper = Stepper::new(StepControl::fixed(1e-5));
-    let e = stepper
-        .step(&mut world, &mut [&mut joints], 0.01)
-        .unwrap_err();
+    use clearance_joint::rapier::pipeline::{stepper::StepControl, world::ClearanceWorld};
+    let (world, joints, _) = api_pendulum();
+    let mut world = ClearanceWorld::new(world, StepControl::fixed(1e-5));
+    world.clearance = joints;
+    world.rapier.gravity = rapier3d_f64::math::Vector::new(0.0, f64::NAN, 0.0);
+    let e = world.step(0.01).unwrap_err();
     assert!(
         matches!(&e, Error::Invalid { field, .. } if field == "gravity"),
         "{e}"
@@ -238,22 +237,24 @@ fn api_refuses_a_gravity_that_is_not_finite() {
 #[test]
 fn api_names_a_journal_body_removed_after_the_joint() {
     // The step check used to read "stable only below 0 s ... use `dt` below 0 s".
-    use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
-    let (mut world, mut joints, arm) = api_pendulum();
-    let mut stepper = Stepper::new(StepControl::fixed(1e-5));
-    stepper.step(&mut world, &mut [&mut joints], 1e-3).unwrap();
-    world.bodies.remove(
+    use clearance_joint::rapier::pipeline::{stepper::StepControl, world::ClearanceWorld};
+    let (world, joints, arm) = api_pendulum();
+    let mut world = ClearanceWorld::new(world, StepControl::fixed(1e-5));
+    world.clearance = joints;
+    world.step(1e-3).unwrap();
+    let rapier = &mut world.rapier;
+    rapier.bodies.remove(
         arm,
-        &mut world.islands,
-        &mut world.colliders,
-        &mut world.impulse_joints,
-        &mut world.multibody_joints,
-        &mut world.soft_bodies,
+        &mut rapier.islands,
+        &mut rapier.colliders,
+        &mut rapier.impulse_joints,
+        &mut rapier.multibody_joints,
+        &mut rapier.soft_bodies,
         true,
     );
     let e = loop {
-        match stepper.step(&mut world, &mut [&mut joints], 1e-2) {
-            Ok(_) => assert!(stepper.time() < 1e-2, "the missing body went unnoticed"),
+        match world.step(1e-2) {
+            Ok(_) => assert!(world.time() < 1e-2, "the missing body went unnoticed"),
             Err(e) => break e.to_string(),
         }
     };
@@ -266,9 +267,9 @@ fn api_names_a_journal_body_removed_after_the_joint() {
 #[test]
 fn api_divergence_names_the_handle_and_the_likely_cause() {
     // A stone flung at 300 m/s beside the pendulum leaves the physical range at once.
-    use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
+    use clearance_joint::rapier::pipeline::{stepper::StepControl, world::ClearanceWorld};
     use rapier3d_f64::prelude::{MassProperties, RigidBodyBuilder};
-    let (mut world, mut joints, _) = api_pendulum();
+    let (mut world, joints, _) = api_pendulum();
     let stone = world.bodies.insert(
         RigidBodyBuilder::dynamic()
             .translation(rapier3d_f64::math::Vector::new(1.0, 0.0, 0.0))
@@ -279,10 +280,11 @@ fn api_divergence_names_the_handle_and_the_likely_cause() {
                 rapier3d_f64::math::Vector::splat(0.01),
             )),
     );
-    let mut stepper = Stepper::new(StepControl::fixed(1e-6));
+    let mut world = ClearanceWorld::new(world, StepControl::fixed(1e-6));
+    world.clearance = joints;
     let e = loop {
-        match stepper.step(&mut world, &mut [&mut joints], 1e-2) {
-            Ok(_) => assert!(stepper.time() < 1e-2, "never diverged"),
+        match world.step(1e-2) {
+            Ok(_) => assert!(world.time() < 1e-2, "never diverged"),
             Err(e) => break e,
         }
     };

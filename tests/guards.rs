@@ -5,7 +5,7 @@
 use clearance_joint::Error;
 use clearance_joint::prelude::*;
 use clearance_joint::rapier::pipeline::protocol::GuardKind;
-use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
+use clearance_joint::rapier::pipeline::stepper::StepControl;
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::runner::{RunOptions, Simulation};
 use rapier3d_f64::prelude::*;
@@ -60,25 +60,35 @@ fn track(slot: &mut (f64, f64, f64, u64), ratio: f64, value: f64, t: f64) {
     }
 }
 
+/// `arm`'s world and joint in a [`ClearanceWorld`] stepped with `control`.
+fn arm_world(
+    clearance: HingeDesign,
+    control: StepControl,
+) -> (ClearanceWorld, ClearanceJointHandle) {
+    let (rapier, joints, pin) = arm(clearance);
+    let mut world = ClearanceWorld::new(rapier, control);
+    world.clearance = joints;
+    (world, pin)
+}
+
 fn run_arm(
     clearance: HingeDesign,
     control: StepControl,
     end: f64,
-) -> (Stepper, Tracked, ClearanceJointHandle) {
-    let (mut world, mut joints, pin) = arm(clearance);
-    let mut stepper = Stepper::new(control);
+) -> (ClearanceWorld, Tracked, ClearanceJointHandle) {
+    let (mut world, pin) = arm_world(clearance, control);
     let mut seen = Tracked::default();
-    while stepper.time() < end {
-        let info = stepper.step(&mut world, &mut [&mut joints], end).unwrap();
-        let j = joints.get(pin).unwrap();
+    while world.time() < end {
+        let info = world.step(end).unwrap();
+        let j = world.clearance.get(pin).unwrap();
         let r = j.report();
-        let t = stepper.time();
+        let t = world.time();
         let pen = r.state.penetration;
         track(&mut seen.pen, pen / j.max_valid_penetration(), pen, t);
         let fric = info.dt / r.friction_stable_dt;
         track(&mut seen.fric, fric, fric, t);
     }
-    (stepper, seen, pin)
+    (world, seen, pin)
 }
 
 #[test]
@@ -87,8 +97,8 @@ fn penetration_guard_reports_the_worst_depth_when_and_how_often() {
     let clearance = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
         .max_valid_penetration(0.2e-6);
-    let (stepper, seen, pin) = run_arm(clearance, StepControl::adaptive(1e-3, 0.02), 0.1);
-    let g = stepper.guards();
+    let (world, seen, pin) = run_arm(clearance, StepControl::adaptive(1e-3, 0.02), 0.1);
+    let g = world.guards();
     let v = g.worst(GuardKind::Penetration).expect("the guard fires");
     assert_eq!(v.joint.as_deref(), Some("pin"));
     assert_eq!(v.handle, Some(pin.id()));
@@ -109,18 +119,23 @@ fn penetration_guard_reports_the_worst_depth_when_and_how_often() {
     let clearance = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
         .max_valid_penetration(0.2e-6);
-    let (mut world, mut joints, _) = arm(clearance);
-    let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.02).strict(true));
+    let (mut world, _) = arm_world(
+        clearance,
+        StepControl {
+            strict: true,
+            ..StepControl::adaptive(1e-3, 0.02)
+        },
+    );
     let err = loop {
-        match stepper.step(&mut world, &mut [&mut joints], 0.1) {
-            Ok(_) => assert!(stepper.time() < 0.1, "strict run ended clean"),
+        match world.step(0.1) {
+            Ok(_) => assert!(world.time() < 0.1, "strict run ended clean"),
             Err(e) => break e,
         }
     };
     assert!(
         matches!(&err, Error::Guard { violations, .. } if violations.iter().any(|v| v.kind == GuardKind::Penetration
             && v.joint.as_deref() == Some("pin")
-            && v.message().contains("joint `pin` penetrated"))),
+            && v.to_string().contains("joint `pin` penetrated"))),
         "{err}"
     );
 }
@@ -132,8 +147,8 @@ fn friction_guard_reports_the_worst_ratio_of_a_fixed_step_too_long() {
         .friction(clearance_joint::model::laws::FrictionModel::Bai(
             clearance_joint::model::laws::Bai::DRY,
         ));
-    let (stepper, seen, _) = run_arm(clearance, StepControl::fixed(2e-5), 0.3);
-    let v = stepper
+    let (world, seen, _) = run_arm(clearance, StepControl::fixed(2e-5), 0.3);
+    let v = world
         .guards()
         .worst(GuardKind::Friction)
         .expect("the guard fires");

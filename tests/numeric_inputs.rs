@@ -7,23 +7,22 @@
 //!   parameter, and whatever they accept gives finite values at finite states;
 //! - pure functions of numbers (laws, kinematics, angles, tables, step choice): no panic, a
 //!   finite result for finite arguments in their documented domain, NaN only for a NaN input;
-//! - functions that size an output (`per_period`): an error beyond their documented bound.
+//! - functions that size an output: an error beyond their documented bound (the impact
+//!   recorder's per-turn table: `src/rapier/observers/metrics/tests.rs`).
 
 use clearance_joint::model::angle::{HingeAngle, UnwrappedAngle, twist_angle};
 use clearance_joint::model::kinematics::{BodyMotion, contact_force, journal_state, stable_step};
 use clearance_joint::model::laws::*;
 use clearance_joint::rapier::hinge::design::HingeDesign;
 use clearance_joint::rapier::large_step::LargeStepJointBuilder;
-use clearance_joint::rapier::observers::metrics::{
-    ContactObservation, Impact, ImpactRecorder, per_period,
-};
 use clearance_joint::rapier::pipeline::stepper::StepControl;
+use clearance_joint::rapier::pipeline::world::ClearanceWorld;
 use clearance_joint::rapier::sources::drive::TorsionSpring;
 use clearance_joint::rapier::sources::prescribed::Table;
 use clearance_joint::{Error, error};
 use proptest::prelude::*;
 use rapier3d_f64::math::{Rotation, Vector};
-use rapier3d_f64::prelude::RigidBodyHandle;
+use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle};
 
 /// The numbers that break code: NaN, the infinities, signed zeros, the extremes of the normal
 /// range, subnormals, and ordinary values of both signs over many decades.
@@ -236,25 +235,6 @@ proptest! {
     }
 
     #[test]
-    fn metrics_any_numbers(
-        period in any_number(), end in any_number(), onset in any_number(), duration in any_number(),
-        t in any_number(), dt in any_number(), force in any_number(),
-    ) {
-        let impacts = [Impact { onset_t_s: onset, duration_s: duration, peak_force_n: force, ..Impact::default() }];
-        match per_period(&impacts, period, end) {
-            Ok(p) => prop_assert!(p.len() <= clearance_joint::rapier::observers::metrics::MAX_PERIODS),
-            Err(e) => prop_assert!(e.to_string().contains("period"), "{e}"),
-        }
-        let mut rec = ImpactRecorder::new();
-        let obs = ContactObservation::ideal(force);
-        rec.record(t, dt, &obs);
-        rec.record(t, dt, &ContactObservation { onset: true, impact: true, penetration: force.abs(), ..obs });
-        rec.finish(t, &obs);
-        rec.set_final_angle_deg(force);
-        let _ = (rec.metrics(), rec.contact_time(), rec.contacts_table());
-    }
-
-    #[test]
     fn builders_refuse_what_is_not_finite(
         a in any_number(), b in any_number(), axis in any_vector(), anchor in any_vector(),
     ) {
@@ -297,11 +277,16 @@ proptest! {
     fn step_control_refuses_what_is_not_finite(
         dt in any_number(), tol in any_number(), floor in any_number(), growth in any_number(),
     ) {
-        let fixed = StepControl::fixed(dt);
-        refuses_non_finite(&[dt], &fixed.validate())?;
-        let c = StepControl::adaptive(dt, tol).with_tolerance(tol).min_dt(floor).max_growth(growth);
-        refuses_non_finite(&[dt, tol, floor, growth], &c.validate())?;
-        if c.validate().is_ok() {
+        // The world checks its control at every step (and at `prepare`).
+        let check = |c: StepControl| ClearanceWorld::new(PhysicsWorld::new(), c).prepare();
+        refuses_non_finite(&[dt], &check(StepControl::fixed(dt)))?;
+        let c = StepControl {
+            min_dt: floor,
+            max_growth: growth,
+            ..StepControl::adaptive(dt, tol)
+        };
+        refuses_non_finite(&[dt, tol, floor, growth], &check(c))?;
+        if check(c).is_ok() {
             prop_assert!(c.max_dt > 0.0 && c.min_dt <= c.max_dt);
         }
     }
@@ -324,6 +309,4 @@ fn the_reported_panics_are_values_or_errors() {
     let t = Table::new(&[0.0, 1.0], &[0.0, 1.0]).unwrap();
     let (v, d, dd) = t.eval(f64::NAN);
     assert!(v.is_nan() && d.is_nan() && dd.is_nan());
-    assert!(per_period(&[], 1e-300, 1.0).is_err());
-    assert!(per_period(&[], 1e-6, 1e4).is_err());
 }

@@ -48,7 +48,6 @@ fn every_prelude_name_resolves_next_to_rapiers_prelude() {
         step_hooks::<LargeStepJointSet>(),
         std::any::type_name::<StepControl>(),
         std::any::type_name::<StepInfo>(),
-        std::any::type_name::<Stepper>(),
         std::any::type_name::<Vector>(),
     ];
     // Each resolved to this crate's item (Vector to Rapier's own, which the prelude re-exports).
@@ -118,15 +117,15 @@ fn a_hinge_in_a_rapier_loop_with_both_preludes() -> Result<(), clearance_joint::
         .friction(FrictionModel::Bai(Bai::DRY));
     let hinge =
         clearance.convert_revolute(hinge, BearingSide::Body1, play, &mut world.impulse_joints)?;
-    let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.0075));
-    while stepper.time() < 0.1 {
-        stepper.step(&mut world, &mut [&mut clearance], 0.1)?;
-    }
-    let report = clearance
+    let mut world = ClearanceWorld::new(world, StepControl::adaptive(1e-3, 0.0075));
+    world.clearance = clearance;
+    world.step_to(0.1)?;
+    let report = world
+        .clearance
         .get(hinge)
         .expect("the hinge is in the set")
         .report();
     assert!(report.state.penetration >= 0.0, "{report:?}");
-    assert!(stepper.guards().is_clean(), "{:?}", stepper.guards());
+    assert!(world.guards().is_clean(), "{:?}", world.guards());
     Ok(())
 }

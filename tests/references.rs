@@ -987,7 +987,10 @@ fn the_four_bars_impacts_with_the_issues_point_laws_match_its_ode() {
 /// sub-steps' tolerance `tol`, and `iterations` solver iterations (Rapier's substeps).
 fn sub_cycled(tol: f64, iterations: usize) -> Stepping {
     Stepping {
-        control: StepControl::fixed(1e-3).with_tolerance(tol),
+        control: StepControl {
+            tolerance: tol,
+            ..StepControl::fixed(1e-3)
+        },
         integration: ContactIntegration::SubCycled,
         iterations,
     }

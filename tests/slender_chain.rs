@@ -11,7 +11,8 @@ use clearance_joint::model::laws::{
 };
 use clearance_joint::rapier::hinge::design::HingeDesign;
 use clearance_joint::rapier::joint::ClearanceJointSet;
-use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
+use clearance_joint::rapier::pipeline::stepper::StepControl;
+use clearance_joint::rapier::pipeline::world::ClearanceWorld;
 use clearance_joint::{Error, Result};
 use rapier3d_f64::prelude::*;
 
@@ -73,16 +74,20 @@ fn run(correction: bool, end: f64) -> Result<f64> {
 
 /// [`run`] at adaptive tolerance `tol`.
 fn run_at(tol: f64, correction: bool, end: f64) -> Result<f64> {
-    let (mut world, mut joints, link2) = double_pendulum();
-    let control = StepControl::adaptive(1e-3, tol).joint_correction(correction);
-    let mut stepper = Stepper::new(control);
+    let (rapier, joints, link2) = double_pendulum();
+    let control = StepControl {
+        joint_correction: correction,
+        ..StepControl::adaptive(1e-3, tol)
+    };
+    let mut world = ClearanceWorld::new(rapier, control);
+    world.clearance = joints;
     let mut tilt_rate: f64 = 0.0;
-    while stepper.time() < end {
-        stepper.step(&mut world, &mut [&mut joints], end)?;
-        let w = world.bodies[link2].angvel();
+    while world.time() < end {
+        world.step(end)?;
+        let w = world.rapier.bodies[link2].angvel();
         tilt_rate = tilt_rate.max(w.x.hypot(w.y));
     }
-    assert!(stepper.guards().is_clean(), "{:?}", stepper.guards());
+    assert!(world.guards().is_clean(), "{:?}", world.guards());
     Ok(tilt_rate)
 }
 

@@ -77,7 +77,10 @@ fn a_door_rests_edge_loaded_and_friction_held_with_its_static_balance() {
     let weight = MASS * G;
     let tau = 0.05;
     for (dt, iterations) in [(1e-3, 1), (1.0 / 60.0, 4)] {
-        let control = StepControl::fixed(dt).with_tolerance(0.0075);
+        let control = StepControl {
+            tolerance: 0.0075,
+            ..StepControl::fixed(dt)
+        };
         let friction = FrictionModel::Bai(Bai::DRY);
         let sub_cycled = ContactIntegration::SubCycled;
         let (mut world, door, pin) = door_world(ARM, control, iterations, G, friction, sub_cycled);
@@ -165,7 +168,10 @@ fn a_face_knock_matches_the_explicit_joint_at_a_tiny_step() {
     assert!(reference.peak > 100.0 && reference.separation < -0.05);
     let mut last = f64::INFINITY;
     for tolerance in [0.0075, 1e-3, 1e-4] {
-        let control = StepControl::fixed(1e-3).with_tolerance(tolerance);
+        let control = StepControl {
+            tolerance,
+            ..StepControl::fixed(1e-3)
+        };
         let k = face_knock(control, ContactIntegration::SubCycled);
         let errors = [
             k.peak / reference.peak - 1.0,

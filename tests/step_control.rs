@@ -10,7 +10,7 @@ mod flores;
 use clearance_joint::model::laws::{BearingGeometry, LankaraniNikravesh, Material, NormalModel};
 use clearance_joint::prelude::*;
 use clearance_joint::rapier::observers::metrics::{ContactObservation, ImpactRecorder};
-use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
+use clearance_joint::rapier::pipeline::stepper::StepControl;
 use flores::*;
 use rapier3d_f64::prelude::*;
 
@@ -114,15 +114,16 @@ fn a_slow_loaded_recontact_neither_stalls_nor_turns_stiff() {
     // 0.1 mm/s floor of delta_dot0, and gravity then loads it to its static depth. With that
     // delta_dot0 the law's damping 3 K (1 - cr^2)/(4 delta_dot0) delta^1.5 made the stable step
     // fall towards 1e-10 s; the loaded impact speed bounds it.
-    let (mut world, mut joints, pin) = journal_in_bearing(1e-9, Vector::ZERO, 9.81);
-    let mut stepper = Stepper::new(defaults());
+    let (rapier, joints, pin) = journal_in_bearing(1e-9, Vector::ZERO, 9.81);
+    let mut world = ClearanceWorld::new(rapier, defaults());
+    world.clearance = joints;
     let end = 0.05;
-    while stepper.time() < end {
-        stepper.step(&mut world, &mut [&mut joints], end).unwrap();
-        assert!(stepper.steps() < 200_000, "t = {} s", stepper.time());
+    while world.time() < end {
+        world.step(end).unwrap();
+        assert!(world.steps() < 200_000, "t = {} s", world.time());
     }
-    assert_eq!(stepper.guards().floor_steps, 0, "{:?}", stepper.guards());
-    let r = joints.get(pin).unwrap().report();
+    assert_eq!(world.guards().floor_steps, 0, "{:?}", world.guards());
+    let r = world.clearance.get(pin).unwrap().report();
     // Settled on the floor: the contact carries the weight.
     assert!(
         (r.force.normal_force / (2.0 * 9.81) - 1.0).abs() < 0.01,
@@ -142,14 +143,15 @@ fn onset_interpolated_on_a_constant_velocity_approach() {
     // between steps of 1e-4 s (at 33.3 steps).
     let v = 0.03;
     let gap = 0.1e-3;
-    let (mut world, mut joints, pin) = journal_in_bearing(gap, Vector::new(v, 0.0, 0.0), 0.0);
-    let mut stepper = Stepper::new(StepControl::fixed(1e-4));
-    stepper.prepare(&mut world, &mut [&mut joints]).unwrap();
+    let (rapier, joints, pin) = journal_in_bearing(gap, Vector::new(v, 0.0, 0.0), 0.0);
+    let mut world = ClearanceWorld::new(rapier, StepControl::fixed(1e-4));
+    world.clearance = joints;
+    world.prepare().unwrap();
     let mut recorder = ImpactRecorder::new();
     let end = 4e-3;
-    while stepper.time() < end {
-        let before = ContactObservation::of(joints.get(pin).unwrap());
-        let info = stepper.step(&mut world, &mut [&mut joints], end).unwrap();
+    while world.time() < end {
+        let before = ContactObservation::of(world.clearance.get(pin).unwrap());
+        let info = world.step(end).unwrap();
         recorder.record(info.t0, info.dt, &before);
     }
     let first = recorder.contacts()[0];

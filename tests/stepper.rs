@@ -1,4 +1,4 @@
-//! The public stepper: consistent variable steps, step acceptance, guards, and the numbers they
+//! The step control (through `ClearanceWorld`): consistent variable steps, step acceptance, guards, and the numbers they
 //! make trustworthy (agreement with converged fixed steps, independence of the output interval,
 //! exact ideal reactions), on the paper's scene and on a kinematically driven mechanism.
 
@@ -9,7 +9,8 @@ use clearance_joint::rapier::joint::ClearanceJointSet;
 use clearance_joint::rapier::observers::reaction::{
     IdealJoint, ReactionSolver, prepare_mass_properties,
 };
-use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
+use clearance_joint::rapier::pipeline::stepper::StepControl;
+use clearance_joint::rapier::pipeline::world::ClearanceWorld;
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::runner::{RunOptions, RunResult, Simulation, TwinKind, Twins};
 use rapier3d_f64::math::Vector;
@@ -280,18 +281,19 @@ struct CrankRun {
     /// Largest ratio of a contact's depth at its onset state to its deepest point, over contacts
     /// that began faster than 1 cm/s: a step that crossed the gap blind enters at full depth.
     onset_ratio: f64,
-    stepper: Stepper,
+    world: ClearanceWorld,
 }
 
 fn crank_run(control: StepControl, end: f64) -> clearance_joint::Result<CrankRun> {
-    let (mut world, mut joints, _) =
+    let (rapier, joints, _) =
         crank_mechanism(HingeDesign::steel_improved_liu(0.010, 0.5e-3, 0.016)?);
-    let mut stepper = Stepper::new(control);
+    let mut world = ClearanceWorld::new(rapier, control);
+    world.clearance = joints;
     let (mut first, mut contacts, mut onset_ratio) = (0.0f64, 0u32, 0.0f64);
     let (mut onset_depth, mut peak, mut fast) = (0.0, 0.0f64, false);
-    while stepper.time() < end {
-        stepper.step(&mut world, &mut [&mut joints], end)?;
-        let (_, j) = joints.iter().next().unwrap();
+    while world.time() < end {
+        world.step(end)?;
+        let (_, j) = world.clearance.iter().next().unwrap();
         let r = j.report();
         let depth = r.state.penetration;
         if r.onset {
@@ -313,7 +315,7 @@ fn crank_run(control: StepControl, end: f64) -> clearance_joint::Result<CrankRun
     Ok(CrankRun {
         first,
         onset_ratio,
-        stepper,
+        world,
     })
 }
 
@@ -334,7 +336,7 @@ fn a_driven_mechanism_at_the_default_step_control_never_enters_deeper_than_allow
     // longer needs a rejection here; the rejection path is exercised in tests/step_control.rs.
     // What must hold is that the run met contacts at all.
     assert!(run.first > 0.0, "no contact: the test tests nothing");
-    assert_eq!(run.stepper.guards().floor_steps, 0);
+    assert_eq!(run.world.guards().floor_steps, 0);
     // The first impact against the limit of fixed steps. They converge at first order on this
     // crank (16.63, 16.42, 16.31 and 16.26 um at 1e-7 to 1.25e-8 s), so the limit is Richardson's
     // extrapolation of two of them, 16.21 um. Its deepest contacts are heavily damped (the
@@ -349,9 +351,15 @@ fn a_driven_mechanism_at_the_default_step_control_never_enters_deeper_than_allow
     let fixed = |dt: f64| crank_run(StepControl::fixed(dt), 0.004).unwrap().first;
     let converged = 2.0 * fixed(2.5e-8) - fixed(5e-8);
     let first = |tolerance: f64| {
-        crank_run(control.with_tolerance(tolerance), 0.004)
-            .unwrap()
-            .first
+        crank_run(
+            StepControl {
+                tolerance,
+                ..control
+            },
+            0.004,
+        )
+        .unwrap()
+        .first
     };
     let (coarse, half, finer) = (first(0.0075), first(0.00375), first(0.001));
     let error = |depth: f64| (depth - converged) / converged;
@@ -384,11 +392,16 @@ fn a_contact_no_step_can_resolve_stops_with_a_named_error() {
     // stable only far below the floor, so no step resolves it.
     let geometry = BearingGeometry::from_clearance(0.010, 0.5e-3, 0.016).unwrap();
     let law = NormalModel::Hertz(Hertz::new(1e16, 1.5).unwrap());
-    let (mut world, mut joints, _) = crank_mechanism(HingeDesign::new(geometry, law));
-    let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.0075).min_dt(1e-6));
+    let (rapier, joints, _) = crank_mechanism(HingeDesign::new(geometry, law));
+    let control = StepControl {
+        min_dt: 1e-6,
+        ..StepControl::adaptive(1e-3, 0.0075)
+    };
+    let mut world = ClearanceWorld::new(rapier, control);
+    world.clearance = joints;
     let e = loop {
-        match stepper.step(&mut world, &mut [&mut joints], 0.05) {
-            Ok(_) => assert!(stepper.time() < 0.05, "never stalled"),
+        match world.step(0.05) {
+            Ok(_) => assert!(world.time() < 0.05, "never stalled"),
             Err(e) => break e,
         }
     };

@@ -82,7 +82,10 @@ fn a_friction_held_journal_rests_at_game_and_robot_steps_with_its_static_balance
     let f_n = (weight * weight - f_t * f_t).sqrt();
     for (dt, iterations) in [(1e-3, 1), (1.0 / 60.0, 4)] {
         let sub_cycled = ContactIntegration::SubCycled;
-        let control = StepControl::fixed(dt).with_tolerance(0.0075);
+        let control = StepControl {
+            tolerance: 0.0075,
+            ..StepControl::fixed(dt)
+        };
         let (world, pin) = held_journal(f_t * r_j, control, iterations, 12.0, sub_cycled).unwrap();
         let r = world.clearance.get(pin).unwrap().report();
         let e = r.state.eccentricity;
@@ -123,7 +126,10 @@ fn a_friction_held_journal_rests_at_game_and_robot_steps_with_its_static_balance
 fn a_sub_cycle_beyond_its_sub_step_cap_is_a_guard_violation() {
     use clearance_joint::rapier::pipeline::protocol::GuardKind;
     let sub_cycled = ContactIntegration::SubCycled;
-    let control = StepControl::fixed(1.0 / 60.0).with_tolerance(1e-6);
+    let control = StepControl {
+        tolerance: 1e-6,
+        ..StepControl::fixed(1.0 / 60.0)
+    };
     let (world, _) = held_journal(0.0, control, 1, 0.05, sub_cycled).unwrap();
     let v = &world.guards().violations;
     assert!(
@@ -131,8 +137,17 @@ fn a_sub_cycle_beyond_its_sub_step_cap_is_a_guard_violation() {
             .any(|v| v.kind == GuardKind::SubSteps && v.joint.as_deref() == Some("clearance joint")),
         "{v:?}"
     );
-    println!("{}", v[0].message());
-    let strict = held_journal(0.0, control.strict(true), 1, 0.05, sub_cycled);
+    println!("{}", v[0]);
+    let strict = held_journal(
+        0.0,
+        StepControl {
+            strict: true,
+            ..control
+        },
+        1,
+        0.05,
+        sub_cycled,
+    );
     assert!(
         matches!(strict, Err(clearance_joint::Error::Guard { .. })),
         "{:?}",
@@ -152,7 +167,10 @@ fn an_elastic_bounce_under_gravity_keeps_its_height_at_any_step() {
     use clearance_joint::model::laws::{BearingGeometry, Hertz, NormalModel};
     let speed = (2.0 * G * C).sqrt();
     for dt in [1.0 / 60.0, 1e-3] {
-        let control = StepControl::fixed(dt).with_tolerance(0.0075);
+        let control = StepControl {
+            tolerance: 0.0075,
+            ..StepControl::fixed(dt)
+        };
         let (mut world, base, journal) = journal_world(control, 1);
         let hertz = NormalModel::Hertz(Hertz::new(1e10, 1.5).unwrap());
         let pin = HingeDesign::new(BearingGeometry::new(R_B, R_B - C, 0.016).unwrap(), hertz)

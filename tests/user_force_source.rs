@@ -283,7 +283,7 @@ fn the_source_guard_shows_in_the_world_guards() {
         .expect("the spring's guard");
     assert_eq!(v.kind, GuardKind::Other);
     assert!(v.worst > 0.099 && v.limit == 0.08 && v.count > 1, "{v:?}");
-    assert_eq!(v.message(), "the spring is stretched past its maximum");
+    assert_eq!(v.to_string(), "the spring is stretched past its maximum");
     assert!(!world.guards().is_clean());
 }
 
@@ -359,8 +359,9 @@ fn a_swap_through_the_public_fields_is_noticed() {
     let pressed = 0.2e-3 + 5e-6;
     let (mut swapped, base, arm) = arm_world();
     let old_pin = swapped.insert_clearance(base, arm, pin(0.0)).unwrap();
-    let old_drive =
-        swapped.insert_drive(TorsionSpring::new(base, arm, Vector::Z, 5.0, 0.0).unwrap());
+    let old_drive = swapped
+        .drives
+        .insert(TorsionSpring::new(base, arm, Vector::Z, 5.0, 0.0).unwrap());
     swapped.prepare().unwrap();
     // The swap, through the fields: the same number of joints and of drives.
     let w = &mut swapped;
@@ -383,7 +384,9 @@ fn a_swap_through_the_public_fields_is_noticed() {
     // Built directly with the new pin and drive.
     let (mut direct, base, arm) = arm_world();
     let direct_pin = direct.insert_clearance(base, arm, pin(pressed)).unwrap();
-    direct.insert_drive(TorsionSpring::new(base, arm, Vector::Z, -3.0, 0.0).unwrap());
+    direct
+        .drives
+        .insert(TorsionSpring::new(base, arm, Vector::Z, -3.0, 0.0).unwrap());
     for step in 0..50 {
         let (a, b) = (swapped.step(1.0).unwrap(), direct.step(1.0).unwrap());
         assert_eq!(a.dt, b.dt, "step {step}");

@@ -1,6 +1,7 @@
 //! `ClearanceWorld`: the one world type. Its step runs every set's hooks (the large-step joints'
-//! included, which a bare `world.step()` loop can forget), it steps to the bit like the `Stepper`
-//! with the same sets, and it notices a compliant joint added through its public field.
+//! included, which a bare `world.step()` loop can forget), it steps to the bit the same whether a
+//! set is filled through its methods or its public field, and it notices a compliant joint added
+//! through that field.
 
 use clearance_joint::model::laws::BearingGeometry;
 use clearance_joint::prelude::*;
@@ -74,9 +75,10 @@ fn large_step_hooks_run_inside_the_world_step() {
     assert!(world.guards().is_clean(), "{:?}", world.guards());
 }
 
-/// The world's step is the `Stepper`'s with the same sets, to the bit.
+/// A world whose joint set was filled apart and put in its public field before the first step
+/// steps to the bit like one whose joint came through `insert_clearance`.
 #[test]
-fn the_world_steps_like_the_stepper_with_the_same_sets() {
+fn a_set_filled_apart_steps_like_one_filled_through_the_world() {
     let control = StepControl::adaptive(1e-3, 0.0075);
     let (rapier, base, arm) = arm_world(1);
     let mut world = ClearanceWorld::new(rapier, control);
@@ -94,12 +96,11 @@ fn the_world_steps_like_the_stepper_with_the_same_sets() {
             &mut rapier.impulse_joints,
         )
         .unwrap();
-    let mut stepper = Stepper::new(control);
-    while stepper.time() < 0.05 {
-        stepper.step(&mut rapier, &mut [&mut joints], 0.05).unwrap();
-    }
-    assert_eq!(world.steps(), stepper.steps());
-    let (a, b) = (&world.rapier.bodies[arm], &rapier.bodies[arm2]);
+    let mut apart = ClearanceWorld::new(rapier, control);
+    apart.clearance = joints;
+    apart.step_to(0.05).unwrap();
+    assert_eq!(world.steps(), apart.steps());
+    let (a, b) = (&world.rapier.bodies[arm], &apart.rapier.bodies[arm2]);
     assert_eq!(a.translation(), b.translation());
     assert_eq!(a.linvel(), b.linvel());
     assert_eq!(a.angvel(), b.angvel());
@@ -365,11 +366,9 @@ fn a_set_joint_on_a_missing_body_is_refused() {
                 .unwrap();
         }
         remove_body(&mut r, later);
-        let mut stepper = Stepper::new(StepControl::fixed(1e-4));
-        let e = stepper
-            .step(&mut r, &mut [&mut joints, &mut play], 1e-3)
-            .unwrap_err()
-            .to_string();
+        let mut world = ClearanceWorld::new(r, StepControl::fixed(1e-4));
+        (world.clearance, world.large_step) = (joints, play);
+        let e = world.step(1e-3).unwrap_err().to_string();
         assert!(
             e.contains("`body2`") && e.contains("not in the world"),
             "large {large}, removed later: {e}"

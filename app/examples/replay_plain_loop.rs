@@ -1,5 +1,5 @@
 //! A replay from your own Rapier loop: a pendulum arm (a box collider) on a revolute hinge with
-//! 0.2 mm of play, released at 60 degrees under gravity, stepped by the `Stepper`; the library's
+//! 0.2 mm of play, released at 60 degrees under gravity, stepped by a `ClearanceWorld`; the library's
 //! `ReplayRecorder` reads the world after every step, and the app's `ReplayPage` writes the
 //! self-contained `replay.html`.
 //!
@@ -39,19 +39,21 @@ pub fn run(end: f64) -> clearance_joint::Result<Recording> {
     let hinge =
         clearance.convert_revolute(hinge, BearingSide::Body1, play, &mut world.impulse_joints)?;
 
-    let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.0075));
-    stepper.prepare(&mut world, &mut [&mut clearance])?;
+    let mut world = ClearanceWorld::new(world, StepControl::adaptive(1e-3, 0.0075));
+    world.clearance = clearance;
+    world.prepare()?;
+    let rapier = &mut world.rapier;
     // Mass properties before the first step (Rapier computes them in it).
-    clearance_joint::rapier::observers::reaction::prepare_mass_properties(&mut world.bodies);
+    clearance_joint::rapier::observers::reaction::prepare_mass_properties(&mut rapier.bodies);
     // A frame per ms in free flight, per 10 us in contact (every onset and the state before it).
     let mut recorder = ReplayRecorder::new(1e-3, 1e-5)?;
-    recorder.track_body("base", "clearance", base, &world.bodies, &world.colliders);
-    recorder.track_body("arm", "clearance", arm, &world.bodies, &world.colliders);
-    recorder.track_journal("hinge", "clearance", 0, hinge, &clearance)?;
-    recorder.record(0.0, &world.bodies, &[&clearance]);
-    while stepper.time() < end {
-        stepper.step(&mut world, &mut [&mut clearance], end)?;
-        recorder.record(stepper.time(), &world.bodies, &[&clearance]);
+    recorder.track_body("base", "clearance", base, &rapier.bodies, &rapier.colliders);
+    recorder.track_body("arm", "clearance", arm, &rapier.bodies, &rapier.colliders);
+    recorder.track_journal("hinge", "clearance", 0, hinge, &world.clearance)?;
+    recorder.record(0.0, &world.rapier.bodies, &[&world.clearance]);
+    while world.time() < end {
+        world.step(end)?;
+        recorder.record(world.time(), &world.rapier.bodies, &[&world.clearance]);
     }
     Ok(recorder.finish())
 }

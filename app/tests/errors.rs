@@ -254,7 +254,8 @@ fn a_divergence_names_the_body_as_the_scene_does() {
         .unwrap()
         .run()
     {
-        Err(Error::Diverged { reason, .. }) => {
+        Err(Error::Diverged { what, .. }) => {
+            let reason = what.to_string();
             assert!(
                 reason.contains("body `stone`")
                     && reason.contains("likely cause")

@@ -130,7 +130,7 @@ impl Physics {
     /// `time()` reaches the frame's time ([`run_frame`](super::run_frame); each run records its
     /// state and counts, and adds to the frame's mean and peak force).
     pub fn set_step_control(&mut self, control: StepControl) {
-        self.world.set_step_control(control);
+        self.world.step_control = control;
     }
 
     /// What the run-time guards recorded (rejected steps, penetrations beyond a law's validity,
@@ -338,7 +338,7 @@ impl Physics {
     fn unrealize_drive(&mut self, entity: Entity) {
         if let Some(d) = self.drives.remove(&entity) {
             self.changed = true;
-            self.world.remove_drive(d.handle);
+            self.world.drives.remove(d.handle);
         }
     }
 
@@ -496,7 +496,7 @@ impl Physics {
             drive.stiffness,
         )
         .map_err(|e| e.within(&format!("drive {entity}")))?;
-        let handle = self.world.insert_drive(spring);
+        let handle = self.world.drives.insert(spring);
         self.changed = true;
         self.drives.insert(
             entity,

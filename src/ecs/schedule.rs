@@ -13,7 +13,7 @@ pub enum PhysicsSet {
     /// Torsion-spring torques and clearance contact and friction forces at the current state,
     /// when the stepper has not evaluated them yet ([`apply_forces`]).
     Forces,
-    /// One accepted step of the [`Stepper`](crate::rapier::pipeline::stepper::Stepper).
+    /// One accepted step of the [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld).
     Step,
     /// Rapier to [`HingeState`](super::HingeState) and [`BodyState`](super::BodyState).
     Record,

@@ -4,7 +4,7 @@
 //! - The scene format ([`Scene`] and its parts), validated with errors naming the field.
 //! - Study presets declared in a scene ([`StudySpec`]): named sweeps the app's `study` runs.
 //! - [`runner`]: builds the twins in one Rapier world and steps them with the
-//!   [`Stepper`](crate::rapier::pipeline::stepper::Stepper).
+//!   [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld).
 //! - [`output`]: result files written whole or not at all, folder locks, memory estimates.
 //! - [`report`]: the summary (`summary.json`) and the printed comparison.
 //!

@@ -137,9 +137,9 @@ impl RunResult {
     }
 
     /// Writes `<twin>.csv` for each twin, `<twin>_<joint>_impacts.csv` for each clearance joint
-    /// (its contact list, every onset, [`ImpactRecorder::contacts_table`](crate::rapier::observers::metrics::ImpactRecorder::contacts_table)),
-    /// `<twin>_<joint>_turns.csv` when a body spins (per-turn statistics,
-    /// [`per_period`](crate::rapier::observers::metrics::per_period))
+    /// (its contact list, every onset, from its
+    /// [`ImpactRecorder`](crate::rapier::observers::metrics::ImpactRecorder)),
+    /// `<twin>_<joint>_turns.csv` when a body spins (per-turn statistics of that list)
     /// and `summary.json` into `dir` as one set
     /// ([`write_set`]): the tables are streamed (and checked finite) into temporary files, then
     /// renamed into place, `summary.json` last. An incomplete run ([`RunResult::stopped`])
@@ -264,10 +264,14 @@ pub fn summary_json(summary: &Summary) -> Result<String> {
     ];
     fn check(v: &serde_json::Value, key: &str, path: &str, end: f64) -> Result<()> {
         match v {
-            serde_json::Value::Null if !MAY_BE_NULL.contains(&key) => Err(Error::Diverged {
-                t: end,
-                reason: format!("non-finite value of `{path}` in the summary"),
-            }),
+            serde_json::Value::Null if !MAY_BE_NULL.contains(&key) => Err(Error::diverged(
+                end,
+                crate::error::Divergence::NonFinite {
+                    name: path.to_string(),
+                    place: "in the summary".into(),
+                    value: None,
+                },
+            )),
             serde_json::Value::Object(o) => o
                 .iter()
                 .try_for_each(|(k, c)| check(c, k, &format!("{path}.{k}"), end)),

@@ -569,6 +569,6 @@ pub fn new_violations(run: &Outcome, converged: &Outcome) -> Vec<String> {
     run.violations
         .iter()
         .filter(|v| !known.contains(&violation_kind(v)))
-        .map(|v| v.message())
+        .map(|v| v.to_string())
         .collect()
 }

@@ -3,7 +3,7 @@
 //! rows (angle deviation, force decay time, journal path length, contact arc), as pure functions
 //! of series so they can be tested on hand-made data.
 
-use clearance_joint::error::{Error, Result};
+use clearance_joint::error::{Divergence, Error, Result};
 use clearance_joint::scene::Scene;
 use clearance_joint::scene::report::Summary;
 use clearance_joint::scene::runner::RunResult;
@@ -300,7 +300,11 @@ impl RunMetrics {
             {
                 return Err(Error::Diverged {
                     t: self.end_s,
-                    reason: format!("metric `{name}` is not finite ({x})"),
+                    what: Box::new(Divergence::NonFinite {
+                        name,
+                        place: "among the run's metrics".into(),
+                        value: Some(x),
+                    }),
                 });
             }
         }

@@ -15,7 +15,7 @@ use crate::advice::memory_options;
 use crate::process::files::{write_all_atomic, write_atomic};
 use crate::process::memory::bytes_text;
 use crate::resultset::{ResultSet, pause_at};
-use clearance_joint::error::{Error, Result};
+use clearance_joint::error::{Divergence, Error, Result};
 use clearance_joint::scene::runner::convergence::{self, ConvergenceVerdict};
 use clearance_joint::scene::{Scene, ValidatedScene, field_within};
 use indicatif::{ProgressBar, ProgressStyle};

@@ -2,7 +2,7 @@
 //! hooks, and the hinges' forces the step held.
 
 use super::{HingeJoint, Physics};
-use crate::error::{Error, Result};
+use crate::error::{Divergence, Error, Result};
 use crate::rapier::observers::reaction::{IdealJoint, IdealRevolute, JointModel};
 use crate::rapier::pipeline::stepper::{StepHooks, StepMode};
 use crate::rapier::pipeline::world::ClearanceWorld;
@@ -109,12 +109,7 @@ impl Physics {
                     .map(|(e, f)| (*e, f.length()))
                     .collect()
             })
-            .ok_or_else(|| Error::Diverged {
-                t,
-                reason: "the ideal hinges' reactions cannot be solved: the state or a body's \
-                         mass is not finite"
-                    .into(),
-            })?;
+            .ok_or_else(|| Error::diverged(t, Divergence::Reactions { twin: None }))?;
         self.ideal_cache = (self.world.steps(), forces.clone());
         Ok(forces)
     }
@@ -122,9 +117,7 @@ impl Physics {
 
 /// Fixed steps follow `integration_parameters.dt` as the user sets it, between any two steps.
 fn follow_dt(world: &mut ClearanceWorld) {
-    let mut control = *world.step_control();
-    if control.mode == StepMode::Fixed {
-        control.max_dt = world.rapier.integration_parameters.dt;
-        world.set_step_control(control);
+    if world.step_control.mode == StepMode::Fixed {
+        world.step_control.max_dt = world.rapier.integration_parameters.dt;
     }
 }

@@ -158,7 +158,7 @@ impl ClearanceJointSet {
     /// (every contact peak then converges at first order). Knowing the step, the joints carry the
     /// penetration rate to the state ([`ClearanceReport::contact_rate`]). [`apply`](Self::apply)
     /// sets it to `params.dt` itself, and the
-    /// [`Stepper`](crate::rapier::pipeline::stepper::Stepper) to each step it takes; call it yourself only
+    /// [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld) to each step it takes; call it yourself only
     /// when you call `evaluate` or `apply_forces` in your own loop. 0 (the default, and the value
     /// for velocities that are the state's own: at the start, or after you set them by hand)
     /// gives the laws the stored rate. A negative or non-finite `dt` counts as 0.
@@ -176,7 +176,7 @@ impl ClearanceJointSet {
 
     /// Evaluates every joint at the bodies' current state (contact history, report, the
     /// wrenches of [`wrenches`](Self::wrenches)) without touching the bodies' forces: the
-    /// [`Stepper`](crate::rapier::pipeline::stepper::Stepper) adds the wrenches for the duration of its step only,
+    /// [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld) adds the wrenches for the duration of its step only,
     /// so the bodies carry nothing but the user's own forces between steps. A joint whose body is
     /// gone reports free flight and applies nothing.
     ///

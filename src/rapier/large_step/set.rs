@@ -311,7 +311,6 @@ impl LargeStepJointSet {
 /// The large-step joints take part in the stepper's steps: their substeps and friction motors
 /// before each Rapier step, their readout and bounces after it, saved and restored with a
 /// rejected step ([`crate::rapier::pipeline::step_hooks`]). Under a
-/// [`Stepper`](crate::rapier::pipeline::stepper::Stepper) or a
 /// [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld) no hook can be forgotten.
 /// Reading the set is reading its [`ElementSet`]: [`get`](ElementSet::get),
 /// [`contains`](ElementSet::contains), [`iter`](ElementSet::iter) (insertion order),

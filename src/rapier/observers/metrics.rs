@@ -39,30 +39,34 @@
 //! use clearance_joint::prelude::*;
 //! use rapier3d_f64::prelude::*;
 //!
-//! let mut world = PhysicsWorld::new(); // gravity along -y
-//! world.integration_parameters.num_solver_iterations = 1;
-//! let base = world.bodies.insert(RigidBodyBuilder::fixed());
-//! let arm = world.bodies.insert(
+//! let mut rapier = PhysicsWorld::new(); // gravity along -y
+//! rapier.integration_parameters.num_solver_iterations = 1;
+//! let mut world = ClearanceWorld::new(rapier, StepControl::fixed(2e-5));
+//! let base = world.rapier.bodies.insert(RigidBodyBuilder::fixed());
+//! let arm = world.rapier.bodies.insert(
 //!     RigidBodyBuilder::dynamic()
 //!         .translation(Vector::new(0.0, -0.3, 0.0))
 //!         .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02)))
 //!         .can_sleep(false),
 //! );
 //! let revolute = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0));
-//! let pivot = world.impulse_joints.insert(base, arm, revolute, true);
-//! let mut clearance = ClearanceJointSet::new();
+//! let pivot = world.rapier.impulse_joints.insert(base, arm, revolute, true);
 //! let clear = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)?;
-//! let pivot = clearance.convert_revolute(pivot, BearingSide::Body1, clear, &mut world.impulse_joints)?;
+//! let pivot = world.clearance.convert_revolute(
+//!     pivot,
+//!     BearingSide::Body1,
+//!     clear,
+//!     &mut world.rapier.impulse_joints,
+//! )?;
 //!
-//! let mut stepper = Stepper::new(StepControl::fixed(2e-5));
-//! stepper.prepare(&mut world, &mut [&mut clearance])?;
+//! world.prepare()?;
 //! let mut recorder = ImpactRecorder::new();
-//! while stepper.time() < 0.1 {
-//!     let before = ContactObservation::of(clearance.get(pivot).unwrap());
-//!     let info = stepper.step(&mut world, &mut [&mut clearance], 0.1)?;
+//! while world.time() < 0.1 {
+//!     let before = ContactObservation::of(world.clearance.get(pivot).unwrap());
+//!     let info = world.step(0.1)?;
 //!     recorder.record(info.t0, info.dt, &before);
 //! }
-//! recorder.finish(stepper.time(), &ContactObservation::of(clearance.get(pivot).unwrap()));
+//! recorder.finish(world.time(), &ContactObservation::of(world.clearance.get(pivot).unwrap()));
 //! // The journal drops through the 0.2 mm gap and bounces on the bearing's floor.
 //! let first = &recorder.contacts()[0];
 //! assert!(first.approach_speed_m_s > 0.01 && first.peak_force_n > 100.0);
@@ -71,11 +75,13 @@
 //! # Ok::<(), clearance_joint::Error>(())
 //! ```
 
-use crate::error::{Error, Result, sig4};
 use crate::model::laws::crossing_fraction;
 use crate::rapier::joint::ClearanceJoint;
 use crate::table::Table;
 use serde::Serialize;
+
+mod periods;
+pub(crate) use periods::{MAX_PERIODS, per_period, per_period_table};
 
 /// Impacts slower than this (m/s) are not judged by their apparent restitution: at a grazing
 /// approach the separation speed is set by the other forces, not by the contact.
@@ -147,7 +153,7 @@ impl ContactObservation {
     }
 
     /// Whether the surfaces are in contact (penetration above 0).
-    pub fn in_contact(&self) -> bool {
+    pub(crate) fn in_contact(&self) -> bool {
         self.penetration > 0.0
     }
 }
@@ -461,7 +467,7 @@ impl ImpactRecorder {
 
     /// The contact list as a table: `onset_t_s, approach_speed_mm_s, peak_force_n, peak_t_s,
     /// max_penetration_um, duration_s, separated` (1 for an impact, 0 for chatter).
-    pub fn contacts_table(&self) -> Table {
+    pub(crate) fn contacts_table(&self) -> Table {
         let mut t = Table::new(
             [
                 "onset_t_s",
@@ -488,112 +494,6 @@ impl ImpactRecorder {
         }
         t
     }
-}
-
-/// One period (a crank turn) of a driven mechanism's clearance joint.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
-pub struct PeriodStats {
-    /// Start of the period, s.
-    pub start_s: f64,
-    /// Its length, s (the last period may be cut short by the end of the run).
-    pub length_s: f64,
-    /// [Onsets](crate::rapier::observers::metrics#onsets-impacts-and-chatter) in it: contacts that began in it, chatter
-    /// included.
-    pub onsets: u64,
-    /// [Impacts](crate::rapier::observers::metrics#onsets-impacts-and-chatter) in it: its onsets after a
-    /// separation. JSON key `separated_impacts`.
-    #[serde(rename = "separated_impacts")]
-    pub impacts: u64,
-    /// Largest peak force of the contacts that began in it, N (0 without one).
-    pub peak_force_n: f64,
-    /// Time in contact within it, s (contacts are split at the period's bounds).
-    pub contact_s: f64,
-}
-
-/// Per-period statistics of a contact list over `[0, end)` in periods of `period` (s): onsets,
-/// impacts, peak force and time in contact per crank turn. A contact's duration is the contiguous span
-/// from its onset, so the time in contact is split exactly at the bounds; its peak counts in the
-/// period of its onset. Empty for a period or end that is not positive (or NaN); an error when
-/// `end / period` is more than [`MAX_PERIODS`] (or infinite): the table would not fit in
-/// memory.
-pub fn per_period(impacts: &[Impact], period: f64, end: f64) -> Result<Vec<PeriodStats>> {
-    if !(period > 0.0) || !(end > 0.0) {
-        return Ok(Vec::new());
-    }
-    let count = (end / period).ceil().max(1.0);
-    if !(count <= MAX_PERIODS as f64) {
-        return Err(Error::invalid(
-            "period",
-            format!(
-                "{} s over {} s is {} periods, more than {MAX_PERIODS}",
-                sig4(period),
-                sig4(end),
-                sig4(count)
-            ),
-        ));
-    }
-    let n = count as usize;
-    let mut out: Vec<PeriodStats> = (0..n)
-        .map(|k| {
-            let start = k as f64 * period;
-            PeriodStats {
-                start_s: start,
-                length_s: ((k + 1) as f64 * period).min(end) - start,
-                ..Default::default()
-            }
-        })
-        .collect();
-    for i in impacts {
-        let k = ((i.onset_t_s / period) as usize).min(n - 1);
-        let p = &mut out[k];
-        p.onsets += 1;
-        p.impacts += u64::from(i.separated);
-        p.peak_force_n = p.peak_force_n.max(i.peak_force_n);
-        let (a, b) = (i.onset_t_s, i.onset_t_s + i.duration_s);
-        for p in out.iter_mut().skip(k) {
-            let (lo, hi) = (p.start_s, p.start_s + p.length_s);
-            if lo >= b {
-                break;
-            }
-            p.contact_s += (b.min(hi) - a.max(lo)).max(0.0);
-        }
-    }
-    Ok(out)
-}
-
-/// Most periods [`per_period`] tabulates (a table of about 50 MB).
-pub const MAX_PERIODS: usize = 1_000_000;
-
-/// The per-period statistics as a table: `turn, start_s, onsets, separated_impacts,
-/// peak_force_n, contact_fraction` (`separated_impacts`: the [impacts](crate::rapier::observers::metrics#onsets-impacts-and-chatter)).
-pub(crate) fn per_period_table(periods: &[PeriodStats]) -> Table {
-    let mut t = Table::new(
-        [
-            "turn",
-            "start_s",
-            "onsets",
-            "separated_impacts",
-            "peak_force_n",
-            "contact_fraction",
-        ]
-        .map(String::from)
-        .to_vec(),
-    );
-    for (k, p) in periods.iter().enumerate() {
-        t.values.extend_from_slice(&[
-            k as f64,
-            p.start_s,
-            p.onsets as f64,
-            p.impacts as f64,
-            p.peak_force_n,
-            if p.length_s > 0.0 {
-                p.contact_s / p.length_s
-            } else {
-                0.0
-            },
-        ]);
-    }
-    t
 }
 
 #[cfg(test)]

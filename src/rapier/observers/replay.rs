@@ -3,7 +3,7 @@
 //! force, penetration, contact and impact flags), thinned by time.
 //!
 //! The recorder only reads the world (after each step, with the force sources evaluated at the
-//! new state as [`Stepper::step`](crate::rapier::pipeline::stepper::Stepper::step) leaves them), so the
+//! new state as [`ClearanceWorld::step`](crate::rapier::pipeline::world::ClearanceWorld::step) leaves them), so the
 //! same piece serves a plain-Rapier loop and the scene runner. Its [`Recording`] is plain data
 //! (serde); the app turns it into a self-contained `replay.html`.
 //!
@@ -50,15 +50,16 @@
 //! recorder.track_body("base", "clearance", base, &world.bodies, &world.colliders);
 //! recorder.track_body("arm", "clearance", arm, &world.bodies, &world.colliders);
 //! recorder.track_journal("hinge", "clearance", 0, hinge, &clearance)?;
-//! let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.0075));
-//! stepper.prepare(&mut world, &mut [&mut clearance])?;
-//! recorder.record(0.0, &world.bodies, &[&clearance]);
-//! while stepper.time() < 0.05 {
-//!     stepper.step(&mut world, &mut [&mut clearance], 0.05)?;
-//!     recorder.record(stepper.time(), &world.bodies, &[&clearance]);
+//! let mut world = ClearanceWorld::new(world, StepControl::adaptive(1e-3, 0.0075));
+//! world.clearance = clearance;
+//! world.prepare()?;
+//! recorder.record(0.0, &world.rapier.bodies, &[&world.clearance]);
+//! while world.time() < 0.05 {
+//!     world.step(0.05)?;
+//!     recorder.record(world.time(), &world.rapier.bodies, &[&world.clearance]);
 //! }
 //! let recording = recorder.finish();
-//! assert_eq!(recording.frames.last().unwrap().t, stepper.time());
+//! assert_eq!(recording.frames.last().unwrap().t, world.time());
 //! assert!(matches!(recording.bodies[1].shapes[0], ReplayShape::Box { .. }));
 //! # Ok::<(), clearance_joint::Error>(())
 //! ```

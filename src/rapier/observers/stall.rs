@@ -302,7 +302,7 @@ fn explain(
     format!(
         "{seen} (the floor `min_dt` is {} s); {}. Cause: {cause}",
         sig4(min_dt),
-        c.state()
+        c
     )
 }
 

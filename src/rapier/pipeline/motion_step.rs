@@ -1,4 +1,4 @@
-//! The step the bodies' own motion needs, for the adaptive [`Stepper`](crate::rapier::pipeline::stepper::Stepper):
+//! The step the bodies' own motion needs, for the adaptive [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld):
 //! the contacts are not the only thing a step must resolve. A crank at 5000 rpm turns 30 deg in
 //! a 1 ms step; Rapier's joints are linearised at the step's start and its kinematic bodies
 //! turned to first order, so the constraint, a slider's acceleration and the approach to the

@@ -1,4 +1,4 @@
-//! The step protocol: what the [`Stepper`](crate::rapier::pipeline::stepper::Stepper) asks of everything
+//! The step protocol: what the [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld) asks of everything
 //! that takes part in a step, as a hook trait with default methods (as Rapier's
 //! `PhysicsHooks`), each hook given a context struct (as Rapier's `PairFilterContext`). Every
 //! joint set of this crate implements it
@@ -62,7 +62,7 @@ pub trait StepHooks {
     fn restore_state(&mut self) {}
 
     /// Whether the world's settings can step this participant (checked before the first step
-    /// and after [`Stepper::invalidate`](crate::rapier::pipeline::stepper::Stepper::invalidate)). Default:
+    /// and after [`ClearanceWorld::invalidate`](crate::rapier::pipeline::world::ClearanceWorld::invalidate)). Default:
     /// any settings.
     fn check_world(&self, _params: &IntegrationParameters) -> Result<()> {
         Ok(())
@@ -114,7 +114,8 @@ pub trait StepHooks {
     fn record_guards(&self, _step: &StepContext, _guards: &mut GuardReport) {}
 
     /// The contact of this participant whose step limit is the shortest, with its numbers, for a
-    /// stall's diagnosis; `None` when none is in contact. Default: none.
+    /// stall's diagnosis; `None` when none is in contact. This crate's compliant joint set
+    /// reports its contacts; a participant of your own keeps the default: none.
     fn stalled_contact(&self, _bodies: &RigidBodySet) -> Option<StalledContact> {
         None
     }

@@ -1,9 +1,9 @@
 //! [`ClearanceWorld`]: a Rapier world with everything a clearance joint needs around its step,
 //! in one type (as Rapier's `PhysicsWorld` bundles its sets): the compliant and large-step
 //! clearance joints, the drives, the prescribed motions, and the one step control that takes
-//! every step ([`Stepper`]). The scene runner and the bevy_ecs layer are built on it; a
-//! plain-Rapier user calls [`ClearanceWorld::step`] in place of `world.step()`, and no hook can
-//! be forgotten.
+//! every step ([`crate::rapier::pipeline::stepper`]). It is the one path to stepping: the scene
+//! runner and the bevy_ecs layer are built on it; a plain-Rapier user calls
+//! [`ClearanceWorld::step`] in place of `world.step()`, and no hook can be forgotten.
 //!
 //! ```
 //! use clearance_joint::prelude::*;
@@ -54,15 +54,17 @@ use crate::rapier::observers::reaction::{IdealJoint, KinematicState, ReactionSol
 use crate::rapier::pipeline::protocol::Wrench;
 use crate::rapier::pipeline::step_hooks::StepHooks;
 use crate::rapier::pipeline::stepper::{GuardReport, StepControl, StepInfo, Stepper};
-use crate::rapier::sources::drive::{DriveHandle, DriveSet, TorsionSpring};
+use crate::rapier::sources::drive::DriveSet;
 use crate::rapier::sources::prescribed::{PrescribedMotion, PrescribedSet};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle};
 
-/// A Rapier world with clearance joints, drives and prescribed motions, stepped by one
-/// [`Stepper`]. The sets are public fields, as in Rapier's `PhysicsWorld`: read them freely;
-/// add and remove joints, drives and motions with the `insert_*`/`remove_*` methods (which also
-/// add their Rapier parts and tell the step control when forces must be evaluated again). A
+/// A Rapier world with clearance joints, drives and prescribed motions, stepped by one step
+/// control ([`crate::rapier::pipeline::stepper`]). The sets and the step control are public
+/// fields, as in Rapier's `PhysicsWorld`: read them freely; add and remove joints and motions
+/// with the `insert_*`/`remove_*` methods (which also add their Rapier parts and tell the step
+/// control when forces must be evaluated again), drives with the drive set's own
+/// [`insert`](DriveSet::insert) and [`remove`](DriveSet::remove) (they have no Rapier part). A
 /// compliant joint or a drive added, removed or edited through the fields is noticed at the
 /// next step (by the sets' revisions, [`ElementSet::revision`](crate::rapier::pipeline::element_set::ElementSet::revision));
 /// after moving bodies or setting velocities by hand between steps, call
@@ -82,6 +84,9 @@ pub struct ClearanceWorld {
     pub drives: DriveSet,
     /// The tabulated (prescribed) motions of kinematic bodies.
     pub prescribed: PrescribedSet,
+    /// The step control: fixed or adaptive steps, their bounds, strictness. Set it between
+    /// steps; each step checks it, naming a field out of its domain.
+    pub step_control: StepControl,
     stepper: Stepper,
     /// The revisions of the compliant joint set and the drive set at the last step (`None`
     /// before the first): a change means their forces must be evaluated again before the next
@@ -101,6 +106,7 @@ impl ClearanceWorld {
             large_step: LargeStepJointSet::new(),
             drives: DriveSet::new(),
             prescribed: PrescribedSet::default(),
+            step_control: control,
             stepper: Stepper::new(control),
             revisions: None,
             wrenches: Vec::new(),
@@ -159,18 +165,6 @@ impl ClearanceWorld {
             .remove(handle, &mut w.bodies, &mut w.impulse_joints)
     }
 
-    /// Adds a drive.
-    pub fn insert_drive(&mut self, drive: TorsionSpring) -> DriveHandle {
-        self.stepper.invalidate(false);
-        self.drives.insert(drive)
-    }
-
-    /// Removes a drive; `None` for a handle of no drive.
-    pub fn remove_drive(&mut self, handle: DriveHandle) -> Option<TorsionSpring> {
-        self.stepper.invalidate(false);
-        self.drives.remove(handle)
-    }
-
     /// Adds a prescribed motion; returns its index in [`PrescribedSet::motions`]. Refused, naming
     /// `motions[i].body` or its path's field, unless its body is a position-based kinematic body
     /// of this world and its axis or direction a unit vector; nothing is added then.
@@ -183,11 +177,27 @@ impl ClearanceWorld {
 
     // ----- The step -----
 
-    /// Takes one accepted step towards `until` (s), landing on it exactly
-    /// ([`Stepper::step`]: the step control, acceptance, guards; the joints', drives' and
-    /// motions' hooks in their order). Call it in place of Rapier's `PhysicsWorld::step`.
-    /// `until` must be finite, after the current time and within what the clock can reach (a
-    /// step of `max_dt` must change the time there); else it is refused, naming `until`.
+    /// Takes one accepted step towards `until` (s), landing on it exactly (the step control,
+    /// acceptance, guards: [`crate::rapier::pipeline::stepper`]; the joints', drives' and
+    /// motions' hooks in their order); returns what the step did. Call it in place of Rapier's
+    /// `PhysicsWorld::step`. The joints and drives are evaluated at the state before the step
+    /// (by the previous step, or by [`prepare`](Self::prepare) on the first) and again at the
+    /// state after it. `until` must be finite, after the current time and within what the clock
+    /// can reach (a step of `max_dt` must change the time there); else it is refused, naming
+    /// `until`. The world's gravity must be finite and within what one step of `max_dt` can
+    /// take without passing the speed guard (`|g| max_dt` at most half Rapier's
+    /// `max_linear_velocity`), else it is refused naming `gravity`. An error after the step (a
+    /// fixed step beyond a contact's stability limit, a guard under `strict`, a diverged body)
+    /// leaves the world and the clock at the state the step reached.
+    ///
+    /// Between steps the bodies carry only your own forces: the sources' wrenches are added for
+    /// the step and taken away after it. Velocity-based kinematic bodies are placed exactly where
+    /// their velocities take them over each step. A kinematic position target
+    /// (`set_next_kinematic_position`) set by hand is reached within one step whatever its
+    /// length: under adaptive steps prescribe such motion as a function of time with
+    /// [`insert_prescribed`](Self::insert_prescribed), which sets the target of each step
+    /// (retried ones included) from the step's end time.
+    ///
     /// The same as [`step_with`](Self::step_with) with no hooks of your own (`&mut ()`).
     pub fn step(&mut self, until: f64) -> Result<StepInfo> {
         self.step_with(until, &mut ())
@@ -252,8 +262,10 @@ impl ClearanceWorld {
         stepper.prepare(physics, &mut hooks)
     }
 
-    /// [`Stepper::peek`]: a step of the last step's size (or `dt`: > 0 and at most the
-    /// control's `max_dt`, else refused naming `dt`), read by `read`, then undone exactly.
+    /// Takes a step of the last step's size (or `dt` before the first: > 0 and at most the
+    /// control's `max_dt`, else refused naming `dt`), lets `read` look at the world and the
+    /// step, then restores the state before it exactly: e.g. an ideal joint's reaction at the
+    /// final time, which only the step after it determines.
     pub fn peek<R>(
         &mut self,
         dt: f64,
@@ -276,8 +288,13 @@ impl ClearanceWorld {
     }
 
     /// Forgets the evaluation of the joints and drives, after you changed the world between
-    /// steps by hand (bodies moved, sets edited through their fields); with `restart_kick`, also
-    /// after setting velocities by hand ([`Stepper::invalidate`]).
+    /// steps by hand (bodies moved, sets edited through their fields): the next step evaluates
+    /// them again first. With `restart_kick` the next step is a half kick again, as from a new
+    /// initial state (after setting velocities by hand), and the clearance joints' contact laws
+    /// get the stored rate at that evaluation. Without it they carry the rate to the state with
+    /// its change since their last evaluation, across your edit: off by at most half that
+    /// change, once
+    /// ([`ClearanceJointSet::set_last_step`](crate::rapier::joint::ClearanceJointSet::set_last_step)).
     pub fn invalidate(&mut self, restart_kick: bool) {
         self.stepper.invalidate(restart_kick);
     }
@@ -300,21 +317,6 @@ impl ClearanceWorld {
     /// What the run-time guards recorded.
     pub fn guards(&self) -> &GuardReport {
         self.stepper.guards()
-    }
-
-    /// The step control.
-    pub fn step_control(&self) -> &StepControl {
-        self.stepper.control()
-    }
-
-    /// Replaces the step control (between steps).
-    pub fn set_step_control(&mut self, control: StepControl) {
-        self.stepper.set_control(control);
-    }
-
-    /// The stepper itself.
-    pub fn stepper(&self) -> &Stepper {
-        &self.stepper
     }
 
     // ----- Reactions -----
@@ -370,6 +372,7 @@ impl ClearanceWorld {
         &'a mut PhysicsWorld,
         [&'a mut dyn StepHooks; 5],
     ) {
+        self.stepper.set_control(self.step_control);
         (
             &mut self.stepper,
             &mut self.rapier,

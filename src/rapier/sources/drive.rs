@@ -110,8 +110,7 @@ impl TorsionSpring {
 pub type DriveHandle = ElementHandle<TorsionSpring>;
 
 /// All drives of a world, visited in insertion order. Under the
-/// [`Stepper`](crate::rapier::pipeline::stepper::Stepper) (or a
-/// [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld)) their torques act during the steps
+/// [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld) their torques act during the steps
 /// only; a loop that calls `world.step()` itself calls [`DriveSet::apply`] before every step.
 #[derive(Clone, Debug, Default)]
 pub struct DriveSet {
@@ -141,7 +140,7 @@ impl DriveSet {
         Some(d)
     }
     /// Replaces the torques applied at the previous call by the current ones (for a loop that
-    /// calls `world.step()` itself; the [`Stepper`](crate::rapier::pipeline::stepper::Stepper) uses
+    /// calls `world.step()` itself; the [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld) uses
     /// [`evaluate`](StepHooks::evaluate) and adds the torques for its step only).
     pub fn apply(&mut self, bodies: &mut RigidBodySet) {
         self.evaluate(bodies);

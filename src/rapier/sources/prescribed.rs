@@ -3,7 +3,7 @@
 //! (cubic Hermite, continuous slope: [`Table`]).
 //!
 //! A [`PrescribedSet`] takes part in the stepper's steps ([`StepHooks`]) but applies no force:
-//! before each Rapier step the [`Stepper`](crate::rapier::pipeline::stepper::Stepper) hands it the step's start and
+//! before each Rapier step the [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld) hands it the step's start and
 //! length, and it sets each body's next pose at the step's end (Rapier's position-based kinematic
 //! bodies then move there, their velocity being the step's mean). Poses are exact at every
 //! state, whatever the step.

@@ -91,16 +91,19 @@ fn default_end() -> f64 {
 impl RunSettings {
     /// The stepper's control for these settings.
     pub fn step_control(&self) -> crate::rapier::pipeline::stepper::StepControl {
+        use crate::rapier::pipeline::stepper::StepControl;
         let c = match self.step {
             // The tolerance also sets a sub-cycled contact's sub-steps.
-            StepMode::Fixed => crate::rapier::pipeline::stepper::StepControl::fixed(self.dt_s)
-                .with_tolerance(self.tolerance),
-            StepMode::Adaptive => crate::rapier::pipeline::stepper::StepControl::adaptive(
-                self.max_dt_s,
-                self.tolerance,
-            ),
+            StepMode::Fixed => StepControl {
+                tolerance: self.tolerance,
+                ..StepControl::fixed(self.dt_s)
+            },
+            StepMode::Adaptive => StepControl::adaptive(self.max_dt_s, self.tolerance),
         };
-        c.strict(self.strict)
+        StepControl {
+            strict: self.strict,
+            ..c
+        }
     }
 
     /// The step control in words, e.g. "adaptive steps of at most 1e-3 s (tolerance 0.0075:

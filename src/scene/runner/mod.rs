@@ -446,21 +446,21 @@ impl Simulation {
         } else {
             "an initial velocity too high, or a contact too stiff for the step".to_string()
         };
-        let speed = if speed.is_finite() {
+        let state = if speed.is_finite() {
             format!("speed {} m/s", crate::error::sig4(speed))
         } else {
             "its state is not finite".to_string()
         };
-        crate::Error::Diverged {
+        crate::Error::diverged(
             t,
-            reason: format!(
-                "body `{}` of the {} twin left the physical range ({speed}, the guard being {} \
-                 m/s); likely cause: {cause}",
-                body.name,
-                kind.name(),
-                crate::error::sig4(0.5 * params.max_linear_velocity()),
-            ),
-        }
+            crate::error::Divergence::Body {
+                body: format!("`{}` of the {} twin", body.name, kind.name()),
+                joined: Vec::new(),
+                state,
+                guard: 0.5 * params.max_linear_velocity(),
+                cause,
+            },
+        )
     }
 
     /// Records the final state: invariants, a last row at `end_s` (its reactions, velocities and

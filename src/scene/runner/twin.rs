@@ -371,14 +371,12 @@ impl Twin {
         }
         let t = world.time();
         let Some(forces) = world.solve_reactions(&mut self.reactions, &self.ideal_joints) else {
-            return Err(crate::Error::Diverged {
+            return Err(crate::Error::diverged(
                 t,
-                reason: format!(
-                    "the {} twin's ideal-joint reactions cannot be solved: its state or a \
-                     body's mass is not finite",
-                    self.kind.name()
-                ),
-            });
+                crate::error::Divergence::Reactions {
+                    twin: Some(self.kind.name().to_string()),
+                },
+            ));
         };
         {
             let n = self.ideal_hinges.len();

@@ -95,7 +95,11 @@ impl MetricsTable {
                     Some(x) => {
                         return Err(Error::Diverged {
                             t: r.metrics.end_s,
-                            reason: format!("metric `{name}` of `{}` is {x}", r.point.dir),
+                            what: Box::new(Divergence::NonFinite {
+                                name: name.clone(),
+                                place: format!("among the metrics of point `{}`", r.point.dir),
+                                value: Some(x),
+                            }),
                         });
                     }
                     None => String::new(),

@@ -74,7 +74,7 @@ pub enum ContactIntegration {
     /// and friction implicitly; Rapier's step carries the result (two Rapier passes: the rest of
     /// the world's motion, then the contact's impulse; docs/sub-cycled-contact.md). The
     /// world's step is set by its slow motion: the joint adds no stability limit. Needs the
-    /// [`Stepper`](crate::rapier::pipeline::stepper::Stepper) (or a world built on it); a loop of your own
+    /// [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld) (or a layer built on it); a loop of your own
     /// that calls `ClearanceJointSet::apply` gets the explicit forces.
     SubCycled,
 }

@@ -90,3 +90,28 @@ fn per_turn_statistics_by_hand() {
     assert!(per_period(&[], 1e-6, 1e4).is_err());
     assert!(per_period(&[], 1.0, f64::INFINITY).is_err());
 }
+
+proptest::proptest! {
+    /// The recorder and the per-turn table fed any number (tests/numeric_inputs.rs): no panic,
+    /// and no table beyond [`MAX_PERIODS`].
+    #[test]
+    fn metrics_any_numbers(
+        period in proptest::num::f64::ANY, end in proptest::num::f64::ANY,
+        onset in proptest::num::f64::ANY, duration in proptest::num::f64::ANY,
+        t in proptest::num::f64::ANY, dt in proptest::num::f64::ANY,
+        force in proptest::num::f64::ANY,
+    ) {
+        let impacts = [Impact { onset_t_s: onset, duration_s: duration, peak_force_n: force, ..Impact::default() }];
+        match per_period(&impacts, period, end) {
+            Ok(p) => proptest::prop_assert!(p.len() <= MAX_PERIODS),
+            Err(e) => proptest::prop_assert!(e.to_string().contains("period"), "{e}"),
+        }
+        let mut rec = ImpactRecorder::new();
+        let obs = ContactObservation::ideal(force);
+        rec.record(t, dt, &obs);
+        rec.record(t, dt, &ContactObservation { onset: true, impact: true, penetration: force.abs(), ..obs });
+        rec.finish(t, &obs);
+        rec.set_final_angle_deg(force);
+        let _ = (rec.metrics(), rec.contact_time(), rec.contacts_table());
+    }
+}

@@ -14,7 +14,7 @@
 //!
 //! **The state's velocities.** Rapier's stored velocities are not the state's: with one solver
 //! iteration a step is symplectic Euler, whose velocities live half a step before the positions
-//! (the [`Stepper`](crate::rapier::pipeline::stepper::Stepper) makes that exactly half the last step), and
+//! (the [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld) makes that exactly half the last step), and
 //! they satisfy the joints at the previous positions, not the current ones. The solver therefore
 //! (1) advances the stored velocities by [`velocity_lag`](ReactionSolver::velocity_lag) with the
 //! accelerations it solves at them (second order in the lag: a second pass), and (2) projects
@@ -101,8 +101,8 @@ pub struct ReactionSolver {
     pub kinematic: Vec<KinematicState>,
     /// How long before the state the bodies' stored velocities are, s: the stored velocities are
     /// advanced by it with the accelerations solved. Half the last step for Rapier's velocities
-    /// after a step of the [`Stepper`](crate::rapier::pipeline::stepper::Stepper)
-    /// (`stepper.last_dt() / 2`; 0 before the first step, whose velocities are the initial
+    /// after a step of the [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld)
+    /// (`world.last_dt() / 2`; 0 before the first step, whose velocities are the initial
     /// state's) or of a plain Rapier loop at constant steps (`dt / 2`). Default 0: the stored
     /// velocities are taken as the state's (and only projected onto the joints).
     pub velocity_lag: f64,

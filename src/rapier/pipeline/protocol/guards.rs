@@ -31,12 +31,13 @@ pub enum GuardKind {
     /// `worst` the sub-steps it took, `limit` that cap; the rest of the step went in one
     /// sub-step, unresolved.
     SubSteps,
-    /// A violation recorded in words only ([`GuardReport::violation`]): `worst` and `limit` 0.
+    /// A guard of a participant of your own: its [`note`](Violation::note) is the whole
+    /// message; `worst` and `limit` are its own.
     Other,
 }
 
 /// One kind of guard violated by one joint (or twin): the worst value, when, and how many
-/// states violated it.
+/// states violated it. Its `Display` states them in words.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Violation {
     /// The guard.
@@ -65,7 +66,7 @@ pub struct Violation {
     /// in place of the default that names the plain API's parameters; for [`GuardKind::Other`]
     /// the whole message.
     #[serde(skip)]
-    pub note: String,
+    pub(crate) note: String,
     /// The unit of `worst` and `limit` where they are absolute rather than the kind's usual
     /// measure: a velocity motor whose target is 0 reports its miss in rad/s or m/s (relative to
     /// a zero target it has no meaning).
@@ -99,7 +100,7 @@ impl Violation {
     }
 
     /// Names the twin.
-    pub fn twin(mut self, name: &str) -> Self {
+    pub(crate) fn twin(mut self, name: &str) -> Self {
         self.twin = Some(name.to_string());
         self
     }
@@ -119,16 +120,25 @@ impl Violation {
     }
 
     /// `worst` over `limit` (0 without a limit).
-    pub fn ratio(&self) -> f64 {
+    pub(crate) fn ratio(&self) -> f64 {
         if self.limit > 0.0 {
             self.worst / self.limit
         } else {
             0.0
         }
     }
+}
 
-    /// The violation in words: the worst value against its limit, when, where, how often.
-    pub fn message(&self) -> String {
+/// The violation in words: the worst value against its limit, when, where, how often.
+impl std::fmt::Display for Violation {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.in_words())
+    }
+}
+
+impl Violation {
+    /// The violation in words ([`Display`](std::fmt::Display)).
+    fn in_words(&self) -> String {
         let joint = self.joint.as_deref().unwrap_or("?");
         let twin = self.twin.as_deref().unwrap_or("?");
         let states = |n: u64| {
@@ -255,26 +265,6 @@ impl GuardReport {
         }
     }
 
-    /// Records a violation known only in words, once per `key` (later calls with the same key
-    /// count it again): for guards of your own.
-    pub fn violation(&mut self, key: &str, text: impl FnOnce() -> String) {
-        let tag = format!("\u{0}{key}");
-        match self
-            .violations
-            .iter_mut()
-            .find(|e| e.kind == GuardKind::Other && e.joint.as_deref() == Some(&tag))
-        {
-            Some(e) => e.count += 1,
-            None => {
-                let mut v = Violation::new(GuardKind::Other, 0.0, 0.0, f64::NAN).note(text());
-                v.joint = Some(tag);
-                v.first_t_s = 0.0;
-                v.t_s = 0.0;
-                self.violations.push(v);
-            }
-        }
-    }
-
     /// The worst violation of `kind` over all joints and twins (largest ratio to its limit).
     pub fn worst(&self, kind: GuardKind) -> Option<&Violation> {
         self.violations
@@ -285,7 +275,7 @@ impl GuardReport {
 
     /// Every violation in words, each stating its worst value, when, where and how often.
     pub fn messages(&self) -> Vec<String> {
-        self.violations.iter().map(Violation::message).collect()
+        self.violations.iter().map(Violation::to_string).collect()
     }
 }
 
@@ -359,7 +349,7 @@ mod tests {
             (v.worst, v.t_s, v.first_t_s, v.count),
             (325e-6, 0.004, 0.001, 3)
         );
-        let m = v.message();
+        let m = v.to_string();
         assert!(
             m.contains("325 um") && m.contains("6.5 times") && m.contains("3 states"),
             "{m}"
@@ -379,8 +369,13 @@ mod tests {
                 .joint("other", Some(ElementId::from_raw_parts(1, 0))),
         );
         g.record(Violation::new(GuardKind::Energy, 0.05, 0.01, 0.3).twin("ideal"));
-        g.violation("mine", || "my own guard".into());
-        g.violation("mine", || unreachable!("recorded once"));
+        let mine = || {
+            Violation::new(GuardKind::Other, 2.0, 1.0, 0.5)
+                .joint("mine", None)
+                .note("my own guard")
+        };
+        g.record(mine());
+        g.record(mine());
         assert_eq!(g.violations.len(), 4);
         assert_eq!(
             g.worst(GuardKind::Penetration).unwrap().joint.as_deref(),

@@ -68,8 +68,10 @@ pub struct BodyShare {
     pub rotational_inverse_mass: f64,
 }
 
-/// The numbers of the contact the step control could not resolve, as a participant reports it
-/// ([`StepHooks::stalled_contact`](crate::rapier::pipeline::step_hooks::StepHooks::stalled_contact)).
+/// The contact the step control could not resolve, as this crate's joint sets report it
+/// ([`StepHooks::stalled_contact`](crate::rapier::pipeline::step_hooks::StepHooks::stalled_contact))
+/// for a stall's diagnosis: the joint, and its contact state in words through its `Display`
+/// (the numbers the diagnosis reads are the crate's).
 #[derive(Clone, Debug, PartialEq)]
 pub struct StalledContact {
     /// The name of the joint (or element) in contact.
@@ -77,49 +79,50 @@ pub struct StalledContact {
     /// Its handle in its set, if it has one.
     pub handle: Option<ElementId>,
     /// The normal law.
-    pub law: LawKind,
+    pub(crate) law: LawKind,
     /// Penetration, m (negative: a gap).
-    pub penetration: f64,
+    pub(crate) penetration: f64,
     /// Penetration rate, m/s.
-    pub rate: f64,
+    pub(crate) rate: f64,
     /// The approach speed the hysteresis laws divide by, `delta_dot0`, m/s (0 in free flight).
-    pub impact_rate: f64,
+    pub(crate) impact_rate: f64,
     /// The joint's floor on it, m/s.
-    pub min_impact_speed: f64,
+    pub(crate) min_impact_speed: f64,
     /// Linearised damping ratio.
-    pub zeta: f64,
+    pub(crate) zeta: f64,
     /// Linearised natural frequency, rad/s: from `dF/d delta`, the spring's tangent stiffness
     /// plus the slope of a hysteresis law's damping times the rate.
-    pub omega: f64,
+    pub(crate) omega: f64,
     /// The spring's own tangent stiffness at the penetration, N/m (the law without its
     /// damping): against `omega^2 m` it tells a stiff spring from a steep damping.
-    pub elastic_stiffness: f64,
+    pub(crate) elastic_stiffness: f64,
     /// Whether the contact is a shoulder on a bearing face (the spatial joint's face law), not
     /// the journal on the bore.
-    pub face: bool,
+    pub(crate) face: bool,
     /// Damped stability limit of the step, s.
-    pub stable_dt: f64,
+    pub(crate) stable_dt: f64,
     /// Friction's step limit, s.
-    pub friction_dt: f64,
+    pub(crate) friction_dt: f64,
     /// Normal force, N.
-    pub normal_force: f64,
+    pub(crate) normal_force: f64,
     /// Effective mass along the normal, kg.
-    pub effective_mass: f64,
+    pub(crate) effective_mass: f64,
     /// Each movable body's share (fixed and kinematic bodies have none).
-    pub bodies: Vec<BodyShare>,
+    pub(crate) bodies: Vec<BodyShare>,
     /// The law's validity limit, m.
-    pub max_valid_penetration: f64,
+    pub(crate) max_valid_penetration: f64,
     /// The deepest penetration the contact can reach from its state (elastic energy plus the
     /// kinetic energy of the approach), m.
-    pub reachable_penetration: f64,
+    pub(crate) reachable_penetration: f64,
     /// The stable step of the contact at the validity limit, s (what a contact that stays valid
     /// needs).
-    pub stable_dt_at_valid: f64,
+    pub(crate) stable_dt_at_valid: f64,
 }
 
-impl StalledContact {
-    /// The contact state in words.
-    pub fn state(&self) -> String {
+/// The contact state in words: the joint, its penetration, rate, `delta_dot0`, damping ratio,
+/// stable steps and effective mass.
+impl std::fmt::Display for StalledContact {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let place = if self.face {
             ", a shoulder on a bearing face"
         } else {
@@ -128,7 +131,8 @@ impl StalledContact {
         let handle = self
             .handle
             .map_or(String::new(), |h| format!(" (handle {h})"));
-        format!(
+        write!(
+            f,
             "joint `{}`{handle}{place}: penetration {} um, rate {} m/s, delta_dot0 {} m/s, damping ratio \
              {}, stable step {} s (friction's {} s), effective mass {} kg",
             self.joint,

@@ -1,5 +1,5 @@
-//! The step control's settings: [`StepMode`] and [`StepControl`], built with chained setters
-//! and checked by [`StepControl::validate`].
+//! The step control's settings: [`StepMode`] and [`StepControl`], plain data with public fields
+//! (as Rapier's `IntegrationParameters`), checked at every step.
 
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
@@ -23,7 +23,24 @@ pub enum StepMode {
 /// run with [`Error::Stalled`](crate::Error::Stalled).
 pub(crate) const STALL_STEPS: u64 = 100_000;
 
-/// The step control of a [`Stepper`](super::Stepper), built with chained setters.
+/// The step control of a [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld):
+/// plain data, as Rapier's `IntegrationParameters`. Start from [`fixed`](Self::fixed) or
+/// [`adaptive`](Self::adaptive) and set the other fields with struct update syntax:
+///
+/// ```
+/// use clearance_joint::rapier::pipeline::stepper::StepControl;
+///
+/// let control = StepControl {
+///     strict: true,
+///     min_dt: 1e-6,
+///     ..StepControl::adaptive(1e-3, 0.0075)
+/// };
+/// # assert!(control.strict);
+/// ```
+///
+/// The fields are checked at every step (a control set between steps included), and one out of
+/// its domain is refused naming it: finite steps of at least 1e-10 s, an adaptive `tolerance`
+/// from 1e-6 to 1, `min_dt` positive and at most `max_dt`, `max_growth` above 1.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepControl {
     /// Fixed or adaptive.
@@ -89,42 +106,9 @@ impl StepControl {
         }
     }
 
-    /// Sets the adaptive tolerance ([`tolerance`](Self::tolerance): half the fraction of a
-    /// contact period one step may cover, and 8 times the angle in rad a body may turn in one
-    /// step).
-    pub fn with_tolerance(mut self, tolerance: f64) -> Self {
-        self.tolerance = tolerance;
-        self
-    }
-
-    /// Sets the floor of the adaptive step, s.
-    pub fn min_dt(mut self, dt: f64) -> Self {
-        self.min_dt = dt;
-        self
-    }
-
-    /// Sets the largest growth ratio of one step over the previous.
-    pub fn max_growth(mut self, ratio: f64) -> Self {
-        self.max_growth = ratio;
-        self
-    }
-
-    /// Makes guard violations errors.
-    pub fn strict(mut self, strict: bool) -> Self {
-        self.strict = strict;
-        self
-    }
-
-    /// Turns the step-consistent drift correction of Rapier's joints on (the default) or off
-    /// (Rapier's own correction, the whole drift within each step).
-    pub fn joint_correction(mut self, on: bool) -> Self {
-        self.joint_correction = on;
-        self
-    }
-
     /// Checks the fields: finite steps of at least 1e-10 s, a tolerance from 1e-6 to 1, growth
     /// above 1.
-    pub fn validate(&self) -> Result<()> {
+    pub(crate) fn validate(&self) -> Result<()> {
         let ok = |v: f64| v.is_finite() && v > 0.0;
         let step = match self.mode {
             StepMode::Fixed => "dt",

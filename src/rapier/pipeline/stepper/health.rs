@@ -2,7 +2,7 @@
 //! guards after it, and the words of a divergence or a stall.
 
 use super::{GuardKind, STALL_STEPS, StepMode, Stepper, Violation};
-use crate::error::{Error, Result};
+use crate::error::{Divergence, Error, Result};
 use crate::rapier::observers::stall::{Stall, StallCause};
 use crate::rapier::pipeline::step_hooks::{StepContext, StepHooks};
 use rapier3d_f64::prelude::PhysicsWorld;
@@ -91,16 +91,16 @@ impl Stepper {
             if let Some(rb) = world.bodies.get(b.handle)
                 && let Some(speed) = left_physical_range(rb, &world.integration_parameters)
             {
-                return Err(Error::Diverged {
-                    t: self.t,
-                    reason: diverged_body(
+                return Err(Error::diverged(
+                    self.t,
+                    diverged_body(
                         world,
                         sources,
                         b.handle,
                         speed,
                         self.control.joint_correction,
                     ),
-                });
+                ));
             }
         }
         let step = self.step_context(self.t, dt);
@@ -228,7 +228,7 @@ fn diverged_body(
     body: rapier3d_f64::prelude::RigidBodyHandle,
     speed: f64,
     joint_correction: bool,
-) -> String {
+) -> Divergence {
     let mut joined: Vec<String> = world
         .impulse_joints
         .attached_joints(body)
@@ -239,12 +239,7 @@ fn diverged_body(
     for s in sources {
         s.joints_of(body, &mut joined);
     }
-    let joined = if joined.is_empty() {
-        String::new()
-    } else {
-        format!(", joined by {}", joined.join(", "))
-    };
-    let speed = state_in_words(world.bodies.get(body), speed);
+    let state = state_in_words(world.bodies.get(body), speed);
     let correction = if jointed && !joint_correction {
         "; with the joint correction off (`StepControl::joint_correction`), also Rapier's joint \
          drift correction under changing steps, which makes a chain of slender bodies tilt out of \
@@ -252,13 +247,16 @@ fn diverged_body(
     } else {
         ""
     };
-    format!(
-        "body {:?}{joined} left the physical range ({speed}, the guard being {} m/s); likely \
-         cause: a motor, drive or prescribed motion that moves it too fast, a contact too stiff \
-         for the step, or a non-finite input (gravity, a force, a mass){correction}",
-        body.into_raw_parts(),
-        crate::error::sig4(0.5 * world.integration_parameters.max_linear_velocity())
-    )
+    Divergence::Body {
+        body: format!("{:?}", body.into_raw_parts()),
+        joined,
+        state,
+        guard: 0.5 * world.integration_parameters.max_linear_velocity(),
+        cause: format!(
+            "a motor, drive or prescribed motion that moves it too fast, a contact too stiff for \
+             the step, or a non-finite input (gravity, a force, a mass){correction}"
+        ),
+    }
 }
 
 /// What is out of range in a diverged body's state: its pose, its velocities, Rapier's quarantine,

@@ -1,9 +1,10 @@
-//! The step control, public: one [`Stepper`] chooses, takes, judges and (when needed) retries
-//! every Rapier step of a world that holds clearance joints. It steps whatever takes part in the
-//! step through the step protocol ([`StepHooks`]: the joint sets, the drives, the prescribed
-//! motions; called the sources here). [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld)
-//! bundles it with the sets (the scene runner and the bevy_ecs layer are built on it); a loop that
-//! keeps its sets apart calls [`Stepper::step`] with them in place of `world.step()`.
+//! The step control: the one `Stepper` inside a
+//! [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld) chooses, takes, judges and
+//! (when needed) retries every Rapier step of a world that holds clearance joints. It steps
+//! whatever takes part in the step through the step protocol ([`StepHooks`]: the joint sets, the
+//! drives, the prescribed motions, a user's own participant; called the sources here). Crate
+//! internal: the world is the one public path to it (its settings, [`StepControl`], and what a
+//! step did, [`StepInfo`], are public here).
 //!
 //! What it adds to `PhysicsWorld::step`:
 //! - **Consistent variable steps.** With one solver iteration a Rapier step is symplectic Euler
@@ -24,7 +25,7 @@
 //!   contacts (the joints'
 //!   [`adaptive_step`](crate::rapier::joint::ClearanceJoint::adaptive_step)), growing by at most
 //!   [`StepControl::max_growth`] per step and landing exactly on the time given to
-//!   [`Stepper::step`].
+//!   [`ClearanceWorld::step`](crate::rapier::pipeline::world::ClearanceWorld::step).
 //! - **Step acceptance.** After the step the force sources are evaluated at the new state (the
 //!   forces of the next step) and every clearance joint judges it
 //!   ([`judge_step`](crate::rapier::joint::ClearanceJoint::judge_step)): a contact that began deeper than
@@ -42,42 +43,6 @@
 //!   floor are recorded (and fail the run under [`StepControl::strict`]); a step control that
 //!   cannot make progress (no accepted step above the floor for 100,000 steps) is an
 //!   [`Error::Stalled`].
-//!
-//! ```
-//! use clearance_joint::prelude::*;
-//! use clearance_joint::rapier::pipeline::stepper::{StepControl, Stepper};
-//! use rapier3d_f64::prelude::*;
-//!
-//! // A 2 kg arm on a steel pin with 0.2 mm of play, released horizontal under gravity.
-//! let mut world = PhysicsWorld::new();
-//! world.gravity = Vector::new(0.0, -9.81, 0.0);
-//! world.integration_parameters.num_solver_iterations = 1;
-//! let base = world.bodies.insert(RigidBodyBuilder::fixed());
-//! let arm = world.bodies.insert(
-//!     RigidBodyBuilder::dynamic()
-//!         .translation(Vector::new(0.3, 0.0, 0.0))
-//!         .additional_mass_properties(MassProperties::new(Vector::ZERO, 2.0, Vector::splat(0.02)))
-//!         .can_sleep(false),
-//! );
-//! let mut joints = ClearanceJointSet::new();
-//! // Improved Liu law, steel on steel: bearing radius 10 mm, clearance 0.2 mm, width 16 mm.
-//! let pin = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)?.joint(
-//!     Vector::ZERO,
-//!     Vector::new(-0.3, 0.0, 0.0),
-//!     Vector::Z,
-//!     Vector::Z,
-//! )?;
-//! let pin = joints.insert(base, arm, pin, &world.bodies, &mut world.impulse_joints)?;
-//! let mut stepper = Stepper::new(StepControl::adaptive(1e-3, 0.02));
-//! let mut peak: f64 = 0.0;
-//! while stepper.time() < 0.2 {
-//!     stepper.step(&mut world, &mut [&mut joints], 0.2)?;
-//!     peak = peak.max(joints.get(pin).unwrap().report().force.normal_force);
-//! }
-//! assert!(stepper.guards().is_clean(), "{:?}", stepper.guards());
-//! assert!(peak > 19.62, "the first impact exceeds the static load: {peak} N");
-//! # Ok::<(), clearance_joint::Error>(())
-//! ```
 
 mod control;
 mod health;
@@ -105,7 +70,8 @@ const MAX_PASSES: u32 = 3;
 /// Rejections of one step after which the step control gives up ([`Error::Stalled`]).
 const MAX_REJECTIONS: u32 = 60;
 
-/// What one accepted step did.
+/// What one accepted step did
+/// ([`ClearanceWorld::step`](crate::rapier::pipeline::world::ClearanceWorld::step)).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepInfo {
     /// Time at the step's start, s.
@@ -122,7 +88,7 @@ pub struct StepInfo {
 
 /// The step control of a world with clearance joints: see the module docs.
 #[derive(Clone, Debug)]
-pub struct Stepper {
+pub(crate) struct Stepper {
     control: StepControl,
     t: f64,
     last_dt: f64,
@@ -150,12 +116,7 @@ impl Stepper {
         }
     }
 
-    /// The step control.
-    pub fn control(&self) -> &StepControl {
-        &self.control
-    }
-
-    /// Changes the step control (e.g. the ECS layer follows `integration_parameters.dt`).
+    /// Changes the step control (the world's `step_control`, before each step).
     pub(crate) fn set_control(&mut self, control: StepControl) {
         self.control = control;
     }

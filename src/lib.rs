@@ -69,8 +69,6 @@
 //!   at a state, from the constrained equations (no difference quotients);
 //! - [`StepInfo`](rapier::pipeline::stepper::StepInfo) of every step and the world's guards (penetration
 //!   beyond the law's validity, energy gained, steps at the floor).
-//! - [`ReplayRecorder`](rapier::observers::replay::ReplayRecorder): the bodies' poses and each journal in its
-//!   bearing, thinned by time, for a replay of the run (the app writes it as `replay.html`).
 //!
 //! The README's "A driven mechanism" builds a slider-crank with a clearance pin this way in under
 //! 40 lines; `examples/slider_crank.rs` compares it with its ideal twin.

@@ -1,12 +1,12 @@
-//! The source tree's shape: no library file over 600 lines (test files aside), and no import
-//! circle among the modules of `src/rapier` (a module's `use crate::rapier::...` lines, resolved
+//! The source tree's shape: no source file of the library or the app over 600 lines (test files
+//! aside), and no import circle among the modules of `src/rapier` (a module's `use crate::rapier::...` lines, resolved
 //! to the longest module path that exists; a child's `use super::...` is not an edge).
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
 use std::path::{Path, PathBuf};
 
-/// The longest a library source file may be, lines.
+/// The longest a source file of the library or the app may be, lines.
 const MAX_LINES: usize = 600;
 
 fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -110,19 +110,36 @@ fn circle_through(graph: &BTreeMap<String, BTreeSet<String>>, start: &str) -> Op
     None
 }
 
-#[test]
-fn no_library_file_is_longer_than_the_limit() {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+/// The files under `dir` longer than [`MAX_LINES`] (test files aside), with their lengths.
+fn too_long(dir: &Path) -> Vec<String> {
     let mut files = Vec::new();
-    rust_files(&src, &mut files);
-    let long: Vec<String> = files
+    rust_files(dir, &mut files);
+    files
         .iter()
         .filter(|f| !is_test_file(f))
         .filter_map(|f| {
             let lines = fs::read_to_string(f).unwrap().lines().count();
             (lines > MAX_LINES).then(|| format!("{} ({lines} lines)", f.display()))
         })
-        .collect();
+        .collect()
+}
+
+#[test]
+fn no_library_file_is_longer_than_the_limit() {
+    let long = too_long(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src"));
+    assert!(long.is_empty(), "split by job: {long:?}");
+}
+
+#[test]
+fn no_app_file_is_longer_than_the_limit() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("app/src");
+    let mut files = Vec::new();
+    rust_files(&src, &mut files);
+    assert!(
+        files.len() > 20,
+        "the walk found the app's files: {files:?}"
+    );
+    let long = too_long(&src);
     assert!(long.is_empty(), "split by job: {long:?}");
 }
 

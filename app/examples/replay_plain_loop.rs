@@ -1,13 +1,13 @@
 //! A replay from your own Rapier loop: a pendulum arm (a box collider) on a revolute hinge with
-//! 0.2 mm of play, released at 60 degrees under gravity, stepped by a `ClearanceWorld`; the library's
-//! `ReplayRecorder` reads the world after every step, and the app's `ReplayPage` writes the
+//! 0.2 mm of play, released at 60 degrees under gravity, stepped by a `ClearanceWorld`; the app's
+//! `ReplayRecorder` reads the world after every step, and its `ReplayPage` writes the
 //! self-contained `replay.html`.
 //!
 //! `cargo run --release -p clearance_joint_app --example replay_plain_loop [OUT_DIR]`
 //! (default `out/replay_plain_loop`).
 
 use clearance_joint::prelude::*;
-use clearance_joint::rapier::observers::replay::{Recording, ReplayRecorder};
+use clearance_joint_app::replay::record::{JournalFrame, Recording, ReplayRecorder};
 use clearance_joint_app::replay::{Line, ReplayPage, Series};
 use rapier3d_f64::prelude::*;
 use std::path::PathBuf;
@@ -77,7 +77,7 @@ fn main() -> clearance_joint::Result<()> {
         t: t.clone(),
         v,
     };
-    let journal = |f: &dyn Fn(&clearance_joint::rapier::observers::replay::JournalFrame) -> f64| {
+    let journal = |f: &dyn Fn(&JournalFrame) -> f64| {
         recording
             .frames
             .iter()

@@ -14,7 +14,7 @@
 //! - [`summary`]: `summary.json` with the effective scene (the scene after overrides).
 //! - [`advice`]: the library's errors phrased for the command line (its options added).
 //!
-//! The binary (`src/main.rs`) parses arguments, calls these, prints and sets the exit code. The
+//! The binary (`src/bin/clearance_joint/`, a file per command) parses arguments, calls these, prints and sets the exit code. The
 //! library crate `clearance_joint` knows nothing of this crate: depending on it builds none of
 //! the app's dependencies.
 

@@ -58,6 +58,31 @@ pub struct JournalState {
     pub contact_point: Vector,
 }
 
+/// The in-plane reference direction `u` of a bearing with unit axis `axis`: the coordinate axis
+/// (x, y or z) least aligned with `axis`, made orthogonal to it (x for an axis along y; then
+/// `v = axis x u` is z). The scene runner's CSV columns `*_ecc_u_mm`/`*_ecc_v_mm` report the
+/// eccentricity along these directions, in the bearing body's frame.
+///
+/// ```
+/// use clearance_joint::model::kinematics::in_plane_u;
+/// use rapier3d_f64::math::Vector;
+///
+/// assert_eq!(in_plane_u(Vector::Y), Vector::X);
+/// assert_eq!(in_plane_u(Vector::X), Vector::Y);
+/// let tilted = Vector::new(1.0, 1.0, 0.0).normalize();
+/// assert!(in_plane_u(tilted).dot(tilted).abs() < 1e-15);
+/// ```
+pub fn in_plane_u(axis: Vector) -> Vector {
+    let candidates = [Vector::X, Vector::Y, Vector::Z];
+    let mut best = candidates[0];
+    for c in candidates {
+        if c.dot(axis).abs() < best.dot(axis).abs() - 1e-12 {
+            best = c;
+        }
+    }
+    (best - best.dot(axis) * axis).normalize()
+}
+
 /// Computes [`JournalState`] from the bearing centre `p_i`, journal centre `p_j`, the unit
 /// bearing axis `axis` (world), and both bodies' motion.
 pub fn journal_state(

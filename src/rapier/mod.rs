@@ -7,7 +7,7 @@
 //! - [`hinge`]: the hinge's specification both joints are built from, and the conversions from and
 //!   to Rapier's revolute joint.
 //! - [`sources`]: drives (torsion springs, torques) and prescribed motions.
-//! - [`observers`]: guards, stall diagnoses, metrics, ideal-joint reactions and replays.
+//! - [`observers`]: guards, stall diagnoses, metrics and ideal-joint reactions.
 //!
 //! Depends on [`crate::model`] only (and on Rapier); knows nothing of scenes or the ECS.
 

@@ -1,5 +1,5 @@
 //! What the commands do between parsing their arguments and printing: the binary
-//! (`src/main.rs`) parses, calls these, and prints what they return.
+//! (`src/bin/clearance_joint/`) parses, calls these, and prints what they return.
 //!
 //! - [`run`]: one scene's ideal-vs-clearance run into a result set (`run`, the default job).
 //! - [`sweep`]: a grid of runs, or a shard of it, into one folder (`sweep`).

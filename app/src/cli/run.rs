@@ -62,10 +62,7 @@ impl SceneRun {
         &self,
         progress: impl FnMut(&Progress),
         replay: bool,
-    ) -> Result<(
-        RunResult,
-        Option<clearance_joint::rapier::observers::replay::Recording>,
-    )> {
+    ) -> Result<(RunResult, Option<crate::replay::record::Recording>)> {
         crate::replay::run_recorded(&self.scene, progress, replay)
             .map_err(|e| e.with_step_mode(self.scene.run.step == StepMode::Adaptive))
     }

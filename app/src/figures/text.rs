@@ -381,7 +381,7 @@ mod tests {
     const AT: (i32, i32) = (10, 10);
 
     fn font() -> FontRef<'static> {
-        super::super::font().unwrap()
+        super::super::render::font().unwrap()
     }
 
     /// Darkness (0 white to 1 black), row by row, of `text` drawn in black at `at` (top left

@@ -5,9 +5,7 @@
 //!   [`GuardReport`](crate::rapier::pipeline::protocol::GuardReport)).
 //! - [`metrics`]: impact lists, contact fraction and per-turn statistics.
 //! - [`reaction`]: exact ideal-joint reactions from the constrained equations.
-//! - [`replay`]: bodies' poses and journals' states, thinned by time, for a replay of a run.
 
 pub mod metrics;
 pub mod reaction;
-pub mod replay;
 pub mod stall;

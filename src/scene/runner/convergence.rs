@@ -12,7 +12,8 @@
 //! (`tests/stepper.rs`) passes a check at half the tolerance.
 //!
 //! One call runs a scene and checks it ([`run_checked`]); [`check`] checks a run you already
-//! have (from [`Simulation::run`](super::Simulation::run) or a run recording its replay). A scene
+//! have (from [`Simulation::run`](super::Simulation::run) or
+//! [`Simulation::run_observed`](super::Simulation::run_observed)). A scene
 //! without a clearance hinge has nothing to compare: the check says so
 //! ([`Convergence::NothingToCheck`]) and runs nothing more.
 //!

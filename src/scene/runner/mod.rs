@@ -9,10 +9,9 @@ mod twin;
 
 pub use comparison::{Comparison, RateDeviation, Settling};
 pub use invariants::{ENERGY_GROWTH_LIMIT, Invariants, MOTOR_SPEED_ERROR_LIMIT};
-pub use twin::{Twin, TwinKind};
+pub use twin::{HingeJoint, Twin, TwinHinge, TwinKind};
 
 use crate::error::Result;
-use crate::rapier::observers::replay::ReplayRecorder;
 use crate::rapier::pipeline::stepper::{GuardKind, GuardReport, Violation};
 use crate::rapier::pipeline::world::ClearanceWorld;
 use crate::scene::{Scene, ValidatedScene};
@@ -224,31 +223,12 @@ impl Simulation {
         self.run_observed(progress, |_| {})
     }
 
-    /// A recorder tracking both twins' bodies and hinges for a replay (groups `ideal` and
-    /// `clearance`), keeping a state per `interval` s in free flight and per
-    /// `contact_interval` s in contact; feed it with [`record_replay`](Self::record_replay),
-    /// e.g. from [`run_observed`](Self::run_observed).
-    pub fn replay_recorder(&self, interval: f64, contact_interval: f64) -> Result<ReplayRecorder> {
-        let mut recorder = ReplayRecorder::new(interval, contact_interval)?;
-        for twin in &self.twins {
-            twin.track_replay(&self.scene, &self.world, &mut recorder)?;
-        }
-        Ok(recorder)
-    }
-
-    /// Records the current state into a recorder from [`replay_recorder`](Self::replay_recorder).
-    pub fn record_replay(&self, recorder: &mut ReplayRecorder) {
-        recorder.record(
-            self.time(),
-            &self.world.rapier.bodies,
-            &[&self.world.clearance],
-        );
-    }
-
     /// As [`run_keeping_partial`](Self::run_keeping_partial) (a stalled run returns what it
     /// computed, with the error in [`RunResult::stopped`]), also calling `observe` with the
     /// simulation at the initial state and after every internal step (the force sources
-    /// evaluated at each of those states), e.g. to [`record_replay`](Self::record_replay).
+    /// evaluated at each of those states), e.g. to record a replay: [`Simulation::world`] holds
+    /// the bodies and joints, each twin's [`bodies`](Twin::bodies) and
+    /// [`hinges`](Twin::hinges) name them.
     pub fn run_observed(
         mut self,
         mut progress: impl FnMut(&Progress),

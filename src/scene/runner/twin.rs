@@ -12,11 +12,9 @@ use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle, SpatialReport};
 use crate::rapier::large_step::{LargeStepJoint, LargeStepJointHandle};
 use crate::rapier::observers::metrics::{ContactObservation, ImpactRecorder};
 use crate::rapier::observers::reaction::{IdealJoint, ReactionSolver};
-use crate::rapier::observers::replay::ReplayRecorder;
 use crate::rapier::pipeline::stepper::StepInfo;
 use crate::rapier::pipeline::world::ClearanceWorld;
 use crate::rapier::sources::drive::DriveHandle;
-use crate::scene::Scene;
 use crate::table::Table;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::*;
@@ -64,11 +62,15 @@ pub(super) struct BodyTrack {
     rotation_before: rapier3d_f64::math::Rotation,
 }
 
-#[derive(Clone, Copy, Debug)]
-enum HingeJoint {
+/// How a twin models one of its hinges, with the joint's handle in the world's set.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HingeJoint {
+    /// Rapier's ideal revolute joint (in the world's impulse joints).
     Ideal,
+    /// A compliant clearance joint, in the world's [`ClearanceWorld::clearance`] set.
     Clearance(ClearanceJointHandle),
-    /// A clearance hinge of the large-step model (`clearance.model: LargeStep`).
+    /// A clearance hinge of the large-step model (`clearance.model: LargeStep`), in the world's
+    /// [`ClearanceWorld::large_step`] set.
     LargeStep(LargeStepJointHandle),
 }
 
@@ -78,6 +80,8 @@ pub(super) struct HingeTrack {
     joint: HingeJoint,
     bearing: usize,
     journal: usize,
+    /// The hinge's point in the bearing body's frame, m.
+    local_anchor1: Vector,
     local_axis1: Vector,
     local_u1: Vector,
     local_v1: Vector,
@@ -502,41 +506,39 @@ impl Twin {
 }
 
 impl Twin {
-    /// Tracks this twin's bodies and hinges in `recorder` (group: the twin's name): clearance
-    /// hinges as journals of the world's clearance set (passed first to
-    /// [`ReplayRecorder::record`]), ideal hinges as pins at their scene point.
-    pub fn track_replay(
-        &self,
-        scene: &Scene,
-        world: &ClearanceWorld,
-        recorder: &mut ReplayRecorder,
-    ) -> Result<()> {
-        let group = self.kind.name();
-        let physics = &world.rapier;
-        for b in &self.bodies {
-            recorder.track_body(
-                &b.name,
-                group,
-                b.handle,
-                &physics.bodies,
-                &physics.colliders,
-            );
-        }
-        for (h, spec) in self.hinges.iter().zip(&scene.hinges) {
-            let (b1, b2) = (self.bodies[h.bearing].handle, self.bodies[h.journal].handle);
-            match h.joint {
-                HingeJoint::Clearance(c) => {
-                    recorder.track_journal(&h.name, group, 0, c, &world.clearance)?
-                }
-                // The replay draws journals of the compliant set only: a large-step hinge is
-                // drawn as a pin at its scene point (its orbit is in the rows).
-                HingeJoint::Ideal | HingeJoint::LargeStep(_) => {
-                    let anchor =
-                        Vector::from(spec.point_m) - Vector::from(scene.body_origin(h.bearing));
-                    recorder.track_pin(&h.name, group, b1, b2, anchor, h.local_axis1)?
-                }
-            }
-        }
-        Ok(())
+    /// This twin's bodies, in scene order: each one's name and its handle in the world's
+    /// bodies.
+    pub fn bodies(&self) -> impl Iterator<Item = (&str, RigidBodyHandle)> {
+        self.bodies.iter().map(|b| (b.name.as_str(), b.handle))
     }
+
+    /// This twin's hinges, in scene order: what each one is in the world (see [`TwinHinge`]).
+    pub fn hinges(&self) -> impl Iterator<Item = TwinHinge<'_>> {
+        self.hinges.iter().map(|h| TwinHinge {
+            name: &h.name,
+            bearing: self.bodies[h.bearing].handle,
+            journal: self.bodies[h.journal].handle,
+            joint: h.joint,
+            local_anchor1: h.local_anchor1,
+            local_axis1: h.local_axis1,
+        })
+    }
+}
+
+/// One hinge of a [`Twin`], read from [`Twin::hinges`]: enough to find it in the world and to
+/// draw it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TwinHinge<'a> {
+    /// The scene's name of the hinge.
+    pub name: &'a str,
+    /// The body carrying the bearing.
+    pub bearing: RigidBodyHandle,
+    /// The body carrying the journal.
+    pub journal: RigidBodyHandle,
+    /// Ideal or clearance, with the joint's handle.
+    pub joint: HingeJoint,
+    /// The hinge's point in the bearing body's frame, m.
+    pub local_anchor1: Vector,
+    /// The hinge's axis in the bearing body's frame (unit).
+    pub local_axis1: Vector,
 }

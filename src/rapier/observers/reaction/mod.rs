@@ -341,8 +341,9 @@ fn with_mass_properties(rb: &RigidBody) -> RigidBody {
 }
 
 /// Computes the local mass properties of every dynamic body that has none yet (Rapier does it at
-/// the first step), from the bodies' additional mass properties: what the replay's body shapes
-/// need before the first step. Colliders' mass is not included (the `ColliderSet` is not given):
+/// the first step), from the bodies' additional mass properties: what a reader of the bodies'
+/// inertia (e.g. a replay drawing a body without colliders as its equivalent box) needs before
+/// the first step. Colliders' mass is not included (the `ColliderSet` is not given):
 /// for a body with colliders, call Rapier's `recompute_mass_properties_from_colliders`. The
 /// [`ReactionSolver`] does not need this call.
 pub fn prepare_mass_properties(bodies: &mut RigidBodySet) {

@@ -4,13 +4,13 @@
 use super::{BodyTrack, ContactSample, HingeJoint, HingeTrack, SPATIAL_COLUMNS, Twin, TwinKind};
 use crate::error::Result;
 use crate::model::angle::{HingeAngle, UnwrappedAngle};
+use crate::model::kinematics::in_plane_u;
 use crate::rapier::hinge::design::ClearanceModel;
 use crate::rapier::observers::metrics::ImpactRecorder;
 use crate::rapier::observers::reaction::{
     IdealFixed, IdealJoint, IdealPrismatic, IdealRevolute, IdealSpherical, JointModel,
     ReactionSolver, SoftMotor,
 };
-use crate::rapier::observers::replay::in_plane_u;
 use crate::rapier::pipeline::world::ClearanceWorld;
 use crate::rapier::sources::drive::{DriveHandle, TorsionSpring};
 use crate::rapier::sources::prescribed::{PrescribedMotion, PrescribedPath, Table as MotionTable};
@@ -252,6 +252,7 @@ fn build_hinges(
             joint,
             bearing: ib,
             journal: ij,
+            local_anchor1: a1,
             local_axis1: axis,
             local_u1: u,
             local_v1: axis.cross(u),

@@ -1,7 +1,9 @@
-//! The recorder's thinning: which states a replay keeps, and its cap on frames.
+//! The recorder: what it tracks, and each state it reads from the world.
 
-use super::frames::*;
+use super::journal::{journal_frame, substep_frame};
+use super::shapes::body_shapes;
 use super::*;
+use clearance_joint::model::kinematics::in_plane_u;
 
 impl ReplayRecorder {
     /// A recorder keeping a state per `interval` s in free flight and per `contact_interval`
@@ -44,7 +46,7 @@ impl ReplayRecorder {
     /// Tracks a body (in group `group`), its shapes from its colliders or its mass properties
     /// (see [`ReplayBody::shapes`]; call after the mass properties are known: Rapier computes
     /// them in the first step,
-    /// [`prepare_mass_properties`](crate::rapier::observers::reaction::prepare_mass_properties) before it).
+    /// [`prepare_mass_properties`](clearance_joint::rapier::observers::reaction::prepare_mass_properties) before it).
     /// Returns its index.
     pub fn track_body(
         &mut self,
@@ -139,78 +141,6 @@ impl ReplayRecorder {
             self.record_frame(inside);
         }
         self.record_frame(frame);
-    }
-
-    /// Records one state (thinned as [`record`](Self::record) says).
-    fn record_frame(&mut self, frame: ReplayFrame) {
-        let t = frame.t;
-        let contact = frame.journals.iter().any(|j| j.contact);
-        let onset = contact && !self.in_contact;
-        if onset {
-            self.onset = t;
-        }
-        let dense = t - self.onset <= DENSE_FRAMES * self.recording.contact_interval_s;
-        let spacing = if (contact || self.in_contact) && dense {
-            self.recording.contact_interval_s
-        } else {
-            self.recording.interval_s
-        };
-        let keep = onset || t - self.last_kept >= spacing * (1.0 - 1e-9);
-        if onset && let Some(before) = self.pending.take() {
-            self.push_after_peak(before);
-        }
-        self.in_contact = contact;
-        if keep {
-            self.pending = None;
-            self.push_after_peak(frame);
-        } else {
-            if self.peak.as_ref().is_none_or(|p| force(&frame) > force(p)) {
-                self.peak = Some(frame.clone());
-            }
-            self.pending = Some(frame);
-        }
-    }
-
-    /// Keeps `frame`, after the state of largest force skipped since the last kept one when
-    /// that force exceeds both neighbours' (a peak between kept states: so the recording's
-    /// largest force is the run's, whatever the thinning).
-    fn push_after_peak(&mut self, frame: ReplayFrame) {
-        if let Some(peak) = self.peak.take() {
-            let before = self.recording.frames.last().map_or(0.0, force);
-            if peak.t < frame.t && force(&peak) > before.max(force(&frame)) {
-                self.push(peak);
-            }
-        }
-        self.push(frame);
-    }
-
-    fn push(&mut self, frame: ReplayFrame) {
-        self.last_kept = frame.t;
-        self.recording.frames.push(frame);
-        if self.recording.frames.len() > self.max_frames {
-            self.halve();
-        }
-    }
-
-    /// Halves the frames kept (see the module docs' cap): the first and last stay, each pair
-    /// between keeps its frame of larger force, with the other's impact flags.
-    fn halve(&mut self) {
-        let frames = std::mem::take(&mut self.recording.frames);
-        let n = frames.len();
-        let mut kept = Vec::with_capacity(n / 2 + 2);
-        let mut it = frames.into_iter();
-        kept.extend(it.next());
-        let last = it.next_back();
-        while let Some(a) = it.next() {
-            kept.push(match it.next() {
-                Some(b) => merge_pair(a, b),
-                None => a,
-            });
-        }
-        kept.extend(last);
-        self.recording.frames = kept;
-        self.recording.interval_s *= 2.0;
-        self.recording.contact_interval_s *= 2.0;
     }
 
     fn frame(&self, t: f64, bodies: &RigidBodySet, sets: &[&ClearanceJointSet]) -> ReplayFrame {

@@ -1,4 +1,5 @@
-use super::frames::{body_shapes, force};
+use super::shapes::body_shapes;
+use super::thinning::force;
 use super::*;
 
 #[test]
@@ -19,7 +20,7 @@ fn equivalent_box_of_a_uniform_box_is_the_box() {
             j,
         )),
     );
-    crate::rapier::observers::reaction::prepare_mass_properties(&mut bodies);
+    clearance_joint::rapier::observers::reaction::prepare_mass_properties(&mut bodies);
     let shapes = body_shapes(&bodies[h], &ColliderSet::new());
     let ReplayShape::Box { half_extents_m, .. } = shapes[0] else {
         panic!("expected a box, got {shapes:?}");
@@ -65,7 +66,7 @@ fn the_cap_halves_frames_and_keeps_the_first_and_last() {
 /// where the steps' own states see nothing of the impact.
 #[test]
 fn a_sub_cycled_impact_inside_a_step_is_recorded_at_its_sub_steps() {
-    use crate::prelude::*;
+    use clearance_joint::prelude::*;
     let mut rapier = PhysicsWorld::new();
     rapier.gravity = Vector::new(0.0, -9.81, 0.0);
     let base = rapier.bodies.insert(RigidBodyBuilder::fixed());
@@ -126,8 +127,8 @@ fn a_sub_cycled_impact_inside_a_step_is_recorded_at_its_sub_steps() {
 
 #[test]
 fn a_spatial_frame_carries_the_joints_tilt_and_edge_forces() {
-    use crate::model::spatial::SpatialModel;
-    use crate::prelude::*;
+    use clearance_joint::model::spatial::SpatialModel;
+    use clearance_joint::prelude::*;
     // The library's spatial example: an arm 0.2 m out from a vertical pin tilts its journal
     // onto both edges of the bore.
     let mut rapier = PhysicsWorld::new();

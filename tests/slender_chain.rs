@@ -100,13 +100,14 @@ fn a_slender_double_pendulum_stays_planar_at_the_defaults() {
 
 /// The failure the correction removes, shown on purpose with Rapier's own correction: the locked
 /// tilt grows at each change of the step. Measured over 0.3 s: the lower bar's out-of-plane rate
-/// reaches 0.055 rad/s at the defaults and 0.73 rad/s at twice the default tolerance
-/// (below 1e-6 with the correction at both; the growth is chaotic, so the figures move with any
-/// change of the step sequence). Before the contact step was doubled (issue 16) the run at the
+/// reaches 0.055 rad/s at the defaults and 0.73 rad/s at twice the default tolerance while the
+/// contact laws read the bodies' stored rate, and 0.009 and 0.0055 rad/s since they read
+/// the rate the positions moved at (below 1e-6 with the correction at both; the growth is
+/// chaotic, so the figures move with any change of the step sequence). Before the contact step was doubled (issue 16) the run at the
 /// defaults diverged (200 m/s at t = 0.15 s); a run that diverges must name the switch.
 #[test]
 fn without_the_joint_correction_the_same_run_leaves_its_plane() {
-    for (tol, at_least) in [(0.0075, 1e-4), (0.015, 0.1)] {
+    for (tol, at_least) in [(0.0075, 1e-4), (0.015, 1e-3)] {
         let result = run_at(tol, false, 0.3);
         match result {
             Ok(rate) => assert!(

@@ -337,19 +337,18 @@ fn a_driven_mechanism_at_the_default_step_control_never_enters_deeper_than_allow
     // What must hold is that the run met contacts at all.
     assert!(run.first > 0.0, "no contact: the test tests nothing");
     assert_eq!(run.world.guards().floor_steps, 0);
-    // The first impact against the limit of fixed steps. They converge at first order on this
-    // crank (16.63, 16.42, 16.31 and 16.26 um at 1e-7 to 1.25e-8 s), so the limit is Richardson's
-    // extrapolation of two of them, 16.21 um. Its deepest contacts are heavily damped (the
-    // improved law's damping at 16 um, on 0.5 kg bodies: their damped stability limit, not their
-    // period, bounds the step), and their steps are bounded by a
-    // fraction of the stability limit that scales with the tolerance
-    // (`STABLE_FRACTION_PER_TOLERANCE`): the default is left 12.2 % deep, half the tolerance
-    // 6.3 %, 0.001 1.7 %. Bounded by stability alone the steps did not depend on
-    // the tolerance, and the error stayed at 11 % down to 0.002, invisible to a run at half the
-    // tolerance (what `run --check` compares with); the Flores-Ambrosio slider-crank's first
-    // impact, with the Lankarani-Nikravesh law, is within 0.1 % at the defaults.
+    // The first impact against the limit of fixed steps. Its deepest contacts are heavily damped
+    // (the improved law's damping at 16 um, on 0.5 kg bodies: their damped stability limit, not
+    // their period, bounds the step), their steps bounded by a fraction of the stability limit
+    // that scales with the tolerance (`STABLE_FRACTION_PER_TOLERANCE`), and pressed on the wall
+    // by the drive for 3.5 ms, so their depth integrates any error in the rate the law reads.
+    // Fixed steps converge at second order (16.2079, 16.2091, 16.2094 and 16.2095 um at 2e-7 to
+    // 2.5e-8 s; its ODE, tests/references.rs: 16.2095), so the limit is Richardson's
+    // extrapolation of two of them. While the law read the bodies' stored rate, off the
+    // positions' by a term of order `h`, fixed steps converged at first order and the default was
+    // 12.2 % deep (6.3 % at half the tolerance, 1.7 % at 0.001).
     let fixed = |dt: f64| crank_run(StepControl::fixed(dt), 0.004).unwrap().first;
-    let converged = 2.0 * fixed(2.5e-8) - fixed(5e-8);
+    let converged = (4.0 * fixed(2.5e-8) - fixed(5e-8)) / 3.0;
     let first = |tolerance: f64| {
         crank_run(
             StepControl {
@@ -362,24 +361,19 @@ fn a_driven_mechanism_at_the_default_step_control_never_enters_deeper_than_allow
         .first
     };
     let (coarse, half, finer) = (first(0.0075), first(0.00375), first(0.001));
-    let error = |depth: f64| (depth - converged) / converged;
+    let error = |depth: f64| ((depth - converged) / converged).abs();
     assert!(
-        error(coarse) > 0.0 && error(coarse) < 0.15,
+        error(coarse) < 1e-3,
         "first impact {} of the converged depth off",
         error(coarse)
     );
-    // Tightening converges, and half the tolerance moves the depth by far more than the 1 %
-    // `run --check` allows a first impact: the error is flagged, not silent.
+    // Tightening converges: the steps follow the tolerance.
     assert!(
-        error(half) < 0.7 * error(coarse) && error(finer) < 0.03,
+        error(half) < 0.7 * error(coarse) && error(finer) < 0.2 * error(coarse),
         "no convergence as the tolerance tightens: {} {} {}",
         error(coarse),
         error(half),
         error(finer)
-    );
-    assert!(
-        (coarse - half) / half > 0.03,
-        "half the tolerance does not see the error: {coarse} {half}"
     );
     // The test can fail: a fixed 1e-4 s step crosses the gap blind and is refused.
     let e = crank_run(StepControl::fixed(1e-4), end).err().unwrap();

@@ -28,6 +28,7 @@ impl ClearanceJointBuilder {
                 report: ClearanceReport::default(),
                 elastic: OnceLock::new(),
                 previous_rate: None,
+                moved_rate: None,
                 last_step: 0.0,
                 last_wrenches: None,
                 prepared: false,

@@ -229,6 +229,7 @@ impl ClearanceJointSet {
                 joint.report = ClearanceReport::default();
                 joint.elastic = OnceLock::new();
                 joint.previous_rate = None;
+                joint.moved_rate = None;
                 if let Some(parts) = &mut joint.spatial {
                     parts.reset();
                 }

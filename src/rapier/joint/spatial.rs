@@ -34,6 +34,11 @@ pub(super) struct Patch {
     /// without one).
     impact_rate: f64,
     rate_before: f64,
+    /// The rate at which the positions moved the region's penetration over the step that led
+    /// to this application's state and over the one before (`(delta - delta_before)/h`, NaN
+    /// without one): the rates its contact is carried from (the planar joint's `contact_rate`).
+    moved: f64,
+    moved_before: f64,
 }
 
 impl Patch {
@@ -45,6 +50,8 @@ impl Patch {
             force: 0.0,
             impact_rate: 0.0,
             rate_before: f64::NAN,
+            moved: f64::NAN,
+            moved_before: f64::NAN,
         }
     }
 }

@@ -104,6 +104,13 @@ impl ClearanceJoint {
                 self.min_separation,
             );
             patch.rate_before = patch.state.map_or(f64::NAN, |s| s.penetration_rate);
+            patch.moved_before = patch.moved;
+            patch.moved = match patch.state {
+                Some(before) if steps[1] > 0.0 => {
+                    (state.penetration - before.penetration) / steps[1]
+                }
+                _ => f64::NAN,
+            };
             patch.state = Some(state);
             let range = start..parts.points.len();
             loads[k] = Some(Load::of(&parts.points[range.clone()], law, &state, pair));
@@ -265,6 +272,17 @@ impl ClearanceJoint {
         if n == 0 {
             return out;
         }
+        // Each region's rates, stored and before, from the rate its positions moved at when both
+        // steps' are known (the planar joint's `contact_rate`), and that rate's offset from the
+        // stored one, which its points' rates take too.
+        let rates = |k: usize| {
+            let (patch, stored) = (&parts.patches[k], seen[k].0.penetration_rate);
+            if patch.moved.is_finite() && patch.moved_before.is_finite() {
+                (patch.moved, patch.moved_before, patch.moved - stored)
+            } else {
+                (stored, patch.rate_before, 0.0)
+            }
+        };
         let unit = |k: usize| loads[k].row.map(|r| r / loads[k].total);
         let rows: Vec<[f64; 12]> = active.iter().map(|&k| unit(k)).collect();
         let mut force = [0.0; 4];
@@ -276,7 +294,7 @@ impl ClearanceJoint {
             for p in &parts.points[seen[k].1.clone()] {
                 let c = NormalContact {
                     penetration: p.contact.depth,
-                    penetration_rate: p.penetration_rate,
+                    penetration_rate: p.penetration_rate + rates(k).2,
                     impact_rate: parts.patches[k].impact_rate,
                 };
                 let (f, d) = crate::model::kinematics::force_and_damping(law, &c);
@@ -289,9 +307,8 @@ impl ClearanceJoint {
         let mut m = [[0.0; 5]; 4];
         for a in 0..n {
             let k = active[a];
-            let patch = &parts.patches[k];
-            let stored = seen[k].0.penetration_rate;
-            let mut rest = (stored - patch.rate_before) / kick;
+            let (stored, before, _) = rates(k);
+            let mut rest = (stored - before) / kick;
             let mut pushed = 0.0;
             for b in 0..n {
                 let c = pair.between(&rows[a], &rows[b]);
@@ -304,7 +321,7 @@ impl ClearanceJoint {
         let solved = solve_small(&mut m, n);
         for (a, &k) in active.iter().enumerate() {
             let x = solved[a];
-            out[k] = if x.is_finite() { x } else { 0.0 };
+            out[k] = rates(k).2 + if x.is_finite() { x } else { 0.0 };
         }
         out
     }

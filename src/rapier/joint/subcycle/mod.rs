@@ -237,6 +237,7 @@ impl ClearanceJoint {
         };
         self.elastic = std::sync::OnceLock::new();
         self.previous_rate = None;
+        self.moved_rate = None;
         self.cycle.adopt_run(held);
         let f = end.force.on_journal;
         let p = end.force.point;

@@ -2,7 +2,7 @@
 //! (the law's elastic force at the position, damping and friction implicit), the sub-step's
 //! length, and what a sub-cycle hands back ([`SubCycle`]).
 
-use super::pair::{Motion, Pair12, PairStart, axpy, dot, load, mul, part, rotate, row};
+use super::pair::{Motion, Pair12, PairStart, axpy, dot, load, mul, part, put, rotate, row};
 use super::{APPROACH_FRACTION, MAX_SUBSTEPS, STABLE_FRACTION_PER_TOLERANCE, SubStep};
 use crate::model::kinematics::{BodyMotion, JournalState, journal_state};
 use crate::model::laws::{FrictionLaw, NormalContact, NormalForceLaw, loaded_impact_rate};
@@ -97,6 +97,30 @@ pub(crate) struct Cycle<'a> {
 }
 
 impl Cycle<'_> {
+    /// The velocity at which the stabilisation moves the pair, spread evenly over the step
+    /// (`stabilisation / h`, as [`Pair12`]): the bodies' positions move at `v` plus it, so the
+    /// contact's rates are read at `v` plus it. Rapier stores its velocities without it, and it
+    /// is of the order of the ideal joints' accelerations times `h/2` (a rate of order `h` that
+    /// a heavily damped contact would integrate into its depth: docs/sub-cycled-contact.md).
+    pub(super) fn drift(&self) -> Pair12 {
+        let mut d = [0.0; 12];
+        if self.h > 0.0 {
+            for k in 0..2 {
+                put(&mut d, 2 * k, self.stabilisation[0][k] / self.h);
+                put(&mut d, 2 * k + 1, self.stabilisation[1][k] / self.h);
+            }
+        }
+        d
+    }
+
+    /// The velocity the contact's rates are read at when the pair's is `v`: `v` plus the
+    /// stabilisation's [`drift`](Self::drift).
+    pub(super) fn moving(&self, v: &Pair12) -> Pair12 {
+        let mut m = *v;
+        axpy(&mut m, 1.0, &self.drift());
+        m
+    }
+
     pub(super) fn here(&self, m: &Motion) -> Here {
         let s = self.start;
         let com = [s.com[0] + m.shift[0], s.com[1] + m.shift[1]];
@@ -235,7 +259,8 @@ impl Cycle<'_> {
         beta: f64,
         impact_rate: f64,
     ) -> ([f64; 2], Pair12, f64) {
-        let c_a = [dot(&here.rows[0], v), dot(&here.rows[1], v)];
+        let moving = self.moving(v);
+        let c_a = [dot(&here.rows[0], &moving), dot(&here.rows[1], &moving)];
         // The rates the rest of the world brings over the span.
         let a = [
             sigma * dot(&here.rows[0], &self.a_free),

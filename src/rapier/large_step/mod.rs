@@ -98,7 +98,7 @@ use resolution::{quantized_substeps, rocking_frequency, substeps_needed};
 use std::collections::BTreeMap;
 
 /// Default of [`LargeStepJointBuilder::max_substeps`].
-pub const DEFAULT_MAX_SUBSTEPS: usize = 64;
+pub(crate) const DEFAULT_MAX_SUBSTEPS: usize = 64;
 /// A journal within this fraction of `c` from the wall counts as touching it.
 const CONTACT_TOLERANCE: f64 = 1e-3;
 /// Damping of the friction motor: large enough that the motor is a hard velocity constraint

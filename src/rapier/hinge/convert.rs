@@ -155,14 +155,7 @@ fn revolute_frames(joint: &GenericJoint) -> Result<[Vector; 4]> {
              clearance joint",
         ));
     }
-    // The X axis of each joint frame. Not `GenericJoint::local_axis1()`: in Rapier 0.36 it
-    // transforms X as a point by the whole frame, so it adds the anchor to the axis.
-    Ok([
-        joint.local_anchor1(),
-        joint.local_anchor2(),
-        joint.local_frame1.rotation * Vector::X,
-        joint.local_frame2.rotation * Vector::X,
-    ])
+    Ok(crate::rapier::observers::reaction::joint_frames(joint))
 }
 
 /// The ideal revolute joint with the anchors and axes of `joint`. Contacts between the two

@@ -291,10 +291,11 @@ impl ClearanceJoint {
             let law = parts.patches[k]
                 .region
                 .law(&self.normal_law, &parts.face_law);
+            let offset = rates(k).2;
             for p in &parts.points[seen[k].1.clone()] {
                 let c = NormalContact {
                     penetration: p.contact.depth,
-                    penetration_rate: p.penetration_rate + rates(k).2,
+                    penetration_rate: p.penetration_rate + offset,
                     impact_rate: parts.patches[k].impact_rate,
                 };
                 let (f, d) = crate::model::kinematics::force_and_damping(law, &c);

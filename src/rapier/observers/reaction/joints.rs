@@ -5,7 +5,7 @@ use super::SoftMotor;
 use crate::error::{Error, Result};
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
-    ImpulseJointHandle, ImpulseJointSet, JointAxesMask, JointAxis, RigidBodyHandle,
+    GenericJoint, ImpulseJointHandle, ImpulseJointSet, JointAxesMask, JointAxis, RigidBodyHandle,
 };
 
 /// An ideal joint for [`ReactionSolver::solve`](super::ReactionSolver::solve): one of Rapier's
@@ -31,10 +31,7 @@ impl IdealJoint {
         };
         let data = &joint.data;
         let (body1, body2) = (joint.body1(), joint.body2());
-        let (local_anchor1, local_anchor2) = (data.local_anchor1(), data.local_anchor2());
-        // The frame's rotation only: Rapier's `local_axis1()` maps X as a point, so the anchor's
-        // offset is added to the axis.
-        let local_axis1 = data.local_frame1.rotation * Vector::X;
+        let [local_anchor1, local_anchor2, local_axis1, _] = joint_frames(data);
         let motor = |axis| data.motor(axis).map(SoftMotor::from_rapier);
         let axes = data.locked_axes;
         let model = if axes == JointAxesMask::LOCKED_REVOLUTE_AXES {
@@ -114,6 +111,19 @@ impl IdealJoint {
     pub(super) fn force_rows(&self) -> usize {
         self.0.force_rows()
     }
+}
+
+/// The anchors and X axes of a Rapier joint's two frames, in their bodies' frames:
+/// `[anchor1, anchor2, axis1, axis2]`. The axes are the frames' rotations of X, not
+/// `GenericJoint::local_axis1()`: in Rapier 0.36 that transforms X as a point by the whole frame,
+/// so it adds the anchor to the axis.
+pub(crate) fn joint_frames(joint: &GenericJoint) -> [Vector; 4] {
+    [
+        joint.local_anchor1(),
+        joint.local_anchor2(),
+        joint.local_frame1.rotation * Vector::X,
+        joint.local_frame2.rotation * Vector::X,
+    ]
 }
 
 /// An ideal revolute joint for the solve: anchors

@@ -80,7 +80,9 @@ mod tests;
 
 pub use body::KinematicState;
 pub use joints::IdealJoint;
-pub(crate) use joints::{IdealFixed, IdealPrismatic, IdealRevolute, IdealSpherical, JointModel};
+pub(crate) use joints::{
+    IdealFixed, IdealPrismatic, IdealRevolute, IdealSpherical, JointModel, joint_frames,
+};
 pub(crate) use motor::SoftMotor;
 
 use crate::rapier::pipeline::ledger::Wrench;

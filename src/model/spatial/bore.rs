@@ -107,10 +107,12 @@ fn farthest_point(eccentricity: Vector, ai: Vector, aj: Vector, cos: f64, rj: f6
     let u2 = ai.cross(u1);
     let (a, b) = (rj / cos, rj);
     let (ex, ey) = (eccentricity.dot(u1), eccentricity.dot(u2));
-    // The point whose normal is along e.
-    let mut phi = (b * ey).atan2(a * ex);
+    // The point whose normal is along e: its angle's cosine and sine, `(a ex, b ey)` normalised.
+    let (mut cs, mut sn) = match ((a * ex).powi(2) + (b * ey).powi(2)).sqrt() {
+        n if n > 0.0 => (a * ex / n, b * ey / n),
+        _ => (1.0, 0.0),
+    };
     for _ in 0..FARTHEST_POINT_STEPS {
-        let (sn, cs) = phi.sin_cos();
         let (px, py) = (a * cs, b * sn);
         let (dx, dy) = (-a * sn, b * cs);
         let slope = (ex + px) * dx + (ey + py) * dy;
@@ -118,10 +120,30 @@ fn farthest_point(eccentricity: Vector, ai: Vector, aj: Vector, cos: f64, rj: f6
         if !(curvature < 0.0) {
             break;
         }
-        phi -= slope / curvature;
+        let step = -slope / curvature;
+        if step == 0.0 {
+            break;
+        }
+        // The angle's Newton step as a rotation of (cos, sin): the point's trigonometry is
+        // most of a spatial joint's cost, and after the first step the angle is tiny.
+        let (s, c) = rotation(step);
+        (cs, sn) = (cs * c - sn * s, sn * c + cs * s);
     }
-    let (sn, cs) = phi.sin_cos();
     a * cs * u1 + b * sn * u2
+}
+
+/// `(sin d, cos d)`: by their series to rounding below 1e-3 rad (the error terms `d^7/5040` and
+/// `d^6/720` are below 1e-20), else by the library's.
+fn rotation(d: f64) -> (f64, f64) {
+    if d.abs() < 1e-3 {
+        let d2 = d * d;
+        (
+            d * (1.0 - d2 / 6.0 * (1.0 - d2 / 20.0)),
+            1.0 - d2 / 2.0 * (1.0 - d2 / 12.0),
+        )
+    } else {
+        d.sin_cos()
+    }
 }
 
 /// The bore's contact region touching `end`. The crossing's eccentricity is affine in `s`, so

@@ -8,17 +8,17 @@ use super::{ClearanceJoint, ClearanceReport, ContactHistory, Mechanism, friction
 use crate::model::kinematics::{BodyMotion, ForcePair, JournalState, stable_step};
 use crate::model::laws::loaded_impact_rate;
 use crate::model::laws::{FrictionLaw, NormalContact, NormalForceLaw, NormalModel};
-use crate::model::spatial::{
-    ContactPoint, End, Shoulder, SpatialModel, SpatialPose, bore_points, bore_region, bore_section,
-};
+use crate::model::spatial::{ContactPoint, End, SpatialModel, SpatialPose};
 use crate::rapier::pipeline::ledger::{Wrench, world_center_of_mass};
 use rapier3d_f64::math::{AngularInertia, Vector};
 use rapier3d_f64::prelude::{RigidBody, RigidBodySet};
 
 mod evaluate;
+mod places;
 pub(super) mod report;
 pub(super) mod subcycle;
-use evaluate::{Totals, apply_region};
+use evaluate::{Totals, load_region};
+use places::Places;
 use report::{Region, SpatialPoint, SpatialReport};
 
 /// One region's memory between steps.
@@ -66,9 +66,10 @@ pub(super) struct SpatialParts {
     local_transverse1: Vector,
     patches: [Patch; 4],
     points: Vec<SpatialPoint>,
-    /// Scratch for the bore's points.
-    bore_scratch: Vec<(f64, ContactPoint)>,
-    face_scratch: Vec<ContactPoint>,
+    /// Where the pose puts the regions' contacts; the sub-cycle's Jacobian keeps its base
+    /// pose's in `base_places`.
+    places: Places,
+    base_places: Places,
     pub(super) report: SpatialReport,
     /// Rate of the fastest region's path across its gap, relative to the gap (1/s).
     flight_rate: f64,
@@ -88,8 +89,8 @@ impl SpatialParts {
             local_transverse1: local_axis1.any_orthonormal_vector(),
             patches: Region::ALL.map(Patch::new),
             points: Vec::new(),
-            bore_scratch: Vec::new(),
-            face_scratch: Vec::new(),
+            places: Places::default(),
+            base_places: Places::default(),
             report: SpatialReport::default(),
             flight_rate: 0.0,
             contact_share: 1.0,
@@ -314,89 +315,6 @@ fn point_state(
         slip: v_rel - along * normal,
         eccentricity_rate,
         contact_point: contact.point,
-    }
-}
-
-/// A region's deepest point as a contact state, and its gap scale (the radial clearance for the
-/// bore, the axial play for a face): its path across the gap bounds the free-flight step.
-fn deepest_state(
-    joint: &ClearanceJoint,
-    spatial: &crate::model::spatial::SpatialGeometry,
-    pose: &SpatialPose,
-    region: Region,
-    bodies: [&BodyMotion; 2],
-) -> (JournalState, f64) {
-    let geometry = &joint.geometry;
-    let ai = pose.bearing_axis;
-    match region {
-        Region::Bore(end) => {
-            let section = bore_section(geometry, pose, end.sign() * 0.5 * geometry.length());
-            let centres = bodies[1].velocity_at(section.crossing)
-                - bodies[0].velocity_at(section.plane_center);
-            let rate = centres - centres.dot(ai) * ai;
-            let state = point_state(&section.contact, section.eccentricity, rate, bodies);
-            (state, geometry.clearance())
-        }
-        Region::Face(end) => {
-            let shoulder = Shoulder::at(geometry, spatial, pose, end);
-            let centres = bodies[1].velocity_at(pose.journal_center)
-                - bodies[0].velocity_at(pose.bearing_center);
-            let eccentricity = (pose.axial_offset() * -end.sign()) * shoulder.normal;
-            let rate = centres.dot(ai) * ai;
-            let state = point_state(&shoulder.deepest_point(), eccentricity, rate, bodies);
-            (state, spatial.axial_play)
-        }
-    }
-}
-
-/// Appends the quadrature points of `region` in contact to the parts' points (with their
-/// stored rates); returns the region's length along the width (0 for a face).
-fn region_points(
-    joint: &ClearanceJoint,
-    parts: &mut SpatialParts,
-    pose: &SpatialPose,
-    region: Region,
-    bodies: [&BodyMotion; 2],
-) -> f64 {
-    let geometry = &joint.geometry;
-    let ai = pose.bearing_axis;
-    let push = |contact: ContactPoint, s: f64, out: &mut Vec<SpatialPoint>| {
-        if contact.depth > 0.0 {
-            let v_rel = bodies[1].velocity_at(contact.point) - bodies[0].velocity_at(contact.point);
-            let normal = contact.gradient.normalize();
-            out.push(SpatialPoint {
-                region,
-                s,
-                contact,
-                penetration_rate: v_rel.dot(contact.gradient),
-                slip: v_rel - v_rel.dot(normal) * normal,
-                normal_force: 0.0,
-                friction_force: 0.0,
-            });
-        }
-    };
-    match region {
-        Region::Bore(end) => {
-            let Some(r) = bore_region(geometry, pose, end) else {
-                return 0.0;
-            };
-            parts.bore_scratch.clear();
-            bore_points(geometry, pose, &r, &mut parts.bore_scratch);
-            for &(s, c) in &parts.bore_scratch {
-                push(c, s, &mut parts.points);
-            }
-            r.length()
-        }
-        Region::Face(end) => {
-            let shoulder = Shoulder::at(geometry, &parts.model.geometry, pose, end);
-            parts.face_scratch.clear();
-            shoulder.points(&mut parts.face_scratch);
-            for &c in &parts.face_scratch {
-                let s = (c.point - pose.bearing_center).dot(ai);
-                push(c, s, &mut parts.points);
-            }
-            0.0
-        }
     }
 }
 

@@ -89,12 +89,16 @@ impl ClearanceJoint {
         // First the regions' states, histories, points and loads; their masses take all loads.
         let mut seen: [(JournalState, std::ops::Range<usize>, f64); 4] = Default::default();
         let mut loads: [Option<Load>; 4] = Default::default();
+        let mut places = std::mem::take(&mut parts.places);
+        places.read(self, &spatial, pose, parts.patches.map(|p| p.region));
         for (k, view) in seen.iter_mut().enumerate() {
             let region = parts.patches[k].region;
-            let (state, gap) = deepest_state(self, &spatial, pose, region, motions);
-            flight_rate = flight_rate.max(state.eccentricity_rate.length() / gap);
+            let place = &places.deepest[k];
+            let state = place.state(motions);
+            flight_rate = flight_rate.max(state.eccentricity_rate.length() / place.gap);
             let start = parts.points.len();
-            let length = region_points(self, parts, pose, region, motions);
+            places.moving(k, motions, &mut parts.points);
+            let length = places.lengths[k];
             let law = region.law(&self.normal_law, &parts.face_law);
             let patch = &mut parts.patches[k];
             patch.contact.advance(
@@ -116,6 +120,7 @@ impl ClearanceJoint {
             loads[k] = Some(Load::of(&parts.points[range.clone()], law, &state, pair));
             *view = (state, range, length);
         }
+        parts.places = places;
         let loads = loads.map(|l| l.expect("every region is loaded above"));
         let masses = coupled_masses(&loads, pair);
         for (k, patch) in parts.patches.iter_mut().enumerate() {
@@ -356,10 +361,10 @@ fn solve_small(m: &mut [[f64; 5]; 4], n: usize) -> [f64; 4] {
     x
 }
 
-/// The region's points' forces at their rates carried by `carried` (m/s), into `totals`; each
-/// point's force pair acts at its surface point along its gradient (the elastic part is the
-/// gradient of the region's elastic energy), friction against its slip.
-pub(super) fn apply_region(
+/// The region's points' forces at their rates carried by `carried` (m/s), into `totals`
+/// ([`load_point`]), and what the explicit joint's step bounds read of them: the region's
+/// stiffness, damping and friction slopes.
+fn apply_region(
     points: &mut [SpatialPoint],
     law: &NormalModel,
     friction: &impl FrictionLaw,
@@ -370,54 +375,115 @@ pub(super) fn apply_region(
 ) -> RegionForces {
     let mut sums = RegionForces::default();
     for p in points.iter_mut() {
-        let (w, g) = (p.contact.weight, p.contact.gradient);
-        let c = NormalContact {
-            penetration: p.contact.depth,
-            penetration_rate: p.penetration_rate + carried,
-            impact_rate,
-        };
-        p.penetration_rate = c.penetration_rate;
-        let f = w * law.normal_force(&c);
-        if !(f > 0.0) {
+        let at = (carried, centres);
+        let Some(k) = load_point(p, law, friction, impact_rate, at, true, totals) else {
             continue;
-        }
-        let g2 = g.length_squared();
-        let normal = f * g2.sqrt();
-        let (slip, speed) = (p.slip, p.slip.length());
-        let mu = if speed > 0.0 {
-            friction.coefficient(speed)
-        } else {
-            0.0
         };
-        let friction_force = mu * normal;
-        let friction_vector = if speed > 0.0 {
-            -friction_force / speed * slip
-        } else {
-            Vector::ZERO
-        };
-        let on_journal = -f * g + friction_vector;
-        totals.force += on_journal;
-        totals.normal -= f * g;
-        totals.friction += friction_vector;
-        totals.torque[1] += (p.contact.point - centres[1]).cross(on_journal);
-        totals.torque[0] += (p.contact.point - centres[0]).cross(-on_journal);
-        let elastic = w * law.elastic_force(p.contact.depth);
-        totals.dissipation += (f - elastic) * c.penetration_rate + friction_force * speed;
-        p.normal_force = normal;
-        p.friction_force = friction_force;
-        sums.normal += normal;
-        sums.law_force += f;
-        sums.moment += normal * p.contact.point;
+        let c = &k.contact;
+        sums.normal += p.normal_force;
+        sums.law_force += k.law_force;
+        sums.moment += p.normal_force * p.contact.point;
         let tangent = law.tangent_stiffness(c.penetration);
-        sums.tangent += w * tangent * g2;
-        sums.stiffness += w * (tangent + law.damping_slope(&c) * c.penetration_rate) * g2;
-        sums.damping += w * law.damping_coefficient(&c) * g2;
-        let slope = friction_slope(friction, speed);
-        let across = if speed > 0.0 { mu / speed } else { slope };
-        sums.friction_along += normal * slope.max(0.0);
-        sums.friction_across += normal * across.max(0.0);
+        sums.tangent += k.weight * tangent * k.gradient2;
+        sums.stiffness +=
+            k.weight * (tangent + law.damping_slope(c) * c.penetration_rate) * k.gradient2;
+        sums.damping += k.weight * law.damping_coefficient(c) * k.gradient2;
+        let slope = friction_slope(friction, k.speed);
+        let across = if k.speed > 0.0 { k.mu / k.speed } else { slope };
+        sums.friction_along += p.normal_force * slope.max(0.0);
+        sums.friction_across += p.normal_force * across.max(0.0);
     }
     sums
+}
+
+/// The region's points' forces into `totals` ([`load_point`]), no more: the sub-cycle's load,
+/// which its Jacobian evaluates some twenty times per sub-step (without the `dissipation`,
+/// which only an accepted state's power needs).
+pub(super) fn load_region(
+    points: &mut [SpatialPoint],
+    (law, friction): (&NormalModel, &impl FrictionLaw),
+    impact_rate: f64,
+    centres: [Vector; 2],
+    dissipation: bool,
+    totals: &mut Totals,
+) {
+    for p in points.iter_mut() {
+        let at = (0.0, centres);
+        load_point(p, law, friction, impact_rate, at, dissipation, totals);
+    }
+}
+
+/// What [`apply_region`]'s sums read of a loaded point besides its forces.
+struct LoadedPoint {
+    contact: NormalContact,
+    /// The law's force times the point's weight, N.
+    law_force: f64,
+    weight: f64,
+    /// The gradient's squared length.
+    gradient2: f64,
+    speed: f64,
+    mu: f64,
+}
+
+/// One point's force pair at its rate carried by `carried` (m/s), into `totals` (the bodies'
+/// centres of mass at `centres`; the power the damping and friction take when `dissipation`),
+/// and its normal and friction forces onto the point: it acts at the surface point along the
+/// gradient (the elastic part is the gradient of the region's elastic energy), friction against
+/// the slip. `None` where the law pushes nothing.
+fn load_point(
+    p: &mut SpatialPoint,
+    law: &NormalModel,
+    friction: &impl FrictionLaw,
+    impact_rate: f64,
+    (carried, centres): (f64, [Vector; 2]),
+    dissipation: bool,
+    totals: &mut Totals,
+) -> Option<LoadedPoint> {
+    let (w, g) = (p.contact.weight, p.contact.gradient);
+    let c = NormalContact {
+        penetration: p.contact.depth,
+        penetration_rate: p.penetration_rate + carried,
+        impact_rate,
+    };
+    p.penetration_rate = c.penetration_rate;
+    let f = w * law.normal_force(&c);
+    if !(f > 0.0) {
+        return None;
+    }
+    let g2 = g.length_squared();
+    let normal = f * g2.sqrt();
+    let (slip, speed) = (p.slip, p.slip.length());
+    let mu = if speed > 0.0 {
+        friction.coefficient(speed)
+    } else {
+        0.0
+    };
+    let friction_force = mu * normal;
+    let friction_vector = if speed > 0.0 {
+        -friction_force / speed * slip
+    } else {
+        Vector::ZERO
+    };
+    let on_journal = -f * g + friction_vector;
+    totals.force += on_journal;
+    totals.normal -= f * g;
+    totals.friction += friction_vector;
+    totals.torque[1] += (p.contact.point - centres[1]).cross(on_journal);
+    totals.torque[0] += (p.contact.point - centres[0]).cross(-on_journal);
+    if dissipation {
+        let elastic = w * law.elastic_force(p.contact.depth);
+        totals.dissipation += (f - elastic) * c.penetration_rate + friction_force * speed;
+    }
+    p.normal_force = normal;
+    p.friction_force = friction_force;
+    Some(LoadedPoint {
+        contact: c,
+        law_force: f,
+        weight: w,
+        gradient2: g2,
+        speed,
+        mu,
+    })
 }
 
 /// Adds a region in contact to the linearised sums, through its effective mass at its load's

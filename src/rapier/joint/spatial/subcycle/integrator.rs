@@ -206,7 +206,7 @@ impl SpatialCycle<'_> {
         (pose, [motion(0), motion(1)])
     }
 
-    /// The regions' load and states at `x`, `v`.
+    /// The regions' load, states and dissipation at `x`, `v`.
     pub(super) fn eval(
         &self,
         parts: &mut SpatialParts,
@@ -214,31 +214,67 @@ impl SpatialCycle<'_> {
         v: &Pair12,
         clocks: &[RegionClock; 4],
     ) -> Eval {
+        self.eval_with(parts, (x, v), clocks, true)
+    }
+
+    /// The regions' load alone at `x`, `v`.
+    pub(super) fn load(
+        &self,
+        parts: &mut SpatialParts,
+        x: &Pair12,
+        v: &Pair12,
+        clocks: &[RegionClock; 4],
+    ) -> Pair12 {
+        self.eval_with(parts, (x, v), clocks, false).load
+    }
+
+    fn eval_with(
+        &self,
+        parts: &mut SpatialParts,
+        (x, v): (&Pair12, &Pair12),
+        clocks: &[RegionClock; 4],
+        dissipation: bool,
+    ) -> Eval {
+        let mut places = std::mem::take(&mut parts.places);
+        self.read_places(parts, &mut places, x);
+        let out = self.eval_at(parts, (&places, x, v), clocks, dissipation);
+        parts.places = places;
+        out
+    }
+
+    /// Where the pose at `x` puts the regions' contacts, into `places`.
+    fn read_places(&self, parts: &SpatialParts, places: &mut Places, x: &Pair12) {
+        let (pose, _) = self.pose(x, &[0.0; 12]);
+        let regions = parts.patches.map(|p| p.region);
+        places.read(self.joint, &parts.model.geometry, &pose, regions);
+    }
+
+    /// The regions' load and states at `x`, `v`, the contacts at `places` (read at `x`), and
+    /// their dissipation when asked.
+    fn eval_at(
+        &self,
+        parts: &mut SpatialParts,
+        (places, x, v): (&Places, &Pair12, &Pair12),
+        clocks: &[RegionClock; 4],
+        dissipation: bool,
+    ) -> Eval {
         let j = self.joint;
-        let (pose, motions) = self.pose(x, v);
+        let (_, motions) = self.pose(x, v);
         let bodies = [&motions[0], &motions[1]];
         let centres = [motions[0].center_of_mass, motions[1].center_of_mass];
-        let geometry = parts.model.geometry;
         let mut totals = Totals::default();
         let mut out = Eval::default();
         parts.points.clear();
         for (k, clock) in clocks.iter().enumerate() {
             let region = parts.patches[k].region;
-            let (state, _) = deepest_state(j, &geometry, &pose, region, bodies);
+            let state = places.deepest[k].state(bodies);
             let first = parts.points.len();
-            region_points(j, parts, &pose, region, bodies);
+            places.moving(k, bodies, &mut parts.points);
             let law = *region.law(&j.normal_law, &parts.face_law);
             let rate = clock.rate_at(&state, j.min_impact_speed);
             let points = &mut parts.points[first..];
-            apply_region(
-                points,
-                &law,
-                &j.friction_law,
-                rate,
-                0.0,
-                centres,
-                &mut totals,
-            );
+            let laws = (&law, &j.friction_law);
+            load_region(points, laws, rate, centres, dissipation, &mut totals);
             out.states[k] = state;
         }
         put(&mut out.load, 0, -totals.force);
@@ -269,6 +305,9 @@ impl SpatialCycle<'_> {
     ) -> Slopes {
         let mut lx = [0.0; 144];
         let mut lv = [0.0; 144];
+        // A velocity's step leaves the contacts where they are: read them once.
+        let mut base_places = std::mem::take(&mut parts.base_places);
+        self.read_places(parts, &mut base_places, x);
         for c in (0..12).filter(|&c| self.moving[c]) {
             for (jac, dv, e) in [(&mut lx, false, 1e-6), (&mut lv, true, 1e-3)] {
                 let step = e * self.scale[c];
@@ -278,12 +317,18 @@ impl SpatialCycle<'_> {
                 } else {
                     xp[c] += step;
                 }
-                let load = self.eval(parts, &xp, &vp, clocks).load;
+                let load = if dv {
+                    let at = (&base_places, &xp, &vp);
+                    self.eval_at(parts, at, clocks, false).load
+                } else {
+                    self.load(parts, &xp, &vp, clocks)
+                };
                 for r in 0..12 {
                     jac[r * 12 + c] = (load[r] - base[r]) / step;
                 }
             }
         }
+        parts.base_places = base_places;
         let p = &self.start.mobility;
         let through = |l: &Square| -> Square {
             std::array::from_fn(|i| {
@@ -327,7 +372,7 @@ impl SpatialCycle<'_> {
         axpy(&mut y1.pi, s, &k1.pi);
         axpy(&mut y1.gamma, s, &k1.gamma);
         let (x1, v1) = self.kinematics(t + s, &y1);
-        let f1 = self.eval(parts, &x1, &v1, clocks).load;
+        let f1 = self.load(parts, &x1, &v1, clocks);
         let mut r2 = Impulses {
             pi: y1.gamma,
             gamma: f1,

@@ -34,7 +34,7 @@
 
 use super::super::subcycle::{MAX_SUBSTEPS, PairStart, SubCycle, SubStep};
 use super::super::{ClearanceJoint, ContactHistory, Mechanism, motion};
-use super::{Mobility, Pair, SpatialParts, Totals, apply_region, deepest_state, region_points};
+use super::{Mobility, Pair, Places, SpatialParts, Totals, load_region};
 use crate::model::kinematics::{BodyMotion, ForcePair, JournalState};
 use crate::model::spatial::SpatialPose;
 use crate::rapier::pipeline::ledger::{Wrench, world_center_of_mass};

@@ -59,10 +59,12 @@ pub(crate) const POSITION_SCALE: f64 = 0.01;
 /// counts against this floor.
 pub(crate) const VELOCITY_SCALE: f64 = POSITION_SCALE * 1e3;
 
-/// Accepted sub-steps a Jacobian serves at most (ROS2 keeps its order with any Jacobian; a
-/// stale one costs accuracy per sub-step and the error estimate sees it). It is also retaken
-/// when a region starts or stops touching, and when a sub-step is rejected.
-const JACOBIAN_AGE: u32 = 8;
+/// Accepted sub-steps a Jacobian serves at most. ROS2 keeps its order with any Jacobian; a
+/// stale one costs accuracy per sub-step, which the error estimate sees. It is also retaken
+/// when a region starts or stops touching, when a sub-step is rejected, and when the load moves
+/// by [`JACOBIAN_DRIFT`]. A Jacobian costs twelve loads against a sub-step's two: it is retaken
+/// where it goes stale, not on a short clock.
+const JACOBIAN_AGE: u32 = 32;
 
 /// Which regions touch at `eval`.
 fn contact_set(eval: &Eval) -> [bool; 4] {
@@ -77,8 +79,9 @@ fn changed(now: &Pair12, then: &Pair12) -> bool {
     norm(&diff) > JACOBIAN_DRIFT * norm(then)
 }
 
-/// The load's relative change after which the Jacobian is retaken.
-const JACOBIAN_DRIFT: f64 = 0.02;
+/// The load's relative change after which the Jacobian is retaken: a tenth, since the error
+/// estimate, not the Jacobian, holds the sub-step's accuracy.
+const JACOBIAN_DRIFT: f64 = 0.1;
 
 /// ROS2's `gamma = 1 + 1/sqrt(2)` (L-stable).
 const GAMMA: f64 = 1.0 + std::f64::consts::FRAC_1_SQRT_2;

@@ -343,15 +343,17 @@ impl Twin {
         for h in &self.hinges {
             if let HingeJoint::Clearance(c) = h.joint {
                 let j = world.clearance.get(c).expect("handle of this twin");
+                if let Some(loss) = j.step_dissipation() {
+                    // Sub-cycled, planar or spatial: integrated over the sub-steps (the power
+                    // at the step's start held over a step that spans the contact's motion is
+                    // not the work the sub-steps' forces did).
+                    self.invariants.dissipated_j += loss;
+                    continue;
+                }
                 if let Some(s) = &h.spatial_sample {
                     // The power of every contact point's damping and friction at the state
                     // before the step, as the planar joint's force at that state.
                     self.invariants.dissipated_j += s.report.dissipation_power * info.dt;
-                    continue;
-                }
-                if let Some(loss) = j.step_dissipation() {
-                    // Integrated over the sub-steps.
-                    self.invariants.dissipated_j += loss;
                     continue;
                 }
                 let r = j.report();

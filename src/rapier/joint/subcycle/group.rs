@@ -344,7 +344,7 @@ pub(super) fn plan_group(
         })
         .collect();
     for (a, run) in runs.iter_mut().enumerate() {
-        run.start_correction = moved(a, &beyond);
+        run.start_correction = attributed(a, &members, &starts[a], &cross, &beyond);
     }
     for ((a, &i), mut run) in group.iter().enumerate().zip(runs) {
         let mut left = held[a];
@@ -355,6 +355,42 @@ pub(super) fn plan_group(
         joint.cycle.pending = Some(left);
         deliveries[i] = deliver[a].iter().any(|q| *q != 0.0).then_some(deliver[a]);
     }
+}
+
+/// Member `a`'s share of the velocity correction its pair's bodies have from the impulses
+/// `beyond` of the group's `members` (`cross`: each member's mobilities from the others'
+/// impulses): its own impulse on its pair, and another member's impulse on a body of `a`'s pair
+/// only where that body is in neither the other member's pair nor the pair of an earlier member
+/// that the impulse moves too. Readers add the corrections of all joints per body
+/// ([`ClearanceJoint::start_velocity_correction`]); a body two pairs share (the yoke between a
+/// deployable array's root and its next hinge) would otherwise have every impulse's velocity
+/// twice: `moved` gives each pair the whole correction of its bodies.
+fn attributed(
+    a: usize,
+    members: &[&ClearanceJoint],
+    start: &PairStart,
+    cross: &[Vec<(usize, [f64; 144])>],
+    beyond: &[Pair12],
+) -> Pair12 {
+    let mut v = start.moved_by(&beyond[a]);
+    let pair = |m: &ClearanceJoint| [m.body1, m.body2];
+    let moves = |e: usize, b: usize| cross[e].iter().any(|(x, _)| *x == b);
+    for (b, p) in &cross[a] {
+        let from_b = mul(p, &beyond[*b]);
+        for (slot, body) in pair(members[a]).into_iter().enumerate() {
+            let own = pair(members[*b]).contains(&body);
+            let earlier = members[..a]
+                .iter()
+                .enumerate()
+                .any(|(e, m)| e != *b && moves(e, *b) && pair(m).contains(&body));
+            if !own && !earlier {
+                for q in 6 * slot..6 * slot + 6 {
+                    v[q] += from_b[q];
+                }
+            }
+        }
+    }
+    v
 }
 
 /// The impulse Rapier's pass 1 delivers over a step of `h` (`Q kick`, as a constant wrench

@@ -283,7 +283,10 @@ impl ClearanceJoint {
     /// before the step, `v_after` after it, `h_prev` and `h` the steps before and after the
     /// state): the part of a sub-cycled contact's impulse inside the steps that Rapier's mean
     /// velocities spread over them. Zero for an explicit joint and for steps without contact.
-    /// Add it to read the bodies' momentum or energy at that state.
+    /// Add it to read the bodies' momentum or energy at that state; with several sub-cycled
+    /// joints, add every joint's correction of a body: each impulse's share of a body two
+    /// joints share is in one joint's correction only (a body beyond the joints' pairs that an
+    /// impulse moves through Rapier's joints is in none).
     pub fn start_velocity_correction(&self) -> [(RigidBodyHandle, Vector, Vector); 2] {
         let c = &self.cycle.start_correction;
         [(self.body1, 0), (self.body2, 2)].map(|(b, k)| (b, part(c, k), part(c, k + 1)))

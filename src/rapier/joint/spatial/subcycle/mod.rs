@@ -240,6 +240,16 @@ impl ClearanceJoint {
         self.report.state = end.state;
         let result = self.evaluate_regions(&mut parts, &pose, [&m1, &m2], &pair, [0.0, 0.0]);
         self.spatial = Some(parts);
+        // The step's last sub-step is the state reported here, and the readers of the step
+        // (`ImpactRecorder::record_step`, the runner) take its onset from this report: the
+        // evaluation above moved a history the sub-cycle had already moved into the contact,
+        // so it would never see one that began in that sub-step.
+        if end.onset && self.contact.in_contact {
+            self.report.onset = true;
+            self.report.impact = end.impact;
+            self.report.approach_speed = end.approach_speed;
+            self.report.onset_fraction = end.onset_fraction;
+        }
         self.report.max_stable_dt = f64::INFINITY;
         self.report.friction_stable_dt = f64::INFINITY;
         self.elastic = std::sync::OnceLock::new();

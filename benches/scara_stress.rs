@@ -88,9 +88,9 @@ struct Arm {
 
 /// The links' inertia about their length over the transverse one (`SCARA_AXIAL`). At a
 /// thousandth (the example's slender links) Rapier's joints do not hold the lower link in the
-/// arm's plane at 60 and 120 Hz, the ideal arm's too (its centre of mass drops 0.21 and
-/// 0.08 m, spinning at up to 210 and 26 rad/s about its length); at a tenth the ideal arm stays
-/// within 2 mm of the plane at 60 Hz.
+/// arm's plane at 60 and 120 Hz, the ideal arm's too (its centre of mass leaves the plane by
+/// up to 0.21 and 0.08 m, spinning across it at up to 230 and 26 rad/s); at a tenth the ideal
+/// arm's stays within 2 mm of the plane at 60 Hz.
 fn axial_inertia() -> f64 {
     std::env::var("SCARA_AXIAL")
         .ok()

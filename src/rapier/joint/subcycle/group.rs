@@ -10,6 +10,15 @@ use crate::rapier::joint::{ClearanceJoint, ContactHistory};
 use crate::rapier::pipeline::step_hooks::StepPass;
 use rapier3d_f64::prelude::RigidBodySet;
 
+/// Rounds of the continuity correction over the joints of a group (each joint's correction
+/// moves the others' pairs through the mobilities between them).
+const CONTINUITY_PASSES: usize = 3;
+
+/// Sub-steps beyond which a world step is long against its contact (its sub-cycle then goes
+/// on from where the last one left the pin): twice the ones the world's step control lets a
+/// step span in contact (`WORLD_SUBSTEPS_IN_CONTACT`).
+const LONG_STEP_SUBSTEPS: u32 = 20;
+
 /// One joint's state inside a sub-cycle.
 pub(super) struct Lane {
     pub(super) m: Motion,
@@ -269,8 +278,8 @@ pub(super) fn plan_group(
         .iter()
         .map(|j| j.cycle.start.expect("a planned joint has a start"))
         .collect();
-    let held: Vec<Pair12> = members.iter().map(|j| j.cycle.held).collect();
-    let shift: Vec<Pair12> = members.iter().map(|j| j.cycle.shift).collect();
+    let mut held: Vec<Pair12> = members.iter().map(|j| j.cycle.held).collect();
+    let mut shift: Vec<Pair12> = members.iter().map(|j| j.cycle.shift).collect();
     let cross: Vec<Vec<(usize, [f64; 144])>> = members
         .iter()
         .enumerate()
@@ -289,33 +298,56 @@ pub(super) fn plan_group(
         }
         v
     };
-    let cycles = members
+    let cycle = |a: usize, held: &[Pair12], shift: &[Pair12]| {
+        let joint = members[a];
+        let now = PairStart::velocity_now(joint, bodies).expect("a planned joint's bodies");
+        let mut a_free = [0.0; 12];
+        for ((x, n), v) in a_free.iter_mut().zip(now).zip(starts[a].velocity()) {
+            *x = (n - v) / kick;
+        }
+        let mut u0 = *starts[a].velocity();
+        axpy(&mut u0, c_n * kick - 0.5 * h, &a_free);
+        axpy(&mut u0, 1.0, &moved(a, held));
+        let stabilisation = starts[a]
+            .stabilisation(joint, bodies, &now, h, c_n)
+            .unwrap_or_default();
+        Cycle {
+            joint,
+            start: &starts[a],
+            u0,
+            offset: moved(a, shift),
+            a_free,
+            stabilisation,
+            h,
+            tolerance: pass.tolerance,
+        }
+    };
+    // After a step long against its contact (more than `LONG_STEP_SUBSTEPS` sub-steps), each
+    // contact goes on from where its last sub-cycle left it: what Rapier's pass 1 made of the
+    // step's wrench beyond the pair's mobility at the step's start (the bearing's body turning
+    // on its ideal joints while the contact moves it) is held to the next step as a
+    // displacement and an impulse across the pin. A step the world's step control sized to its
+    // contact starts from Rapier's state: the difference is of the order of the start's own
+    // reading of its rate (Rapier's velocities carried to the state by this step's
+    // acceleration), and a displacement held between the steps is a lever the contact's force
+    // acts through beside Rapier's bodies.
+    let continuing: Vec<bool> = members
         .iter()
-        .enumerate()
-        .map(|(a, &joint)| {
-            let now = PairStart::velocity_now(joint, bodies).expect("a planned joint's bodies");
-            let mut a_free = [0.0; 12];
-            for ((x, n), v) in a_free.iter_mut().zip(now).zip(starts[a].velocity()) {
-                *x = (n - v) / kick;
-            }
-            let mut u0 = *starts[a].velocity();
-            axpy(&mut u0, c_n * kick - 0.5 * h, &a_free);
-            axpy(&mut u0, 1.0, &moved(a, &held));
-            let stabilisation = starts[a]
-                .stabilisation(joint, bodies, &now, h, c_n)
-                .unwrap_or_default();
-            Cycle {
-                joint,
-                start: &starts[a],
-                u0,
-                offset: moved(a, &shift),
-                a_free,
-                stabilisation,
-                h,
-                tolerance: pass.tolerance,
-            }
+        .map(|j| {
+            j.cycle.substep_count > LONG_STEP_SUBSTEPS && j.cycle.impulse.iter().any(|x| *x != 0.0)
         })
         .collect();
+    for _ in 0..CONTINUITY_PASSES {
+        for a in (0..group.len()).filter(|&a| continuing[a]) {
+            let c = cycle(a, &held, &shift);
+            let end = &members[a].report.state;
+            if let Some((e, v)) = c.continuity(end.eccentricity, end.eccentricity_rate) {
+                axpy(&mut shift[a], 1.0, &e);
+                axpy(&mut held[a], 1.0, &v);
+            }
+        }
+    }
+    let cycles: Vec<Cycle> = (0..group.len()).map(|a| cycle(a, &held, &shift)).collect();
     let memory = members
         .iter()
         .map(|j| (j.contact, j.report.state))

@@ -34,6 +34,16 @@
 //! plus `(c_N kick - h/2) a + P H'`. Steps without a contact and without a held impulse take
 //! pass 0 only.
 //!
+//! **Each contact goes on from where its last sub-cycle left it.** The sub-cycle moves the pair
+//! through its mobility at the step's start; Rapier's pass 1 moves the bodies on their ideal
+//! joints, a bearing's body turning under the wrench (the SCARA arm's elbow rides on an upper
+//! link that turns 0.05 rad in a 1/60 s step). The next step's start, read from Rapier's
+//! poses and velocities, would find the wall moved by what pass 1 made of the wrench beyond
+//! the mobility (up to a third of the clearance at 1/60 s). After a step much longer than its
+//! contact (more than 20 sub-steps) the difference in the eccentricity and its rate is held to
+//! the next step as a displacement and an impulse across the pin, at the centres, so that the
+//! next sub-cycle starts where the last one ended and Rapier's pass 1 delivers the rest.
+//!
 //! The sub-steps' states are the joint's [`substeps`](super::ClearanceJoint::substeps): an
 //! impact that begins, peaks and ends inside one world step is reported at its sub-steps
 //! (onset, peak, depth, lift-off), and the world steps at the rate of the slow motion, crossing

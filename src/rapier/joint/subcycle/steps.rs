@@ -164,6 +164,55 @@ impl Cycle<'_> {
         }
     }
 
+    /// Where the pair stands at the step's start: Rapier's poses moved by the held displacement,
+    /// at the state's velocity.
+    pub(super) fn at_start(&self) -> Here {
+        self.here(&Motion {
+            shift: [part(&self.offset, 0), part(&self.offset, 2)],
+            turn: [part(&self.offset, 1), part(&self.offset, 3)],
+            v: self.u0,
+        })
+    }
+
+    /// The displacement (`E`, impulse times time) and the impulse across the pin, as loads at
+    /// the centres along the normal and the tangent, that bring the pair's eccentricity at the
+    /// step's start onto `eccentricity` and its rate onto `rate`; `None` when the pair cannot
+    /// move across the pin.
+    pub(super) fn continuity(
+        &self,
+        eccentricity: Vector,
+        rate: Vector,
+    ) -> Option<(Pair12, Pair12)> {
+        let here = self.at_start();
+        let [p_i, p_j] = here.centres;
+        let n = here.state.normal;
+        let t = here.axis.cross(n);
+        let mid = 0.5 * (p_i + p_j);
+        let rows = [row(&here.com, p_i, p_j, n), row(&here.com, p_i, p_j, t)];
+        let loads = [load(&here.com, mid, n), load(&here.com, mid, t)];
+        let moves = loads.map(|l| mul(&self.start.mobility, &l));
+        let w = [0, 1].map(|r| [0, 1].map(|c| dot(&rows[r], &moves[c])));
+        let det = w[0][0] * w[1][1] - w[0][1] * w[1][0];
+        if !(det.abs() > 1e-12 * (w[0][0] * w[1][1]).abs()) || !det.is_finite() {
+            return None;
+        }
+        let solve = |d: Vector| {
+            let (x, y) = (d.dot(n), d.dot(t));
+            let l = [
+                (w[1][1] * x - w[0][1] * y) / det,
+                (w[0][0] * y - w[1][0] * x) / det,
+            ];
+            let mut out = [0.0; 12];
+            axpy(&mut out, l[0], &loads[0]);
+            axpy(&mut out, l[1], &loads[1]);
+            out
+        };
+        Some((
+            solve(eccentricity - here.state.eccentricity),
+            solve(rate - here.state.eccentricity_rate),
+        ))
+    }
+
     /// `delta_dot0` for the law in the contact of `history` at `here` (as the explicit joint's).
     pub(super) fn impact_rate(&self, history: &ContactHistory, here: &Here) -> f64 {
         let law = &self.joint.normal_law;

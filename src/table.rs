@@ -47,7 +47,8 @@ impl Table {
     /// All values of column `name`.
     pub fn column(&self, name: &str) -> Option<Vec<f64>> {
         let j = self.column_index(name)?;
-        Some((0..self.rows()).map(|i| self.row(i)[j]).collect())
+        let n = self.columns.len();
+        Some(self.values.iter().skip(j).step_by(n).copied().collect())
     }
 
     /// CSV text; fails on a non-finite value, naming its row and column.
@@ -115,10 +116,24 @@ fn push_display(out: &mut String, v: f64, buffer: &mut zmij::Buffer) {
         Some(m) => ("-", m),
         None => ("", mantissa),
     };
-    // `d.ddd` times 10^exponent: the digits, and where the point goes after the first.
-    let digits: String = mantissa.chars().filter(|c| *c != '.').collect();
-    let digits = digits.trim_end_matches('0');
-    let digits = if digits.is_empty() { "0" } else { digits };
+    // `d.ddd` times 10^exponent: the digits (at most 17), and where the point goes after the
+    // first.
+    let mut buf = [b'0'; 24];
+    let mut len = 0;
+    for &b in mantissa
+        .as_bytes()
+        .iter()
+        .filter(|b| **b != b'.')
+        .take(buf.len())
+    {
+        buf[len] = b;
+        len += 1;
+    }
+    while len > 1 && buf[len - 1] == b'0' {
+        len -= 1;
+    }
+    // ASCII digits only.
+    let digits = std::str::from_utf8(&buf[..len.max(1)]).unwrap_or("0");
     let point = exponent + 1;
     out.push_str(sign);
     if point <= 0 {

@@ -18,6 +18,42 @@ fn implicit_slip_by_hand() {
     assert_eq!(implicit_slip(&law, 0.0, 0.5), 0.0);
 }
 
+/// The implicit slip under the paper's dry law (Bai's: steep below 0.1 mm/s, falling to `mu_d`
+/// above) reaches its bracket's width in a few of the law's evaluations, from the stick region
+/// to sliding: it is solved at every sub-step in contact.
+#[test]
+fn implicit_slip_takes_few_evaluations() {
+    use crate::model::laws::{Bai, FrictionLaw};
+    use std::cell::Cell;
+    struct Counted(Bai, Cell<u32>);
+    impl FrictionLaw for Counted {
+        fn coefficient(&self, v: f64) -> f64 {
+            self.1.set(self.1.get() + 1);
+            self.0.coefficient(v)
+        }
+        fn max_coefficient(&self) -> f64 {
+            self.0.max_coefficient()
+        }
+    }
+    let law = Counted(Bai::DRY, Cell::new(0));
+    // Slips before friction from 1 um/s to 1 m/s, against friction's reach of 1 um/s to 10 m/s.
+    for c0 in [1e-6, 1e-5, 3e-5, 1e-4, 3e-4, 1e-3, 1e-2, 0.1, 1.0] {
+        for k in [1e-6, 1e-4, 1e-3, 1e-2, 0.1, 10.0] {
+            law.1.set(0);
+            let x = implicit_slip(&law, c0, k);
+            let calls = law.1.get();
+            let residual = x + k * law.0.coefficient(x) - c0;
+            assert!((0.0..=c0).contains(&x), "c0 {c0} k {k}: {x}");
+            // The root to the bracket's width, or the stick at zero slip.
+            assert!(
+                residual.abs() <= 1e-9 * c0 || x == 0.0,
+                "c0 {c0} k {k}: x {x}, residual {residual:e}"
+            );
+            assert!(calls <= 25, "c0 {c0} k {k}: {calls} evaluations");
+        }
+    }
+}
+
 #[test]
 fn time_to_wall_by_hand() {
     let (x, y) = (Vector::X, Vector::Y);

@@ -3,6 +3,7 @@
 use super::steps::{implicit_slip, time_to_wall};
 use super::*;
 use crate::model::laws::Coulomb;
+use rapier3d_f64::math::Rotation;
 
 #[test]
 fn implicit_slip_by_hand() {
@@ -52,6 +53,25 @@ fn implicit_slip_takes_few_evaluations() {
             assert!(calls <= 25, "c0 {c0} k {k}: {calls} evaluations");
         }
     }
+}
+
+/// A body's turn over a step, read back from the rotation, at every size: 1e-10 rad is a free
+/// satellite's turn in a world step of 1e-6 s (glam's `to_scaled_axis` reads it as none).
+#[test]
+fn rotation_vector_reads_the_smallest_turns() {
+    use super::pair::rotation_vector;
+    let axis = Vector::new(0.36, -0.48, 0.8);
+    for angle in [1e-12, 1e-10, 1e-8, 3e-8, 1e-4, 1.0, 3.0] {
+        let turn = axis * angle;
+        let read = rotation_vector(Rotation::from_scaled_axis(turn));
+        assert!((read - turn).length() <= 1e-14 * angle, "{angle}: {read:?}");
+    }
+    // The shorter way round: a turn of 3.5 rad about the axis is 2 pi - 3.5 the other way.
+    let read = rotation_vector(Rotation::from_scaled_axis(axis * 3.5));
+    assert!(
+        (read + axis * (std::f64::consts::TAU - 3.5)).length() < 1e-12,
+        "{read:?}"
+    );
 }
 
 #[test]

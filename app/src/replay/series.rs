@@ -119,17 +119,55 @@ pub fn min_max_thin(t: &[f64], v: &[f64], buckets: usize) -> (Vec<f64>, Vec<f64>
     )
 }
 
-/// `x` rounded to `digits` significant digits (shorter JSON).
+/// `x` rounded to `digits` significant digits (shorter JSON): the double nearest the decimal
+/// `format!("{:.*e}", digits - 1, x)` writes.
 pub(super) fn round_sig(x: f64, digits: usize) -> f64 {
     if x == 0.0 || !x.is_finite() {
         return x;
     }
-    format!("{:.*e}", digits - 1, x).parse().unwrap_or(x)
+    let digits_i = digits as i32;
+    let mut scale = digits_i - 1 - x.abs().log10().floor() as i32;
+    // `log10` may put the scale a decade off next to a power of ten: one step back in.
+    if let Some(p) = pow10(scale).map(|s| x.abs() * s) {
+        if p < pow10(digits_i - 1).unwrap_or(f64::INFINITY) {
+            scale += 1;
+        } else if p >= pow10(digits_i).unwrap_or(f64::INFINITY) {
+            scale -= 1;
+        }
+    }
+    scaled_round(x, scale).unwrap_or_else(|| format!("{:.*e}", digits - 1, x).parse().unwrap_or(x))
 }
 
-/// `x` rounded to `decimals` decimal places.
+/// `x` rounded to `decimals` decimal places: the double nearest the decimal
+/// `format!("{x:.decimals$}")` writes.
 pub(super) fn round_decimals(x: f64, decimals: usize) -> f64 {
-    format!("{x:.decimals$}").parse().unwrap_or(x)
+    scaled_round(x, decimals as i32)
+        .unwrap_or_else(|| format!("{x:.decimals$}").parse().unwrap_or(x))
+}
+
+/// `x` rounded to a whole number of `10^-scale`, without the text a format and a parse go
+/// through (the replay rounds some 30 numbers per world step): `n = round(x 10^scale)` and
+/// `n / 10^scale`, one correctly rounded division of exact numbers, which is the double nearest
+/// the decimal `n e-scale` as the parse gives. `None` where that is not sure to be the
+/// formatter's rounding: a power of ten not exact in `f64`, a product beyond `2^31` (its own
+/// rounding then nears a unit's millionth) or within a millionth of a half (a tie, or a product
+/// rounded across one).
+fn scaled_round(x: f64, scale: i32) -> Option<f64> {
+    let p = x * pow10(scale)?;
+    let whole = p.abs().floor();
+    if !(p.abs() < 2f64.powi(31)) || (p.abs() - whole - 0.5).abs() < 1e-6 {
+        return None;
+    }
+    Some(p.round() / pow10(scale)?)
+}
+
+/// `10^k` for the `k` whose power is exact in `f64` (0 to 22).
+fn pow10(k: i32) -> Option<f64> {
+    const POW10: [f64; 23] = [
+        1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+        1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+    ];
+    POW10.get(usize::try_from(k).ok()?).copied()
 }
 
 #[cfg(test)]
@@ -146,6 +184,33 @@ mod tests {
         assert!(tt.len() <= 200, "{}", tt.len());
         assert!(vv.contains(&7.0) && vv.contains(&-3.0));
         assert!(tt.windows(2).all(|w| w[0] < w[1]));
+    }
+
+    /// The arithmetic rounding gives the formatter's double, bit for bit, over the replay's
+    /// scales and next to powers of ten and halves.
+    #[test]
+    fn rounding_matches_the_formatted_text() {
+        let by_text_sig = |x: f64| -> f64 { format!("{:.6e}", x).parse().unwrap() };
+        let by_text_dec = |x: f64| -> f64 { format!("{x:.7}").parse().unwrap() };
+        let mut s: u64 = 0x2545_F491_4F6C_DD1D;
+        for i in 0..400_000 {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            let unit = (s >> 11) as f64 / (1u64 << 53) as f64;
+            let x = match i % 4 {
+                0 => (unit - 0.5) * 10f64.powi((s % 30) as i32 - 20),
+                1 => 10f64.powi((s % 30) as i32 - 20) * (1.0 + (unit - 0.5) * 1e-12),
+                2 => ((s >> 20) % 100_000) as f64 * 1e-7 + 0.5e-7 + (unit - 0.5) * 1e-15,
+                _ => (unit - 0.5) * 4.0,
+            };
+            assert_eq!(round_sig(x, 7).to_bits(), by_text_sig(x).to_bits(), "{x:e}");
+            assert_eq!(
+                round_decimals(x, 7).to_bits(),
+                by_text_dec(x).to_bits(),
+                "{x:e}"
+            );
+        }
     }
 
     #[test]

@@ -395,7 +395,10 @@ pub(super) fn time_to_wall(e: Vector, v: Vector, a: Vector, c: f64, left: f64) -
 /// The slip `x` at the state with friction taken there: `x = c0 - k mu(|x|) sign(x)`, `c0` the
 /// slip without this sub-step's friction, `k >= 0` the slip friction's full coefficient removes.
 /// A root lies between 0 and `c0` (friction opposes the slip and never reverses it alone);
-/// bracketed by bisection with a secant guess, as the law may fall with speed (Stribeck).
+/// bracketed, as the law may fall with speed (Stribeck), and found by false position with the
+/// Illinois rule (the value at an end kept twice in a row is halved: the bracket closes from
+/// both sides, in about a tenth of the law's evaluations plain false position takes to the
+/// same width), a bisection where the secant leaves the bracket.
 pub(super) fn implicit_slip(law: &impl FrictionLaw, c0: f64, k: f64) -> f64 {
     if c0 == 0.0 || !(k > 0.0) {
         return c0;
@@ -409,22 +412,33 @@ pub(super) fn implicit_slip(law: &impl FrictionLaw, c0: f64, k: f64) -> f64 {
     if g_lo >= 0.0 {
         return 0.0;
     }
+    // Which end the last iterate moved: -1 the lower, +1 the upper.
+    let mut moved = 0;
     for _ in 0..200 {
-        let secant = lo - g_lo * (hi - lo) / (g_hi - g_lo);
-        let mid = 0.5 * (lo + hi);
-        // The secant when it falls well inside the bracket, else the midpoint.
-        let x = if secant > lo + 0.01 * (hi - lo) && secant < hi - 0.01 * (hi - lo) {
+        let secant = (lo * g_hi - hi * g_lo) / (g_hi - g_lo);
+        let x = if secant > lo && secant < hi {
             secant
         } else {
-            mid
+            0.5 * (lo + hi)
         };
         let gx = g(x);
-        if gx <= 0.0 {
+        if gx == 0.0 {
+            return sign * x;
+        }
+        if gx < 0.0 {
             lo = x;
             g_lo = gx;
+            if moved == -1 {
+                g_hi *= 0.5;
+            }
+            moved = -1;
         } else {
             hi = x;
             g_hi = gx;
+            if moved == 1 {
+                g_lo *= 0.5;
+            }
+            moved = 1;
         }
         if hi - lo <= 1e-14 * target + 1e-300 {
             break;

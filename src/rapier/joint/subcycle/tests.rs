@@ -3,6 +3,7 @@
 use super::steps::{implicit_slip, time_to_wall};
 use super::*;
 use crate::model::laws::Coulomb;
+use rapier3d_f64::math::Rotation;
 
 #[test]
 fn implicit_slip_by_hand() {
@@ -16,6 +17,61 @@ fn implicit_slip_by_hand() {
     // Sliding: x + 0.5 * 0.2 = 1 -> x = 0.9.
     assert!((implicit_slip(&law, 1.0, 0.5) - 0.9).abs() < 1e-13);
     assert_eq!(implicit_slip(&law, 0.0, 0.5), 0.0);
+}
+
+/// The implicit slip under the paper's dry law (Bai's: steep below 0.1 mm/s, falling to `mu_d`
+/// above) reaches its bracket's width in a few of the law's evaluations, from the stick region
+/// to sliding: it is solved at every sub-step in contact.
+#[test]
+fn implicit_slip_takes_few_evaluations() {
+    use crate::model::laws::{Bai, FrictionLaw};
+    use std::cell::Cell;
+    struct Counted(Bai, Cell<u32>);
+    impl FrictionLaw for Counted {
+        fn coefficient(&self, v: f64) -> f64 {
+            self.1.set(self.1.get() + 1);
+            self.0.coefficient(v)
+        }
+        fn max_coefficient(&self) -> f64 {
+            self.0.max_coefficient()
+        }
+    }
+    let law = Counted(Bai::DRY, Cell::new(0));
+    // Slips before friction from 1 um/s to 1 m/s, against friction's reach of 1 um/s to 10 m/s.
+    for c0 in [1e-6, 1e-5, 3e-5, 1e-4, 3e-4, 1e-3, 1e-2, 0.1, 1.0] {
+        for k in [1e-6, 1e-4, 1e-3, 1e-2, 0.1, 10.0] {
+            law.1.set(0);
+            let x = implicit_slip(&law, c0, k);
+            let calls = law.1.get();
+            let residual = x + k * law.0.coefficient(x) - c0;
+            assert!((0.0..=c0).contains(&x), "c0 {c0} k {k}: {x}");
+            // The root to the bracket's width, or the stick at zero slip.
+            assert!(
+                residual.abs() <= 1e-9 * c0 || x == 0.0,
+                "c0 {c0} k {k}: x {x}, residual {residual:e}"
+            );
+            assert!(calls <= 25, "c0 {c0} k {k}: {calls} evaluations");
+        }
+    }
+}
+
+/// A body's turn over a step, read back from the rotation, at every size: 1e-10 rad is a free
+/// satellite's turn in a world step of 1e-6 s (glam's `to_scaled_axis` reads it as none).
+#[test]
+fn rotation_vector_reads_the_smallest_turns() {
+    use super::pair::rotation_vector;
+    let axis = Vector::new(0.36, -0.48, 0.8);
+    for angle in [1e-12, 1e-10, 1e-8, 3e-8, 1e-4, 1.0, 3.0] {
+        let turn = axis * angle;
+        let read = rotation_vector(Rotation::from_scaled_axis(turn));
+        assert!((read - turn).length() <= 1e-14 * angle, "{angle}: {read:?}");
+    }
+    // The shorter way round: a turn of 3.5 rad about the axis is 2 pi - 3.5 the other way.
+    let read = rotation_vector(Rotation::from_scaled_axis(axis * 3.5));
+    assert!(
+        (read + axis * (std::f64::consts::TAU - 3.5)).length() < 1e-12,
+        "{read:?}"
+    );
 }
 
 #[test]

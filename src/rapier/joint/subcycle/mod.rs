@@ -57,9 +57,8 @@ mod tests;
 
 pub(crate) use group::plan_cycles;
 pub(crate) use pair::PairStart;
+pub(crate) use pair::{Pair12, axpy, mul, part, put, rotate};
 pub(crate) use steps::SubCycle;
-
-use pair::{Pair12, part};
 
 use super::effective_mass::Mechanism;
 use super::{ClearanceJoint, ClearanceReport, ContactAhead};

@@ -9,19 +9,19 @@ use rapier3d_f64::prelude::{RigidBody, RigidBodySet};
 
 /// A 12-vector over the pair's coordinates: the bearing's linear and angular, then the
 /// journal's.
-pub(super) type Pair12 = [f64; 12];
+pub(crate) type Pair12 = [f64; 12];
 
 pub(super) fn dot(a: &Pair12, b: &Pair12) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
-pub(super) fn axpy(y: &mut Pair12, s: f64, x: &Pair12) {
+pub(crate) fn axpy(y: &mut Pair12, s: f64, x: &Pair12) {
     for (y, x) in y.iter_mut().zip(x) {
         *y += s * x;
     }
 }
 
-pub(super) fn mul(p: &[f64; 144], x: &Pair12) -> Pair12 {
+pub(crate) fn mul(p: &[f64; 144], x: &Pair12) -> Pair12 {
     let mut y = [0.0; 12];
     for (r, y) in y.iter_mut().enumerate() {
         *y = dot(p[r * 12..r * 12 + 12].try_into().expect("a row"), x);
@@ -29,11 +29,11 @@ pub(super) fn mul(p: &[f64; 144], x: &Pair12) -> Pair12 {
     y
 }
 
-pub(super) fn part(x: &Pair12, k: usize) -> Vector {
+pub(crate) fn part(x: &Pair12, k: usize) -> Vector {
     Vector::new(x[3 * k], x[3 * k + 1], x[3 * k + 2])
 }
 
-pub(super) fn put(x: &mut Pair12, k: usize, v: Vector) {
+pub(crate) fn put(x: &mut Pair12, k: usize, v: Vector) {
     x[3 * k..3 * k + 3].copy_from_slice(&[v.x, v.y, v.z]);
 }
 
@@ -135,8 +135,9 @@ impl PairStart {
                 h * part(&self.velocity, i) + c_n * h * (part(now, i) - part(&self.velocity, i))
             };
             out[0][k] = world_center_of_mass(rb[k]) - self.com[k] - moved(2 * k);
-            let turn = rotation_vector(*rb[k].rotation() * self.rotation[k].inverse());
-            out[1][k] = turn - moved(2 * k + 1);
+            let expected = moved(2 * k + 1);
+            let turn = turn_near(*rb[k].rotation() * self.rotation[k].inverse(), expected);
+            out[1][k] = turn - expected;
         }
         Some(out)
     }
@@ -163,10 +164,23 @@ pub(super) struct Motion {
 
 /// The rotation vector (axis times angle, the shorter way round) of `q`, to the last bit at any
 /// angle. glam's `to_scaled_axis` gives zero for a vector part below 1e-8, a turn below
-/// 2e-8 rad: a free-floating satellite turning at 1.4e-4 rad/s turns less than that in a step
-/// of 1e-4 s, and the stabilisation read its whole turn as Rapier's correction (the sub-cycled
-/// paper's scene: the first impact's peak -0.1 to -0.4 % at tolerances 0.01 to 0.00375, -10.7 %
-/// at world steps of 1e-6 s).
+/// 2e-8 rad, while a free-floating satellite turning at 1.4e-4 rad/s turns less than that in a
+/// step of 1e-4 s: a turn read as none is a turn taken for Rapier's correction.
+/// The rotation vector of `q` nearest to `expected` (rad): `q`'s angle about its axis, whole
+/// turns added or taken. A body spinning faster than half a turn per step (an arm spun up at a
+/// game's 1/60 s) turns the long way round, and its velocities say which way.
+pub(super) fn turn_near(q: Rotation, expected: Vector) -> Vector {
+    let short = rotation_vector(q);
+    let angle = short.length();
+    if angle == 0.0 {
+        return short;
+    }
+    let axis = short / angle;
+    let tau = std::f64::consts::TAU;
+    let whole = ((expected.dot(axis) - angle) / tau).round();
+    (angle + whole * tau) * axis
+}
+
 pub(super) fn rotation_vector(q: Rotation) -> Vector {
     let q = if q.w < 0.0 { -q } else { q };
     let v = Vector::new(q.x, q.y, q.z);
@@ -177,7 +191,7 @@ pub(super) fn rotation_vector(q: Rotation) -> Vector {
     v * (2.0 * s.atan2(q.w) / s)
 }
 
-pub(super) fn rotate(turn: Vector, r: Vector) -> Vector {
+pub(crate) fn rotate(turn: Vector, r: Vector) -> Vector {
     if turn == Vector::ZERO {
         r
     } else {

@@ -92,3 +92,24 @@ fn time_to_wall_by_hand() {
     // Moving away from a wall it is near.
     assert_eq!(time_to_wall(0.9 * x, -x, Vector::ZERO, 1.0, 0.5), None);
 }
+
+/// A body spinning more than half a turn per step turns the long way round: the turn read is
+/// the one its velocities expect, whole turns added or taken, and a quaternion of either sign.
+#[test]
+fn a_fast_turn_is_read_the_way_the_velocities_go() {
+    use super::pair::turn_near;
+    let axis = Vector::new(0.36, -0.48, 0.8);
+    for angle in [1e-9, 0.5, 3.5, 5.0, 7.0, -4.0] {
+        let turn = axis * angle;
+        for q in [
+            Rotation::from_scaled_axis(turn),
+            -Rotation::from_scaled_axis(turn),
+        ] {
+            let read = turn_near(q, turn * 0.97);
+            assert!(
+                (read - turn).length() <= 1e-12 * angle.abs().max(1.0),
+                "{angle}: {read:?}"
+            );
+        }
+    }
+}

@@ -32,19 +32,18 @@
 //! explicit joint's); a region a trial state presses without a history takes its own approach
 //! speed.
 
-use super::super::subcycle::{MAX_SUBSTEPS, PairStart, SubCycle, SubStep};
+use super::super::subcycle::{
+    MAX_SUBSTEPS, Pair12, PairStart, SubCycle, SubStep, axpy, mul, part, put, rotate,
+};
 use super::super::{ClearanceJoint, ContactHistory, Mechanism, motion};
 use super::{Mobility, Pair, Places, SpatialParts, Totals, load_region};
 use crate::model::kinematics::{BodyMotion, ForcePair, JournalState};
 use crate::model::spatial::SpatialPose;
 use crate::rapier::pipeline::ledger::{Wrench, world_center_of_mass};
 use crate::rapier::pipeline::step_hooks::StepPass;
-use rapier3d_f64::math::{Rotation, Vector};
+use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{RigidBody, RigidBodySet};
 
-/// A 12-vector over the pair's coordinates: the bearing's linear and angular, then the
-/// journal's.
-type Pair12 = [f64; 12];
 /// A 12 x 12 matrix over the pair's coordinates, row-major.
 type Square = [f64; 144];
 
@@ -85,32 +84,6 @@ const JACOBIAN_DRIFT: f64 = 0.1;
 
 /// ROS2's `gamma = 1 + 1/sqrt(2)` (L-stable).
 const GAMMA: f64 = 1.0 + std::f64::consts::FRAC_1_SQRT_2;
-
-fn part(x: &Pair12, k: usize) -> Vector {
-    Vector::new(x[3 * k], x[3 * k + 1], x[3 * k + 2])
-}
-
-fn put(x: &mut Pair12, k: usize, v: Vector) {
-    x[3 * k..3 * k + 3].copy_from_slice(&[v.x, v.y, v.z]);
-}
-
-fn axpy(y: &mut Pair12, s: f64, x: &Pair12) {
-    for (y, x) in y.iter_mut().zip(x) {
-        *y += s * x;
-    }
-}
-
-fn mul(p: &Square, x: &Pair12) -> Pair12 {
-    std::array::from_fn(|r| (0..12).map(|c| p[r * 12 + c] * x[c]).sum())
-}
-
-fn rotate(turn: Vector, r: Vector) -> Vector {
-    if turn == Vector::ZERO {
-        r
-    } else {
-        Rotation::from_scaled_axis(turn) * r
-    }
-}
 
 /// The pair of a spatial joint at the start of a step.
 #[derive(Clone, Copy, Debug)]

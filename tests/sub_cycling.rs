@@ -441,12 +441,12 @@ fn a_damped_arm_rattling_on_a_fixed_pin_with_a_second_arm_gains_no_energy() {
 
 /// The deployable array (`assets/deployable_array.ron`: a yoke and three panels unfolding on
 /// four planar clearance hinges in a chain, free-floating, no gravity) sub-cycled at the
-/// adaptive defaults over its first impacts (0.3 s, 117 onsets). Its hinges share bodies (the
+/// adaptive defaults over its first impacts (0.3 s, 139 onsets). Its hinges share bodies (the
 /// yoke is the root's journal and the next hinge's bearing) and are integrated in one
 /// sub-cycle: each hinge's held impulse moves the shared body once, and the readers that add
 /// the hinges' `start_velocity_correction` per body read it once. The runner's invariants at
 /// every state: momentum drifts below 1e-12 of its scale, and the energy balance grows by less
-/// than the ideal twin's own integration error (1.5e-4 of the energy's scale; 7.8e-5 here,
+/// than the ideal twin's own integration error (1.5e-4 of the energy's scale; 3.9e-6 here,
 /// 1.4e-2 with the shared yoke's correction counted by both its hinges).
 #[test]
 fn a_sub_cycled_chain_sharing_its_bodies_keeps_momentum_and_energy() {

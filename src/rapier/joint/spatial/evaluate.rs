@@ -397,8 +397,8 @@ fn apply_region(
 }
 
 /// The region's points' forces into `totals` ([`load_point`]), no more: the sub-cycle's load,
-/// which its Jacobian evaluates some twenty times per sub-step (without the `dissipation`,
-/// which only an accepted state's power needs).
+/// evaluated twice per sub-step and twice per coordinate for its Jacobian (without the
+/// `dissipation` where only the load is wanted: an accepted state's power needs it).
 pub(super) fn load_region(
     points: &mut [SpatialPoint],
     (law, friction): (&NormalModel, &impl FrictionLaw),

@@ -1,7 +1,7 @@
 //! Where a pose puts the spatial joint's contacts, apart from how fast they move: a region's
 //! deepest point and its quadrature points depend on the pair's positions only, and cost most
 //! of an evaluation (the bore's sections, their root along the width). The sub-cycle's
-//! Jacobian perturbs the velocities at one pose six times, and reads them here once.
+//! Jacobian perturbs each velocity the pair moves along at one pose, and reads the places once.
 
 use super::report::{Region, SpatialPoint};
 use super::{ClearanceJoint, point_state};

@@ -298,21 +298,31 @@ pub(super) fn plan_group(
         }
         v
     };
+    // What pass 0 says of each pair: the rest of the world's acceleration over the step and
+    // Rapier's stabilisation. It does not change with the impulse and displacement held, which
+    // the continuity passes below move, so it is read once.
+    let free: Vec<(Pair12, _)> = members
+        .iter()
+        .zip(&starts)
+        .map(|(&joint, start)| {
+            let now = PairStart::velocity_now(joint, bodies).expect("a planned joint's bodies");
+            let mut a_free = [0.0; 12];
+            for ((x, n), v) in a_free.iter_mut().zip(now).zip(start.velocity()) {
+                *x = (n - v) / kick;
+            }
+            let stabilisation = start
+                .stabilisation(joint, bodies, &now, h, c_n)
+                .unwrap_or_default();
+            (a_free, stabilisation)
+        })
+        .collect();
     let cycle = |a: usize, held: &[Pair12], shift: &[Pair12]| {
-        let joint = members[a];
-        let now = PairStart::velocity_now(joint, bodies).expect("a planned joint's bodies");
-        let mut a_free = [0.0; 12];
-        for ((x, n), v) in a_free.iter_mut().zip(now).zip(starts[a].velocity()) {
-            *x = (n - v) / kick;
-        }
+        let (a_free, stabilisation) = free[a];
         let mut u0 = *starts[a].velocity();
         axpy(&mut u0, c_n * kick - 0.5 * h, &a_free);
         axpy(&mut u0, 1.0, &moved(a, held));
-        let stabilisation = starts[a]
-            .stabilisation(joint, bodies, &now, h, c_n)
-            .unwrap_or_default();
         Cycle {
-            joint,
+            joint: members[a],
             start: &starts[a],
             u0,
             offset: moved(a, shift),

@@ -186,24 +186,37 @@ impl SpatialCycle<'_> {
         (x, v)
     }
 
-    /// The pose and the bodies' motions at position increments `x` and velocities `v`.
-    pub(super) fn pose(&self, x: &Pair12, v: &Pair12) -> (SpatialPose, [BodyMotion; 2]) {
+    /// The pose at position increments `x`.
+    pub(super) fn pose(&self, x: &Pair12) -> SpatialPose {
         let s = self.start;
-        let com = [s.com[0] + part(x, 0), s.com[1] + part(x, 2)];
+        let com = self.centres(x);
         let (turn_i, turn_j) = (part(x, 1), part(x, 3));
-        let pose = SpatialPose {
+        SpatialPose {
             bearing_center: com[0] + rotate(turn_i, s.anchor[0]),
             bearing_axis: rotate(turn_i, s.bearing_axis),
             bearing_transverse: rotate(turn_i, s.transverse),
             journal_center: com[1] + rotate(turn_j, s.anchor[1]),
             journal_axis: rotate(turn_j, s.journal_axis),
-        };
-        let motion = |k: usize| BodyMotion {
+        }
+    }
+
+    /// The bodies' centres of mass at position increments `x`.
+    fn centres(&self, x: &Pair12) -> [Vector; 2] {
+        [
+            self.start.com[0] + part(x, 0),
+            self.start.com[1] + part(x, 2),
+        ]
+    }
+
+    /// The bodies' motions at position increments `x` and velocities `v` (no rotation: a
+    /// velocity step of the Jacobian reads only these).
+    fn motions(&self, x: &Pair12, v: &Pair12) -> [BodyMotion; 2] {
+        let com = self.centres(x);
+        std::array::from_fn(|k| BodyMotion {
             center_of_mass: com[k],
             linvel: part(v, 2 * k),
             angvel: part(v, 2 * k + 1),
-        };
-        (pose, [motion(0), motion(1)])
+        })
     }
 
     /// The regions' load, states and dissipation at `x`, `v`.
@@ -244,7 +257,7 @@ impl SpatialCycle<'_> {
 
     /// Where the pose at `x` puts the regions' contacts, into `places`.
     fn read_places(&self, parts: &SpatialParts, places: &mut Places, x: &Pair12) {
-        let (pose, _) = self.pose(x, &[0.0; 12]);
+        let pose = self.pose(x);
         let regions = parts.patches.map(|p| p.region);
         places.read(self.joint, &parts.model.geometry, &pose, regions);
     }
@@ -259,7 +272,7 @@ impl SpatialCycle<'_> {
         dissipation: bool,
     ) -> Eval {
         let j = self.joint;
-        let (_, motions) = self.pose(x, v);
+        let motions = self.motions(x, v);
         let bodies = [&motions[0], &motions[1]];
         let centres = [motions[0].center_of_mass, motions[1].center_of_mass];
         let mut totals = Totals::default();

@@ -67,10 +67,12 @@ impl Table {
             source: e,
         };
         writeln!(w, "{}", self.columns.join(",")).map_err(io)?;
-        let mut line = String::with_capacity(32 * self.columns.len() + 1);
+        // Rows gather in a chunk of whole lines, handed to `w` at `CHUNK` bytes or more: a
+        // buffered writer passes such a write through without copying it.
+        const CHUNK: usize = 1 << 16;
+        let mut line = String::with_capacity(CHUNK + 32 * self.columns.len() + 1);
         let mut buffer = zmij::Buffer::new();
         for i in 0..self.rows() {
-            line.clear();
             for (j, v) in self.row(i).iter().enumerate() {
                 if !v.is_finite() {
                     return Err(Error::diverged(
@@ -88,8 +90,12 @@ impl Table {
                 push_display(&mut line, *v, &mut buffer);
             }
             line.push('\n');
-            w.write_all(line.as_bytes()).map_err(io)?;
+            if line.len() >= CHUNK {
+                w.write_all(line.as_bytes()).map_err(io)?;
+                line.clear();
+            }
         }
+        w.write_all(line.as_bytes()).map_err(io)?;
         Ok(())
     }
 }
@@ -105,7 +111,8 @@ fn push_display(out: &mut String, v: f64, buffer: &mut zmij::Buffer) {
         return;
     }
     let s = buffer.format_finite(v);
-    let Some(e) = s.find('e') else {
+    // The exponent's `e` is among the last five bytes when there is one.
+    let Some(e) = s.bytes().rposition(|b| b == b'e') else {
         // Positional already: `zmij` writes `1.0` where the standard library writes `1`.
         out.push_str(s.strip_suffix(".0").unwrap_or(s));
         return;

@@ -44,6 +44,7 @@ pub(super) fn render_png(f: &impl Drawable) -> Result<Vec<u8>> {
     let mut enc = png::Encoder::new(&mut bytes, w, h);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
+    enc.set_deflate_compression(png::DeflateCompression::Level(1));
     let encode =
         |enc: png::Encoder<'_, &mut Vec<u8>>| -> std::result::Result<(), png::EncodingError> {
             let mut writer = enc.write_header()?;

@@ -1,4 +1,5 @@
-//! Work-precision of fixed and adaptive stepping on the paper's scene (clearance twin).
+//! Work-precision of fixed and adaptive stepping on the paper's scene (clearance twin), with the
+//! explicit contact and sub-cycled (`run.contact_integration=SubCycled`, adaptive and fixed world steps).
 //! `cargo bench --bench work_precision` writes `bench_out/work_precision.{csv,md,svg}`.
 //!
 //! Errors are against the finest fixed run (dt = 1e-6 s); its own error is bounded by step
@@ -133,6 +134,10 @@ struct Row {
 }
 
 const DEFAULT_TOL: f64 = 0.0075;
+/// Sub-cycled contact (`run.contact_integration=SubCycled`) on adaptive world steps.
+const SUB_ADAPTIVE: &str = "sub-cycled, adaptive, max 1e-3";
+/// Sub-cycled contact on fixed world steps.
+const SUB_FIXED: &str = "sub-cycled, fixed";
 
 fn main() {
     let grid = format!("run.output_interval_s={GRID:e}");
@@ -170,6 +175,37 @@ fn main() {
             });
         }
     }
+    // Sub-cycled contact: adaptive world steps at the same tolerances, and fixed world steps of a
+    // game's frame, a robot controller's period and the paper's step.
+    for tol in [0.03, 0.015, DEFAULT_TOL, 0.004, 0.002] {
+        let o = vec![
+            "run.contact_integration=SubCycled".into(),
+            "run.step=Adaptive".into(),
+            format!("run.tolerance={tol}"),
+            "run.max_dt_s=1e-3".into(),
+            grid.clone(),
+        ];
+        eprintln!("{SUB_ADAPTIVE}, tolerance = {tol}");
+        rows.push(Row {
+            mode: SUB_ADAPTIVE,
+            param: tol,
+            outcome: run(&o),
+        });
+    }
+    for dt in [1.0 / 60.0, 1e-3, 1e-4] {
+        let o = vec![
+            "run.contact_integration=SubCycled".into(),
+            "run.step=Fixed".into(),
+            format!("run.dt_s={dt:e}"),
+            grid.clone(),
+        ];
+        eprintln!("{SUB_FIXED}, dt = {dt:e}");
+        rows.push(Row {
+            mode: SUB_FIXED,
+            param: dt,
+            outcome: run(&o),
+        });
+    }
     let find = |mode: &str, param: f64| {
         rows.iter()
             .find(|r| r.mode == mode && r.param == param)
@@ -200,6 +236,8 @@ fn main() {
                 ));
                 let label = if r.mode.starts_with("adaptive, max 1e-3") && r.param == DEFAULT_TOL {
                     format!("**{} (default)**", r.mode)
+                } else if r.mode == SUB_ADAPTIVE && r.param == DEFAULT_TOL {
+                    format!("**{} (default tolerance)**", r.mode)
                 } else {
                     r.mode.to_string()
                 };
@@ -234,6 +272,13 @@ fn main() {
     ));
     let default = find("adaptive, max 1e-3", DEFAULT_TOL);
     let paper = find("fixed", 1e-4);
+    if let (Some(d), Some(p)) = (find(SUB_ADAPTIVE, DEFAULT_TOL), &paper) {
+        md.push_str(&format!(
+            "\nSub-cycled at the default tolerance: {} of the paper's fixed 1e-4 s run's wall time; within the bounds: {}.\n",
+            ratio(d.wall_s, p.wall_s),
+            if within_bounds(&errors(&d, &reference)) { "yes" } else { "no" }
+        ));
+    }
     if let (Some(d), Some(p)) = (default, paper) {
         let de = errors(&d, &reference);
         md.push_str(&format!(
@@ -340,6 +385,8 @@ fn plot(
             ("fixed", RED),
             ("adaptive, max 1e-3", BLUE),
             ("adaptive, max 1e-4", GREEN),
+            (SUB_ADAPTIVE, MAGENTA),
+            (SUB_FIXED, BLACK),
         ] {
             let mut series: Vec<(f64, f64)> = points
                 .iter()

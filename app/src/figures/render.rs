@@ -44,6 +44,8 @@ pub(super) fn render_png(f: &impl Drawable) -> Result<Vec<u8>> {
     let mut enc = png::Encoder::new(&mut bytes, w, h);
     enc.set_color(png::ColorType::Rgb);
     enc.set_depth(png::BitDepth::Eight);
+    // Deflate's fastest level: a tenth of a run's CPU at the default level on the paper's scene,
+    // for files about 1.45 times as large (0.3 MB for its three figures, beside 16 MB of CSV).
     enc.set_deflate_compression(png::DeflateCompression::Level(1));
     let encode =
         |enc: png::Encoder<'_, &mut Vec<u8>>| -> std::result::Result<(), png::EncodingError> {

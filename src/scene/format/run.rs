@@ -65,6 +65,13 @@ pub struct RunSettings {
     /// implicitly; the step follows the slow motion).
     #[serde(default)]
     pub contact_integration: crate::rapier::joint::ContactIntegration,
+    /// Which of the sub-cycle's techniques the sub-cycled hinges use (default all on; e.g.
+    /// `--set run.sub_cycle.implicit_friction=false`): one off gives the plainer method, for
+    /// comparison ([`SubCycleTechniques`](crate::rapier::joint::SubCycleTechniques)). Read
+    /// only with `contact_integration: SubCycled`. Left out of the scene's written form while
+    /// all are on.
+    #[serde(default, skip_serializing_if = "crate::rapier::joint::SubCycleTechniques::all_on")]
+    pub sub_cycle: crate::rapier::joint::SubCycleTechniques,
 }
 
 pub use crate::rapier::pipeline::stepper::StepMode;
@@ -132,6 +139,7 @@ impl Default for RunSettings {
             body_motion: false,
             solver_sweeps: default_solver_sweeps(),
             contact_integration: Default::default(),
+            sub_cycle: Default::default(),
         }
     }
 }

@@ -302,6 +302,8 @@ pub struct Outcome {
     pub violations: Vec<Violation>,
     /// Internal steps.
     pub steps: u64,
+    /// The measured hinge's sub-steps over the run (0 when it is explicit).
+    pub substeps: u64,
     /// Wall time of the run (both twins in one world), s.
     pub wall_s: f64,
     /// The measured hinge's contacts, recorded at every internal step.
@@ -388,6 +390,7 @@ pub fn run(
         error: None,
         violations: Vec::new(),
         steps: 0,
+        substeps: 0,
         wall_s: 0.0,
         impacts: Vec::new(),
         end_s,
@@ -439,6 +442,7 @@ pub fn run(
     );
     let rec = clear.hinge_recorders()[case.hinge];
     out.impacts = rec.contacts().to_vec();
+    out.substeps = rec.substeps_recorded();
     out.peak_force_n = rec.metrics().peak_force_n;
     out.max_penetration_um = rec.metrics().max_penetration_um;
     let t = ideal.table.column("t_s").unwrap();

@@ -50,7 +50,12 @@ struct Entry {
     reference_tolerance: Option<f64>,
 }
 
-fn spatial_case(name: &'static str, file: &'static str, end: (f64, f64), window: (f64, f64)) -> Case {
+fn spatial_case(
+    name: &'static str,
+    file: &'static str,
+    end: (f64, f64),
+    window: (f64, f64),
+) -> Case {
     Case {
         name,
         file,
@@ -142,7 +147,10 @@ fn main() {
                 o.steps,
                 o.substeps,
                 o.wall_s,
-                o.error.as_ref().map(|e| format!(" ({e})")).unwrap_or_default()
+                o.error
+                    .as_ref()
+                    .map(|e| format!(" ({e})"))
+                    .unwrap_or_default()
             );
             let w = o
                 .error

@@ -494,7 +494,7 @@ fn ablation() {
     }
     let mut md = String::from(
         "| arm, 0.1 mm, 1 kHz | world steps | sub-steps | wall (s) | peak force shoulder, elbow (N) \
-         vs reference | deepest penetration shoulder, elbow (um) vs reference | onsets (reference) \
+         vs reference | deepest penetration shoulder, elbow (um) vs reference | onsets \
          | hand RMS offset from the ideal arm (mm) vs reference | guards |\n|---|---|---|---|---|---|---|---|---|\n",
     );
     md.push_str(&format!(

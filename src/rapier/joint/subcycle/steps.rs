@@ -284,7 +284,7 @@ impl Cycle<'_> {
 
     /// With friction explicit ([`SubCycleTechniques::implicit_friction`] off): the sub-step
     /// within friction's stability limit near the slip at `here`, as the explicit joint's step
-    /// (`0.8 x 2/(w_t F_N dmu/dv)`, `w_t` the slip's rate per unit of tangential load, `F_N`
+    /// (`STABILITY_SAFETY x 2/(w_t F_N dmu/dv)`, 0.8 of the limit, `w_t` the slip's rate per unit of tangential load, `F_N`
     /// the law's force at the state); unbounded out of contact.
     ///
     /// [`SubCycleTechniques::implicit_friction`]: super::SubCycleTechniques::implicit_friction
@@ -303,7 +303,7 @@ impl Cycle<'_> {
         let slope = super::super::friction_slope(&j.friction_law, st.slip.length());
         let w_t = here.w[1][1].abs();
         if f_n > 0.0 && slope > 0.0 && w_t > 0.0 {
-            0.8 * 2.0 / (w_t * f_n * slope)
+            super::super::step_policy::STABILITY_SAFETY * 2.0 / (w_t * f_n * slope)
         } else {
             f64::INFINITY
         }

@@ -12,6 +12,11 @@
 //! the reference's against an ideal arm at the reference's steps); and the cost of a world step
 //! against the ideal arm's at the world rate, measured in the same run.
 //!
+//! `-- --ablation`: the arm at 1 kHz and 0.1 mm with each technique of the planar sub-cycle
+//! off in turn ([`SubCycleTechniques`]) against the same reference: world steps, sub-steps,
+//! wall time, the pins' peaks, depths and onsets, the hand's offset; printed and written to
+//! `bench_out/ablation_arm.md`.
+//!
 //! Knobs for diagnosis (environment): `SCARA_RATES=60,1000` (world rates, Hz),
 //! `SCARA_TOLERANCE` (the sub-cycled arms' tolerance, default 0.0075), `SCARA_PINS=shoulder` or
 //! `elbow` (play in that pin only, the other an ideal revolute), `SCARA_ITERS` (the sub-cycled
@@ -113,7 +118,12 @@ fn link(world: &mut PhysicsWorld, (mass, length): (f64, f64), start: f64) -> Rig
 }
 
 impl Arm {
-    fn new(pins: Pins, clearance: f64, control: StepControl) -> clearance_joint::Result<Arm> {
+    fn new(
+        pins: Pins,
+        clearance: f64,
+        control: StepControl,
+        techniques: SubCycleTechniques,
+    ) -> clearance_joint::Result<Arm> {
         let mut rapier = PhysicsWorld::new();
         rapier.gravity = Vector::new(0.0, 0.0, -9.81);
         // Four iterations, Rapier's default, except for the explicit reference, which needs one.
@@ -149,6 +159,7 @@ impl Arm {
                     let joint = HingeDesign::steel_improved_liu(PIN_RADIUS, clearance, PIN_WIDTH)?
                         .friction(FrictionModel::Coulomb(Coulomb::new(MU, 1e-4)?))
                         .integration(integration)
+                        .sub_cycle_techniques(techniques)
                         .name(["shoulder", "elbow"][i])
                         .joint(a1, a2, Vector::Z, Vector::Z)?;
                     handles.push(world.insert_clearance(b1, b2, joint)?);
@@ -230,6 +241,8 @@ struct Outcome {
     steps: u64,
     /// Largest sub-steps of one world step (either pin).
     max_substeps: usize,
+    /// Sub-steps over the run, both pins.
+    substeps: u64,
     wall_s: f64,
     /// The guards' messages (empty: the run stayed valid).
     guards: Vec<String>,
@@ -244,9 +257,25 @@ fn run(
     rate: f64,
     control: StepControl,
 ) -> clearance_joint::Result<Outcome> {
+    run_with(
+        pins,
+        clearance,
+        rate,
+        control,
+        SubCycleTechniques::default(),
+    )
+}
+
+fn run_with(
+    pins: Pins,
+    clearance: f64,
+    rate: f64,
+    control: StepControl,
+    techniques: SubCycleTechniques,
+) -> clearance_joint::Result<Outcome> {
     let tick = 1.0 / rate;
     let gains = gains(tick);
-    let mut arm = Arm::new(pins, clearance, control)?;
+    let mut arm = Arm::new(pins, clearance, control, techniques)?;
     let ticks = (END / tick).round() as u64;
     let mut o = Outcome::default();
     let clock = Instant::now();
@@ -272,6 +301,7 @@ fn run(
     o.wall_s = clock.elapsed().as_secs_f64();
     o.steps = arm.world.steps();
     for k in 0..arm.pins.len() {
+        o.substeps += arm.recorders[k].substeps_recorded();
         let m = arm.recorders[k].metrics();
         o.peak[k] = m.peak_force_n;
         o.depth[k] = m.max_penetration_um;
@@ -327,6 +357,10 @@ fn pct(x: f64, reference: f64) -> String {
 }
 
 fn main() {
+    if std::env::args().any(|a| a == "--ablation") {
+        ablation();
+        return;
+    }
     let quick = std::env::args().any(|a| a == "--quick");
     // The sub-cycled arms' tolerance (`SCARA_TOLERANCE`, default the library's 0.0075).
     let tolerance = std::env::var("SCARA_TOLERANCE")
@@ -424,5 +458,107 @@ fn main() {
                 cost
             );
         }
+    }
+}
+
+/// The arm at 1 kHz and 0.1 mm, sub-cycled with each planar technique off in turn, against the
+/// explicit reference (`-- --ablation`).
+fn ablation() {
+    let (c, rate) = (0.1e-3, 1000.0);
+    let tick = 1.0 / rate;
+    let control = StepControl {
+        tolerance: 0.0075,
+        ..StepControl::fixed(tick)
+    };
+    let ideal = run(Pins::Ideal, c, rate, StepControl::fixed(tick)).expect("the ideal arm");
+    let reference = run(
+        Pins::Compliant(ContactIntegration::Explicit),
+        c,
+        rate,
+        StepControl::adaptive(REFERENCE_MAX_DT, REFERENCE_TOLERANCE),
+    )
+    .expect("the reference");
+    let ideal_reference = run(Pins::Ideal, c, rate, StepControl::fixed(REFERENCE_MAX_DT))
+        .expect("the ideal arm at the reference's steps");
+    let all = SubCycleTechniques::default();
+    let mut rows: Vec<(String, SubCycleTechniques)> = vec![("all on".into(), all)];
+    for (name, _) in all.switches().into_iter().take(5) {
+        let off = match name {
+            "implicit_friction" => all.implicit_friction(false),
+            "implicit_damping" => all.implicit_damping(false),
+            "continuation" => all.continuation(false),
+            "continuity_rounds" => all.continuity_rounds(false),
+            _ => all.stabilisation(false),
+        };
+        rows.push((format!("{name} off"), off));
+    }
+    let mut md = String::from(
+        "| arm, 0.1 mm, 1 kHz | world steps | sub-steps | wall (s) | peak force shoulder, elbow (N) \
+         vs reference | deepest penetration shoulder, elbow (um) vs reference | onsets \
+         | hand RMS offset from the ideal arm (mm) vs reference | guards |\n|---|---|---|---|---|---|---|---|---|\n",
+    );
+    md.push_str(&format!(
+        "| reference: explicit, tolerance {REFERENCE_TOLERANCE}, steps of at most {REFERENCE_MAX_DT:e} s \
+         | {} | 0 | {:.2} | {:.1}, {:.1} | {:.3}, {:.3} | {}, {} | {:.4} | {} |\n",
+        reference.steps,
+        reference.wall_s,
+        reference.peak[0],
+        reference.peak[1],
+        reference.depth[0],
+        reference.depth[1],
+        reference.onsets[0],
+        reference.onsets[1],
+        rms_offset(&reference, &ideal_reference),
+        if reference.guards.is_empty() { "clean".into() } else { reference.guards.join("; ") }
+    ));
+    let off_ref = rms_offset(&reference, &ideal_reference);
+    for (label, techniques) in rows {
+        let sub = run_with(
+            Pins::Compliant(ContactIntegration::SubCycled),
+            c,
+            rate,
+            control,
+            techniques,
+        );
+        let line = match sub {
+            Err(e) => {
+                format!("| sub-cycled, {label} | - | - | - | - | - | - | - | **failed**: {e} |")
+            }
+            Ok(s) => {
+                let off = rms_offset(&s, &ideal);
+                format!(
+                    "| sub-cycled, {label} | {} | {} | {:.2} | {:.1}, {:.1} ({}, {}) | {:.3}, {:.3} ({}, {}) | {}, {} | {:.4} ({}) | {} |",
+                    s.steps,
+                    s.substeps,
+                    s.wall_s,
+                    s.peak[0],
+                    s.peak[1],
+                    pct(s.peak[0], reference.peak[0]),
+                    pct(s.peak[1], reference.peak[1]),
+                    s.depth[0],
+                    s.depth[1],
+                    pct(s.depth[0], reference.depth[0]),
+                    pct(s.depth[1], reference.depth[1]),
+                    s.onsets[0],
+                    s.onsets[1],
+                    off,
+                    pct(off, off_ref),
+                    if s.guards.is_empty() {
+                        "clean".into()
+                    } else {
+                        s.guards.join("; ")
+                    }
+                )
+            }
+        };
+        eprintln!("{line}");
+        md.push_str(&line);
+        md.push('\n');
+    }
+    println!("{md}");
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("bench_out");
+    let _ = std::fs::create_dir_all(&dir);
+    if let Err(e) = std::fs::write(dir.join("ablation_arm.md"), md) {
+        eprintln!("cannot write bench_out/ablation_arm.md: {e}");
     }
 }

@@ -198,7 +198,8 @@ pub mod prelude {
     pub use crate::rapier::hinge::convert::{BearingSide, ConvertRevolute};
     pub use crate::rapier::hinge::design::{ClearanceModel, HingeDesign};
     pub use crate::rapier::joint::{
-        ClearanceJoint, ClearanceJointHandle, ClearanceJointSet, ContactIntegration, OutOfPlaneLock,
+        ClearanceJoint, ClearanceJointHandle, ClearanceJointSet, ContactIntegration,
+        OutOfPlaneLock, SubCycleTechniques,
     };
     pub use crate::rapier::large_step::{
         LargeStepJoint, LargeStepJointBuilder, LargeStepJointHandle, LargeStepJointSet, Restitution,

@@ -36,6 +36,7 @@ fn every_prelude_name_resolves_next_to_rapiers_prelude() {
         std::any::type_name::<ClearanceJointHandle>(),
         std::any::type_name::<OutOfPlaneLock>(),
         std::any::type_name::<ContactIntegration>(),
+        std::any::type_name::<SubCycleTechniques>(),
         std::any::type_name::<LargeStepJoint>(),
         std::any::type_name::<LargeStepJointBuilder>(),
         std::any::type_name::<LargeStepJointHandle>(),

@@ -38,7 +38,7 @@ pub use spatial::report::{Region, SpatialPoint, SpatialReport};
 use spatial::{SpatialMemory, SpatialParts};
 use step_policy::ContactAhead;
 pub(crate) use step_policy::flight_step;
-pub use subcycle::{ContactIntegration, SubStep};
+pub use subcycle::{ContactIntegration, SubCycleTechniques, SubStep};
 use subcycle::{PairStart, SubCycle};
 
 /// What holds the degrees of freedom the contact law does not (axial translation and the two tilts).
@@ -110,6 +110,8 @@ pub struct ClearanceJoint {
     /// The spatial model's stations (`None`: the planar joint).
     spatial: Option<SpatialParts>,
     integration: ContactIntegration,
+    /// Which of the sub-cycle's techniques a sub-cycled joint uses.
+    techniques: SubCycleTechniques,
     /// The sub-cycle's memory and buffers ([`ContactIntegration::SubCycled`]).
     cycle: CycleState,
 }
@@ -221,6 +223,11 @@ impl ClearanceJoint {
     /// How the contact is integrated ([`ContactIntegration`]).
     pub fn integration(&self) -> ContactIntegration {
         self.integration
+    }
+    /// Which of the sub-cycle's techniques the joint uses ([`SubCycleTechniques`]; read when
+    /// it is sub-cycled).
+    pub fn sub_cycle_techniques(&self) -> SubCycleTechniques {
+        self.techniques
     }
     /// A sub-cycled joint's states inside the last step, in time order, the step's end last
     /// (empty for an explicit joint, and before the first step): its contacts resolved where

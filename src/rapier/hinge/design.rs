@@ -108,6 +108,8 @@ pub struct HingeDesign {
     /// How the compliant planar joint integrates its contact (default
     /// [`ContactIntegration::Explicit`](crate::rapier::joint::ContactIntegration::Explicit)).
     pub(crate) integration: crate::rapier::joint::ContactIntegration,
+    /// Which of the sub-cycle's techniques a sub-cycled joint uses (default all).
+    pub(crate) techniques: crate::rapier::joint::SubCycleTechniques,
 }
 
 impl HingeDesign {
@@ -125,6 +127,7 @@ impl HingeDesign {
             model: ClearanceModel::Compliant,
             restitution: None,
             integration: crate::rapier::joint::ContactIntegration::Explicit,
+            techniques: crate::rapier::joint::SubCycleTechniques::default(),
         }
     }
 
@@ -213,6 +216,17 @@ impl HingeDesign {
         self
     }
 
+    /// Sets which of the sub-cycle's techniques a sub-cycled joint uses
+    /// ([`SubCycleTechniques`](crate::rapier::joint::SubCycleTechniques); default all, and
+    /// an explicit joint ignores them): one off gives the plainer method, for comparison.
+    pub fn sub_cycle_techniques(
+        mut self,
+        techniques: crate::rapier::joint::SubCycleTechniques,
+    ) -> Self {
+        self.techniques = techniques;
+        self
+    }
+
     /// Sets the name used in errors and reports.
     pub fn name(mut self, name: impl Into<String>) -> Self {
         self.name = Some(name.into());
@@ -288,7 +302,8 @@ impl HingeDesign {
             .min_impact_speed(self.min_impact_speed)
             .min_separation(self.min_separation)
             .lock(self.lock)
-            .integration(self.integration);
+            .integration(self.integration)
+            .sub_cycle_techniques(self.techniques);
         if let Some(depth) = self.max_valid_penetration {
             b = b.max_valid_penetration(depth);
         }

@@ -34,6 +34,7 @@ impl ClearanceJointBuilder {
                 prepared: false,
                 spatial: None,
                 integration: ContactIntegration::default(),
+                techniques: SubCycleTechniques::default(),
                 cycle: CycleState::default(),
             },
             spatial: None,
@@ -53,6 +54,12 @@ impl ClearanceJointBuilder {
     /// [`ContactIntegration::Explicit`]).
     pub(crate) fn integration(mut self, integration: ContactIntegration) -> Self {
         self.joint.integration = integration;
+        self
+    }
+    /// Which of the sub-cycle's techniques a sub-cycled joint uses ([`SubCycleTechniques`];
+    /// default all).
+    pub(crate) fn sub_cycle_techniques(mut self, techniques: SubCycleTechniques) -> Self {
+        self.joint.techniques = techniques;
         self
     }
     /// Hinge axis in body 2's frame (defaults to the axis given to [`new`](Self::new)).

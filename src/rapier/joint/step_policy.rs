@@ -33,8 +33,9 @@ const APPROACH_FRACTION: f64 = 0.5;
 /// motion; the factor balances the two error sources. The first-impact errors and steps it gives
 /// are the mechanism matrix's (docs/stepper-and-accuracy.md, `cargo bench --bench mechanisms`).
 pub const CONTACT_PERIODS_PER_TOLERANCE: f64 = 2.0;
-/// Margin on the damped stability limit used by the adaptive step.
-const STABILITY_SAFETY: f64 = 0.8;
+/// Margin on the damped stability limit used by the adaptive step (and by a sub-cycle's
+/// sub-steps with friction explicit).
+pub(super) const STABILITY_SAFETY: f64 = 0.8;
 /// The fraction of the damped stability limit one adaptive step in contact may cover, per unit
 /// of tolerance: `50 tol` (0.375 at the default 0.0075; at most 0.8, the margin kept on that
 /// limit). A heavily damped contact (damping ratio above about 4) relaxes at `2/limit`, and a step

@@ -272,6 +272,8 @@ pub struct ImpactRecorder {
     face_was_loaded: [bool; 2],
     face_time: f64,
     edge_time: f64,
+    /// Sub-steps recorded by [`record_step`](Self::record_step).
+    substeps: u64,
 }
 
 impl ImpactRecorder {
@@ -382,6 +384,7 @@ impl ImpactRecorder {
         before: &ContactObservation,
         substeps: &[crate::rapier::joint::SubStep],
     ) {
+        self.substeps += substeps.len() as u64;
         let Some((_, inside)) = substeps.split_last() else {
             self.record(t0, dt, before);
             return;
@@ -394,6 +397,13 @@ impl ImpactRecorder {
             t = s.t;
         }
         self.record(t0 + t, dt - t, &obs);
+    }
+
+    /// The sub-steps of the sub-cycled steps recorded so far by
+    /// [`record_step`](Self::record_step) (0 for an explicit joint): what a sub-cycled joint's
+    /// contacts cost beyond the world's steps.
+    pub fn substeps_recorded(&self) -> u64 {
+        self.substeps
     }
 
     /// Records a spatial joint's report at a state ([`ClearanceReport::spatial`]), which held

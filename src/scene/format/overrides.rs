@@ -251,6 +251,14 @@ enum Step {
 /// `restitution`, a clearance hinge's `journal_offset_mm`: skipped so that a scene written back reads as before), so that overrides can
 /// name them.
 fn with_skipped_defaults(root: &mut serde_json::Value) {
+    // `run.sub_cycle` is left out while all its techniques are on: written here so that an
+    // override can reach its switches (`run.sub_cycle.implicit_friction=false`).
+    if let Some(run) = root.get_mut("run").and_then(|r| r.as_object_mut()) {
+        run.entry("sub_cycle").or_insert_with(|| {
+            serde_json::to_value(crate::rapier::joint::SubCycleTechniques::default())
+                .unwrap_or(serde_json::Value::Null)
+        });
+    }
     let Some(hinges) = root.get_mut("hinges").and_then(|h| h.as_array_mut()) else {
         return;
     };

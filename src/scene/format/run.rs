@@ -65,6 +65,16 @@ pub struct RunSettings {
     /// implicitly; the step follows the slow motion).
     #[serde(default)]
     pub contact_integration: crate::rapier::joint::ContactIntegration,
+    /// Which of the sub-cycle's techniques the sub-cycled hinges use (default all on; e.g.
+    /// `--set run.sub_cycle.implicit_friction=false`): one off gives the plainer method, for
+    /// comparison ([`SubCycleTechniques`](crate::rapier::joint::SubCycleTechniques)). Read
+    /// only with `contact_integration: SubCycled`. Left out of the scene's written form while
+    /// all are on.
+    #[serde(
+        default,
+        skip_serializing_if = "crate::rapier::joint::SubCycleTechniques::all_on"
+    )]
+    pub sub_cycle: crate::rapier::joint::SubCycleTechniques,
 }
 
 pub use crate::rapier::pipeline::stepper::StepMode;
@@ -132,6 +142,7 @@ impl Default for RunSettings {
             body_motion: false,
             solver_sweeps: default_solver_sweeps(),
             contact_integration: Default::default(),
+            sub_cycle: Default::default(),
         }
     }
 }
@@ -162,6 +173,16 @@ impl RunSettings {
                     "must be 1 to {SWEEPS_MAX} Gauss-Seidel sweeps a step (got {})",
                     r.solver_sweeps
                 ),
+            ));
+        }
+        if !r.sub_cycle.all_on()
+            && r.contact_integration != crate::rapier::joint::ContactIntegration::SubCycled
+        {
+            // A switch that nothing reads would compare a run with itself.
+            return Err(Error::invalid(
+                "run.sub_cycle",
+                "switches the sub-cycle's techniques: read only with \
+                 run.contact_integration = SubCycled (here Explicit)",
             ));
         }
         if r.end_s / r.output_interval_s > MAX_ROWS {

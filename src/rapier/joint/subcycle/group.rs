@@ -310,9 +310,13 @@ pub(super) fn plan_group(
             for ((x, n), v) in a_free.iter_mut().zip(now).zip(start.velocity()) {
                 *x = (n - v) / kick;
             }
-            let stabilisation = start
-                .stabilisation(joint, bodies, &now, h, c_n)
-                .unwrap_or_default();
+            let stabilisation = if joint.techniques.stabilisation {
+                start
+                    .stabilisation(joint, bodies, &now, h, c_n)
+                    .unwrap_or_default()
+            } else {
+                Default::default()
+            };
             (a_free, stabilisation)
         })
         .collect();
@@ -344,10 +348,17 @@ pub(super) fn plan_group(
     let continuing: Vec<bool> = members
         .iter()
         .map(|j| {
-            j.cycle.substep_count > LONG_STEP_SUBSTEPS && j.cycle.impulse.iter().any(|x| *x != 0.0)
+            j.techniques.continuation
+                && j.cycle.substep_count > LONG_STEP_SUBSTEPS
+                && j.cycle.impulse.iter().any(|x| *x != 0.0)
         })
         .collect();
-    for _ in 0..CONTINUITY_PASSES {
+    let rounds = if members.iter().all(|j| j.techniques.continuity_rounds) {
+        CONTINUITY_PASSES
+    } else {
+        1
+    };
+    for _ in 0..rounds {
         for a in (0..group.len()).filter(|&a| continuing[a]) {
             let c = cycle(a, &held, &shift);
             let end = &members[a].report.state;

@@ -52,6 +52,7 @@
 mod group;
 mod pair;
 mod steps;
+mod techniques;
 #[cfg(test)]
 mod tests;
 
@@ -59,6 +60,7 @@ pub(crate) use group::plan_cycles;
 pub(crate) use pair::PairStart;
 pub(crate) use pair::{Pair12, axpy, mul, part, put, rotate};
 pub(crate) use steps::SubCycle;
+pub use techniques::SubCycleTechniques;
 
 use super::effective_mass::Mechanism;
 use super::{ClearanceJoint, ClearanceReport, ContactAhead};

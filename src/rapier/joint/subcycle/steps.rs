@@ -272,9 +272,41 @@ impl Cycle<'_> {
                 }
             }
         };
+        let s = if j.techniques.implicit_friction {
+            s
+        } else {
+            s.min(self.explicit_friction_step(here, history))
+        };
         let s = s.max(1e-9 * self.h);
         // No sliver of a last sub-step.
         if s >= 0.95 * left { left } else { s }
+    }
+
+    /// With friction explicit ([`SubCycleTechniques::implicit_friction`] off): the sub-step
+    /// within friction's stability limit near the slip at `here`, as the explicit joint's step
+    /// (`STABILITY_SAFETY x 2/(w_t F_N dmu/dv)`, 0.8 of the limit, `w_t` the slip's rate per unit of tangential load, `F_N`
+    /// the law's force at the state); unbounded out of contact.
+    ///
+    /// [`SubCycleTechniques::implicit_friction`]: super::SubCycleTechniques::implicit_friction
+    fn explicit_friction_step(&self, here: &Here, history: &ContactHistory) -> f64 {
+        let j = self.joint;
+        let st = &here.state;
+        if st.penetration <= 0.0 {
+            return f64::INFINITY;
+        }
+        let contact = NormalContact {
+            penetration: st.penetration,
+            penetration_rate: st.penetration_rate,
+            impact_rate: self.impact_rate(history, here).max(j.min_impact_speed),
+        };
+        let f_n = j.normal_law.normal_force(&contact).max(0.0);
+        let slope = super::super::friction_slope(&j.friction_law, st.slip.length());
+        let w_t = here.w[1][1].abs();
+        if f_n > 0.0 && slope > 0.0 && w_t > 0.0 {
+            super::super::step_policy::STABILITY_SAFETY * 2.0 / (w_t * f_n * slope)
+        } else {
+            f64::INFINITY
+        }
     }
 
     /// The sub-step after one of `s` that left `left` (s) of the step, from `here`: 0 when that
@@ -329,13 +361,24 @@ impl Cycle<'_> {
             let damping = law.damping_coefficient(&contact);
             let w = &here.w;
             let bs = beta * sigma_c;
+            let t = &self.joint.techniques;
             for _ in 0..50 {
                 // The normal force is affine in the rate (every law here): solved exactly.
                 let c0n = c_a[0] + beta * a[0] + bs * w[0][1] * f[1];
-                let f_n = ((elastic + damping * c0n) / (1.0 - damping * bs * w[0][0])).max(0.0);
+                let f_n = if t.implicit_damping {
+                    ((elastic + damping * c0n) / (1.0 - damping * bs * w[0][0])).max(0.0)
+                } else {
+                    // Explicit (for comparison): at the rate before the kick.
+                    (elastic + damping * c_a[0]).max(0.0)
+                };
                 let c0t = c_a[1] + beta * a[1] + bs * w[1][0] * f_n;
                 let k = bs * w[1][1] * f_n;
-                let slip = implicit_slip(&self.joint.friction_law, c0t, k);
+                let slip = if t.implicit_friction {
+                    implicit_slip(&self.joint.friction_law, c0t, k)
+                } else {
+                    // Explicit (for comparison): at the slip before the kick.
+                    c_a[1]
+                };
                 let f_t = -self.joint.friction_law.coefficient(slip.abs()) * f_n * slip.signum();
                 let change = (f_n - f[0]).abs() + (f_t - f[1]).abs();
                 f = [f_n, if slip == 0.0 { 0.0 } else { f_t }];

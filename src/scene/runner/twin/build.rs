@@ -222,12 +222,18 @@ fn build_hinges(
                 let a2 = a2 + Vector::from(h.journal_offset_mm) * 1e-3;
                 match settings.model {
                     ClearanceModel::Compliant => {
-                        let settings = settings.clone().integration(scene.run.contact_integration);
+                        let settings = settings
+                            .clone()
+                            .integration(scene.run.contact_integration)
+                            .sub_cycle_techniques(scene.run.sub_cycle);
                         let j = settings.joint(a1, a2, axis, axis)?;
                         HingeJoint::Clearance(world.insert_clearance(b1, b2, j)?)
                     }
                     ClearanceModel::Spatial(_) => {
-                        let settings = settings.clone().integration(scene.run.contact_integration);
+                        let settings = settings
+                            .clone()
+                            .integration(scene.run.contact_integration)
+                            .sub_cycle_techniques(scene.run.sub_cycle);
                         let j = settings.joint(a1, a2, axis, axis)?;
                         HingeJoint::Clearance(world.insert_clearance(b1, b2, j)?)
                     }

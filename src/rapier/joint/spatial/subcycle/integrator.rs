@@ -318,6 +318,15 @@ impl SpatialCycle<'_> {
     ) -> Slopes {
         let mut lx = [0.0; 144];
         let mut lv = [0.0; 144];
+        if !self.joint.techniques.implicit_spatial {
+            // A zero Jacobian (for comparison): ROS2 is then explicit.
+            return Slopes {
+                lx,
+                lv,
+                a: lx,
+                b: lv,
+            };
+        }
         // A velocity's step leaves the contacts where they are: read them once.
         let mut base_places = std::mem::take(&mut parts.base_places);
         self.read_places(parts, &mut base_places, x);
@@ -533,7 +542,13 @@ impl SpatialCycle<'_> {
             age += 1;
             let touching = contact_set(&here);
             let moved = changed(&here.load, &taken_at);
-            if t < self.h && (age >= JACOBIAN_AGE || touching != contacts || moved) {
+            // With the reuse off (for comparison) the Jacobian is retaken at every sub-step.
+            let max_age = if j.techniques.jacobian_reuse {
+                JACOBIAN_AGE
+            } else {
+                1
+            };
+            if t < self.h && (age >= max_age || touching != contacts || moved) {
                 slopes = self.slopes(parts, (&x, &v), &here.load, clocks);
                 (age, contacts, taken_at) = (0, touching, here.load);
             }

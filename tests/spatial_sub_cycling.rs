@@ -315,10 +315,10 @@ fn a_sub_cycled_cantilever_lists_the_contact_it_rests_in() {
 /// sub-steps' forces did (`ClearanceJoint::step_dissipation`), and the bodies' energy plus that
 /// work never grows (1e-9 of the energy's scale; the power at each world step's start held over
 /// the step made 1.5 % of it), the balance's error is the integration's (below 1e-3), and the
-/// work is the explicit joint's at the default tolerance within 1e-3 (0.031712 J against
+/// work is the explicit joint's at the default tolerance within 1e-3 (0.031718 J against
 /// 0.031720 J). With the damping off the energy never grows either; the integration's loss is
-/// 4.4e-2 of the scale at the default tolerance (ROS2 damps the edges' rocking it does not
-/// resolve; 4.1e-3 at the tolerance 0.001, the explicit joint's error 7.6e-3).
+/// 2.2e-2 of the scale at the default tolerance (ROS2 damps the edges' rocking it does not
+/// resolve; 4.9e-4 at the tolerance 0.001, the explicit joint's error 7.6e-3).
 #[test]
 fn a_sub_cycled_cantilever_balances_its_energy() {
     let read = |integration: &str, overrides: &[&str]| {

@@ -293,3 +293,35 @@ impl ClearanceJoint {
         result
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fixed body's block is zero, the other's a full symmetric mobility: the balancing load
+    /// undoes the acceleration the moving body can take (`P held = -a` there) and is zero on
+    /// the fixed body, whatever acceleration it is given.
+    #[test]
+    fn the_balancing_load_undoes_what_the_mobility_can_move() {
+        let mut p = [0.0; 144];
+        let block = [[0.5, 0.1, 0.0], [0.1, 0.7, 0.2], [0.0, 0.2, 0.9]];
+        for (r, c) in (0..6).flat_map(|r| (0..6).map(move |c| (r, c))) {
+            let v = if r / 3 == c / 3 {
+                block[r % 3][c % 3] * (1.0 + (r / 3) as f64)
+            } else {
+                0.0
+            };
+            p[(6 + r) * 12 + 6 + c] = v;
+        }
+        let a: Pair12 = std::array::from_fn(|i| (i as f64 * 0.7).sin());
+        let held = balancing_load(&p, &a);
+        let moved = mul(&p, &held);
+        for i in 0..12 {
+            if i < 6 {
+                assert!(held[i].abs() < 1e-12, "{held:?}");
+            } else {
+                assert!((moved[i] + a[i]).abs() < 1e-12, "{moved:?} against {a:?}");
+            }
+        }
+    }
+}

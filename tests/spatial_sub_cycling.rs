@@ -66,7 +66,9 @@ fn door_world(
 /// A door on one spatial pin, turned by a torque `tau` about the hinge that friction holds,
 /// comes to rest at world steps of 1 ms (one solver iteration) and of 1/60 s (Rapier's four) at
 /// the default tolerance, with its static balance by hand: the contact carries the weight
-/// (`F = m g` up, within 0.5 %) and the torque (its moment about the door's centre of mass is
+/// (`F = m g` up, within 0.02 %: the sub-cycle holds the weight's balance over the step, and
+/// ROS2 leaves no offset of the state's curvature on it; 19.627 N of 19.620 N at 1 ms without)
+/// and the torque (its moment about the door's centre of mass is
 /// `-tau` about the axis, within 0.5 % of `m g ARM`); the weight's moment about the pin,
 /// `m g ARM`, less the face's (its force at its resultant's distance from the axis: the tilted
 /// shoulder bears at its rim) is held by the bore's two edges as a couple,
@@ -107,7 +109,7 @@ fn a_door_rests_edge_loaded_and_friction_held_with_its_static_balance() {
             s.tilt,
             world.steps(),
         );
-        assert!((on_door.force - Vector::new(0.0, weight, 0.0)).length() < 5e-3 * weight);
+        assert!((on_door.force - Vector::new(0.0, weight, 0.0)).length() < 2e-4 * weight);
         let torque = on_door.torque + Vector::new(0.0, tau, 0.0);
         assert!(torque.length() < 5e-3 * weight * ARM, "{torque:?}");
         for f in s.edge_force {
@@ -315,10 +317,10 @@ fn a_sub_cycled_cantilever_lists_the_contact_it_rests_in() {
 /// sub-steps' forces did (`ClearanceJoint::step_dissipation`), and the bodies' energy plus that
 /// work never grows (1e-9 of the energy's scale; the power at each world step's start held over
 /// the step made 1.5 % of it), the balance's error is the integration's (below 1e-3), and the
-/// work is the explicit joint's at the default tolerance within 1e-3 (0.031712 J against
+/// work is the explicit joint's at the default tolerance within 1e-3 (0.031718 J against
 /// 0.031720 J). With the damping off the energy never grows either; the integration's loss is
-/// 4.4e-2 of the scale at the default tolerance (ROS2 damps the edges' rocking it does not
-/// resolve; 4.1e-3 at the tolerance 0.001, the explicit joint's error 7.6e-3).
+/// 2.2e-2 of the scale at the default tolerance (ROS2 damps the edges' rocking it does not
+/// resolve; 4.9e-4 at the tolerance 0.001, the explicit joint's error 7.6e-3).
 #[test]
 fn a_sub_cycled_cantilever_balances_its_energy() {
     let read = |integration: &str, overrides: &[&str]| {

@@ -13,7 +13,9 @@
 //! `dPi/dt = Gamma`, `dGamma/dt = L(x, v)`, `L` the four regions' load on the pair (every
 //! quadrature point's normal and friction force, as the explicit joint's). The delivery needs
 //! `Gamma(h)` and `Pi(h)`: they are the state, not a quadrature beside it, so the bodies land
-//! where the sub-steps put them.
+//! where the sub-steps put them. The integrator carries them beyond the load that balances the
+//! free acceleration, held over the step ([`SpatialCycle`]'s held load): at rest the state then
+//! bends by the load's change alone, which ROS2 tracks without an offset.
 //!
 //! **How.** A linearly implicit Rosenbrock method, ROS2 (Verwer et al. 1999: L-stable, second
 //! order for any Jacobian), with the linearly implicit Euler step as its embedded first-order
@@ -21,8 +23,9 @@
 //! coordinates the pair can move. The stiff terms (the loaded edges' and faces' stiffness, the
 //! damping, friction's slope near zero slip) are then integrated implicitly: at rest the
 //! sub-steps grow to the whole world step, and the tolerance, not stability, sets them. The
-//! sub-step follows the error estimate against the tolerance: positions against
-//! [`POSITION_SCALE`] of the clearance (angles against that over the journal's lever), velocities
+//! sub-step follows the error estimate against the tolerance: positions (of the centres of mass
+//! and of the bearing's and journal's centres) against [`POSITION_SCALE`] of the clearance
+//! (angles against that over the journal's lever), velocities
 //! relative to themselves plus [`VELOCITY_SCALE`]. A contact's onset makes the force bend; the
 //! estimate grows there and the sub-steps shrink onto it.
 //!
@@ -81,6 +84,66 @@ fn changed(now: &Pair12, then: &Pair12) -> bool {
 /// The load's relative change after which the Jacobian is retaken: a tenth, since the error
 /// estimate, not the Jacobian, holds the sub-step's accuracy.
 const JACOBIAN_DRIFT: f64 = 0.1;
+
+/// The load that holds the pair against the acceleration `a` through the mobility `p`:
+/// `-P+ a`, `P+` the pseudo-inverse of the symmetric mobility (its eigenvalues below 1e-9 of the
+/// largest, the directions the pair cannot move, left out). A pair at rest carries it (the
+/// door: its weight), and the sub-cycle holds it over the step ([`SpatialCycle`]).
+fn balancing_load(p: &Square, a: &Pair12) -> Pair12 {
+    // Jacobi's rotations diagonalise the symmetric part: `m = V D V^T`.
+    let mut m: Square = std::array::from_fn(|i| 0.5 * (p[i] + p[(i % 12) * 12 + i / 12]));
+    let mut v: Square = std::array::from_fn(|i| if i / 12 == i % 12 { 1.0 } else { 0.0 });
+    for _sweep in 0..30 {
+        let off: f64 = (0..144)
+            .filter(|i| i / 12 != i % 12)
+            .map(|i| m[i] * m[i])
+            .sum();
+        let diag: f64 = (0..12).map(|i| m[i * 13] * m[i * 13]).sum();
+        if !(off > 1e-30 * diag) {
+            break;
+        }
+        for r in 0..12 {
+            for c in r + 1..12 {
+                let mrc = m[r * 12 + c];
+                if mrc == 0.0 {
+                    continue;
+                }
+                let theta = 0.5 * (m[c * 13] - m[r * 13]) / mrc;
+                let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+                let t = if theta == 0.0 { 1.0 } else { t };
+                let (cos, sin) = (1.0 / (t * t + 1.0).sqrt(), t / (t * t + 1.0).sqrt());
+                for k in 0..12 {
+                    let (a, b) = (m[k * 12 + r], m[k * 12 + c]);
+                    m[k * 12 + r] = cos * a - sin * b;
+                    m[k * 12 + c] = sin * a + cos * b;
+                }
+                for k in 0..12 {
+                    let (a, b) = (m[r * 12 + k], m[c * 12 + k]);
+                    m[r * 12 + k] = cos * a - sin * b;
+                    m[c * 12 + k] = sin * a + cos * b;
+                }
+                for k in 0..12 {
+                    let (a, b) = (v[k * 12 + r], v[k * 12 + c]);
+                    v[k * 12 + r] = cos * a - sin * b;
+                    v[k * 12 + c] = sin * a + cos * b;
+                }
+            }
+        }
+    }
+    let largest = (0..12).map(|i| m[i * 13].abs()).fold(0.0, f64::max);
+    let mut out = [0.0; 12];
+    for e in 0..12 {
+        let d = m[e * 13];
+        if !(d.abs() > 1e-9 * largest) {
+            continue;
+        }
+        let along: f64 = (0..12).map(|k| v[k * 12 + e] * a[k]).sum();
+        for (k, o) in out.iter_mut().enumerate() {
+            *o -= v[k * 12 + e] * along / d;
+        }
+    }
+    out
+}
 
 /// ROS2's `gamma = 1 + 1/sqrt(2)` (L-stable).
 const GAMMA: f64 = 1.0 + std::f64::consts::FRAC_1_SQRT_2;
@@ -162,7 +225,7 @@ impl ClearanceJoint {
             impact_rate: p.impact_rate,
         });
         let mut run = std::mem::take(&mut self.cycle.run);
-        let cycle = SpatialCycle::new(self, &start, (u0, a_free), h, pass.tolerance);
+        let mut cycle = SpatialCycle::new(self, &start, (u0, a_free), h, pass.tolerance);
         let before = (self.contact, &self.report.state);
         let guess = self.cycle.substep_guess;
         let last = cycle.run(&mut parts, before, &mut clocks, guess, &mut run);
@@ -228,5 +291,37 @@ impl ClearanceJoint {
         self.elastic = std::sync::OnceLock::new();
         self.cycle.adopt_run(held);
         result
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fixed body's block is zero, the other's a full symmetric mobility: the balancing load
+    /// undoes the acceleration the moving body can take (`P held = -a` there) and is zero on
+    /// the fixed body, whatever acceleration it is given.
+    #[test]
+    fn the_balancing_load_undoes_what_the_mobility_can_move() {
+        let mut p = [0.0; 144];
+        let block = [[0.5, 0.1, 0.0], [0.1, 0.7, 0.2], [0.0, 0.2, 0.9]];
+        for (r, c) in (0..6).flat_map(|r| (0..6).map(move |c| (r, c))) {
+            let v = if r / 3 == c / 3 {
+                block[r % 3][c % 3] * (1.0 + (r / 3) as f64)
+            } else {
+                0.0
+            };
+            p[(6 + r) * 12 + 6 + c] = v;
+        }
+        let a: Pair12 = std::array::from_fn(|i| (i as f64 * 0.7).sin());
+        let held = balancing_load(&p, &a);
+        let moved = mul(&p, &held);
+        for i in 0..12 {
+            if i < 6 {
+                assert!(held[i].abs() < 1e-12, "{held:?}");
+            } else {
+                assert!((moved[i] + a[i]).abs() < 1e-12, "{moved:?} against {a:?}");
+            }
+        }
     }
 }

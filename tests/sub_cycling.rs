@@ -7,6 +7,10 @@ use clearance_joint::model::laws::{Coulomb, FrictionModel};
 use clearance_joint::prelude::*;
 use rapier3d_f64::prelude::*;
 
+#[path = "support/turning_arm.rs"]
+mod turning_arm;
+use turning_arm::turning_arm;
+
 const G: f64 = 9.81;
 /// The journal's mass, kg, and its bearing: radius 10 mm, clearance 0.2 mm, width 16 mm.
 const MASS: f64 = 2.0;
@@ -503,47 +507,14 @@ fn a_sub_cycled_chain_sharing_its_bodies_keeps_momentum_and_energy() {
 /// Rapier's state instead, the arms leave the physical range within a second.
 #[test]
 fn an_undamped_pin_on_a_turning_arm_gains_no_energy_at_game_steps() {
-    use clearance_joint::model::laws::{BearingGeometry, Hertz, NormalModel};
+    use clearance_joint::model::laws::{Hertz, NormalModel};
     use rapier3d_f64::utils::AngularInertiaOps;
-    let (k_hertz, clearance, tau) = (1e10, 0.1e-3, 2.0);
+    // The shared arm's pin: 0.1 mm of clearance, turned by 2 N m.
+    let (k_hertz, tau) = (1e10, 2.0);
     for (dt, iterations) in [(1.0 / 60.0, 4), (1e-3, 1)] {
-        let mut rapier = PhysicsWorld::new();
-        rapier.gravity = Vector::ZERO;
-        rapier.integration_parameters.num_solver_iterations = iterations;
-        let mut world = ClearanceWorld::new(rapier, StepControl::fixed(dt));
-        let base = world.rapier.bodies.insert(RigidBodyBuilder::fixed());
-        let link = |world: &mut ClearanceWorld, mass: f64, length: f64, start: f64| {
-            let j = mass * length * length / 12.0;
-            world.rapier.bodies.insert(
-                RigidBodyBuilder::dynamic()
-                    .translation(Vector::new(start + 0.5 * length, 0.0, 0.0))
-                    .additional_mass_properties(MassProperties::new(
-                        Vector::ZERO,
-                        mass,
-                        Vector::new(0.1 * j, j, j),
-                    ))
-                    .can_sleep(false),
-            )
-        };
-        let upper = link(&mut world, 2.0, 0.4, 0.0);
-        let lower = link(&mut world, 1.0, 0.3, 0.4);
-        let pivot = RevoluteJointBuilder::new(Vector::Z)
-            .local_anchor2(Vector::new(-0.2, 0.0, 0.0))
-            .contacts_enabled(false);
-        world.rapier.impulse_joints.insert(base, upper, pivot, true);
         let hertz = NormalModel::Hertz(Hertz::new(k_hertz, 1.5).unwrap());
-        let geometry = BearingGeometry::new(0.006, 0.006 - clearance, 0.012).unwrap();
-        let pin = HingeDesign::new(geometry, hertz)
-            .integration(ContactIntegration::SubCycled)
-            .joint(
-                Vector::new(0.2, 0.0, 0.0),
-                Vector::new(-0.15, 0.0, 0.0),
-                Vector::Z,
-                Vector::Z,
-            )
-            .unwrap();
-        let pin = world.insert_clearance(upper, lower, pin).unwrap();
-        world.rapier.bodies[upper].add_torque(Vector::new(0.0, 0.0, tau), true);
+        let (mut world, [upper, lower], pin) =
+            turning_arm(hertz, dt, iterations, SubCycleTechniques::default(), false);
         // The bodies' velocities at a state: the Verlet reading of Rapier's velocities around
         // it (the mean of the steps' before and after it, at fixed steps) plus what the pin's
         // sub-cycle still holds there (`start_velocity_correction`).

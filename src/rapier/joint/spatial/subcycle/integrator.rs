@@ -1,6 +1,7 @@
-//! The spatial sub-cycle's integrator: each region's clock, the load and its Jacobian, the
+//! The spatial sub-cycle's integrator: each region's clock, the load, the
 //! linearly implicit Rosenbrock step ([`SpatialCycle`]).
 
+use super::factor::{Factor, Impulses, Slopes};
 use super::*;
 
 /// One region's memory inside the sub-cycle.
@@ -46,87 +47,6 @@ impl Eval {
     }
 }
 
-/// The sub-cycle's state: `Pi` and `Gamma` beyond the held load's (`Q` and `G` of
-/// [`SpatialCycle`]'s held load).
-#[derive(Clone, Copy, Debug, Default)]
-pub(super) struct Impulses {
-    pub(super) pi: Pair12,
-    pub(super) gamma: Pair12,
-}
-
-/// The Jacobian of the load: `dL/dx`, `dL/dv` (over the pair's coordinates) and the same through
-/// the mobility, `A = dL/dx P`, `B = dL/dv P`.
-pub(super) struct Slopes {
-    pub(super) lx: Square,
-    pub(super) lv: Square,
-    pub(super) a: Square,
-    pub(super) b: Square,
-}
-
-/// An LU factorisation of `I - gamma s B - (gamma s)^2 A` with its row order.
-pub(super) struct Factor {
-    pub(super) lu: Square,
-    pub(super) order: [usize; 12],
-    pub(super) gs: f64,
-}
-
-impl Factor {
-    /// `None` when the matrix is singular (the sub-step is then halved).
-    pub(super) fn of(slopes: &Slopes, s: f64) -> Option<Self> {
-        let gs = GAMMA * s;
-        let mut m: Square = std::array::from_fn(|i| {
-            let id = if i / 12 == i % 12 { 1.0 } else { 0.0 };
-            id - gs * slopes.b[i] - gs * gs * slopes.a[i]
-        });
-        let mut order: [usize; 12] = std::array::from_fn(|i| i);
-        for col in 0..12 {
-            let pivot = (col..12)
-                .max_by(|&x, &y| m[x * 12 + col].abs().total_cmp(&m[y * 12 + col].abs()))
-                .unwrap_or(col);
-            if !(m[pivot * 12 + col].abs() > 0.0) {
-                return None;
-            }
-            if pivot != col {
-                for c in 0..12 {
-                    m.swap(col * 12 + c, pivot * 12 + c);
-                }
-                order.swap(col, pivot);
-            }
-            let d = m[col * 12 + col];
-            for r in col + 1..12 {
-                let f = m[r * 12 + col] / d;
-                m[r * 12 + col] = f;
-                for c in col + 1..12 {
-                    m[r * 12 + c] -= f * m[col * 12 + c];
-                }
-            }
-        }
-        Some(Factor { lu: m, order, gs })
-    }
-
-    /// `(I - gamma s J) k = r` for the system `dPi/dt = Gamma`, `dGamma/dt = L`:
-    /// `k_Gamma = M^-1 (r_Gamma + gamma s A r_Pi)`, `k_Pi = r_Pi + gamma s k_Gamma`.
-    pub(super) fn solve(&self, slopes: &Slopes, r: &Impulses) -> Impulses {
-        let mut rhs = r.gamma;
-        axpy(&mut rhs, self.gs, &mul(&slopes.a, &r.pi));
-        let mut x: Pair12 = std::array::from_fn(|i| rhs[self.order[i]]);
-        for i in 0..12 {
-            for c in 0..i {
-                x[i] -= self.lu[i * 12 + c] * x[c];
-            }
-        }
-        for i in (0..12).rev() {
-            for c in i + 1..12 {
-                x[i] -= self.lu[i * 12 + c] * x[c];
-            }
-            x[i] /= self.lu[i * 12 + i];
-        }
-        let mut pi = r.pi;
-        axpy(&mut pi, self.gs, &x);
-        Impulses { pi, gamma: x }
-    }
-}
-
 /// What the spatial sub-cycle integrates over one world step of `h` (s) from the pair's state
 /// `start`, with the velocity `u0` at the state, under the rest of the world's acceleration
 /// `a_free`.
@@ -136,10 +56,10 @@ impl Factor {
 /// `Pi = Q + held t^2/2`; ROS2 integrates `(Q, G)`, whose rate is `L - held`, and `held`'s
 /// impulse goes into the reference motion with the free acceleration (an exact change of
 /// variables). ROS2's stage order is one: in a stiff direction it tracks its state with an
-/// offset of about `0.35 s^2` times the state's curvature. On `Pi` itself that curvature is the
-/// whole load, the weight included: a resting door's contacts sat off their balance by it (its
-/// face's share of the weight 0.5 % low at the default tolerance), and the embedded estimate (the
-/// first-order member failing to carry the weight) set its sub-steps at rest. `held` follows the
+/// offset of about `0.35 s^2` times the state's curvature. On `Pi` itself that curvature would
+/// be the whole load, the weight included: a resting door's contacts would sit off their balance
+/// by it (its face's share of the weight 0.5 % low at the default tolerance), and the embedded
+/// estimate (the first-order member failing to carry the weight) would set its sub-steps at rest. `held` follows the
 /// free acceleration, not the contact, so it moves smoothly from step to step.
 pub(super) struct SpatialCycle<'a> {
     pub(super) joint: &'a ClearanceJoint,

@@ -184,6 +184,7 @@ impl SpatialStart {
     }
 }
 
+mod factor;
 mod integrator;
 
 use integrator::{Eval, RegionClock, SpatialCycle};

@@ -9,7 +9,7 @@ use rapier3d_f64::prelude::*;
 
 #[path = "support/turning_arm.rs"]
 mod turning_arm;
-use turning_arm::turning_arm;
+use turning_arm::{penetrations, turning_arm};
 
 const G: f64 = 9.81;
 /// The journal's mass, kg, and its bearing: radius 10 mm, clearance 0.2 mm, width 16 mm.
@@ -302,13 +302,7 @@ fn a_pin_on_a_turning_arm_ends_each_step_where_its_sub_cycle_put_it() {
     let (mut compared, mut worst) = (0, 0.0f64);
     while world.time() < 0.3 {
         world.step(0.3).unwrap();
-        let j = world.clearance.get(pin).unwrap();
-        let reported = j.report().state.penetration;
-        let bodies = &world.rapier.bodies;
-        let (b1, b2) = (&bodies[upper], &bodies[lower]);
-        let d = *b2.position() * j.local_anchor2() - *b1.position() * j.local_anchor1();
-        let axis = *b1.rotation() * j.local_axis1();
-        let posed = (d - d.dot(axis) * axis).length() - j.geometry().clearance();
+        let (reported, posed) = penetrations(&world, [upper, lower], pin);
         if reported > 0.0 || posed > 0.0 {
             compared += 1;
             let off = (posed - reported).abs() / reported.abs().max(posed.abs()).max(1e-7);

@@ -12,7 +12,7 @@ use rapier3d_f64::utils::AngularInertiaOps;
 
 #[path = "support/turning_arm.rs"]
 mod turning_arm;
-use turning_arm::turning_arm;
+use turning_arm::{penetrations, turning_arm};
 
 /// A 2 kg journal hanging in a fixed bearing (radius 10 mm, clearance 0.2 mm, the improved law,
 /// Coulomb friction 0.3 regularised over 1e-6 m/s), turned by 0.0196 N m (friction holds it),
@@ -72,13 +72,7 @@ fn end_mismatch(techniques: SubCycleTechniques) -> f64 {
     let mut worst = 0.0f64;
     while world.time() < 0.3 {
         world.step(0.3).unwrap();
-        let j = world.clearance.get(pin).unwrap();
-        let reported = j.report().state.penetration;
-        let bodies = &world.rapier.bodies;
-        let (b1, b2) = (&bodies[upper], &bodies[lower]);
-        let d = *b2.position() * j.local_anchor2() - *b1.position() * j.local_anchor1();
-        let axis = *b1.rotation() * j.local_axis1();
-        let posed = (d - d.dot(axis) * axis).length() - j.geometry().clearance();
+        let (reported, posed) = penetrations(&world, [upper, lower], pin);
         if reported > 0.0 || posed > 0.0 {
             let off = (posed - reported).abs() / reported.abs().max(posed.abs()).max(1e-7);
             worst = worst.max(off);

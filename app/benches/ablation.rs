@@ -270,29 +270,6 @@ fn guarded(case: &Case, stepping: Stepping, end: f64, start: f64, cap: f64) -> O
     })
 }
 
-fn sig(x: f64) -> String {
-    if !x.is_finite() {
-        return "-".into();
-    }
-    let a = x.abs();
-    if a == 0.0 {
-        "0".into()
-    } else if !(1e-3..1e5).contains(&a) {
-        format!("{x:.3e}")
-    } else {
-        let digits = (4 - 1 - a.log10().floor() as i32).max(0) as usize;
-        format!("{x:.digits$}")
-    }
-}
-
-fn pct(x: f64) -> String {
-    if x.is_finite() {
-        format!("{:+.2} %", 100.0 * x)
-    } else {
-        "-".into()
-    }
-}
-
 fn guards(o: &Outcome) -> String {
     match &o.error {
         Some(e) => {

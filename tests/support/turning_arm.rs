@@ -67,3 +67,22 @@ pub fn turning_arm(
     world.rapier.bodies[upper].add_torque(Vector::new(0.0, 0.0, 2.0), true);
     (world, [upper, lower], pin)
 }
+
+/// The pin's penetration as its last sub-step reported it, and at Rapier's poses of `bodies`
+/// (bearing side first) at the step's end, m.
+pub fn penetrations(
+    world: &ClearanceWorld,
+    bodies: [RigidBodyHandle; 2],
+    pin: ClearanceJointHandle,
+) -> (f64, f64) {
+    let j = world.clearance.get(pin).unwrap();
+    let reported = j.report().state.penetration;
+    let (b1, b2) = (
+        &world.rapier.bodies[bodies[0]],
+        &world.rapier.bodies[bodies[1]],
+    );
+    let d = *b2.position() * j.local_anchor2() - *b1.position() * j.local_anchor1();
+    let axis = *b1.rotation() * j.local_axis1();
+    let posed = (d - d.dot(axis) * axis).length() - j.geometry().clearance();
+    (reported, posed)
+}

@@ -578,3 +578,28 @@ pub fn new_violations(run: &Outcome, converged: &Outcome) -> Vec<String> {
         .map(|v| v.to_string())
         .collect()
 }
+
+/// `x` to four significant digits (scientific outside 1e-3..1e5), `-` when not finite.
+pub fn sig(x: f64) -> String {
+    if !x.is_finite() {
+        return "-".into();
+    }
+    let a = x.abs();
+    if a == 0.0 {
+        "0".into()
+    } else if !(1e-3..1e5).contains(&a) {
+        format!("{x:.3e}")
+    } else {
+        let digits = (4 - 1 - a.log10().floor() as i32).max(0) as usize;
+        format!("{x:.digits$}")
+    }
+}
+
+/// `x` as a signed percentage with two decimals, `-` when not finite.
+pub fn pct(x: f64) -> String {
+    if x.is_finite() {
+        format!("{:+.2} %", 100.0 * x)
+    } else {
+        "-".into()
+    }
+}

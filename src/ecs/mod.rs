@@ -76,7 +76,7 @@
 //! let pivot = world
 //!     .spawn((
 //!         Hinge::new(base, arm, Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0)),
-//!         // Was: IdealHinge,
+//!         // In place of: IdealHinge,
 //!         ClearanceHinge(HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)?),
 //!     ))
 //!     .id();

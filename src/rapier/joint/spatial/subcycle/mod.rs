@@ -185,6 +185,7 @@ impl SpatialStart {
 }
 
 mod factor;
+mod impact;
 mod integrator;
 
 use integrator::{Eval, RegionClock, SpatialCycle};
@@ -224,6 +225,7 @@ impl ClearanceJoint {
             history: p.contact,
             state: p.state,
             impact_rate: p.impact_rate,
+            impact: p.impact,
         });
         let mut run = std::mem::take(&mut self.cycle.run);
         let mut cycle = SpatialCycle::new(self, &start, (u0, a_free), h, pass.tolerance);
@@ -234,6 +236,7 @@ impl ClearanceJoint {
             patch.contact = clock.history;
             patch.state = clock.state;
             patch.impact_rate = clock.impact_rate;
+            patch.impact = clock.impact;
         }
         self.spatial = Some(parts);
         self.cycle.substep_guess = last;

@@ -200,7 +200,10 @@ mod tests {
             v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
             time += h;
         }
-        assert!((time / johnson - 1.0).abs() < 1e-3, "{time} against {johnson}");
+        assert!(
+            (time / johnson - 1.0).abs() < 1e-3,
+            "{time} against {johnson}"
+        );
         assert!((time / t - 0.641).abs() < 1e-3, "{time} over {t}");
         assert_eq!(contact_period(&hertz, m, 0.0, 0.0, 0.0), f64::INFINITY);
     }

@@ -472,11 +472,17 @@ impl SpatialCycle<'_> {
                 }
                 continue;
             }
-            count += 1;
-            accepted = step;
             let t_next = if step == left { self.h } else { t + step };
             let (x, v) = self.kinematics(t_next, &next);
             let at = self.eval(parts, &x, &v, clocks);
+            if step > floor && count < MAX_SUBSTEPS {
+                if let Some(shorter) = self.onset_retry(parts, &x, (&here, &at), clocks, step) {
+                    s = shorter;
+                    continue;
+                }
+            }
+            count += 1;
+            accepted = step;
             out.dissipated += 0.5 * step * (here.dissipation + at.dissipation);
             self.advance(clocks, &at.states, step);
             let state = at.states[at.deepest()];

@@ -232,11 +232,11 @@ impl ClearanceJoint {
         let before = (self.contact, &self.report.state);
         let guess = self.cycle.substep_guess;
         let last = cycle.run(&mut parts, before, &mut clocks, guess, &mut run);
+        self.cycle.spatial_impacts = clocks.map(|c| c.impact);
         for (patch, clock) in parts.patches.iter_mut().zip(clocks) {
             patch.contact = clock.history;
             patch.state = clock.state;
             patch.impact_rate = clock.impact_rate;
-            patch.impact = clock.impact;
         }
         self.spatial = Some(parts);
         self.cycle.substep_guess = last;
@@ -279,6 +279,10 @@ impl ClearanceJoint {
         self.contact = self.cycle.run.history;
         self.report.state = end.state;
         let result = self.evaluate_regions(&mut parts, &pose, [&m1, &m2], &pair, [0.0, 0.0]);
+        // The regions' impact clocks go on from the sub-cycle's end into the next step.
+        for (patch, impact) in parts.patches.iter_mut().zip(self.cycle.spatial_impacts) {
+            patch.impact = impact;
+        }
         self.spatial = Some(parts);
         // The step's last sub-step is the state reported here, and the readers of the step
         // (`ImpactRecorder::record_step`, the runner) take its onset from this report: the

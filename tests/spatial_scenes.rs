@@ -182,9 +182,9 @@ fn spatial_panel_runs_clean_and_tilts() {
 
 /// The spatial panel's first impact (at 0.0875 s) sub-cycled at the default tolerance against
 /// the explicit joint at fixed 2e-6 s steps (178.188 N; 178.194 N at 5e-7 s): within 1 %. The
-/// sub-steps of an impact are bounded to `tol` of the contact's period (measured 177.715 N,
-/// -0.27 %); bounded by ROS2's error estimate alone, its L-stable damping took the peak 2.5 % low
-/// (173.667 N).
+/// sub-steps of an impact are bounded to `tol` of the contact's period (measured 177.914 N,
+/// -0.15 %); bounded by ROS2's error estimate alone, its L-stable damping took the peak 3.2 % low
+/// over this span (172.551 N).
 #[test]
 fn spatial_panel_first_impact_sub_cycled_matches_the_explicit_joint() {
     let first = |overrides: &[&str]| {

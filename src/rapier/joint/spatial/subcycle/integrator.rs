@@ -475,11 +475,12 @@ impl SpatialCycle<'_> {
             let t_next = if step == left { self.h } else { t + step };
             let (x, v) = self.kinematics(t_next, &next);
             let at = self.eval(parts, &x, &v, clocks);
-            if step > floor && count < MAX_SUBSTEPS {
-                if let Some(shorter) = self.onset_retry(parts, &x, (&here, &at), clocks, step) {
-                    s = shorter;
-                    continue;
-                }
+            if step > floor
+                && count < MAX_SUBSTEPS
+                && let Some(shorter) = self.onset_retry(parts, &x, (&here, &at), clocks, step)
+            {
+                s = shorter;
+                continue;
             }
             count += 1;
             accepted = step;

@@ -27,7 +27,10 @@
 //! and of the bearing's and journal's centres) against [`POSITION_SCALE`] of the clearance
 //! (angles against that over the journal's lever), velocities
 //! relative to themselves plus [`VELOCITY_SCALE`]. A contact's onset makes the force bend; the
-//! estimate grows there and the sub-steps shrink onto it.
+//! estimate grows there and the sub-steps shrink onto it. From a region's onset, for one period
+//! of its contact, the sub-steps are also bounded to `tol` of that period, and a sub-step across
+//! the touch is held to that size (`impact`): ROS2's damping of an oscillation it does not
+//! resolve is not what its estimate measures.
 //!
 //! **Memory.** Each region's contact history (onset, `delta_dot0` at the crossing) advances at
 //! every accepted sub-step, as the joint's own (the deepest region's). A region in contact keeps

@@ -260,8 +260,8 @@ fn cantilever(integration: &str, overrides: &[&str]) -> RunResult {
 /// end reports. The list's largest force and deepest penetration are the hinge's over the run,
 /// its durations add up to the time in contact, its last contact lasts to the end, and its
 /// window after 25 ms (the contact the shaft rests in) matches the explicit joint's at the
-/// default tolerance (largest force and deepest penetration within 1 %: 203.50 N and 30.718 um
-/// against 203.46 N and 30.720 um).
+/// default tolerance (largest force and deepest penetration within 1 %: 203.460 N and 30.7202 um
+/// against 203.463 N and 30.7204 um).
 #[test]
 fn a_sub_cycled_cantilever_lists_the_contact_it_rests_in() {
     let (end, window) = (0.05, 0.025);
@@ -319,8 +319,8 @@ fn a_sub_cycled_cantilever_lists_the_contact_it_rests_in() {
 /// the step made 1.5 % of it), the balance's error is the integration's (below 1e-3), and the
 /// work is the explicit joint's at the default tolerance within 1e-3 (0.031718 J against
 /// 0.031720 J). With the damping off the energy never grows either; the integration's loss is
-/// 2.2e-2 of the scale at the default tolerance (ROS2 damps the edges' rocking it does not
-/// resolve; 4.9e-4 at the tolerance 0.001, the explicit joint's error 7.6e-3).
+/// 2.3e-2 of the scale at the default tolerance (ROS2 damps the edges' rocking it does not
+/// resolve; 4.8e-4 at the tolerance 0.001, the explicit joint's error 7.6e-3).
 #[test]
 fn a_sub_cycled_cantilever_balances_its_energy() {
     let read = |integration: &str, overrides: &[&str]| {

@@ -147,6 +147,9 @@ struct CycleState {
     spatial_start: Option<spatial::subcycle::SpatialStart>,
     /// A spatial joint's last accepted sub-step, s: the next step's first guess (0: none).
     substep_guess: f64,
+    /// A spatial joint's regions' impact clocks at the sub-cycle's end, for the evaluation at
+    /// the step's end (Rapier's pass 1 starts from the regions as pass 0 found them).
+    spatial_impacts: [Option<f64>; 4],
 }
 
 /// The dynamic state of a joint between steps (what a rejected step must restore).

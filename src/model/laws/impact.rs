@@ -62,6 +62,30 @@ pub fn impact_restitution(
     0.0
 }
 
+/// The natural period (s) of a contact of `law` that moves `effective_mass` (kg) along its
+/// normal, now `depth` deep (m) storing `elastic_energy` (J) and moving at `speed` (m/s) along
+/// the normal: `2 pi sqrt(m/k)`, `k` the law's tangent stiffness at the deepest point its energy
+/// (`1/2 m speed^2` plus the stored) reaches, the contact's stiffest point on the way (the
+/// adaptive step's, `ContactAhead::resolving_step`). Exact for a linear law; for Hertz's
+/// `K delta^(3/2)` the impact from first touch to separation lasts 0.641 of it (Johnson's
+/// `2.943 delta_max/v0`): an impact is over within one such period. Infinite without stiffness.
+pub fn contact_period(
+    law: &impl NormalForceLaw,
+    effective_mass: f64,
+    speed: f64,
+    depth: f64,
+    elastic_energy: f64,
+) -> f64 {
+    let m = effective_mass;
+    let energy = 0.5 * m * speed * speed + elastic_energy.max(0.0);
+    let peak = penetration_for_energy(law, energy, 1e-6).max(depth);
+    let stiffness = law.tangent_stiffness(peak);
+    if !(stiffness > 0.0 && m > 0.0) {
+        return f64::INFINITY;
+    }
+    std::f64::consts::TAU * (m / stiffness).sqrt()
+}
+
 /// The impact speed that would bring a contact of `effective_mass` (kg) to a depth storing
 /// `elastic_energy` (J): `sqrt(2 E/m)`, m/s.
 ///
@@ -145,5 +169,42 @@ mod tests {
         assert_eq!(impact_restitution(&law, 0.0, 0.05), 0.0);
         assert_eq!(impact_restitution(&law, 5.0, -1.0), 0.0);
         assert_eq!(impact_restitution(&law, f64::NAN, 1.0), 0.0);
+    }
+
+    /// The period against closed forms on a single knock: a linear law's `2 pi sqrt(m/k)`
+    /// whatever the speed; Hertz's impact (an RK4 integration from touch to separation, as
+    /// `impact_restitution`'s) lasts Johnson's `2.943 delta_max/v0`, 0.641 of the period.
+    #[test]
+    fn the_contact_period_matches_a_single_knock() {
+        let (m, k) = (2.0, 2.3e9);
+        let linear = Hertz::new(k, 1.0).unwrap();
+        let exact = std::f64::consts::TAU * (m / k).sqrt();
+        for (speed, depth) in [(0.1, 0.0), (0.01, 0.0), (0.0, 1e-6)] {
+            let elastic = linear.elastic_energy(depth);
+            let t = contact_period(&linear, m, speed, depth, elastic);
+            assert!((t / exact - 1.0).abs() < 1e-9, "{t} against {exact}");
+        }
+        let (kh, v0) = (1e9, 0.1);
+        let hertz = Hertz::new(kh, 1.5).unwrap();
+        let t = contact_period(&hertz, m, v0, 0.0, 0.0);
+        let deepest = (2.5 * 0.5 * m * v0 * v0 / kh).powf(0.4);
+        let johnson = 2.943 * deepest / v0;
+        let (mut x, mut v, mut time, h) = (0.0_f64, v0, 0.0, 1e-8);
+        let accel = |x: f64| -kh * x.max(0.0).powf(1.5) / m;
+        while x >= 0.0 {
+            let (k1x, k1v) = (v, accel(x));
+            let (k2x, k2v) = (v + 0.5 * h * k1v, accel(x + 0.5 * h * k1x));
+            let (k3x, k3v) = (v + 0.5 * h * k2v, accel(x + 0.5 * h * k2x));
+            let (k4x, k4v) = (v + h * k3v, accel(x + h * k3x));
+            x += h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+            v += h / 6.0 * (k1v + 2.0 * k2v + 2.0 * k3v + k4v);
+            time += h;
+        }
+        assert!(
+            (time / johnson - 1.0).abs() < 1e-3,
+            "{time} against {johnson}"
+        );
+        assert!((time / t - 0.641).abs() < 1e-3, "{time} over {t}");
+        assert_eq!(contact_period(&hertz, m, 0.0, 0.0, 0.0), f64::INFINITY);
     }
 }

@@ -12,7 +12,9 @@ mod normal;
 mod step;
 
 pub use friction::*;
-pub use impact::{crossing_fraction, impact_restitution, loaded_impact_rate, speed_at_crossing};
+pub use impact::{
+    contact_period, crossing_fraction, impact_restitution, loaded_impact_rate, speed_at_crossing,
+};
 pub use material::*;
 pub use normal::*;
 pub use step::step;

@@ -39,6 +39,9 @@ pub(super) struct Patch {
     /// without one): the rates its contact is carried from (the planar joint's `contact_rate`).
     moved: f64,
     moved_before: f64,
+    /// The time since the onset of the region's impact inside the sub-cycle (s), while its
+    /// sub-steps resolve it (`subcycle::impact`); `None` out of one.
+    impact: Option<f64>,
 }
 
 impl Patch {
@@ -52,6 +55,7 @@ impl Patch {
             rate_before: f64::NAN,
             moved: f64::NAN,
             moved_before: f64::NAN,
+            impact: None,
         }
     }
 }

@@ -10,6 +10,9 @@ pub(super) struct RegionClock {
     pub(super) history: ContactHistory,
     pub(super) state: Option<JournalState>,
     pub(super) impact_rate: f64,
+    /// The time since the onset of the region's impact (s), while its sub-steps are bounded
+    /// by its period (`impact`'s [`SpatialCycle::impact_bound`]); `None` out of one.
+    pub(super) impact: Option<f64>,
 }
 
 impl RegionClock {
@@ -434,7 +437,8 @@ impl SpatialCycle<'_> {
             guess.min(self.h)
         } else {
             self.h
-        };
+        }
+        .min(self.impact_bound(parts, &x, clocks));
         let mut slopes = self.slopes(parts, (&x, &v), &here.load, clocks);
         let mut count = 0u32;
         let mut accepted = s;
@@ -468,13 +472,20 @@ impl SpatialCycle<'_> {
                 }
                 continue;
             }
-            count += 1;
-            accepted = step;
             let t_next = if step == left { self.h } else { t + step };
             let (x, v) = self.kinematics(t_next, &next);
             let at = self.eval(parts, &x, &v, clocks);
+            if step > floor
+                && count < MAX_SUBSTEPS
+                && let Some(shorter) = self.onset_retry(parts, &x, (&here, &at), clocks, step)
+            {
+                s = shorter;
+                continue;
+            }
+            count += 1;
+            accepted = step;
             out.dissipated += 0.5 * step * (here.dissipation + at.dissipation);
-            self.advance(clocks, &at.states);
+            self.advance(clocks, &at.states, step);
             let state = at.states[at.deepest()];
             let onset = hist.advance(Some(&prev), &state, j.min_impact_speed, j.min_separation);
             out.samples.push(SubStep {
@@ -489,6 +500,7 @@ impl SpatialCycle<'_> {
             prev = state;
             (t, y, here) = (t_next, next, at);
             s = step * (0.9 / err.max(1e-12).sqrt()).clamp(0.2, 4.0);
+            s = s.min(self.impact_bound(parts, &x, clocks));
             age += 1;
             let touching = contact_set(&here);
             let moved = changed(&here.load, &taken_at);
@@ -513,9 +525,15 @@ impl SpatialCycle<'_> {
         accepted
     }
 
-    /// Each region's history moved to the accepted `states`; a region whose contact began takes
-    /// its approach at the crossing as its impact rate.
-    pub(super) fn advance(&self, clocks: &mut [RegionClock; 4], states: &[JournalState; 4]) {
+    /// Each region's history moved to the accepted `states` after a sub-step of `step` (s); a
+    /// region whose contact began takes its approach at the crossing as its impact rate, and
+    /// starts an impact's clock.
+    pub(super) fn advance(
+        &self,
+        clocks: &mut [RegionClock; 4],
+        states: &[JournalState; 4],
+        step: f64,
+    ) {
         let j = self.joint;
         for (clock, state) in clocks.iter_mut().zip(states) {
             let was = clock.history.in_contact;
@@ -523,6 +541,11 @@ impl SpatialCycle<'_> {
             clock
                 .history
                 .advance(before, state, j.min_impact_speed, j.min_separation);
+            clock.impact = match clock.impact {
+                _ if !clock.history.in_contact => None,
+                _ if !was => Some(0.0),
+                elapsed => elapsed.map(|t| t + step),
+            };
             if !was && clock.history.in_contact {
                 clock.impact_rate = clock.history.impact_rate;
             }

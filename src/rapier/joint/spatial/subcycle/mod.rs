@@ -27,7 +27,10 @@
 //! and of the bearing's and journal's centres) against [`POSITION_SCALE`] of the clearance
 //! (angles against that over the journal's lever), velocities
 //! relative to themselves plus [`VELOCITY_SCALE`]. A contact's onset makes the force bend; the
-//! estimate grows there and the sub-steps shrink onto it.
+//! estimate grows there and the sub-steps shrink onto it. From a region's onset, for one period
+//! of its contact, the sub-steps are also bounded to `tol` of that period, and a sub-step across
+//! the touch is held to that size (`impact`): ROS2's damping of an oscillation it does not
+//! resolve is not what its estimate measures.
 //!
 //! **Memory.** Each region's contact history (onset, `delta_dot0` at the crossing) advances at
 //! every accepted sub-step, as the joint's own (the deepest region's). A region in contact keeps
@@ -185,6 +188,7 @@ impl SpatialStart {
 }
 
 mod factor;
+mod impact;
 mod integrator;
 
 use integrator::{Eval, RegionClock, SpatialCycle};
@@ -224,12 +228,14 @@ impl ClearanceJoint {
             history: p.contact,
             state: p.state,
             impact_rate: p.impact_rate,
+            impact: p.impact,
         });
         let mut run = std::mem::take(&mut self.cycle.run);
         let mut cycle = SpatialCycle::new(self, &start, (u0, a_free), h, pass.tolerance);
         let before = (self.contact, &self.report.state);
         let guess = self.cycle.substep_guess;
         let last = cycle.run(&mut parts, before, &mut clocks, guess, &mut run);
+        self.cycle.spatial_impacts = clocks.map(|c| c.impact);
         for (patch, clock) in parts.patches.iter_mut().zip(clocks) {
             patch.contact = clock.history;
             patch.state = clock.state;
@@ -276,6 +282,10 @@ impl ClearanceJoint {
         self.contact = self.cycle.run.history;
         self.report.state = end.state;
         let result = self.evaluate_regions(&mut parts, &pose, [&m1, &m2], &pair, [0.0, 0.0]);
+        // The regions' impact clocks go on from the sub-cycle's end into the next step.
+        for (patch, impact) in parts.patches.iter_mut().zip(self.cycle.spatial_impacts) {
+            patch.impact = impact;
+        }
         self.spatial = Some(parts);
         // The step's last sub-step is the state reported here, and the readers of the step
         // (`ImpactRecorder::record_step`, the runner) take its onset from this report: the

@@ -111,8 +111,14 @@ fn push_display(out: &mut String, v: f64, buffer: &mut zmij::Buffer) {
         return;
     }
     let s = buffer.format_finite(v);
-    // The exponent's `e` is among the last five bytes when there is one.
-    let Some(e) = s.bytes().rposition(|b| b == b'e') else {
+    // The exponent's `e` is among the last five bytes when there is one (`e-324` at most):
+    // only those are searched, as a positional number (most of a run's) is 15 to 20 bytes.
+    let tail = s.len().saturating_sub(5);
+    let Some(e) = s.as_bytes()[tail..]
+        .iter()
+        .rposition(|&b| b == b'e')
+        .map(|i| tail + i)
+    else {
         // Positional already: `zmij` writes `1.0` where the standard library writes `1`.
         out.push_str(s.strip_suffix(".0").unwrap_or(s));
         return;
@@ -176,7 +182,11 @@ fn may_tie(v: f64) -> bool {
     }
     let lowest = e + mantissa.trailing_zeros() as i32;
     let top = e + 64 - mantissa.leading_zeros() as i32;
-    lowest < 0 && f64::from(top - 1) * std::f64::consts::LOG10_2 - f64::from(lowest) <= 18.5
+    // `(top - 1) log10(2) - lowest <= 18.5` in integers, scaled by 1e5 (one multiply per number
+    // instead of two conversions and a float product): `log10(2)` rounded to 0.30103 moves the
+    // left side by at most 0.011 over every `top` (|top| <= 1024), well inside the half digit
+    // the bound keeps above the 18 a tie needs.
+    lowest < 0 && (top - 1) * 30_103 - lowest * 100_000 <= 1_850_000
 }
 
 #[cfg(test)]

@@ -63,7 +63,8 @@ impl Table {
             .iter()
             .map(|_| Vec::with_capacity(self.rows()))
             .collect();
-        for row in self.values.chunks_exact(self.columns.len()) {
+        // (A table without columns has no values: `max(1)` only keeps the chunk size legal.)
+        for row in self.values.chunks_exact(self.columns.len().max(1)) {
             for (column, &j) in out.iter_mut().zip(&index) {
                 column.push(row[j]);
             }
@@ -210,7 +211,7 @@ fn may_tie(v: f64) -> bool {
     let top = e + 64 - mantissa.leading_zeros() as i32;
     // `(top - 1) log10(2) - lowest <= 18.5` in integers, scaled by 1e5 (one multiply per number
     // instead of two conversions and a float product): `log10(2)` rounded to 0.30103 moves the
-    // left side by at most 0.011 over every `top` (|top| <= 1024), well inside the half digit
+    // left side by less than 1e-5 over every `top` (|top| < 1100), well inside the half digit
     // the bound keeps above the 18 a tie needs.
     lowest < 0 && (top - 1) * 30_103 - lowest * 100_000 <= 1_850_000
 }
@@ -232,6 +233,7 @@ mod tests {
             (0..10).map(|r| r as f64 * 1.5 - 3.0).collect::<Vec<_>>()
         );
         assert!(table.columns(&["a", "missing"]).is_none());
+        assert_eq!(Table::default().columns(&[]), Some(vec![]));
     }
 
     /// The CSV's numbers are the standard library's `{}` text, character for character, over

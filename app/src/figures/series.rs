@@ -6,6 +6,8 @@ use clearance_joint::scene::{HingeSpec, Scene};
 use clearance_joint::table::Table;
 use std::path::Path;
 
+mod tables;
+
 /// Angle and rate of one body in both twins.
 #[derive(Clone, Debug, Default)]
 pub struct BodySeries {
@@ -71,66 +73,6 @@ impl CaseSeries {
     ) -> Self {
         self.peaks = peaks_of(contacts);
         self
-    }
-
-    /// Extracts the series of `scene`'s first clearance hinge from the two twins' tables.
-    pub fn from_tables(
-        label: impl Into<String>,
-        scene: &Scene,
-        ideal: &Table,
-        clear: &Table,
-    ) -> Result<CaseSeries> {
-        let hinge = scene
-            .hinges
-            .iter()
-            .find(|h| h.clearance.is_some())
-            .ok_or_else(|| Error::invalid("hinges", "no hinge has a clearance: nothing to plot"))?;
-        Self::from_hinge_tables(label, scene, &hinge.name, ideal, clear)
-    }
-
-    /// Extracts the series of `scene`'s clearance hinge `hinge` from the two twins' tables.
-    pub fn from_hinge_tables(
-        label: impl Into<String>,
-        scene: &Scene,
-        hinge: &str,
-        ideal: &Table,
-        clear: &Table,
-    ) -> Result<CaseSeries> {
-        let hinge = clearance_hinge(scene, hinge)?;
-        let col = |t: &Table, name: &str| {
-            t.column(name)
-                .ok_or_else(|| Error::invalid("output table", format!("has no column `{name}`")))
-        };
-        let h = |s: &str| format!("{}_{s}", hinge.name);
-        let mut order: Vec<&clearance_joint::scene::BodySpec> =
-            scene.bodies.iter().filter(|b| !b.fixed).collect();
-        order.sort_by_key(|b| b.name != hinge.journal);
-        let bodies = order
-            .into_iter()
-            .map(|b| {
-                let c = |s: &str| format!("{}_{s}", b.name);
-                Ok(BodySeries {
-                    name: b.name.clone(),
-                    angle_deg: col(clear, &c("angle_deg"))?,
-                    rate_deg_s: col(clear, &c("rate_deg_s"))?,
-                    angle_ideal_deg: col(ideal, &c("angle_deg"))?,
-                    rate_ideal_deg_s: col(ideal, &c("rate_deg_s"))?,
-                })
-            })
-            .collect::<Result<Vec<_>>>()?;
-        Ok(CaseSeries {
-            label: label.into(),
-            hinge: hinge.name.clone(),
-            clearance_mm: hinge.clearance.as_ref().map_or(0.0, |c| c.clearance_mm),
-            t_s: col(clear, "t_s")?,
-            bodies,
-            force_n: col(clear, &h("force_n"))?,
-            force_ideal_n: col(ideal, &h("force_n"))?,
-            ecc_u_mm: col(clear, &h("ecc_u_mm"))?,
-            ecc_v_mm: col(clear, &h("ecc_v_mm"))?,
-            contact: col(clear, &h("contact"))?,
-            peaks: Vec::new(),
-        })
     }
 
     /// Reads a point folder's `ideal.csv` and `clearance.csv` (the first clearance hinge).

@@ -117,11 +117,24 @@ impl ReplayPage<'_> {
         .unwrap_or(2.0);
         let json =
             serde_json::to_string(&data).map_err(|e| Error::invalid("replay", e.to_string()))?;
+        // The page in one buffer sized up front: the data (megabytes) is copied once, not once
+        // per substitution.
+        let (head, rest) = TEMPLATE.split_once("__TITLE__").unwrap_or((TEMPLATE, ""));
+        let (middle, tail) = rest.split_once("__DATA__").unwrap_or((rest, ""));
+        let title = escape_html(&self.title);
+        let mut page = String::with_capacity(TEMPLATE.len() + title.len() + json.len() + 64);
+        page.push_str(head);
+        page.push_str(&title);
+        page.push_str(middle);
         // Inside <script>, `</` must not appear (JSON allows `<\/`).
-        let json = json.replace("</", "<\\/");
-        Ok(TEMPLATE
-            .replacen("__TITLE__", &escape_html(&self.title), 1)
-            .replacen("__DATA__", &json, 1))
+        for (k, part) in json.split("</").enumerate() {
+            if k > 0 {
+                page.push_str("<\\/");
+            }
+            page.push_str(part);
+        }
+        page.push_str(tail);
+        Ok(page)
     }
 
     /// Writes the page to `dir/replay.html` (atomically) and returns its path.

@@ -43,8 +43,15 @@ impl Line {
         column: &str,
         points: &[(f64, f64)],
     ) -> Option<Line> {
-        let (t, v) = (table.column("t_s")?, table.column(column)?);
-        let (t, v) = crate::figures::series::merge_points(&t, &v, points);
+        // Both columns in one pass over the rows, and no merged copy when there is nothing to
+        // merge (a run's rows are megabytes).
+        let mut columns = table.columns(&["t_s", column])?;
+        let (v, t) = (columns.pop()?, columns.pop()?);
+        let (t, v) = if points.is_empty() {
+            (t, v)
+        } else {
+            crate::figures::series::merge_points(&t, &v, points)
+        };
         let (t, v) = min_max_thin(&t, &v, SERIES_BUCKETS);
         Some(Line {
             label: label.into(),
@@ -65,13 +72,16 @@ impl Line {
         columns: &[&str],
         f: impl Fn(&[f64]) -> f64,
     ) -> Option<Line> {
-        let t = table.column("t_s")?;
-        let cols = columns
-            .iter()
-            .map(|c| table.column(c))
-            .collect::<Option<Vec<_>>>()?;
+        let mut cols = table.columns(&[&["t_s"], columns].concat())?;
+        let t = cols.remove(0);
+        let mut x = vec![0.0; cols.len()];
         let v: Vec<f64> = (0..t.len())
-            .map(|i| f(&cols.iter().map(|c| c[i]).collect::<Vec<_>>()))
+            .map(|i| {
+                for (x, c) in x.iter_mut().zip(&cols) {
+                    *x = c[i];
+                }
+                f(&x)
+            })
             .collect();
         let (t, v) = min_max_thin(&t, &v, SERIES_BUCKETS);
         Some(Line {

@@ -7,7 +7,8 @@
 //! first impacts); any other word keeps only the cases whose name contains it
 //! (`cargo bench --bench mechanisms -- --quick slider`). `MECHANISMS_INTEGRATION=SubCycled` (or
 //! `Explicit`) sets the contact integration of the default runs (the references stay explicit)
-//! and writes `bench_out/mechanisms[_quick]_SubCycled.md`.
+//! and writes `bench_out/mechanisms[_quick]_SubCycled.md`. `MECHANISMS_STUDY` runs every start at
+//! each listed stepping instead (`study.rs`).
 //!
 //! Per scene, three fixed steps each half the previous are run; the finest is the reference. The
 //! first impact of the default is compared with the reference's. Later statistics (the motion
@@ -22,6 +23,7 @@
 //! runs that agree to four digits is narrower than any tolerance.
 
 mod matrix;
+mod study;
 
 use matrix::*;
 use std::fmt::Write as _;
@@ -47,6 +49,14 @@ fn main() {
         || std::env::var("MECHANISMS_QUICK").is_ok_and(|v| v == "1");
     let filters: Vec<&String> = args.iter().filter(|a| !a.starts_with("--")).collect();
     quiet_abandon();
+    if let Ok(spec) = std::env::var("MECHANISMS_STUDY") {
+        let cases: Vec<Case> = cases()
+            .into_iter()
+            .filter(|c| filters.is_empty() || filters.iter().any(|f| c.name.contains(f.as_str())))
+            .collect();
+        study::study(&spec, &cases, quick);
+        return;
+    }
     let mut detail = String::new();
     let mut summary = String::new();
     let _ = writeln!(

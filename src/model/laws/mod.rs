@@ -12,7 +12,10 @@ mod normal;
 mod step;
 
 pub use friction::*;
-pub use impact::{crossing_fraction, impact_restitution, loaded_impact_rate, speed_at_crossing};
+pub use impact::{
+    crossing_fraction, impact_restitution, loaded_impact_rate, speed_at_crossing,
+    speed_at_crossing_in_substep,
+};
 pub use material::*;
 pub use normal::*;
 pub use step::step;

@@ -124,10 +124,39 @@ pub fn speed_at_crossing(rate_before: f64, rate_after: f64, fraction: f64) -> f6
     rate_after + (rate_after - rate_before) * (fraction - 0.5)
 }
 
+/// The approach speed at the crossing of `fraction` ([`crossing_fraction`]) into a sub-step of a
+/// sub-cycle, from the penetration rate at the state before it (`rate_at_state`, its velocity
+/// at the state) and the one its drift moves at (`rate_drift`, the velocity after the state's
+/// kick: the rate at the sub-step's middle under a constant acceleration), m/s:
+/// `rate_at_state + 2 fraction (rate_drift - rate_at_state)`, exact in a free flight under a
+/// constant acceleration. [`speed_at_crossing`] reads the two as half a step further apart,
+/// and on a sub-step that lands on the wall after a long flight it falls short by a quarter of
+/// the rate the flight's acceleration brings over the sub-step.
+pub fn speed_at_crossing_in_substep(rate_at_state: f64, rate_drift: f64, fraction: f64) -> f64 {
+    rate_at_state + 2.0 * fraction * (rate_drift - rate_at_state)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::model::laws::{Hertz, ImprovedLiu, KelvinVoigt, LankaraniNikravesh, MaxDamping};
+
+    /// A free flight under a constant acceleration `a`, read as a sub-cycle reads it: the rate
+    /// at the state `r0`, the drift's rate `r0 + a s/2`. The crossing's rate is
+    /// `r0 + a f s` at every fraction `f`; read as two mid-step rates (equal steps apart) it
+    /// would fall short by `a s/4` at the sub-step's end.
+    #[test]
+    fn a_sub_steps_crossing_reads_a_constant_acceleration_exactly() {
+        let (r0, a, s) = (-2e-4, 0.6, 1e-3);
+        let drift = r0 + 0.5 * a * s;
+        for f in [0.0, 0.25, 0.5, 0.9, 1.0] {
+            let exact = r0 + a * f * s;
+            let got = speed_at_crossing_in_substep(r0, drift, f);
+            assert!((got - exact).abs() < 1e-15, "{f}: {got} against {exact}");
+        }
+        let short = r0 + a * s - speed_at_crossing(r0, drift, 1.0);
+        assert!((short - 0.25 * a * s).abs() < 1e-15, "{short}");
+    }
 
     #[test]
     fn an_elastic_law_returns_all_the_energy() {

@@ -14,6 +14,7 @@ mod step;
 pub use friction::*;
 pub use impact::{
     contact_period, crossing_fraction, impact_restitution, loaded_impact_rate, speed_at_crossing,
+    speed_at_crossing_in_substep,
 };
 pub use material::*;
 pub use normal::*;

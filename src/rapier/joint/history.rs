@@ -1,6 +1,7 @@
 //! The contact history a joint carries between steps, and how one evaluation moves it.
 
 use super::*;
+use crate::model::laws::speed_at_crossing_in_substep;
 
 /// State carried between steps: whether a contact is on, and its impact velocity.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -52,12 +53,43 @@ impl ContactHistory {
         min_impact_speed: f64,
         min_separation: f64,
     ) -> Onset {
+        self.advance_by(
+            before,
+            state,
+            (min_impact_speed, min_separation),
+            speed_at_crossing,
+        )
+    }
+
+    /// [`advance`](Self::advance) at the end of a planar sub-cycle's sub-step: `before` the
+    /// state the sub-step began from, its rates at the state, and `state` read at the velocity
+    /// the sub-step drifted at ([`speed_at_crossing_in_substep`]).
+    pub(super) fn advance_sub_step(
+        &mut self,
+        before: &JournalState,
+        state: &JournalState,
+        min_impact_speed: f64,
+        min_separation: f64,
+    ) -> Onset {
+        let limits = (min_impact_speed, min_separation);
+        self.advance_by(Some(before), state, limits, speed_at_crossing_in_substep)
+    }
+
+    /// [`advance`](Self::advance) with `crossing` reading the approach speed at the crossing
+    /// from the two states' penetration rates and the fraction.
+    fn advance_by(
+        &mut self,
+        before: Option<&JournalState>,
+        state: &JournalState,
+        (min_impact_speed, min_separation): (f64, f64),
+        crossing: fn(f64, f64, f64) -> f64,
+    ) -> Onset {
         let onset = state.penetration > 0.0 && !self.in_contact;
         let impact = onset && self.max_gap >= min_separation;
         let (fraction, approach_speed) = match (onset, before) {
             (true, Some(before)) if before.penetration <= 0.0 => {
                 let s = crossing_fraction(-before.penetration, state.penetration);
-                let rate = speed_at_crossing(before.penetration_rate, state.penetration_rate, s);
+                let rate = crossing(before.penetration_rate, state.penetration_rate, s);
                 (s, rate)
             }
             (true, _) => (1.0, state.penetration_rate),

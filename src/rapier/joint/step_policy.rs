@@ -24,6 +24,26 @@ pub fn flight_step(tolerance: f64, clearance: f64, speed: f64) -> f64 {
     }
 }
 
+/// The time (s) until a gap of `gap` (m) closes at the rate `rate` (m/s, positive closing) and
+/// the acceleration `accel` (m/s^2): the smallest positive `t` with
+/// `gap = rate t + accel t^2/2`; infinite when it never closes.
+pub(super) fn time_to_contact(gap: f64, rate: f64, accel: f64) -> f64 {
+    if accel.abs() < 1e-300 {
+        if rate > 0.0 {
+            gap / rate
+        } else {
+            f64::INFINITY
+        }
+    } else {
+        let disc = rate * rate + 2.0 * accel * gap;
+        if disc < 0.0 {
+            f64::INFINITY
+        } else {
+            (-rate + disc.sqrt()) / accel
+        }
+    }
+}
+
 /// Fraction of the predicted time to contact that one free-flight step may cover, so that a
 /// contact is approached in shrinking steps and starts near a step boundary.
 const APPROACH_FRACTION: f64 = 0.5;
@@ -135,7 +155,7 @@ impl ClearanceJoint {
                 self.geometry.clearance(),
                 r.state.eccentricity_rate.length(),
             )
-            .min(self.world_contact_step(tolerance));
+            .min(self.world_contact_step(tolerance, last_dt));
         }
         let delta = r.state.penetration;
         let rate = r.state.penetration_rate;
@@ -168,21 +188,7 @@ impl ClearanceJoint {
             Some(prev) if last_dt > 0.0 => (rate - prev) / last_dt,
             _ => 0.0,
         };
-        // Smallest positive t with gap = rate t + accel t^2/2.
-        let time_to_contact = if accel.abs() < 1e-300 {
-            if rate > 0.0 {
-                gap / rate
-            } else {
-                f64::INFINITY
-            }
-        } else {
-            let disc = rate * rate + 2.0 * accel * gap;
-            if disc < 0.0 {
-                f64::INFINITY
-            } else {
-                (-rate + disc.sqrt()) / accel
-            }
-        };
+        let time_to_contact = time_to_contact(gap, rate, accel);
         if !(time_to_contact > 0.0 && time_to_contact.is_finite()) {
             return flight;
         }

@@ -128,8 +128,8 @@ impl Group<'_> {
             for (c, lane) in self.cycles.iter().zip(lanes.iter_mut()) {
                 let j = c.joint;
                 lane.here = c.here(&lane.m);
-                let onset = lane.history.advance(
-                    Some(&lane.prev),
+                let onset = lane.history.advance_sub_step(
+                    &lane.prev,
                     &lane.here.state,
                     j.min_impact_speed,
                     j.min_separation,

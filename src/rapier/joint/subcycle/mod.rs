@@ -63,6 +63,7 @@ pub(crate) use steps::SubCycle;
 pub use techniques::SubCycleTechniques;
 
 use super::effective_mass::Mechanism;
+use super::step_policy::time_to_contact;
 use super::{ClearanceJoint, ClearanceReport, ContactAhead};
 use crate::model::kinematics::{ForcePair, JournalState, stable_step};
 use crate::model::laws::{NormalContact, NormalForceLaw, loaded_impact_rate};
@@ -140,7 +141,7 @@ impl ClearanceJoint {
     /// (`ContactAhead::resolving_step` at `10 tol` of the tolerance); approaching the wall at
     /// the penetration rate, at most half the time to it and no less than that step at its
     /// arrival speed; otherwise no bound (s).
-    pub(crate) fn world_contact_step(&self, tolerance: f64) -> f64 {
+    pub(crate) fn world_contact_step(&self, tolerance: f64, last_dt: f64) -> f64 {
         let st = &self.report.state;
         let (depth, rate) = (st.penetration, st.penetration_rate);
         let step = |speed: f64, depth: f64| {
@@ -157,11 +158,36 @@ impl ClearanceJoint {
             contact.resolving_step(&self.normal_law, elastic, k * tolerance, stable)
         };
         if depth > 0.0 {
-            step(rate.abs(), depth)
-        } else if rate > 0.0 {
-            (APPROACH_FRACTION * -depth / rate).max(step(rate, 0.0))
+            return step(rate.abs(), depth);
+        }
+        // The gap's acceleration too, not its rate only: a journal pressed on its wall by a
+        // load that lifts off in a bounce is on its way back, and a step from the lift-off that
+        // the rate alone leaves unbounded spans the flight, the landing and much of the next
+        // contact (the paper's panel at 5T: its bounces on the wall lost their speed faster
+        // than the converged runs' and ended 60 ms early, docs/sub-cycled-contact.md).
+        let t = time_to_contact(-depth, rate, self.gap_acceleration(last_dt));
+        if t > 0.0 && t.is_finite() {
+            let arrival = (rate + self.gap_acceleration(last_dt) * t).max(0.0);
+            (APPROACH_FRACTION * t).max(step(arrival, 0.0))
         } else {
             f64::INFINITY
+        }
+    }
+
+    /// The gap's closing acceleration at the last step's end, m/s^2: over its last sub-step
+    /// when that was in free flight, else over the last step when it was in free flight
+    /// throughout (0 when neither is known).
+    fn gap_acceleration(&self, last_dt: f64) -> f64 {
+        match self.cycle.substeps.as_slice() {
+            [.., a, b] if b.t > a.t && a.state.penetration <= 0.0 => {
+                (b.state.penetration_rate - a.state.penetration_rate) / (b.t - a.t)
+            }
+            _ => match self.previous_rate {
+                Some(prev) if last_dt > 0.0 => {
+                    (self.report.state.penetration_rate - prev) / last_dt
+                }
+                _ => 0.0,
+            },
         }
     }
 
@@ -206,6 +232,7 @@ impl ClearanceJoint {
         let end = *self.cycle.run.samples.last()?;
         let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
         let history = self.cycle.run.history;
+        let start = self.report.state;
         let mass = self.cycle.run.end_mass;
         let law = &self.normal_law;
         let delta = end.state.penetration;
@@ -247,7 +274,16 @@ impl ClearanceJoint {
             spatial: None,
         };
         self.elastic = std::sync::OnceLock::new();
-        self.previous_rate = None;
+        // A step in free flight throughout leaves the rate it began with, for the gap's
+        // acceleration over it ([`Self::gap_acceleration`]).
+        let flight = start.penetration <= 0.0
+            && self
+                .cycle
+                .run
+                .samples
+                .iter()
+                .all(|s| s.state.penetration <= 0.0);
+        self.previous_rate = flight.then_some(start.penetration_rate);
         self.moved_rate = None;
         self.cycle.adopt_run(held);
         let f = end.force.on_journal;

@@ -17,6 +17,19 @@
 //! wall time, the pins' peaks, depths and onsets, the hand's offset; printed and written to
 //! `bench_out/ablation_arm.md`.
 //!
+//! `SCARA_ENSEMBLE=1`: the largest force of a rattling arm is one sample of a chaotic run, so
+//! the arms are compared as ensembles. For each clearance (`SCARA_CLEARANCES` in mm, default
+//! `0.01,0.1`) and world rate (`SCARA_RATES`, default 1000) the sub-cycled arm and the
+//! reference run from the nominal start and four perturbed ones (the clearance times
+//! 1 -+ 1e-4 and 1 -+ 1e-3); each run's metrics and each pin's five largest impacts (approach
+//! speed, force) are printed, then the sub-cycled arms' mean of each metric against the
+//! references' [min, max] and mean, flagged where it is more than 5 % outside the range.
+//! `SCARA_REFERENCE_TOLERANCE` and `SCARA_REFERENCE_MAX_DT` (default 0.001 and 1e-5 s) set the
+//! reference's convergence, `SCARA_STARTS=1` runs the nominal start only,
+//! `SCARA_STEPS_PER_TICK=4` steps the sub-cycled arm's world four times per controller tick.
+//! `SCARA_RATE=difference` (every mode) reads each joint's rate for the controller as its
+//! angle's change over the last tick.
+//!
 //! Knobs for diagnosis (environment): `SCARA_RATES=60,1000` (world rates, Hz),
 //! `SCARA_TOLERANCE` (the sub-cycled arms' tolerance, default 0.0075), `SCARA_PINS=shoulder` or
 //! `elbow` (play in that pin only, the other an ideal revolute), `SCARA_ITERS` (the sub-cycled
@@ -27,7 +40,7 @@
 
 use clearance_joint::model::laws::{Coulomb, FrictionModel};
 use clearance_joint::prelude::*;
-use clearance_joint::rapier::observers::metrics::{ContactObservation, ImpactRecorder};
+use clearance_joint::rapier::observers::metrics::{ContactObservation, Impact, ImpactRecorder};
 use rapier3d_f64::prelude::*;
 use std::f64::consts::PI;
 use std::time::Instant;
@@ -89,6 +102,8 @@ struct Arm {
     pins: Vec<ClearanceJointHandle>,
     recorders: [ImpactRecorder; 2],
     angles: [clearance_joint::model::angle::HingeAngle; 2],
+    /// The joint angles at the last tick (`SCARA_RATE=difference`).
+    last_angles: [Option<f64>; 2],
 }
 
 /// The links' inertia about their length over the transverse one (`SCARA_AXIAL`). At a
@@ -185,6 +200,7 @@ impl Arm {
             pins: handles,
             recorders: Default::default(),
             angles: Default::default(),
+            last_angles: [None; 2],
         })
     }
 
@@ -200,7 +216,16 @@ impl Arm {
             let bodies = &self.world.rapier.bodies;
             let (r1, r2) = (&bodies[*b1], &bodies[*b2]);
             let q = self.angles[k].update(r1.rotation(), r2.rotation(), Vector::Z);
-            let rate = (r2.angvel() - r1.angvel()).z;
+            let mut rate = (r2.angvel() - r1.angvel()).z;
+            // `SCARA_RATE=difference`: the joint's rate read as its angle's change over the
+            // last tick, the same in every arm, instead of the bodies' stored velocities
+            // (a sub-cycled step stores the mean over the step, the reference's the end's).
+            if std::env::var("SCARA_RATE").is_ok_and(|r| r == "difference") {
+                if let Some(last) = self.last_angles[k] {
+                    rate = (q - last) / (until - t);
+                }
+                self.last_angles[k] = Some(q);
+            }
             let (kp, kd) = gains[k];
             let tau = Vector::new(0.0, 0.0, kp * (qt[k] - q) + kd * (rt[k] - rate));
             for (body, sign) in [(*b2, 1.0), (*b1, -1.0)] {
@@ -249,6 +274,8 @@ struct Outcome {
     /// The lower link's largest drop out of the arm's plane (m) and spin about the plane's
     /// in-plane axes (rad/s).
     out_of_plane: (f64, f64),
+    /// Per pin: the five largest impacts by force, largest first.
+    top: [Vec<Impact>; 2],
 }
 
 fn run(
@@ -306,6 +333,10 @@ fn run_with(
         o.peak[k] = m.peak_force_n;
         o.depth[k] = m.max_penetration_um;
         o.onsets[k] = m.onsets;
+        let mut list: Vec<Impact> = arm.recorders[k].contacts().to_vec();
+        list.sort_by(|a, b| b.peak_force_n.total_cmp(&a.peak_force_n));
+        list.truncate(5);
+        o.top[k] = list;
     }
     o.guards = arm.world.guards().messages();
     if std::env::var("SCARA_PLANE").is_ok() {
@@ -359,6 +390,10 @@ fn pct(x: f64, reference: f64) -> String {
 fn main() {
     if std::env::args().any(|a| a == "--ablation") {
         ablation();
+        return;
+    }
+    if std::env::var("SCARA_ENSEMBLE").is_ok() {
+        ensemble();
         return;
     }
     let quick = std::env::args().any(|a| a == "--quick");
@@ -560,5 +595,166 @@ fn ablation() {
     let _ = std::fs::create_dir_all(&dir);
     if let Err(e) = std::fs::write(dir.join("ablation_arm.md"), md) {
         eprintln!("cannot write bench_out/ablation_arm.md: {e}");
+    }
+}
+
+/// Relative perturbations of the clearance in the ensemble: the nominal start and four a user
+/// would take for the same arm.
+const PERTURBATIONS: [f64; 5] = [0.0, -1e-4, 1e-4, -1e-3, 1e-3];
+
+/// The metrics compared across an ensemble: name, and the value from a run and its hand's RMS
+/// offset (mm).
+type Metric = (&'static str, fn(&Outcome, f64) -> f64);
+
+/// Mean approach speed of a pin's five largest impacts, m/s (0 without impacts).
+fn top_approach(o: &Outcome, pin: usize) -> f64 {
+    let t = &o.top[pin];
+    t.iter().map(|i| i.approach_speed_m_s).sum::<f64>() / t.len().max(1) as f64
+}
+
+const METRICS: [Metric; 9] = [
+    ("peak force shoulder (N)", |o, _| o.peak[0]),
+    ("peak force elbow (N)", |o, _| o.peak[1]),
+    ("deepest penetration shoulder (um)", |o, _| o.depth[0]),
+    ("deepest penetration elbow (um)", |o, _| o.depth[1]),
+    ("onsets shoulder", |o, _| o.onsets[0] as f64),
+    ("onsets elbow", |o, _| o.onsets[1] as f64),
+    ("hand RMS offset from the ideal arm (mm)", |_, off| off),
+    (
+        "five largest impacts' mean approach, shoulder (m/s)",
+        |o, _| top_approach(o, 0),
+    ),
+    (
+        "five largest impacts' mean approach, elbow (m/s)",
+        |o, _| top_approach(o, 1),
+    ),
+];
+
+/// The arm's ensembles (`SCARA_ENSEMBLE=1`): sub-cycled against the reference from perturbed
+/// starts.
+fn ensemble() {
+    let list = |name: &str, default: &[f64]| -> Vec<f64> {
+        match std::env::var(name) {
+            Ok(l) => l.split(',').filter_map(|r| r.parse().ok()).collect(),
+            Err(_) => default.to_vec(),
+        }
+    };
+    let tolerance = list("SCARA_TOLERANCE", &[0.0075])[0];
+    let clearances = list("SCARA_CLEARANCES", &[0.01, 0.1]);
+    let rates = list("SCARA_RATES", &[1000.0]);
+    // The reference's own convergence: its tolerance and largest step, and the starts run
+    // (the first `SCARA_STARTS` of the perturbations).
+    let ref_tolerance = list("SCARA_REFERENCE_TOLERANCE", &[REFERENCE_TOLERANCE])[0];
+    let ref_max_dt = list("SCARA_REFERENCE_MAX_DT", &[REFERENCE_MAX_DT])[0];
+    let starts = list("SCARA_STARTS", &[PERTURBATIONS.len() as f64])[0] as usize;
+    // The sub-cycled arm's world steps per controller tick: its world's step apart from the
+    // controller's tick.
+    let per_tick = list("SCARA_STEPS_PER_TICK", &[1.0])[0];
+    for &rate in &rates {
+        let tick = 1.0 / rate;
+        let ideal = run(Pins::Ideal, 0.0, rate, StepControl::fixed(tick)).expect("the ideal arm");
+        let ideal_reference = run(
+            Pins::Ideal,
+            0.0,
+            rate,
+            StepControl::fixed(tick.min(ref_max_dt)),
+        )
+        .expect("the ideal arm at the reference's steps");
+        for &mm in &clearances {
+            println!("\n### {mm} mm, {rate} Hz\n");
+            println!(
+                "| clearance x | arm | peak force shoulder, elbow (N) | deepest penetration shoulder, elbow (um) | onsets | hand RMS offset (mm) | five largest impacts shoulder: approach (m/s) / force (N) | elbow |"
+            );
+            println!("|---|---|---|---|---|---|---|---|");
+            // Per arm (sub-cycled, reference): each start's metrics.
+            let mut values: [Vec<[f64; METRICS.len()]>; 2] = Default::default();
+            for &p in PERTURBATIONS.iter().take(starts) {
+                let c = mm * 1e-3 * (1.0 + p);
+                let arms = [
+                    (
+                        "sub-cycled",
+                        run(
+                            Pins::Compliant(ContactIntegration::SubCycled),
+                            c,
+                            rate,
+                            StepControl {
+                                tolerance,
+                                ..StepControl::fixed(tick / per_tick)
+                            },
+                        ),
+                        &ideal,
+                    ),
+                    (
+                        "reference",
+                        run(
+                            Pins::Compliant(ContactIntegration::Explicit),
+                            c,
+                            rate,
+                            StepControl::adaptive(tick.min(ref_max_dt), ref_tolerance),
+                        ),
+                        &ideal_reference,
+                    ),
+                ];
+                for (k, (name, o, ideal)) in arms.into_iter().enumerate() {
+                    let o = match o {
+                        Ok(o) => o,
+                        Err(e) => {
+                            println!("| 1{p:+e} | {name} | failed: {e} |||||");
+                            continue;
+                        }
+                    };
+                    for g in &o.guards {
+                        eprintln!("  {mm} mm x 1{p:+e}, {rate} Hz, {name}: {g}");
+                    }
+                    let off = rms_offset(&o, ideal);
+                    let impacts = |pin: usize| {
+                        o.top[pin]
+                            .iter()
+                            .map(|i| format!("{:.4}/{:.0}", i.approach_speed_m_s, i.peak_force_n))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    };
+                    println!(
+                        "| 1{p:+e} | {name} | {:.1}, {:.1} | {:.3}, {:.3} | {}, {} | {:.4} | {} | {} |",
+                        o.peak[0],
+                        o.peak[1],
+                        o.depth[0],
+                        o.depth[1],
+                        o.onsets[0],
+                        o.onsets[1],
+                        off,
+                        impacts(0),
+                        impacts(1)
+                    );
+                    values[k].push(METRICS.map(|(_, f)| f(&o, off)));
+                }
+            }
+            println!(
+                "\n| {mm} mm, {rate} Hz | sub-cycled mean [min, max] | reference mean [min, max] | sub-cycled mean vs reference range |"
+            );
+            println!("|---|---|---|---|");
+            for (m, (name, _)) in METRICS.iter().enumerate() {
+                let stats = |v: &[[f64; METRICS.len()]]| {
+                    let x: Vec<f64> = v.iter().map(|r| r[m]).collect();
+                    let mean = x.iter().sum::<f64>() / x.len().max(1) as f64;
+                    let min = x.iter().copied().fold(f64::INFINITY, f64::min);
+                    let max = x.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                    (mean, min, max)
+                };
+                let (s, r) = (stats(&values[0]), stats(&values[1]));
+                // Outside: the sub-cycled mean more than 5 % beyond the references' range.
+                let verdict = if s.0 < r.1 * 0.95 {
+                    format!("**below** ({})", pct(s.0, r.1))
+                } else if s.0 > r.2 * 1.05 {
+                    format!("**above** ({})", pct(s.0, r.2))
+                } else {
+                    "inside".to_string()
+                };
+                println!(
+                    "| {name} | {:.4} [{:.4}, {:.4}] | {:.4} [{:.4}, {:.4}] | {verdict} |",
+                    s.0, s.1, s.2, r.0, r.1, r.2
+                );
+            }
+        }
     }
 }

@@ -9,7 +9,7 @@ use rapier3d_f64::prelude::*;
 
 #[path = "support/turning_arm.rs"]
 mod turning_arm;
-use turning_arm::{penetrations, turning_arm};
+use turning_arm::{link, penetrations, turning_arm};
 
 const G: f64 = 9.81;
 /// The journal's mass, kg, and its bearing: radius 10 mm, clearance 0.2 mm, width 16 mm.
@@ -270,21 +270,8 @@ fn a_pin_on_a_turning_arm_ends_each_step_where_its_sub_cycle_put_it() {
     rapier.integration_parameters.num_solver_iterations = 1;
     let mut world = ClearanceWorld::new(rapier, StepControl::fixed(1e-3));
     let base = world.rapier.bodies.insert(RigidBodyBuilder::fixed());
-    let link = |world: &mut ClearanceWorld, mass: f64, length: f64, start: f64| {
-        let j = mass * length * length / 12.0;
-        world.rapier.bodies.insert(
-            RigidBodyBuilder::dynamic()
-                .translation(Vector::new(start + 0.5 * length, 0.0, 0.0))
-                .additional_mass_properties(MassProperties::new(
-                    Vector::ZERO,
-                    mass,
-                    Vector::new(j, j, j),
-                ))
-                .can_sleep(false),
-        )
-    };
-    let upper = link(&mut world, 2.0, 0.4, 0.0);
-    let lower = link(&mut world, 1.0, 0.3, 0.4);
+    let upper = link(&mut world, 2.0, 0.4, 0.0, 1.0);
+    let lower = link(&mut world, 1.0, 0.3, 0.4, 1.0);
     let pivot = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(-0.2, 0.0, 0.0));
     world.rapier.impulse_joints.insert(base, upper, pivot, true);
     let pin = HingeDesign::steel_improved_liu(0.006, 0.1e-3, 0.012)

@@ -19,21 +19,8 @@ pub fn turning_arm(
     rapier.integration_parameters.num_solver_iterations = iterations;
     let mut world = ClearanceWorld::new(rapier, StepControl::fixed(dt));
     let base = world.rapier.bodies.insert(RigidBodyBuilder::fixed());
-    let link = |world: &mut ClearanceWorld, mass: f64, length: f64, start: f64| {
-        let j = mass * length * length / 12.0;
-        world.rapier.bodies.insert(
-            RigidBodyBuilder::dynamic()
-                .translation(Vector::new(start + 0.5 * length, 0.0, 0.0))
-                .additional_mass_properties(MassProperties::new(
-                    Vector::ZERO,
-                    mass,
-                    Vector::new(0.1 * j, j, j),
-                ))
-                .can_sleep(false),
-        )
-    };
-    let upper = link(&mut world, 2.0, 0.4, 0.0);
-    let lower = link(&mut world, 1.0, 0.3, 0.4);
+    let upper = link(&mut world, 2.0, 0.4, 0.0, 0.1);
+    let lower = link(&mut world, 1.0, 0.3, 0.4, 0.1);
     let geometry = BearingGeometry::new(0.006, 0.006 - 0.1e-3, 0.012).unwrap();
     let design = HingeDesign::new(geometry, law)
         .integration(ContactIntegration::SubCycled)
@@ -66,6 +53,28 @@ pub fn turning_arm(
     let pin = world.insert_clearance(upper, lower, pin).unwrap();
     world.rapier.bodies[upper].add_torque(Vector::new(0.0, 0.0, 2.0), true);
     (world, [upper, lower], pin)
+}
+
+/// A slender link along x from `start` (m): `mass` (kg), `length` (m), the transverse inertia
+/// of a rod, `axial` of it about its length.
+pub fn link(
+    world: &mut ClearanceWorld,
+    mass: f64,
+    length: f64,
+    start: f64,
+    axial: f64,
+) -> RigidBodyHandle {
+    let j = mass * length * length / 12.0;
+    world.rapier.bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(Vector::new(start + 0.5 * length, 0.0, 0.0))
+            .additional_mass_properties(MassProperties::new(
+                Vector::ZERO,
+                mass,
+                Vector::new(axial * j, j, j),
+            ))
+            .can_sleep(false),
+    )
 }
 
 /// The pin's penetration as its last sub-step reported it, and at Rapier's poses of `bodies`

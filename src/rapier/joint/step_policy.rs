@@ -27,7 +27,7 @@ pub fn flight_step(tolerance: f64, clearance: f64, speed: f64) -> f64 {
 /// The time (s) until a gap of `gap` (m) closes at the rate `rate` (m/s, positive closing) and
 /// the acceleration `accel` (m/s^2): the smallest positive `t` with
 /// `gap = rate t + accel t^2/2`; infinite when it never closes.
-pub(super) fn time_to_contact(gap: f64, rate: f64, accel: f64) -> f64 {
+fn time_to_contact(gap: f64, rate: f64, accel: f64) -> f64 {
     if accel.abs() < 1e-300 {
         if rate > 0.0 {
             gap / rate
@@ -47,6 +47,23 @@ pub(super) fn time_to_contact(gap: f64, rate: f64, accel: f64) -> f64 {
 /// Fraction of the predicted time to contact that one free-flight step may cover, so that a
 /// contact is approached in shrinking steps and starts near a step boundary.
 const APPROACH_FRACTION: f64 = 0.5;
+
+/// The step (s) a journal `gap` (m) off its wall, closing at `rate` (m/s) and `accel` (m/s^2),
+/// may take: [`APPROACH_FRACTION`] of the time to contact, and no less than `resolving` gives
+/// at the arrival speed; infinite when the gap does not close.
+pub(super) fn approach_step(
+    gap: f64,
+    rate: f64,
+    accel: f64,
+    resolving: impl Fn(f64) -> f64,
+) -> f64 {
+    let t = time_to_contact(gap, rate, accel);
+    if !(t > 0.0 && t.is_finite()) {
+        return f64::INFINITY;
+    }
+    let arrival = (rate + accel * t).max(0.0);
+    (APPROACH_FRACTION * t).max(resolving(arrival))
+}
 /// The fraction of a contact's natural period one adaptive step in contact may cover, per unit
 /// of tolerance: `2 tol` (0.015 of the period at the default 0.0075). The contact laws get the
 /// rate at the state (MODEL.md §6), so a contact is integrated at second order like the free
@@ -183,19 +200,18 @@ impl ClearanceJoint {
                 .min(stable_fraction(tolerance) * r.max_stable_dt)
                 .min(STABILITY_SAFETY * r.friction_stable_dt);
         }
-        let gap = -delta;
-        let accel = match self.previous_rate {
-            Some(prev) if last_dt > 0.0 => (rate - prev) / last_dt,
+        approach_step(-delta, rate, self.rate_change(last_dt), |speed| {
+            contact_step(speed, 0.0)
+        })
+        .min(flight)
+    }
+
+    /// The penetration rate's change over the last step, m/s^2 (0 without a rate before it).
+    pub(super) fn rate_change(&self, last_dt: f64) -> f64 {
+        match self.previous_rate {
+            Some(prev) if last_dt > 0.0 => (self.report.state.penetration_rate - prev) / last_dt,
             _ => 0.0,
-        };
-        let time_to_contact = time_to_contact(gap, rate, accel);
-        if !(time_to_contact > 0.0 && time_to_contact.is_finite()) {
-            return flight;
         }
-        let speed_at_contact = (rate + accel * time_to_contact).max(0.0);
-        (APPROACH_FRACTION * time_to_contact)
-            .max(contact_step(speed_at_contact, 0.0))
-            .min(flight)
     }
 
     /// The step that resolves a contact now `depth` deep (m) whose journal moves at

@@ -58,12 +58,12 @@ mod tests;
 
 pub(crate) use group::plan_cycles;
 pub(crate) use pair::PairStart;
-pub(crate) use pair::{Pair12, axpy, mul, part, put, rotate};
+pub(crate) use pair::{Pair12, axpy, dot, load, mul, part, put, rotate};
 pub(crate) use steps::SubCycle;
 pub use techniques::SubCycleTechniques;
 
 use super::effective_mass::Mechanism;
-use super::step_policy::time_to_contact;
+use super::step_policy::approach_step;
 use super::{ClearanceJoint, ClearanceReport, ContactAhead};
 use crate::model::kinematics::{ForcePair, JournalState, stable_step};
 use crate::model::laws::{NormalContact, NormalForceLaw, loaded_impact_rate};
@@ -165,13 +165,9 @@ impl ClearanceJoint {
         // the rate alone leaves unbounded spans the flight, the landing and much of the next
         // contact (the paper's panel at 5T: its bounces on the wall lost their speed faster
         // than the converged runs' and ended 60 ms early, docs/sub-cycled-contact.md).
-        let t = time_to_contact(-depth, rate, self.gap_acceleration(last_dt));
-        if t > 0.0 && t.is_finite() {
-            let arrival = (rate + self.gap_acceleration(last_dt) * t).max(0.0);
-            (APPROACH_FRACTION * t).max(step(arrival, 0.0))
-        } else {
-            f64::INFINITY
-        }
+        approach_step(-depth, rate, self.gap_acceleration(last_dt), |speed| {
+            step(speed, 0.0)
+        })
     }
 
     /// The gap's closing acceleration at the last step's end, m/s^2: over its last sub-step
@@ -182,12 +178,7 @@ impl ClearanceJoint {
             [.., a, b] if b.t > a.t && a.state.penetration <= 0.0 => {
                 (b.state.penetration_rate - a.state.penetration_rate) / (b.t - a.t)
             }
-            _ => match self.previous_rate {
-                Some(prev) if last_dt > 0.0 => {
-                    (self.report.state.penetration_rate - prev) / last_dt
-                }
-                _ => 0.0,
-            },
+            _ => self.rate_change(last_dt),
         }
     }
 

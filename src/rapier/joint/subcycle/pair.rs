@@ -11,7 +11,7 @@ use rapier3d_f64::prelude::{RigidBody, RigidBodySet};
 /// journal's.
 pub(crate) type Pair12 = [f64; 12];
 
-pub(super) fn dot(a: &Pair12, b: &Pair12) -> f64 {
+pub(crate) fn dot(a: &Pair12, b: &Pair12) -> f64 {
     a.iter().zip(b).map(|(x, y)| x * y).sum()
 }
 
@@ -39,7 +39,7 @@ pub(crate) fn put(x: &mut Pair12, k: usize, v: Vector) {
 
 /// The pair's coordinates of a load at `point` on the journal (`on_journal`) and its opposite
 /// on the bearing, about the centres of mass `com`.
-pub(super) fn load(com: &[Vector; 2], point: Vector, on_journal: Vector) -> Pair12 {
+pub(crate) fn load(com: &[Vector; 2], point: Vector, on_journal: Vector) -> Pair12 {
     let mut l = [0.0; 12];
     put(&mut l, 0, -on_journal);
     put(&mut l, 1, (point - com[0]).cross(-on_journal));

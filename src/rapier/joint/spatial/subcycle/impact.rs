@@ -58,15 +58,8 @@ impl SpatialCycle<'_> {
             self.start.com[0] + part(x, 0),
             self.start.com[1] + part(x, 2),
         ];
-        let (point, gradient) = (deepest.contact.point, deepest.contact.gradient);
-        let mut row = [0.0; 12];
-        for (b, sign) in [(0usize, -1.0), (1, 1.0)] {
-            let lin = sign * gradient;
-            put(&mut row, 2 * b, lin);
-            put(&mut row, 2 * b + 1, (point - centres[b]).cross(lin));
-        }
-        let moved = mul(&self.start.mobility, &row);
-        let inverse: f64 = row.iter().zip(moved).map(|(r, m)| r * m).sum();
+        let row = load(&centres, deepest.contact.point, deepest.contact.gradient);
+        let inverse = dot(&row, &mul(&self.start.mobility, &row));
         if !(inverse > 0.0) {
             return f64::INFINITY;
         }

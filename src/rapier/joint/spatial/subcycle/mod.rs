@@ -39,7 +39,7 @@
 //! speed.
 
 use super::super::subcycle::{
-    MAX_SUBSTEPS, Pair12, PairStart, SubCycle, SubStep, axpy, mul, part, put, rotate,
+    MAX_SUBSTEPS, Pair12, PairStart, SubCycle, SubStep, axpy, dot, load, mul, part, put, rotate,
 };
 use super::super::{ClearanceJoint, ContactHistory, Mechanism, motion};
 use super::{Mobility, Pair, Places, SpatialParts, Totals, load_region};

@@ -178,6 +178,7 @@ fn the_convergence_check_flags_a_coarse_run_and_strict_fails() {
             .output()
             .unwrap();
         let json = std::fs::read_to_string(dir.join("convergence.json")).unwrap();
+        std::fs::remove_dir_all(&dir).ok();
         let check: serde_json::Value = serde_json::from_str(&json).unwrap();
         (out, check)
     };

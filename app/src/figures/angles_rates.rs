@@ -16,14 +16,6 @@ where
     let single_ideal = own_ideal.iter().filter(|&&b| b).count() == 1;
     for (r, body) in cases[0].bodies.iter().enumerate() {
         for (c, is_rate) in [(0, false), (1, true)] {
-            let pick = |b: &series::BodySeries, ideal: bool| -> Vec<f64> {
-                match (is_rate, ideal) {
-                    (false, false) => b.angle_deg.clone(),
-                    (false, true) => b.angle_ideal_deg.clone(),
-                    (true, false) => b.rate_deg_s.clone(),
-                    (true, true) => b.rate_ideal_deg_s.clone(),
-                }
-            };
             let mut curves: Vec<Curve> = Vec::new();
             // The clearance curves first, the ideal ones dashed over them: the two nearly
             // coincide, and a dashed line on top leaves both visible.
@@ -35,7 +27,7 @@ where
                     case.label.clone(),
                     case_color(i),
                     false,
-                    minmax_decimate(&case.t_s, &pick(b, false), t0, t1, DECIMATE_BINS),
+                    minmax_decimate(&case.t_s, pick(b, is_rate, false), t0, t1, DECIMATE_BINS),
                 ));
             }
             for (i, case) in cases.iter().enumerate() {
@@ -52,7 +44,7 @@ where
                         label,
                         color,
                         true,
-                        minmax_decimate(&case.t_s, &pick(b, true), t0, t1, DECIMATE_BINS),
+                        minmax_decimate(&case.t_s, pick(b, is_rate, true), t0, t1, DECIMATE_BINS),
                     ));
                 }
             }
@@ -81,4 +73,16 @@ where
         }
     }
     Ok(())
+}
+
+/// A body's series: its angle or rate (`is_rate`), of the clearance or the ideal twin. Borrowed:
+/// a series is a run's rows (50,001 numbers for the paper's scene), and the figure is drawn once
+/// per format.
+fn pick(b: &series::BodySeries, is_rate: bool, ideal: bool) -> &[f64] {
+    match (is_rate, ideal) {
+        (false, false) => &b.angle_deg,
+        (false, true) => &b.angle_ideal_deg,
+        (true, false) => &b.rate_deg_s,
+        (true, true) => &b.rate_ideal_deg_s,
+    }
 }

@@ -59,6 +59,11 @@ struct PageData<'a> {
 impl ReplayPage<'_> {
     /// The page's HTML: the viewer with the data inside (no external resource).
     pub fn html(&self) -> Result<String> {
+        String::from_utf8(self.html_bytes()?).map_err(|e| Error::invalid("replay", e.to_string()))
+    }
+
+    /// [`html`](Self::html) as bytes: the data serialized straight into the page.
+    fn html_bytes(&self) -> Result<Vec<u8>> {
         let r = self.recording;
         if r.frames.is_empty() {
             return Err(Error::invalid("replay", "the recording holds no frame"));
@@ -115,32 +120,31 @@ impl ReplayPage<'_> {
         .into_iter()
         .find(|&s| span / s <= 25.0)
         .unwrap_or(2.0);
-        let json =
-            serde_json::to_string(&data).map_err(|e| Error::invalid("replay", e.to_string()))?;
-        // The page in one buffer sized up front: the data (megabytes) is copied once, not once
-        // per substitution.
+        // The data (megabytes) is serialized into the page's own buffer, after the head: no
+        // copy of it is held, and no pass searches it for `</` (only its strings can hold one,
+        // and [`ScriptSafe`] escapes it there).
         let (head, rest) = TEMPLATE.split_once("__TITLE__").unwrap_or((TEMPLATE, ""));
         let (middle, tail) = rest.split_once("__DATA__").unwrap_or((rest, ""));
         let title = escape_html(&self.title);
-        let mut page = String::with_capacity(TEMPLATE.len() + title.len() + json.len() + 64);
-        page.push_str(head);
-        page.push_str(&title);
-        page.push_str(middle);
-        // Inside <script>, `</` must not appear (JSON allows `<\/`).
-        for (k, part) in json.split("</").enumerate() {
-            if k > 0 {
-                page.push_str("<\\/");
-            }
-            page.push_str(part);
-        }
-        page.push_str(tail);
+        // The numbers' text is at most about 24 bytes each; capacity never written is never
+        // touched.
+        let numbers = data.t.len() + data.poses.len() + data.jf.len() + data.sf.len();
+        let mut page = Vec::with_capacity(TEMPLATE.len() + title.len() + 24 * numbers + 64);
+        page.extend_from_slice(head.as_bytes());
+        page.extend_from_slice(title.as_bytes());
+        page.extend_from_slice(middle.as_bytes());
+        data.serialize(&mut serde_json::Serializer::with_formatter(
+            &mut page, ScriptSafe,
+        ))
+        .map_err(|e| Error::invalid("replay", e.to_string()))?;
+        page.extend_from_slice(tail.as_bytes());
         Ok(page)
     }
 
     /// Writes the page to `dir/replay.html` (atomically) and returns its path.
     pub fn write(&self, dir: &Path) -> Result<PathBuf> {
         let path = dir.join(FILE);
-        write_atomic(&path, self.html()?.as_bytes())?;
+        write_atomic(&path, &self.html_bytes()?)?;
         Ok(path)
     }
 }
@@ -185,8 +189,59 @@ fn spatial_numbers(j: &JournalFrame) -> [f64; SPATIAL_NUMBERS] {
     ]
 }
 
+/// JSON as `serde_json::to_string` writes it, but `</` inside strings written `<\/` (the same
+/// string to a JSON reader): inside `<script>` the sequence must not appear. Outside strings
+/// JSON has no `<`, and `serde_json` escapes neither `<` nor `/`, so a string's `</` is never
+/// split between two fragments.
+struct ScriptSafe;
+
+impl serde_json::ser::Formatter for ScriptSafe {
+    fn write_string_fragment<W: ?Sized + std::io::Write>(
+        &mut self,
+        writer: &mut W,
+        fragment: &str,
+    ) -> std::io::Result<()> {
+        for (k, part) in fragment.split("</").enumerate() {
+            if k > 0 {
+                writer.write_all(b"<\\/")?;
+            }
+            writer.write_all(part.as_bytes())?;
+        }
+        Ok(())
+    }
+}
+
 fn escape_html(s: &str) -> String {
     s.replace('&', "&amp;")
         .replace('<', "&lt;")
         .replace('>', "&gt;")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ScriptSafe;
+    use serde::Serialize;
+
+    #[test]
+    fn script_safe_json_is_serde_json_with_only_strings_closing_tags_escaped() {
+        // A `</` right after an escaped quote (a fragment's start), at a string's end, twice
+        // in a row, and in a key; numbers beside them.
+        let value = serde_json::json!({
+            "title": "a</script>b\"</",
+            "n": "<</</",
+            "x</": [1.5, -0.0, 1e-7, 123456.789],
+        });
+        let mut out = Vec::new();
+        value
+            .serialize(&mut serde_json::Serializer::with_formatter(
+                &mut out, ScriptSafe,
+            ))
+            .unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let plain = serde_json::to_string(&value).unwrap();
+        assert!(plain.contains("</"));
+        assert_eq!(text, plain.replace("</", "<\\/"));
+        let back: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(back, value);
+    }
 }

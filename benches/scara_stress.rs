@@ -28,7 +28,16 @@
 //! reference's convergence, `SCARA_STARTS=1` runs the nominal start only,
 //! `SCARA_STEPS_PER_TICK=4` steps the sub-cycled arm's world four times per controller tick.
 //! `SCARA_RATE=difference` (every mode) reads each joint's rate for the controller as its
-//! angle's change over the last tick.
+//! angle's change over the last tick, `SCARA_RATE=state` as the bodies' velocity at the state
+//! (`ClearanceWorld::velocity_at_state`), `SCARA_RATE_FILTER=0.005` through a low pass of that
+//! time constant (s). `SCARA_PERTURB=gain` makes the starts scale the controller's gains instead
+//! of the clearance, `SCARA_PERTURBATIONS=0,-0.01,0.01` sets the starts' relative
+//! perturbations, `SCARA_REFERENCE=none` leaves the reference out,
+//! `SCARA_IDEAL_STEPS_PER_TICK=40` steps the ideal arm's world 40 times per tick, and
+//! `SCARA_COST=3` only times a world step of the sub-cycled arm against the ideal arm's, the two
+//! run in turn three times. `SCARA_TRACE=/tmp/arm` (every mode) writes, per arm, each tick's
+//! state of each pin (at the joint's report and from Rapier's bodies), each step's first
+//! sub-step and every impact to `/tmp/arm_<arm>_<clearance in um>_<world steps>.csv`.
 //!
 //! Knobs for diagnosis (environment): `SCARA_RATES=60,1000` (world rates, Hz),
 //! `SCARA_TOLERANCE` (the sub-cycled arms' tolerance, default 0.0075), `SCARA_PINS=shoulder` or
@@ -104,6 +113,8 @@ struct Arm {
     angles: [clearance_joint::model::angle::HingeAngle; 2],
     /// The joint angles at the last tick (`SCARA_RATE=difference`).
     last_angles: [Option<f64>; 2],
+    /// The rates the controller read at the last tick, low-passed (`SCARA_RATE_FILTER`).
+    filtered: [Option<f64>; 2],
 }
 
 /// The links' inertia about their length over the transverse one (`SCARA_AXIAL`). At a
@@ -201,6 +212,7 @@ impl Arm {
             recorders: Default::default(),
             angles: Default::default(),
             last_angles: [None; 2],
+            filtered: [None; 2],
         })
     }
 
@@ -217,6 +229,13 @@ impl Arm {
             let (r1, r2) = (&bodies[*b1], &bodies[*b2]);
             let q = self.angles[k].update(r1.rotation(), r2.rotation(), Vector::Z);
             let mut rate = (r2.angvel() - r1.angvel()).z;
+            // `SCARA_RATE=state`: the bodies' velocity at the state
+            // (`ClearanceWorld::velocity_at_state`: a sub-cycled step's Rapier velocities do
+            // not hold the part of its impulse delivered with the next step).
+            if std::env::var("SCARA_RATE").is_ok_and(|r| r == "state") {
+                let w = |b| self.world.velocity_at_state(b).expect("in the world").1;
+                rate = (w(*b2) - w(*b1)).z;
+            }
             // `SCARA_RATE=difference`: the joint's rate read as its angle's change over the
             // last tick, the same in every arm, instead of the bodies' stored velocities
             // (a sub-cycled step stores the mean over the step, the reference's the end's).
@@ -225,6 +244,17 @@ impl Arm {
                     rate = (q - last) / (until - t);
                 }
                 self.last_angles[k] = Some(q);
+            }
+            // `SCARA_RATE_FILTER=tau` (s): the rate read through a first-order low pass of
+            // time constant `tau` at the tick, the same in every arm (diagnosis: what the
+            // controller makes of the rattle's velocity jumps).
+            if let Some(tau) = std::env::var("SCARA_RATE_FILTER")
+                .ok()
+                .and_then(|t| t.parse::<f64>().ok())
+            {
+                let f = self.filtered[k].unwrap_or(rate);
+                rate = f + (rate - f) * ((until - t) / tau).min(1.0);
+                self.filtered[k] = Some(rate);
             }
             let (kp, kd) = gains[k];
             let tau = Vector::new(0.0, 0.0, kp * (qt[k] - q) + kd * (rt[k] - rate));
@@ -301,14 +331,21 @@ fn run_with(
     techniques: SubCycleTechniques,
 ) -> clearance_joint::Result<Outcome> {
     let tick = 1.0 / rate;
-    let gains = gains(tick);
+    let scale = f64::from_bits(GAIN_SCALE.load(std::sync::atomic::Ordering::Relaxed));
+    let gains = gains(tick).map(|(kp, kd)| (kp * scale, kd * scale));
     let mut arm = Arm::new(pins, clearance, control, techniques)?;
     let ticks = (END / tick).round() as u64;
     let mut o = Outcome::default();
     let clock = Instant::now();
+    // `SCARA_TRACE=path`: each tick's state of each pin, as the sub-cycle ended it and as
+    // Rapier's bodies have it, written to `path`.
+    let mut trace = std::env::var("SCARA_TRACE").ok().map(|_| String::new());
     for i in 0..ticks {
         let t = i as f64 * tick;
         arm.tick(t, (i + 1) as f64 * tick, gains)?;
+        if let Some(out) = trace.as_mut() {
+            trace_tick(&arm, (i + 1) as f64 * tick, out);
+        }
         o.hands.push(arm.hand());
         let lower = &arm.world.rapier.bodies[arm.lower];
         let w = lower.angvel();
@@ -326,6 +363,28 @@ fn run_with(
         }
     }
     o.wall_s = clock.elapsed().as_secs_f64();
+    if let (Some(out), Ok(path)) = (trace, std::env::var("SCARA_TRACE")) {
+        let path = format!(
+            "{path}_{pins:?}_{}_{}.csv",
+            clearance * 1e6,
+            arm.world.steps()
+        );
+        let mut all = out;
+        for (k, r) in arm.recorders.iter().enumerate() {
+            for i in r.contacts() {
+                all.push_str(&format!(
+                    "impact,{k},{:.7},{:.6},{:.3},{:.5},{:.4},{:.2}\n",
+                    i.onset_t_s,
+                    i.approach_speed_m_s,
+                    i.peak_force_n,
+                    i.peak_t_s,
+                    i.max_penetration_um,
+                    i.duration_s * 1e6
+                ));
+            }
+        }
+        let _ = std::fs::write(&path, all);
+    }
     o.steps = arm.world.steps();
     for k in 0..arm.pins.len() {
         o.substeps += arm.recorders[k].substeps_recorded();
@@ -366,6 +425,61 @@ fn run_with(
         }
     }
     Ok(o)
+}
+
+/// One tick's line per pin (`SCARA_TRACE`): time, pin, the eccentricity and its rate at the
+/// joint's report (a sub-cycled joint's: the sub-cycle's end), the same read from Rapier's
+/// bodies (their velocities plus the joint's velocity correction), and the links' spins.
+fn trace_tick(arm: &Arm, t: f64, out: &mut String) {
+    let bodies = &arm.world.rapier.bodies;
+    if arm.pins.is_empty() {
+        let (u, l) = (&bodies[arm.pairs[1].0], &bodies[arm.pairs[1].1]);
+        out.push_str(&format!(
+            "tick,{t:.6},9,0,0,0,0,0,0,0,0,{:.6e},{:.6e}\n",
+            u.angvel().z,
+            l.angvel().z
+        ));
+    }
+    for (k, h) in arm.pins.iter().enumerate() {
+        let j = arm.world.clearance.get(*h).expect("inserted");
+        let (b1, b2) = (&bodies[j.body1()], &bodies[j.body2()]);
+        let p1 = *b1.position() * j.local_anchor1();
+        let p2 = *b2.position() * j.local_anchor2();
+        let mut v = [b1.linvel(), b1.angvel(), b2.linvel(), b2.angvel()];
+        for (n, (_, dv, dw)) in j.start_velocity_correction().into_iter().enumerate() {
+            v[2 * n] += dv;
+            v[2 * n + 1] += dw;
+        }
+        let vp1 = v[0] + v[1].cross(p1 - b1.center_of_mass());
+        let vp2 = v[2] + v[3].cross(p2 - b2.center_of_mass());
+        let (e, r) = (p2 - p1, vp2 - vp1);
+        let s = &j.report().state;
+        if let Some(f) = j.substeps().first() {
+            let f0 = &f.state;
+            out.push_str(&format!(
+                "first,{t:.6},{k},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{}\n",
+                f0.eccentricity.x,
+                f0.eccentricity.y,
+                f0.eccentricity_rate.x,
+                f0.eccentricity_rate.y,
+                f.t,
+                j.substeps().len()
+            ));
+        }
+        out.push_str(&format!(
+            "tick,{t:.6},{k},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e},{:.6e}\n",
+            s.eccentricity.x,
+            s.eccentricity.y,
+            s.eccentricity_rate.x,
+            s.eccentricity_rate.y,
+            e.x,
+            e.y,
+            r.x,
+            r.y,
+            b1.angvel().z,
+            b2.angvel().z
+        ));
+    }
 }
 
 /// RMS distance between two arms' hands, mm.
@@ -602,6 +716,11 @@ fn ablation() {
 /// would take for the same arm.
 const PERTURBATIONS: [f64; 5] = [0.0, -1e-4, 1e-4, -1e-3, 1e-3];
 
+/// The controller's gains' scale for the next run (1; the ensemble's `SCARA_PERTURB=gain`),
+/// as the bits of an `f64`.
+static GAIN_SCALE: std::sync::atomic::AtomicU64 =
+    std::sync::atomic::AtomicU64::new(0x3FF0_0000_0000_0000);
+
 /// The metrics compared across an ensemble: name, and the value from a run and its hand's RMS
 /// offset (mm).
 type Metric = (&'static str, fn(&Outcome, f64) -> f64);
@@ -642,17 +761,62 @@ fn ensemble() {
     let tolerance = list("SCARA_TOLERANCE", &[0.0075])[0];
     let clearances = list("SCARA_CLEARANCES", &[0.01, 0.1]);
     let rates = list("SCARA_RATES", &[1000.0]);
+    // `SCARA_COST=n`: the cost of a world step against the ideal arm's, the two run in turn
+    // n times (timings on a shared machine are noisy), then nothing else.
+    if let Some(&n) = list("SCARA_COST", &[]).first() {
+        for &rate in &rates {
+            for &mm in &clearances {
+                let control = StepControl {
+                    tolerance,
+                    ..StepControl::fixed(1.0 / rate)
+                };
+                let per_step = |o: &Outcome| o.wall_s / o.steps as f64;
+                for _ in 0..n as usize {
+                    let ideal = run(Pins::Ideal, 0.0, rate, control).expect("the ideal arm");
+                    let sub = run(
+                        Pins::Compliant(ContactIntegration::SubCycled),
+                        mm * 1e-3,
+                        rate,
+                        control,
+                    )
+                    .expect("the sub-cycled arm");
+                    println!(
+                        "{mm} mm, {rate} Hz: ideal {:.2} us, sub-cycled {:.1} us a world step \
+                         ({:.1} sub-steps of both pins): {:.1} times",
+                        per_step(&ideal) * 1e6,
+                        per_step(&sub) * 1e6,
+                        sub.substeps as f64 / sub.steps as f64,
+                        per_step(&sub) / per_step(&ideal)
+                    );
+                }
+            }
+        }
+        return;
+    }
     // The reference's own convergence: its tolerance and largest step, and the starts run
     // (the first `SCARA_STARTS` of the perturbations).
     let ref_tolerance = list("SCARA_REFERENCE_TOLERANCE", &[REFERENCE_TOLERANCE])[0];
     let ref_max_dt = list("SCARA_REFERENCE_MAX_DT", &[REFERENCE_MAX_DT])[0];
-    let starts = list("SCARA_STARTS", &[PERTURBATIONS.len() as f64])[0] as usize;
+    // `SCARA_PERTURBATIONS`: the starts' relative perturbations (default the five above);
+    // `SCARA_PERTURB=gain`: they scale the controller's gains instead of the clearance (the
+    // arm's slow motion moved, as a world step's error of it moves it).
+    let perturbations = list("SCARA_PERTURBATIONS", &PERTURBATIONS);
+    let on_gain = std::env::var("SCARA_PERTURB").is_ok_and(|w| w == "gain");
+    let starts = list("SCARA_STARTS", &[perturbations.len() as f64])[0] as usize;
     // The sub-cycled arm's world steps per controller tick: its world's step apart from the
     // controller's tick.
     let per_tick = list("SCARA_STEPS_PER_TICK", &[1.0])[0];
     for &rate in &rates {
         let tick = 1.0 / rate;
-        let ideal = run(Pins::Ideal, 0.0, rate, StepControl::fixed(tick)).expect("the ideal arm");
+        // `SCARA_IDEAL_STEPS_PER_TICK`: the ideal arm's world steps per tick (diagnosis).
+        let ideal_per_tick = list("SCARA_IDEAL_STEPS_PER_TICK", &[1.0])[0];
+        let ideal = run(
+            Pins::Ideal,
+            0.0,
+            rate,
+            StepControl::fixed(tick / ideal_per_tick),
+        )
+        .expect("the ideal arm");
         let ideal_reference = run(
             Pins::Ideal,
             0.0,
@@ -668,23 +832,30 @@ fn ensemble() {
             println!("|---|---|---|---|---|---|---|---|");
             // Per arm (sub-cycled, reference): each start's metrics.
             let mut values: [Vec<[f64; METRICS.len()]>; 2] = Default::default();
-            for &p in PERTURBATIONS.iter().take(starts) {
-                let c = mm * 1e-3 * (1.0 + p);
-                let arms = [
-                    (
-                        "sub-cycled",
-                        run(
-                            Pins::Compliant(ContactIntegration::SubCycled),
-                            c,
-                            rate,
-                            StepControl {
-                                tolerance,
-                                ..StepControl::fixed(tick / per_tick)
-                            },
-                        ),
-                        &ideal,
+            for &p in perturbations.iter().take(starts) {
+                let (c, g) = if on_gain {
+                    (mm * 1e-3, 1.0 + p)
+                } else {
+                    (mm * 1e-3 * (1.0 + p), 1.0)
+                };
+                GAIN_SCALE.store(g.to_bits(), std::sync::atomic::Ordering::Relaxed);
+                // `SCARA_REFERENCE=none`: the sub-cycled arms only (diagnosis, profiles).
+                let skip = std::env::var("SCARA_REFERENCE").is_ok_and(|r| r == "none");
+                let mut arms = vec![(
+                    "sub-cycled",
+                    run(
+                        Pins::Compliant(ContactIntegration::SubCycled),
+                        c,
+                        rate,
+                        StepControl {
+                            tolerance,
+                            ..StepControl::fixed(tick / per_tick)
+                        },
                     ),
-                    (
+                    &ideal,
+                )];
+                if !skip {
+                    arms.push((
                         "reference",
                         run(
                             Pins::Compliant(ContactIntegration::Explicit),
@@ -693,8 +864,8 @@ fn ensemble() {
                             StepControl::adaptive(tick.min(ref_max_dt), ref_tolerance),
                         ),
                         &ideal_reference,
-                    ),
-                ];
+                    ));
+                }
                 for (k, (name, o, ideal)) in arms.into_iter().enumerate() {
                     let o = match o {
                         Ok(o) => o,
@@ -729,6 +900,7 @@ fn ensemble() {
                     values[k].push(METRICS.map(|(_, f)| f(&o, off)));
                 }
             }
+            GAIN_SCALE.store(1f64.to_bits(), std::sync::atomic::Ordering::Relaxed);
             println!(
                 "\n| {mm} mm, {rate} Hz | sub-cycled mean [min, max] | reference mean [min, max] | sub-cycled mean vs reference range |"
             );

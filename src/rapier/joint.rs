@@ -134,6 +134,9 @@ struct CycleState {
     pending: Option<[f64; 12]>,
     /// [`ClearanceJoint::start_velocity_correction`] of the last step.
     start_correction: [f64; 12],
+    /// [`ClearanceJoint::state_velocity`]: the pair's velocity at the last step's end, as its
+    /// sub-cycle ended it (`None` when no sub-cycle ran).
+    end_velocity: Option<[f64; 12]>,
     /// [`ClearanceJoint::step_dissipation`] of the last step, J.
     dissipated: f64,
     /// The contact's impulse over the last step ([`ClearanceJoint::step_impulse`]).

@@ -299,6 +299,25 @@ impl ClearanceWorld {
         self.stepper.invalidate(restart_kick);
     }
 
+    /// The velocity (linear, angular) of `body` at the world's state: a sub-cycled joint's
+    /// ([`ClearanceJoint::state_velocity`](crate::rapier::joint::ClearanceJoint::state_velocity))
+    /// where one ended its last step on a pair with the body, Rapier's otherwise (`None` for a
+    /// body not in the world): after a sub-cycled step Rapier's velocities hold only part of the
+    /// step's contact impulse.
+    pub fn velocity_at_state(&self, body: RigidBodyHandle) -> Option<(Vector, Vector)> {
+        let rb = self.rapier.bodies.get(body)?;
+        let joints = self
+            .clearance
+            .iter()
+            .filter_map(|(_, j)| j.state_velocity());
+        Some(
+            joints
+                .flatten()
+                .find(|(b, _, _)| *b == body)
+                .map_or((rb.linvel(), rb.angvel()), |(_, v, w)| (v, w)),
+        )
+    }
+
     /// The simulated time, s.
     pub fn time(&self) -> f64 {
         self.stepper.time()

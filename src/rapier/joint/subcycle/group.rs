@@ -494,6 +494,7 @@ impl crate::rapier::joint::CycleState {
         self.held = held;
         self.shift = self.run.shift_next;
         self.start_correction = self.run.start_correction;
+        self.end_velocity = Some(self.run.end_velocity);
         self.dissipated = self.run.dissipated;
         self.impulse = self.run.impulse;
         self.substep_count = self.run.substeps;

@@ -219,7 +219,10 @@ impl ClearanceJoint {
     /// states inside the step, the impulse left held. `None` when no step was planned (the
     /// joint is then evaluated as an explicit one) or a body is gone.
     pub(crate) fn finish_cycle(&mut self, bodies: &RigidBodySet) -> Option<(Wrench, Wrench)> {
-        let held = self.cycle.pending.take()?;
+        let Some(held) = self.cycle.pending.take() else {
+            self.cycle.end_velocity = None;
+            return None;
+        };
         let end = *self.cycle.run.samples.last()?;
         let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
         let history = self.cycle.run.history;
@@ -328,6 +331,20 @@ impl ClearanceJoint {
     pub fn start_velocity_correction(&self) -> [(RigidBodyHandle, Vector, Vector); 2] {
         let c = &self.cycle.start_correction;
         [(self.body1, 0), (self.body2, 2)].map(|(b, k)| (b, part(c, k), part(c, k + 1)))
+    }
+
+    /// The velocity (linear, angular) of the bearing's body and of the journal's at the state
+    /// the last step ended at, as the joint's sub-cycle ended it (`None` for an explicit or
+    /// spatial joint, and when no sub-cycle ran). Rapier's velocities after a sub-cycled step
+    /// are the mean over the step and do not yet hold the part of the step's contact impulse
+    /// delivered with the next step (of an impact inside the step, up to most of it): read the
+    /// bodies' velocity at the state here, for their momentum and energy at it or a force of
+    /// yours that acts on it
+    /// ([`ClearanceWorld::velocity_at_state`](crate::rapier::pipeline::world::ClearanceWorld::velocity_at_state)
+    /// for any body). Each impulse of the joints sub-cycled together is in every pair it moves.
+    pub fn state_velocity(&self) -> Option<[(RigidBodyHandle, Vector, Vector); 2]> {
+        let v = self.cycle.end_velocity.filter(|_| self.spatial.is_none())?;
+        Some([(self.body1, 0), (self.body2, 2)].map(|(b, k)| (b, part(&v, k), part(&v, k + 1))))
     }
 
     /// The contact's impulse on the journal over the last step, N s, summed over a sub-cycled

@@ -2,19 +2,29 @@
 //! Each listed stepping runs all five starts (nominal and [`PERTURBATIONS`]), so a fixed step's
 //! ensemble is compared with the default's, start by start, over the matrix's own window.
 //!
-//! `MECHANISMS_STUDY="2.5e-7,1.25e-7,tol=0.002" cargo bench --bench mechanisms -- "c=0.1mm"`:
-//! a number is an explicit fixed step (s); `tol=X` the explicit adaptive default at tolerance `X`.
+//! `MECHANISMS_STUDY="2.5e-7,1.25e-7,tol=0.002,sub=0.002" cargo bench --bench mechanisms --
+//! "c=0.1mm"`: a number is an explicit fixed step (s); `tol=X` the explicit adaptive default at
+//! tolerance `X`; `sub=X` the sub-cycled adaptive default at tolerance `X`. `MECHANISMS_SET`
+//! (`key=value` pairs separated by `;`) is applied to every run of the study after the case's own
+//! settings (`MECHANISMS_SET="run.max_dt_s=1e-4"`: a knob's effect on every start).
 
 use crate::matrix::*;
 
-/// One stepping of the study: a fixed step, or the adaptive default at a tolerance.
-fn parse(item: &str) -> (Stepping, Option<String>) {
-    match item.strip_prefix("tol=") {
-        Some(tol) => (Stepping::Default, Some(tol.to_string())),
-        None => (
-            Stepping::Fixed(item.parse().expect("a fixed step in seconds or tol=X")),
+/// One stepping of the study: a fixed step, or the adaptive default at a tolerance with its
+/// contact integration.
+fn parse(item: &str) -> (Stepping, Option<(String, &'static str)>) {
+    if let Some(tol) = item.strip_prefix("tol=") {
+        (Stepping::Default, Some((tol.to_string(), "Explicit")))
+    } else if let Some(tol) = item.strip_prefix("sub=") {
+        (Stepping::Default, Some((tol.to_string(), "SubCycled")))
+    } else {
+        (
+            Stepping::Fixed(
+                item.parse()
+                    .expect("a fixed step in seconds, tol=X or sub=X"),
+            ),
             None,
-        ),
+        )
     }
 }
 
@@ -34,10 +44,20 @@ pub fn study(spec: &str, cases: &[Case], quick: bool) {
         for item in spec.split(',').map(str::trim).filter(|s| !s.is_empty()) {
             let (stepping, tol) = parse(item);
             let mut base = case.clone();
-            if let Some(tol) = &tol {
-                // The explicit adaptive stepper at this tolerance (the case's settings go last).
+            if let Some((tol, integration)) = &tol {
+                // The adaptive stepper at this tolerance (the case's settings go last).
                 base.set.push(format!("run.tolerance={tol}"));
-                base.set.push("run.contact_integration=Explicit".into());
+                base.set
+                    .push(format!("run.contact_integration={integration}"));
+            }
+            if let Ok(extra) = std::env::var("MECHANISMS_SET") {
+                base.set.extend(
+                    extra
+                        .split(';')
+                        .map(str::trim)
+                        .filter(|s| !s.is_empty())
+                        .map(String::from),
+                );
             }
             let starts: Vec<(String, Case)> =
                 std::iter::once(("nominal".to_string(), base.clone()))

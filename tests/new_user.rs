@@ -85,3 +85,61 @@ fn a_finite_user_torque_steps() {
     }
     assert!(world.guards().is_clean());
 }
+
+/// The same sub-cycled pin through bevy_ecs at 1/60 s and four iterations: `HingeState` holds
+/// what the plain world's sub-steps hold (onsets, impacts, the largest force inside the steps).
+#[cfg(feature = "ecs")]
+#[test]
+fn a_sub_cycled_hinge_in_bevy_ecs_reports_its_sub_steps() {
+    use bevy_ecs::prelude::*;
+    use clearance_joint::ecs::*;
+    let (mut plain, _) = game_pendulum();
+    let (mut peak, mut onsets, mut impacts, mut last) = (0.0f64, 0u64, 0u64, 0usize);
+    let pin = plain.clearance.iter().next().unwrap().0;
+    for frame in 1..=60 {
+        plain.step(frame as f64 / 60.0).unwrap();
+        let s = plain.clearance.get(pin).unwrap().substeps();
+        last = s.len();
+        for s in s {
+            peak = peak.max(s.force.normal_force);
+            onsets += s.onset as u64;
+            impacts += s.impact as u64;
+        }
+    }
+    let mut world = World::new();
+    world.insert_resource(Physics::new(1.0 / 60.0, Vector::new(0.0, -9.81, 0.0)));
+    let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
+    let arm = world
+        .spawn(Body::new(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(0.3, 0.0, 0.0))
+                .additional_mass_properties(MassProperties::new(
+                    Vector::ZERO,
+                    2.0,
+                    Vector::splat(0.02),
+                ))
+                .can_sleep(false),
+        ))
+        .id();
+    let design = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
+        .unwrap()
+        .integration(ContactIntegration::SubCycled);
+    let hinge = world
+        .spawn((
+            Hinge::new(base, arm, Vector::Z).local_anchor2(Vector::new(-0.3, 0.0, 0.0)),
+            ClearanceHinge(design),
+        ))
+        .id();
+    let mut schedule = physics_schedule();
+    for _ in 0..60 {
+        run_step(&mut world, &mut schedule).unwrap();
+    }
+    let state = world.get::<HingeState>(hinge).unwrap();
+    assert_eq!(state.mode, HingeMode::Clearance);
+    assert_eq!((state.onsets, state.impacts), (onsets, impacts));
+    assert_eq!(state.peak_force, peak);
+    // The last step's sub-steps, as the plain joint's `substeps()` (more than one: the contact
+    // is resolved inside the 1/60 s step).
+    assert!(last > 1, "{last}");
+    assert_eq!(state.substeps, last);
+}

@@ -143,3 +143,61 @@ fn a_sub_cycled_hinge_in_bevy_ecs_reports_its_sub_steps() {
     assert!(last > 1, "{last}");
     assert_eq!(state.substeps, last);
 }
+
+/// Switching a live bevy_ecs hinge from sub-cycled to explicit in a world at Rapier's four
+/// iterations is refused naming the setting and both ways out; switching back steps on.
+#[cfg(feature = "ecs")]
+#[test]
+fn switching_a_live_hinge_off_sub_cycling_at_four_iterations_is_refused() {
+    use bevy_ecs::prelude::*;
+    use clearance_joint::ecs::*;
+    let mut world = World::new();
+    world.insert_resource(Physics::new(1.0 / 60.0, Vector::new(0.0, -9.81, 0.0)));
+    let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
+    let arm = world
+        .spawn(Body::new(
+            RigidBodyBuilder::dynamic()
+                .translation(Vector::new(0.3, 0.0, 0.0))
+                .additional_mass_properties(MassProperties::new(
+                    Vector::ZERO,
+                    2.0,
+                    Vector::splat(0.02),
+                ))
+                .can_sleep(false),
+        ))
+        .id();
+    let design = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016).unwrap();
+    let sub_cycled = design.clone().integration(ContactIntegration::SubCycled);
+    let hinge = world
+        .spawn((
+            Hinge::new(base, arm, Vector::Z).local_anchor2(Vector::new(-0.3, 0.0, 0.0)),
+            ClearanceHinge(sub_cycled.clone()),
+        ))
+        .id();
+    let mut schedule = physics_schedule();
+    for _ in 0..10 {
+        run_step(&mut world, &mut schedule).unwrap();
+    }
+    world.get_mut::<ClearanceHinge>(hinge).unwrap().0 = design;
+    let m = run_step(&mut world, &mut schedule).unwrap_err().to_string();
+    assert!(
+        m.contains("num_solver_iterations")
+            && m.contains("ContactIntegration::SubCycled")
+            && m.contains("ClearanceModel::LargeStep"),
+        "{m}"
+    );
+    world.get_mut::<ClearanceHinge>(hinge).unwrap().0 = sub_cycled;
+    for _ in 0..10 {
+        run_step(&mut world, &mut schedule).unwrap();
+    }
+    let physics = world.resource::<Physics>();
+    assert!(
+        (physics.world.time() - 20.0 / 60.0).abs() < 1e-12,
+        "{}",
+        physics.world.time()
+    );
+    assert!(physics.guards().is_clean());
+    let state = world.get::<HingeState>(hinge).unwrap();
+    assert_eq!(state.mode, HingeMode::Clearance);
+    assert!(state.substeps > 1, "{}", state.substeps);
+}

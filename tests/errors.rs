@@ -337,6 +337,7 @@ fn rapiers_default_iterations_suggest_the_large_step_model() {
         m.contains("is 4")
             && m.contains("num_solver_iterations = 1")
             && m.contains("HingeDesign::model(ClearanceModel::LargeStep)")
+            && m.contains("HingeDesign::integration(ContactIntegration::SubCycled)")
             && m.contains("any number of iterations"),
         "{m}"
     );

@@ -250,9 +250,10 @@ pub struct HingeState {
     /// 0 without a bounce, and always 0 for the compliant model, whose contacts are resolved
     /// as force histories in `force`, and for ideal hinges.
     pub impulse: f64,
-    /// Rapier substeps the hinge's bodies took in the last step (large step; it chooses them,
-    /// see [`large_step`](crate::rapier::large_step)); 0 for the other modes, whose substeps are
-    /// the world's `num_solver_iterations`.
+    /// The hinge's own substeps in the last step: a large-step hinge's Rapier substeps (it
+    /// chooses them, see [`large_step`](crate::rapier::large_step)); a sub-cycled hinge's
+    /// contact sub-steps ([`ClearanceJoint::substeps`](crate::rapier::joint::ClearanceJoint::substeps)'s
+    /// length); 0 for the other modes, whose substeps are the world's `num_solver_iterations`.
     pub substeps: usize,
     /// Whether the last step needed more substeps than the large-step joint allows, so that its
     /// eccentricity and force may be off by more than the model's resolution promises (large

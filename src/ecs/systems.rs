@@ -260,6 +260,7 @@ pub fn record(
                         // Sub-cycled: the contacts inside the step, from its sub-steps.
                         Some(impulse) => {
                             let inside = j.substeps();
+                            state.substeps = inside.len();
                             state.onsets += inside.iter().filter(|s| s.onset).count() as u64;
                             state.impacts += inside.iter().filter(|s| s.impact).count() as u64;
                             let peak = inside

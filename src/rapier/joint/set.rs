@@ -296,8 +296,10 @@ impl ClearanceJointSet {
                      contact force is evaluated once per step and held over it, and Rapier's \
                      substeps would make every impact gain energy. Set Rapier's \
                      `integration_parameters.num_solver_iterations = 1` (every body of the world \
-                     then gets one iteration: stacks of resting bodies soften), or build the \
-                     hinges with the large-step model, \
+                     then gets one iteration: stacks of resting bodies soften), sub-cycle the \
+                     joints' contact (`HingeDesign::integration(ContactIntegration::SubCycled)`, \
+                     the same laws resolved inside each step, with any number of iterations), or \
+                     build the hinges with the large-step model, \
                      `HingeDesign::model(ClearanceModel::LargeStep)` into a LargeStepJointSet, which \
                      works with any number of iterations and steps as long as 1/60 s",
                     params.num_solver_iterations

@@ -5,7 +5,9 @@ use super::{GuardKind, STALL_STEPS, StepMode, Stepper, Violation};
 use crate::error::{Divergence, Error, Result};
 use crate::rapier::observers::stall::{Stall, StallCause};
 use crate::rapier::pipeline::step_hooks::{StepContext, StepHooks};
-use rapier3d_f64::prelude::PhysicsWorld;
+use rapier3d_f64::prelude::{
+    MassProperties, PhysicsWorld, RigidBody, RigidBodyAdditionalMassProps,
+};
 
 impl Stepper {
     /// The stall message for `seen`: the contact that stops the steps, its state and its cause
@@ -169,10 +171,12 @@ pub(super) fn check_gravity(world: &PhysicsWorld, max_dt: f64) -> Result<()> {
     Ok(())
 }
 
-/// Every body's pose and velocities are finite before a step: a NaN set by hand would otherwise
-/// show only as a body leaving the physical range after it, with nothing to say why.
+/// Every body's pose, velocities, mass properties and user forces are finite before a step: a
+/// NaN set by hand (a controller's torque, a mass) would otherwise show only as a body leaving
+/// the physical range after it, with nothing to say which input it was.
 pub(super) fn check_body_states(world: &PhysicsWorld) -> Result<()> {
     for (handle, rb) in world.bodies.iter() {
+        let mprops = &rb.mass_properties().local_mprops;
         let bad = [
             (
                 "position",
@@ -180,24 +184,59 @@ pub(super) fn check_body_states(world: &PhysicsWorld) -> Result<()> {
             ),
             ("linvel", rb.linvel().is_finite()),
             ("angvel", rb.angvel().is_finite()),
+            ("mass", finite_mass(mprops) && additional_mass_is_finite(rb)),
+            ("user_force", rb.user_force().is_finite()),
+            ("user_torque", rb.user_torque().is_finite()),
         ]
         .into_iter()
         .find(|(_, ok)| !ok);
         if let Some((field, _)) = bad {
-            return Err(Error::invalid(
-                field,
-                format!(
-                    "body {:?} has a non-finite {field} before the step (position {:?}, linvel \
-                     {:?}, angvel {:?}): set finite values",
-                    handle.into_raw_parts(),
+            let what = match field {
+                "mass" => format!(
+                    "mass {:?}, principal inertia {:?}, additional mass properties {:?}",
+                    rb.mass(),
+                    mprops.principal_inertia(),
+                    rb.mass_properties().additional_local_mprops
+                ),
+                "user_force" | "user_torque" => format!(
+                    "user force {:?}, user torque {:?}: a force added with `add_force` or \
+                     `add_torque` since the last step (Rapier keeps them until \
+                     `reset_forces`/`reset_torques`)",
+                    rb.user_force(),
+                    rb.user_torque()
+                ),
+                _ => format!(
+                    "position {:?}, linvel {:?}, angvel {:?}",
                     rb.translation(),
                     rb.linvel(),
                     rb.angvel()
+                ),
+            };
+            return Err(Error::invalid(
+                field,
+                format!(
+                    "body {:?} has a non-finite {field} before the step ({what}): set finite values",
+                    handle.into_raw_parts(),
                 ),
             ));
         }
     }
     Ok(())
+}
+
+/// Whether mass properties hold a finite mass and inertia.
+fn finite_mass(m: &MassProperties) -> bool {
+    m.inv_mass.is_finite() && m.inv_principal_inertia.is_finite()
+}
+
+/// Whether a body's additional mass properties (`set_additional_mass_properties`,
+/// `set_additional_mass`; Rapier folds them into the body's mass at its next step) are finite.
+fn additional_mass_is_finite(rb: &RigidBody) -> bool {
+    match rb.mass_properties().additional_local_mprops.as_deref() {
+        Some(RigidBodyAdditionalMassProps::MassProps(m)) => finite_mass(m),
+        Some(RigidBodyAdditionalMassProps::Mass(m)) => m.is_finite(),
+        None => true,
+    }
 }
 
 /// Every impulse joint (Rapier's own, a clearance joint's lock, a large-step joint's) and every

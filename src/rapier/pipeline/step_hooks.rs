@@ -185,8 +185,9 @@ pub struct RapierStepContext<'a> {
 pub struct StepPass {
     /// The step, s.
     pub dt: f64,
-    /// Its velocity kick, `(h_prev + h)/2` (`h/2` for a first step), s: the stepper scales every
-    /// force by `kick/dt` for the step.
+    /// Its velocity kick, s (`(h_prev + h)/2` with one solver iteration, `h/2` for a first step;
+    /// with Rapier's `n` substeps, the rule that keeps them on the exact motion): the stepper
+    /// scales every force by `kick/dt` for the step.
     pub kick: f64,
     /// The step control's tolerance.
     pub tolerance: f64,

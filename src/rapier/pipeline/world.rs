@@ -289,8 +289,8 @@ impl ClearanceWorld {
 
     /// Forgets the evaluation of the joints and drives, after you changed the world between
     /// steps by hand (bodies moved, sets edited through their fields): the next step evaluates
-    /// them again first. With `restart_kick` the next step is a half kick again, as from a new
-    /// initial state (after setting velocities by hand), and the clearance joints' contact laws
+    /// them again first. With `restart_kick` the next step's kick is a first step's again, as from
+    /// a new initial state (after setting velocities by hand), and the clearance joints' contact laws
     /// get the stored rate at that evaluation. Without it they carry the rate to the state with
     /// its change since their last evaluation, across your edit: off by at most half that
     /// change, once
@@ -344,15 +344,17 @@ impl ClearanceWorld {
     /// of `joints`; [`ReactionSolver::solve`]), with what the step loop knows and a
     /// bare solve would not: the joints' and drives' wrenches (they act during the steps only;
     /// a large-step joint's, its constraint's force over the last step),
-    /// the prescribed motions' rates at this time, and the stored velocities' lag of half the
-    /// last step. `None` when the solve fails ([`ReactionSolver::failure`] says why).
+    /// the prescribed motions' rates at this time, and the stored velocities' lag behind the
+    /// state (half the last step with one solver iteration). `None` when the solve fails ([`ReactionSolver::failure`] says why).
     pub fn solve_reactions<'s>(
         &mut self,
         solver: &'s mut ReactionSolver,
         joints: &[IdealJoint],
     ) -> Option<&'s [Vector]> {
         let t = self.time();
-        solver.velocity_lag = 0.5 * self.stepper.last_dt();
+        solver.velocity_lag = self
+            .stepper
+            .velocity_lag(self.rapier.integration_parameters.num_solver_iterations);
         solver.kinematic.clear();
         for m in &self.prescribed.motions {
             let (linvel, linacc, angvel, angacc) = m.rates(t);

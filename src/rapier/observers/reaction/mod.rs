@@ -102,10 +102,11 @@ pub struct ReactionSolver {
     /// constant velocity.
     pub kinematic: Vec<KinematicState>,
     /// How long before the state the bodies' stored velocities are, s: the stored velocities are
-    /// advanced by it with the accelerations solved. Half the last step for Rapier's velocities
-    /// after a step of the [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld)
-    /// (`world.last_dt() / 2`; 0 before the first step, whose velocities are the initial
-    /// state's) or of a plain Rapier loop at constant steps (`dt / 2`). Default 0: the stored
+    /// advanced by it with the accelerations solved. For Rapier's velocities after a step of the
+    /// [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld) its
+    /// `solve_reactions` sets it (half the last step with one solver iteration, `h/(2 n)` at
+    /// constant steps with `n`; 0 before the first step, whose velocities are the initial
+    /// state's); for a plain Rapier loop at constant steps `dt/(2 n)`. Default 0: the stored
     /// velocities are taken as the state's (and only projected onto the joints).
     pub velocity_lag: f64,
     /// Further bodies whose velocities and accelerations at the state the solve reports

@@ -41,7 +41,34 @@ pub(super) fn snapshot_bodies(world: &PhysicsWorld, into: &mut Vec<BodySnapshot>
 }
 
 impl Stepper {
-    /// One Rapier step of `dt` from the saved state, with the kick `(h_prev + h)/2`: your forces,
+    /// The velocity kick of a step of `dt` after the last accepted one, for Rapier's `n`
+    /// substeps, s. Rapier's `n` substeps of a step `h` under a held acceleration `a` raise the
+    /// velocity by `a k` (`k` the kick) and move the body by `h v + c_n a k h`,
+    /// `c_n = (n + 1)/(2 n)`: its stored velocity lags the state's by `s = c_n k - h/2` at the
+    /// step's start. The kick keeps that relation from step to step,
+    /// `k' = (h' + h - 2 (1 - c_n) k)/(2 c_n)`, so a held acceleration moves the bodies as the
+    /// exact motion does at every step; from a state whose velocities are the state's (`s = 0`:
+    /// the first step, or after `invalidate(true)`) `k = h/(2 c_n)`. With one substep it is
+    /// the leapfrog's `(h_prev + h)/2`; with more, the leapfrog's kick would leave the world
+    /// `(n - 1)/(2 n)` of a step behind (6 ms at 60 Hz and Rapier's four). Never negative: after
+    /// an abrupt fall of the step at many substeps the rule would kick against the force.
+    pub(super) fn kick_for(&self, dt: f64, n: usize) -> f64 {
+        let c_n = substep_share(n);
+        if self.last_dt > 0.0 {
+            ((dt + self.last_dt - 2.0 * (1.0 - c_n) * self.last_kick) / (2.0 * c_n)).max(0.0)
+        } else {
+            dt / (2.0 * c_n)
+        }
+    }
+
+    /// How long before the state Rapier's stored velocities are after the last accepted step,
+    /// s, for its `n` substeps: `h/2 - (1 - c_n) k` ([`Self::kick_for`]); half the step with
+    /// one substep, 0 before the first step.
+    pub(crate) fn velocity_lag(&self, n: usize) -> f64 {
+        0.5 * self.last_dt - (1.0 - substep_share(n)) * self.last_kick
+    }
+
+    /// One Rapier step of `dt` from the saved state, with the kick of [`Self::kick_for`]: your forces,
     /// the sources' wrenches and gravity scaled to the kick for this step only, the sources'
     /// hooks around it, the joint correction, exact kinematic poses ([`Self::rapier_pass`]),
     /// taken again from the saved state while a source asks ([`StepHooks::resolve_step`], at
@@ -53,7 +80,7 @@ impl Stepper {
         sources: &mut [&mut dyn StepHooks],
         dt: f64,
     ) -> f64 {
-        let kick = 0.5 * (self.last_dt + dt);
+        let kick = self.kick_for(dt, world.integration_parameters.num_solver_iterations);
         let mut pass = StepPass {
             dt,
             kick,
@@ -190,4 +217,11 @@ fn exact_kinematic_poses(world: &mut PhysicsWorld, saved: &[BodySnapshot], dt: f
             rb.set_position(pose, false);
         }
     }
+}
+
+/// `c_n = (n + 1)/(2 n)`: the share of a step's velocity kick Rapier's `n` substeps move the
+/// bodies by over the step (1 for one substep; towards 1/2, the exact motion's, for many).
+pub(crate) fn substep_share(n: usize) -> f64 {
+    let n = n.max(1) as f64;
+    (n + 1.0) / (2.0 * n)
 }

@@ -88,25 +88,16 @@ fn a_finite_user_torque_steps() {
 
 /// The same sub-cycled pin through bevy_ecs at 1/60 s and four iterations: `HingeState` holds
 /// what the plain world's sub-steps hold (onsets, impacts, the largest force inside the steps).
+/// A bevy_ecs world at 1/60 s with gravity, a fixed base and a 2 kg arm 0.3 m from it (the
+/// guide's), not yet hinged.
 #[cfg(feature = "ecs")]
-#[test]
-fn a_sub_cycled_hinge_in_bevy_ecs_reports_its_sub_steps() {
-    use bevy_ecs::prelude::*;
+fn ecs_arm() -> (
+    bevy_ecs::world::World,
+    bevy_ecs::entity::Entity,
+    bevy_ecs::entity::Entity,
+) {
     use clearance_joint::ecs::*;
-    let (mut plain, _) = game_pendulum();
-    let (mut peak, mut onsets, mut impacts, mut last) = (0.0f64, 0u64, 0u64, 0usize);
-    let pin = plain.clearance.iter().next().unwrap().0;
-    for frame in 1..=60 {
-        plain.step(frame as f64 / 60.0).unwrap();
-        let s = plain.clearance.get(pin).unwrap().substeps();
-        last = s.len();
-        for s in s {
-            peak = peak.max(s.force.normal_force);
-            onsets += s.onset as u64;
-            impacts += s.impact as u64;
-        }
-    }
-    let mut world = World::new();
+    let mut world = bevy_ecs::world::World::new();
     world.insert_resource(Physics::new(1.0 / 60.0, Vector::new(0.0, -9.81, 0.0)));
     let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
     let arm = world
@@ -121,6 +112,27 @@ fn a_sub_cycled_hinge_in_bevy_ecs_reports_its_sub_steps() {
                 .can_sleep(false),
         ))
         .id();
+    (world, base, arm)
+}
+
+#[cfg(feature = "ecs")]
+#[test]
+fn a_sub_cycled_hinge_in_bevy_ecs_reports_its_sub_steps() {
+    use clearance_joint::ecs::*;
+    let (mut plain, _) = game_pendulum();
+    let (mut peak, mut onsets, mut impacts, mut last) = (0.0f64, 0u64, 0u64, 0usize);
+    let pin = plain.clearance.iter().next().unwrap().0;
+    for frame in 1..=60 {
+        plain.step(frame as f64 / 60.0).unwrap();
+        let s = plain.clearance.get(pin).unwrap().substeps();
+        last = s.len();
+        for s in s {
+            peak = peak.max(s.force.normal_force);
+            onsets += s.onset as u64;
+            impacts += s.impact as u64;
+        }
+    }
+    let (mut world, base, arm) = ecs_arm();
     let design = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
         .integration(ContactIntegration::SubCycled);
@@ -149,23 +161,8 @@ fn a_sub_cycled_hinge_in_bevy_ecs_reports_its_sub_steps() {
 #[cfg(feature = "ecs")]
 #[test]
 fn switching_a_live_hinge_off_sub_cycling_at_four_iterations_is_refused() {
-    use bevy_ecs::prelude::*;
     use clearance_joint::ecs::*;
-    let mut world = World::new();
-    world.insert_resource(Physics::new(1.0 / 60.0, Vector::new(0.0, -9.81, 0.0)));
-    let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
-    let arm = world
-        .spawn(Body::new(
-            RigidBodyBuilder::dynamic()
-                .translation(Vector::new(0.3, 0.0, 0.0))
-                .additional_mass_properties(MassProperties::new(
-                    Vector::ZERO,
-                    2.0,
-                    Vector::splat(0.02),
-                ))
-                .can_sleep(false),
-        ))
-        .id();
+    let (mut world, base, arm) = ecs_arm();
     let design = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016).unwrap();
     let sub_cycled = design.clone().integration(ContactIntegration::SubCycled);
     let hinge = world

@@ -267,7 +267,7 @@ pub(super) fn plan_group(
     deliveries: &mut [Option<Pair12>],
 ) {
     let (h, kick) = (pass.dt, pass.kick);
-    let c_n = (iterations as f64 + 1.0) / (2.0 * iterations.max(1) as f64);
+    let c_n = crate::rapier::pipeline::stepper::substep_share(iterations);
     let mut runs: Vec<SubCycle> = group
         .iter()
         .map(|&i| std::mem::take(&mut joints[i].cycle.run))

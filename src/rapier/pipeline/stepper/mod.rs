@@ -51,6 +51,7 @@
 mod control;
 mod health;
 mod pass;
+pub(crate) use pass::substep_share;
 
 use crate::error::{Error, Result};
 use crate::rapier::pipeline::joint_correction::JointCorrection;

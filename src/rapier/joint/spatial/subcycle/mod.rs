@@ -218,7 +218,7 @@ impl ClearanceJoint {
         let start = self.cycle.spatial_start?;
         let now = PairStart::velocity_now(self, bodies)?;
         let (h, kick) = (pass.dt, pass.kick);
-        let c_n = (iterations as f64 + 1.0) / (2.0 * iterations.max(1) as f64);
+        let c_n = crate::rapier::pipeline::stepper::substep_share(iterations);
         let a_free: Pair12 = std::array::from_fn(|i| (now[i] - start.velocity[i]) / kick);
         let mut u0 = start.velocity;
         axpy(&mut u0, c_n * kick - 0.5 * h, &a_free);

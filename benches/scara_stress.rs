@@ -408,10 +408,8 @@ fn run_with(
         );
     }
     if std::env::var("SCARA_IMPACTS").is_ok() {
-        for (k, r) in arm.recorders.iter().enumerate() {
-            let mut list: Vec<_> = r.contacts().to_vec();
-            list.sort_by(|a, b| b.peak_force_n.total_cmp(&a.peak_force_n));
-            for i in list.iter().take(5) {
+        for (k, list) in o.top.iter().enumerate() {
+            for i in list {
                 eprintln!(
                     "{pins:?} pin {k}: onset {:.5} s, approach {:.4} m/s, peak {:.1} N at {:.5}, depth {:.3} um, {:.1} us",
                     i.onset_t_s,

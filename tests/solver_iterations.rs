@@ -32,9 +32,7 @@ fn a_held_force_moves_the_bodies_exactly_at_any_substeps() {
             rapier.bodies[body].add_force(Vector::new(3.0, 0.0, 0.0), true);
             let mut world = ClearanceWorld::new(rapier, StepControl::fixed(dt));
             for until in untils {
-                while world.time() < until - 1e-12 {
-                    world.step(until).unwrap();
-                }
+                run_to(&mut world, until);
                 let t = world.time();
                 let p = world.rapier.bodies[body].translation();
                 let (y, x) = (-0.5 * G * t * t, 0.5 * 1.5 * t * t);
@@ -47,6 +45,37 @@ fn a_held_force_moves_the_bodies_exactly_at_any_substeps() {
             }
         }
     }
+}
+
+/// Steps `world` until `until` (s).
+fn run_to(world: &mut ClearanceWorld, until: f64) {
+    while world.time() < until - 1e-12 {
+        world.step(until).unwrap();
+    }
+}
+
+/// The plate's width, m: its centre of mass is half of it from the pin.
+const PLATE_W: f64 = 0.8;
+
+/// A world under gravity with `n` solver iterations, a fixed base and a 5 kg plate (inertia
+/// 0.68 kg m^2 about its centre, on the pin's axis) lying level with its edge on the base's
+/// origin: (world, base, plate).
+fn level_plate(n: usize) -> (PhysicsWorld, RigidBodyHandle, RigidBodyHandle) {
+    let mut rapier = PhysicsWorld::new();
+    rapier.gravity = Vector::new(0.0, -G, 0.0);
+    rapier.integration_parameters.num_solver_iterations = n;
+    let base = rapier.bodies.insert(RigidBodyBuilder::fixed());
+    let plate = rapier.bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(Vector::new(PLATE_W / 2.0, 0.0, 0.0))
+            .additional_mass_properties(MassProperties::new(
+                Vector::ZERO,
+                5.0,
+                Vector::new(0.42, 0.28, 0.68),
+            ))
+            .can_sleep(false),
+    );
+    (rapier, base, plate)
 }
 
 /// The plate's hinge angle (rad) and rate by RK4 of `I theta'' = -m g r cos(theta)`, from rest
@@ -71,31 +100,13 @@ fn pendulum_ode(inertia: f64, m: f64, r: f64, t: f64) -> (f64, f64) {
 /// 0.1 s and 0.5 s (rad) and the pivot's reaction at 0.5 s (N, on the plate) read from
 /// `solve_reactions`.
 fn ideal_plate(n: usize) -> (f64, f64, Vector) {
-    let mut rapier = PhysicsWorld::new();
-    rapier.gravity = Vector::new(0.0, -G, 0.0);
-    rapier.integration_parameters.num_solver_iterations = n;
-    let (m, w) = (5.0, 0.8);
-    let base = rapier.bodies.insert(RigidBodyBuilder::fixed());
-    let plate = rapier.bodies.insert(
-        RigidBodyBuilder::dynamic()
-            .translation(Vector::new(w / 2.0, 0.0, 0.0))
-            .additional_mass_properties(MassProperties::new(
-                Vector::ZERO,
-                m,
-                Vector::new(0.42, 0.28, 0.68),
-            ))
-            .can_sleep(false),
-    );
-    let rev = RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(-w / 2.0, 0.0, 0.0));
+    let (mut rapier, base, plate) = level_plate(n);
+    let rev =
+        RevoluteJointBuilder::new(Vector::Z).local_anchor2(Vector::new(-PLATE_W / 2.0, 0.0, 0.0));
     let joint = rapier.impulse_joints.insert(base, plate, rev, true);
     let dt = 1.0 / 60.0;
     let mut world = ClearanceWorld::new(rapier, StepControl::fixed(dt));
     let angle = |world: &ClearanceWorld| world.rapier.bodies[plate].rotation().to_scaled_axis().z;
-    let run_to = |world: &mut ClearanceWorld, until: f64| {
-        while world.time() < until - 1e-12 {
-            world.step(until).unwrap();
-        }
-    };
     run_to(&mut world, 6.0 * dt);
     let early = angle(&world);
     run_to(&mut world, 30.0 * dt);
@@ -147,30 +158,15 @@ fn an_ideal_hinge_at_60_hz_follows_its_ode_with_four_substeps() {
 /// The largest contact force of a 5 kg plate released level on a sub-cycled steel pin (0.2 mm
 /// of play, dry friction), over 1 s at 1/60 s with `n` solver iterations, N.
 fn sub_cycled_plate_peak(n: usize) -> f64 {
-    let mut rapier = PhysicsWorld::new();
-    rapier.gravity = Vector::new(0.0, -G, 0.0);
-    rapier.integration_parameters.num_solver_iterations = n;
-    let dt = 1.0 / 60.0;
-    let mut world = ClearanceWorld::new(rapier, StepControl::fixed(dt));
-    let (m, w) = (5.0, 0.8);
-    let base = world.rapier.bodies.insert(RigidBodyBuilder::fixed());
-    let plate = world.rapier.bodies.insert(
-        RigidBodyBuilder::dynamic()
-            .translation(Vector::new(w / 2.0, 0.0, 0.0))
-            .additional_mass_properties(MassProperties::new(
-                Vector::ZERO,
-                m,
-                Vector::new(0.42, 0.28, 0.68),
-            ))
-            .can_sleep(false),
-    );
+    let (rapier, base, plate) = level_plate(n);
+    let mut world = ClearanceWorld::new(rapier, StepControl::fixed(1.0 / 60.0));
     let pin = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
         .friction(FrictionModel::Bai(Bai::DRY))
         .integration(ContactIntegration::SubCycled)
         .joint(
             Vector::ZERO,
-            Vector::new(-w / 2.0, 0.0, 0.0),
+            Vector::new(-PLATE_W / 2.0, 0.0, 0.0),
             Vector::Z,
             Vector::Z,
         )

@@ -20,6 +20,17 @@ const C: f64 = 0.2e-3;
 const MU: f64 = 0.3;
 const V_EPS: f64 = 1e-4;
 
+/// The journal's sub-cycled pin in its bearing (16 mm wide), Hertz's law of stiffness `k`
+/// (N/m^1.5) with no damping and no friction, centred on both bodies' origins.
+fn sub_cycled_hertz_pin(k: f64) -> ClearanceJoint {
+    use clearance_joint::model::laws::{BearingGeometry, Hertz, NormalModel};
+    let hertz = NormalModel::Hertz(Hertz::new(k, 1.5).unwrap());
+    HingeDesign::new(BearingGeometry::new(R_B, R_B - C, 0.016).unwrap(), hertz)
+        .integration(ContactIntegration::SubCycled)
+        .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
+        .unwrap()
+}
+
 /// A rattle's energy check: more than ten onsets, the largest gain below `bound` (J), the
 /// world's guards clean.
 fn assert_rattled_without_gain(onsets: usize, worst: f64, bound: f64, world: &ClearanceWorld) {
@@ -176,7 +187,6 @@ fn a_sub_cycle_beyond_its_sub_step_cap_is_a_guard_violation() {
 /// some 200 bounces), wherever the world's steps fall in the bounces.
 #[test]
 fn an_elastic_bounce_under_gravity_keeps_its_height_at_any_step() {
-    use clearance_joint::model::laws::{BearingGeometry, Hertz, NormalModel};
     let speed = (2.0 * G * C).sqrt();
     for dt in [1.0 / 60.0, 1e-3] {
         let control = StepControl {
@@ -184,11 +194,7 @@ fn an_elastic_bounce_under_gravity_keeps_its_height_at_any_step() {
             ..StepControl::fixed(dt)
         };
         let (mut world, base, journal) = journal_world(control, 1);
-        let hertz = NormalModel::Hertz(Hertz::new(1e10, 1.5).unwrap());
-        let pin = HingeDesign::new(BearingGeometry::new(R_B, R_B - C, 0.016).unwrap(), hertz)
-            .integration(ContactIntegration::SubCycled)
-            .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
-            .unwrap();
+        let pin = sub_cycled_hertz_pin(1e10);
         let pin = world.insert_clearance(base, journal, pin).unwrap();
         let mut approaches = Vec::new();
         while world.time() < 3.0 {
@@ -221,17 +227,12 @@ fn an_elastic_bounce_under_gravity_keeps_its_height_at_any_step() {
 /// root hinge every window statistic left its converged range.
 #[test]
 fn a_resting_sub_cycled_journal_bounds_the_world_step_by_its_contact_period() {
-    use clearance_joint::model::laws::{BearingGeometry, Hertz, NormalModel};
     let k_hertz = 1e10;
     let static_depth = (MASS * G / k_hertz).powf(1.0 / 1.5);
     for tol in [0.0075, 0.00375] {
         let control = StepControl::adaptive(1e-3, tol);
         let (mut world, base, journal) = journal_world(control, 1);
-        let hertz = NormalModel::Hertz(Hertz::new(k_hertz, 1.5).unwrap());
-        let pin = HingeDesign::new(BearingGeometry::new(R_B, R_B - C, 0.016).unwrap(), hertz)
-            .integration(ContactIntegration::SubCycled)
-            .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
-            .unwrap();
+        let pin = sub_cycled_hertz_pin(k_hertz);
         let at_rest = Vector::new(0.0, -(C + static_depth), 0.0);
         world.rapier.bodies[journal].set_translation(at_rest, true);
         let pin = world.insert_clearance(base, journal, pin).unwrap();
@@ -594,17 +595,12 @@ fn the_paper_scenes_first_impact_goes_as_deep_as_its_ode_at_any_world_step() {
 /// more than a tenth after a bounce (what a controller's damping reading them feeds on).
 #[test]
 fn a_bounce_inside_a_step_is_whole_in_the_velocity_at_the_state() {
-    use clearance_joint::model::laws::{BearingGeometry, Hertz, NormalModel};
     let control = StepControl {
         tolerance: 0.0075,
         ..StepControl::fixed(1e-3)
     };
     let (mut world, base, journal) = journal_world(control, 4);
-    let hertz = NormalModel::Hertz(Hertz::new(1e10, 1.5).unwrap());
-    let pin = HingeDesign::new(BearingGeometry::new(R_B, R_B - C, 0.016).unwrap(), hertz)
-        .integration(ContactIntegration::SubCycled)
-        .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
-        .unwrap();
+    let pin = sub_cycled_hertz_pin(1e10);
     let pin = world.insert_clearance(base, journal, pin).unwrap();
     let (mut state_worst, mut rapier_worst, mut free_ends, mut bounces) = (0.0f64, 0.0f64, 0, 0);
     while world.time() < 0.1 {

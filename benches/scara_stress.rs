@@ -45,7 +45,8 @@
 //! arms' solver iterations, default 4), `SCARA_IMPACTS=1` (each arm's five largest impacts),
 //! `SCARA_AXIAL` (the links' inertia about their length over the transverse one, default 0.1;
 //! `examples/robot_backlash.rs` has 0.001), `SCARA_PLANE=1` (each arm's largest drop of the
-//! lower link's centre of mass out of the arm's plane and its largest spin about its length).
+//! lower link's centre of mass out of the arm's plane and its largest spin about its length), `SCARA_SPATIAL=0.1`
+//! (both pins spatial, with 0.1 mm of axial play and collars of twice the pin's radius).
 
 use clearance_joint::model::laws::{Coulomb, FrictionModel};
 use clearance_joint::prelude::*;
@@ -122,6 +123,20 @@ struct Arm {
 /// arm's plane at 60 and 120 Hz, the ideal arm's too (its centre of mass leaves the plane by
 /// up to 0.21 and 0.08 m, spinning across it at up to 230 and 26 rad/s); at a tenth the ideal
 /// arm's stays within 2 mm of the plane at 60 Hz.
+/// `SCARA_SPATIAL=0.1`: the pins spatial, with that axial play in mm and collars of twice the
+/// pin's radius; unset, planar.
+fn spatial_pins() -> ClearanceModel {
+    match std::env::var("SCARA_SPATIAL")
+        .ok()
+        .and_then(|t| t.parse::<f64>().ok())
+    {
+        Some(play) => ClearanceModel::Spatial(
+            clearance_joint::model::spatial::SpatialModel::steel(play * 1e-3, 2.0 * PIN_RADIUS),
+        ),
+        None => ClearanceModel::Compliant,
+    }
+}
+
 fn axial_inertia() -> f64 {
     std::env::var("SCARA_AXIAL")
         .ok()
@@ -186,6 +201,7 @@ impl Arm {
                         .friction(FrictionModel::Coulomb(Coulomb::new(MU, 1e-4)?))
                         .integration(integration)
                         .sub_cycle_techniques(techniques)
+                        .model(spatial_pins())
                         .name(["shoulder", "elbow"][i])
                         .joint(a1, a2, Vector::Z, Vector::Z)?;
                     handles.push(world.insert_clearance(b1, b2, joint)?);

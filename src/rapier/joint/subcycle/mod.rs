@@ -146,11 +146,12 @@ impl ClearanceJoint {
     /// for the first sub-cycle (Rapier's velocities after an explicit step lack it, as they
     /// lack a sub-cycled step's held impulse); switched to explicit, the impulse a sub-cycled
     /// joint held for the next step is dropped, which is right where Rapier's velocities lack
-    /// just the half kick of its force (a resting or sliding pin: both ways seamless to
-    /// rounding, `cargo test --release --test sub_cycling switched`); inside an impact the
-    /// rest of the held impulse is lost. A spatial joint switched to sub-cycled starts from
-    /// Rapier's velocities (no half kick held). Explicit needs Rapier's `num_solver_iterations = 1`
-    /// and steps the contact allows: the next step says so otherwise, as at build.
+    /// just the half kick of its force, as under a steady load (a resting pin goes on to
+    /// rounding both ways: `cargo test --release --test sub_cycling switched`); inside an
+    /// impact the rest of the held impulse is lost. A spatial joint switched to sub-cycled
+    /// starts from Rapier's velocities (no half kick held). Explicit needs Rapier's
+    /// `num_solver_iterations = 1` and steps the contact allows: the next step says so
+    /// otherwise, as at build.
     pub fn set_integration(&mut self, integration: ContactIntegration) -> &mut Self {
         self.integration = integration;
         self

@@ -181,6 +181,112 @@ fn a_sub_cycle_beyond_its_sub_step_cap_is_a_guard_violation() {
     assert!(world.guards().is_clean(), "{:?}", world.guards());
 }
 
+/// A sub-cycle that hits its cap and then throws its journal out says why in the divergence: the
+/// journal of the test above with the law's damping explicit (`implicit_damping` off) at the
+/// tolerance 1e-6 in steps of 1/60 s hits the cap at its first step, and the rest of its second
+/// step, taken in one sub-step far beyond the damped limit, throws the journal out. The message
+/// names the cap, the joint and the technique that is off; with the technique on, the same run
+/// hits the cap without diverging (the test above).
+#[test]
+fn a_divergence_after_the_sub_step_cap_names_the_cap() {
+    let (mut world, base, journal) = journal_world(
+        StepControl {
+            tolerance: 1e-6,
+            ..StepControl::fixed(1.0 / 60.0)
+        },
+        1,
+    );
+    let pin = HingeDesign::steel_improved_liu(R_B, C, 0.016)
+        .unwrap()
+        .friction(FrictionModel::Coulomb(Coulomb::new(MU, V_EPS).unwrap()))
+        .integration(ContactIntegration::SubCycled)
+        .sub_cycle_techniques(SubCycleTechniques::default().implicit_damping(false))
+        .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
+        .unwrap();
+    world.insert_clearance(base, journal, pin).unwrap();
+    let error = world.step_to(0.1).expect_err("the journal is thrown out");
+    let message = error.to_string();
+    println!("{message}");
+    assert!(
+        matches!(error, clearance_joint::Error::Diverged { .. }),
+        "{error:?}"
+    );
+    for words in [
+        "clearance joint `clearance joint` hit its sub-cycle's cap of 100000 sub-steps",
+        "shorter world steps",
+        "a larger tolerance",
+        "`implicit_damping` back on",
+    ] {
+        assert!(message.contains(words), "`{words}` not in: {message}");
+    }
+}
+
+/// A pin switched between explicit and sub-cycled contact mid-run
+/// ([`ClearanceJoint::set_integration`]) goes on as it was: the 2 kg journal resting at the
+/// bottom of its bearing (steel, the improved law, Coulomb friction; adaptive steps of at most
+/// 1 ms, one solver iteration), explicit to 1 s, sub-cycled to 1.2 s, explicit again to 1.4 s.
+/// At every step after each switch the contact stays closed with no new onset, the step's
+/// contact impulse is the weight's over the step (within 1e-9 of it; measured 4e-12), and the
+/// journal's energy (kinetic at the state, elastic, potential) stays within 1e-15 J of its value
+/// at the switch (measured 2e-18 J). Switched to sub-cycled without the explicit force's half
+/// kick held, the journal fell into its wall at `g h/2` and rang: the impulse 4.3 % off the
+/// weight's, 3.8e-9 J gained.
+#[test]
+fn a_resting_pin_switched_between_explicit_and_sub_cycled_goes_on_as_it_was() {
+    let (mut world, base, journal) = journal_world(StepControl::adaptive(1e-3, 0.0075), 1);
+    let pin = HingeDesign::steel_improved_liu(R_B, C, 0.016)
+        .unwrap()
+        .friction(FrictionModel::Coulomb(Coulomb::new(MU, V_EPS).unwrap()))
+        .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
+        .unwrap();
+    let pin = world.insert_clearance(base, journal, pin).unwrap();
+    world.step_to(1.0).unwrap();
+    let energy = |world: &ClearanceWorld| {
+        let (v, w) = world.velocity_at_state(journal).unwrap();
+        let rb = &world.rapier.bodies[journal];
+        let kinetic = 0.5 * MASS * v.length_squared() + 0.5 * 0.01 * w.length_squared();
+        let elastic = world.clearance.get(pin).unwrap().elastic_energy();
+        kinetic + elastic + MASS * G * rb.translation().y
+    };
+    for (integration, end) in [
+        (ContactIntegration::SubCycled, 1.2),
+        (ContactIntegration::Explicit, 1.4),
+    ] {
+        let before = energy(&world);
+        world
+            .clearance
+            .get_mut(pin)
+            .unwrap()
+            .set_integration(integration);
+        let (mut worst_impulse, mut worst_energy, mut steps) = (0.0f64, 0.0f64, 0);
+        while world.time() < end - 1e-12 {
+            let t0 = world.time();
+            world.step(end).unwrap();
+            let h = world.time() - t0;
+            let j = world.clearance.get(pin).unwrap();
+            assert_eq!(j.integration(), integration);
+            assert!(j.in_contact() && !j.report().onset, "at {}", world.time());
+            assert!(j.substeps().iter().all(|s| !s.onset));
+            // The contact's impulse over the step: summed over the sub-steps, or the explicit
+            // force held over it.
+            let impulse = j
+                .step_impulse()
+                .unwrap_or(j.report().force.on_journal * h)
+                .length();
+            worst_impulse = worst_impulse.max((impulse / (MASS * G * h) - 1.0).abs());
+            worst_energy = worst_energy.max((energy(&world) - before).abs());
+            steps += 1;
+        }
+        println!(
+            "{integration:?} to {end} s: {steps} steps, impulse off the weight's by at most \
+             {worst_impulse:.2e}, energy by at most {worst_energy:.2e} J"
+        );
+        assert!(worst_impulse < 1e-9, "{worst_impulse:e}");
+        assert!(worst_energy < 1e-15, "{worst_energy:e} J");
+    }
+    assert!(world.guards().is_clean(), "{:?}", world.guards());
+}
+
 /// A journal bouncing elastically (Hertz, no damping, no friction) under gravity in a bearing,
 /// sub-cycled in steps of 1/60 s and of 1 ms: every bounce comes back to the bearing's centre,
 /// the drop's height, and strikes at `sqrt(2 g c)` (each approach within 2 % of it over 3 s and

@@ -153,6 +153,9 @@ struct CycleState {
     /// A spatial joint's regions' impact clocks at the sub-cycle's end, for the evaluation at
     /// the step's end (Rapier's pass 1 starts from the regions as pass 0 found them).
     spatial_impacts: [Option<f64>; 4],
+    /// Whether the joint was explicit at its last evaluation (its force then held over the
+    /// step after it; [`ClearanceJoint::set_integration`]).
+    explicit_before: bool,
 }
 
 /// The dynamic state of a joint between steps (what a rejected step must restore).

@@ -214,9 +214,13 @@ impl ClearanceJointSet {
                 joint.cycle.substep_count = 0;
                 joint.cycle.substeps.clear();
             }
+            let first = finished.is_none();
             joint.last_wrenches = finished
                 .or_else(|| joint.evaluate(bodies, self.last_step, &self.mechanism))
                 .map(|(w1, w2)| [w1, w2]);
+            if first {
+                joint.hold_explicit_half_kick(self.last_step);
+            }
             joint.take_start(bodies, &self.mechanism);
             joint.take_spatial_start(bodies, &self.mechanism);
             let partners = self.partners.iter().enumerate();
@@ -490,6 +494,13 @@ impl StepHooks for ClearanceJointSet {
                 limit(a).total_cmp(&limit(b))
             })
             .map(|(h, j)| stalled_contact_of(h, j, bodies))
+    }
+    fn divergence_causes(&self, body: RigidBodyHandle, causes: &mut Vec<String>) {
+        for (_, j) in self.iter() {
+            if j.body1() == body || j.body2() == body {
+                causes.extend(j.cap_in_words());
+            }
+        }
     }
     fn joints_of(&self, body: RigidBodyHandle, names: &mut Vec<String>) {
         for (_, j) in self.iter() {

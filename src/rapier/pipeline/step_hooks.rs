@@ -124,6 +124,11 @@ pub trait StepHooks {
     /// Default: none.
     fn joints_of(&self, _body: RigidBodyHandle, _names: &mut Vec<String>) {}
 
+    /// Adds to `causes` (in words) what this participant knows made `body` diverge in the step
+    /// just taken, for the divergence's message ahead of the generic causes. This crate's
+    /// compliant joint set names a sub-cycle that hit its cap of sub-steps. Default: nothing.
+    fn divergence_causes(&self, _body: RigidBodyHandle, _causes: &mut Vec<String>) {}
+
     /// Checks that this participant's joints join bodies of `bodies` (before every step; an error
     /// names `body1` or `body2`, as this crate's joint sets word it). Default: nothing to check.
     fn check_bodies(&self, _bodies: &RigidBodySet) -> Result<()> {

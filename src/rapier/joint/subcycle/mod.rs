@@ -136,6 +136,52 @@ const STABLE_FRACTION_PER_TOLERANCE: f64 = 10.0;
 const WORLD_SUBSTEPS_IN_CONTACT: f64 = 10.0;
 
 impl ClearanceJoint {
+    /// Switches how the contact is integrated ([`ContactIntegration`]), as
+    /// [`HingeDesign::integration`](crate::rapier::hinge::design::HingeDesign::integration) sets
+    /// it at build; from the next step on. Reach the joint through
+    /// [`ClearanceJointSet::get_mut`](crate::rapier::joint::ClearanceJointSet::get_mut): the
+    /// world then evaluates its joints again before that step, at the state as it stands, and
+    /// the contact goes on in the new mode with its history (a closed contact stays one, with
+    /// its impact rate). Switched to sub-cycled, the joint holds its explicit force's half kick
+    /// for the first sub-cycle (Rapier's velocities after an explicit step lack it, as they
+    /// lack a sub-cycled step's held impulse); switched to explicit, the impulse a sub-cycled
+    /// joint held for the next step is dropped, which is right where Rapier's velocities lack
+    /// just the half kick of its force, as under a steady load (a resting pin goes on to
+    /// rounding both ways: `cargo test --release --test sub_cycling switched`); inside an
+    /// impact the rest of the held impulse is lost. A spatial joint switched to sub-cycled
+    /// starts from Rapier's velocities (no half kick held). Explicit needs Rapier's
+    /// `num_solver_iterations = 1` and steps the contact allows: the next step says so
+    /// otherwise, as at build.
+    pub fn set_integration(&mut self, integration: ContactIntegration) -> &mut Self {
+        self.integration = integration;
+        self
+    }
+
+    /// At the first evaluation of a joint switched to sub-cycled after an explicit step
+    /// (`last_step` s long): the impulse it holds for the next step is the half kick of its
+    /// force at the state, `F h/2`. Rapier's velocities after the explicit step are the mean
+    /// over it and lack that half kick to the state (the Verlet reading), as after a
+    /// sub-cycled step they lack the impulse held: so the sub-cycle starts from the state's
+    /// velocity. Without it a resting pin switched over falls at `g h/2` into its wall. A
+    /// switch the other way needs nothing: the explicit joint reads Rapier's velocities the
+    /// same way, its half kick included in the step's force.
+    pub(crate) fn hold_explicit_half_kick(&mut self, last_step: f64) {
+        let explicit_now = !self.sub_cycled();
+        let was_explicit = std::mem::replace(&mut self.cycle.explicit_before, explicit_now);
+        if !(was_explicit && self.sub_cycled() && self.spatial.is_none()) {
+            return;
+        }
+        if let Some([w1, w2]) = self.last_wrenches {
+            let half = 0.5 * last_step;
+            for (k, v) in [w1.force, w1.torque, w2.force, w2.torque]
+                .into_iter()
+                .enumerate()
+            {
+                put(&mut self.cycle.held, k, v * half);
+            }
+        }
+    }
+
     /// The world step a sub-cycled joint allows near contact, from its state at the last step's
     /// end: in contact, [`WORLD_SUBSTEPS_IN_CONTACT`] of the sub-steps the contact needs there
     /// (`ContactAhead::resolving_step` at `10 tol` of the tolerance); approaching the wall at
@@ -366,6 +412,36 @@ impl ClearanceJoint {
     /// one sub-step).
     pub(crate) fn substeps_beyond_cap(&self) -> Option<u32> {
         (self.cycle.substep_count > MAX_SUBSTEPS).then_some(self.cycle.substep_count)
+    }
+
+    /// When the last step reached [`MAX_SUBSTEPS`], what that did and what to do, for a
+    /// divergence's message: the rest of the step went in one sub-step, far beyond what the
+    /// contact allows, and such a sub-step is what throws a body out.
+    pub(crate) fn cap_in_words(&self) -> Option<String> {
+        let n = self.substeps_beyond_cap()?;
+        let off: Vec<String> = self
+            .techniques
+            .switches()
+            .iter()
+            .filter(|(_, on)| !on)
+            .map(|(name, _)| format!("`{name}`"))
+            .collect();
+        let techniques = if off.is_empty() {
+            String::new()
+        } else {
+            format!(
+                ", or turn the sub-cycle's {} back on (off here, the sub-steps are held to \
+                 stability)",
+                off.join(", ")
+            )
+        };
+        Some(format!(
+            "clearance joint `{}` hit its sub-cycle's cap of {} sub-steps in the step ({n} \
+             sub-steps) and took the rest of the step in one sub-step, which its contact cannot \
+             take: take shorter world steps (a smaller fixed step or `max_dt`), a larger \
+             tolerance (the sub-steps scale with it){techniques}",
+            self.name, MAX_SUBSTEPS
+        ))
     }
 
     /// The deepest penetration of the last step, m: over its sub-steps for a sub-cycled joint,

@@ -275,8 +275,10 @@ fn diverged_body(
         .collect();
     // Rapier's joints: the ones whose drift correction can make it diverge.
     let jointed = !joined.is_empty();
+    let mut known = Vec::new();
     for s in sources {
         s.joints_of(body, &mut joined);
+        s.divergence_causes(body, &mut known);
     }
     let state = state_in_words(world.bodies.get(body), speed);
     let correction = if jointed && !joint_correction {
@@ -292,8 +294,12 @@ fn diverged_body(
         state,
         guard: 0.5 * world.integration_parameters.max_linear_velocity(),
         cause: format!(
-            "a motor, drive or prescribed motion that moves it too fast, a contact too stiff for \
-             the step, or a non-finite input (gravity, a force, a mass){correction}"
+            "{}a motor, drive or prescribed motion that moves it too fast, a contact too stiff for \
+             the step, or a non-finite input (gravity, a force, a mass){correction}",
+            known
+                .iter()
+                .map(|k| format!("{k}; else "))
+                .collect::<String>()
         ),
     }
 }

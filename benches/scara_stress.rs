@@ -350,7 +350,12 @@ fn run_with(
     let scale = f64::from_bits(GAIN_SCALE.load(std::sync::atomic::Ordering::Relaxed));
     let gains = gains(tick).map(|(kp, kd)| (kp * scale, kd * scale));
     let mut arm = Arm::new(pins, clearance, control, techniques)?;
-    let ticks = (END / tick).round() as u64;
+    // `SCARA_END=0.1`: a shorter run (s; diagnosis of the first impacts).
+    let end = std::env::var("SCARA_END")
+        .ok()
+        .and_then(|t| t.parse().ok())
+        .unwrap_or(END);
+    let ticks = (end / tick).round() as u64;
     let mut o = Outcome::default();
     let clock = Instant::now();
     // `SCARA_TRACE=path`: each tick's state of each pin, as the sub-cycle ended it and as

@@ -244,9 +244,10 @@ impl ClearanceJointSet {
     }
 
     /// After Rapier's pass `pass.pass` of a step: at pass 0 the sub-cycled joints run their
-    /// sub-cycles (the planar joints of one island together, `subcycle::plan_cycles`; each
-    /// spatial joint on its own) and the set asks for pass 1 with their deliveries when one has
-    /// an impulse to deliver; later passes stand.
+    /// sub-cycles (the planar joints of one island together, `subcycle::plan_cycles`; the
+    /// spatial joints of one island together, `spatial::subcycle::plan_spatial_cycles`) and
+    /// the set asks for pass 1 with their deliveries when one has an impulse to deliver; later
+    /// passes stand.
     pub(crate) fn resolve_step(
         &mut self,
         bodies: &RigidBodySet,
@@ -259,11 +260,13 @@ impl ClearanceJointSet {
         }
         self.planned.clear();
         let mut joints: Vec<&mut ClearanceJoint> = self.joints.values_mut().collect();
-        // The planar joints of one island together; each spatial joint on its own.
+        // The planar joints of one island together, and the spatial joints of one island
+        // together.
         let mut deliveries = subcycle::plan_cycles(&mut joints, bodies, pass, iterations);
-        for (joint, deliver) in joints.iter_mut().zip(deliveries.iter_mut()) {
-            if joint.spatial.is_some() {
-                *deliver = joint.plan_spatial_cycle(bodies, pass, iterations);
+        let spatial = spatial::subcycle::plan_spatial_cycles(&mut joints, bodies, pass, iterations);
+        for (deliver, s) in deliveries.iter_mut().zip(spatial) {
+            if s.is_some() {
+                *deliver = s;
             }
         }
         for (joint, deliver) in joints.iter().zip(deliveries) {

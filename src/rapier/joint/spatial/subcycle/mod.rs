@@ -216,7 +216,14 @@ pub(in crate::rapier::joint) fn plan_spatial_cycles(
         })
         .collect();
     for group in islands(joints, &planned) {
-        plan_group(joints, &group, bodies, pass, iterations, &mut deliveries);
+        // With the coupling off (for comparison) each joint on its own.
+        if group.iter().all(|&i| joints[i].techniques.spatial_coupling) {
+            plan_group(joints, &group, bodies, pass, iterations, &mut deliveries);
+        } else {
+            for i in group {
+                plan_group(joints, &[i], bodies, pass, iterations, &mut deliveries);
+            }
+        }
     }
     deliveries
 }

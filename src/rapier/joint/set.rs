@@ -495,10 +495,36 @@ impl StepHooks for ClearanceJointSet {
             .map(|(h, j)| stalled_contact_of(h, j, bodies))
     }
     fn joints_of(&self, body: RigidBodyHandle, names: &mut Vec<String>) {
-        for (_, j) in self.iter() {
-            if j.body1() == body || j.body2() == body {
-                names.push(format!("clearance joint `{}`", j.name()));
-            }
+        let on_body = || {
+            self.iter()
+                .map(|(_, j)| j)
+                .filter(move |j| j.body1() == body || j.body2() == body)
+        };
+        // Sub-cycled spatial and planar joints on one body are integrated apart, each one's
+        // contact reaching the other's pair through Rapier's pass 1 only: say so, and what to do.
+        let sub_cycled =
+            |spatial: bool| on_body().any(|j| j.sub_cycled() && j.spatial.is_some() == spatial);
+        let apart = sub_cycled(true) && sub_cycled(false);
+        for j in on_body() {
+            let note = if apart && j.sub_cycled() {
+                let kind = if j.spatial.is_some() {
+                    "spatial"
+                } else {
+                    "planar"
+                };
+                format!(
+                    " ({kind}, sub-cycled apart from the {} sub-cycled joints on this body: make \
+                     them all spatial or all planar, or integrate them `Explicit`)",
+                    if j.spatial.is_some() {
+                        "planar"
+                    } else {
+                        "spatial"
+                    }
+                )
+            } else {
+                String::new()
+            };
+            names.push(format!("clearance joint `{}`{note}", j.name()));
         }
     }
     fn check_bodies(&self, bodies: &RigidBodySet) -> Result<()> {

@@ -506,23 +506,17 @@ impl StepHooks for ClearanceJointSet {
             |spatial: bool| on_body().any(|j| j.sub_cycled() && j.spatial.is_some() == spatial);
         let apart = sub_cycled(true) && sub_cycled(false);
         for j in on_body() {
-            let note = if apart && j.sub_cycled() {
-                let kind = if j.spatial.is_some() {
-                    "spatial"
-                } else {
-                    "planar"
-                };
-                format!(
-                    " ({kind}, sub-cycled apart from the {} sub-cycled joints on this body: make \
-                     them all spatial or all planar, or integrate them `Explicit`)",
-                    if j.spatial.is_some() {
-                        "planar"
-                    } else {
-                        "spatial"
-                    }
-                )
-            } else {
-                String::new()
+            let kinds = ["planar", "spatial"];
+            let (kind, other) = match j.spatial.is_some() {
+                true => (kinds[1], kinds[0]),
+                false => (kinds[0], kinds[1]),
+            };
+            let note = match apart && j.sub_cycled() {
+                true => format!(
+                    " ({kind}, sub-cycled apart from the {other} sub-cycled joints on this body: \
+                     make them all spatial or all planar, or integrate them `Explicit`)"
+                ),
+                false => String::new(),
             };
             names.push(format!("clearance joint `{}`{note}", j.name()));
         }

@@ -46,7 +46,10 @@
 //! `SCARA_AXIAL` (the links' inertia about their length over the transverse one, default 0.1;
 //! `examples/robot_backlash.rs` has 0.001), `SCARA_PLANE=1` (each arm's largest drop of the
 //! lower link's centre of mass out of the arm's plane and its largest spin about its length), `SCARA_SPATIAL=0.1`
-//! (both pins spatial, with 0.1 mm of axial play and collars of twice the pin's radius).
+//! (both pins spatial, with 0.1 mm of axial play and collars of twice the pin's radius;
+//! `SCARA_SPATIAL_ONLY=shoulder` or `elbow` that pin only, the other planar;
+//! `SCARA_UNCOUPLED=1` each spatial pin sub-cycled on its own), `SCARA_END=0.1` (a shorter
+//! run, s).
 
 use clearance_joint::model::laws::{Coulomb, FrictionModel};
 use clearance_joint::prelude::*;
@@ -125,15 +128,18 @@ struct Arm {
 /// arm's stays within 2 mm of the plane at 60 Hz.
 /// `SCARA_SPATIAL=0.1`: the pins spatial, with that axial play in mm and collars of twice the
 /// pin's radius; unset, planar.
-fn spatial_pins() -> ClearanceModel {
+/// `SCARA_SPATIAL_ONLY=shoulder` (or `elbow`): that pin spatial, the other planar (a mixed
+/// arm).
+fn spatial_pins(pin: &str) -> ClearanceModel {
+    let only = std::env::var("SCARA_SPATIAL_ONLY").unwrap_or_else(|_| pin.to_string());
     match std::env::var("SCARA_SPATIAL")
         .ok()
         .and_then(|t| t.parse::<f64>().ok())
     {
-        Some(play) => ClearanceModel::Spatial(
+        Some(play) if only == pin => ClearanceModel::Spatial(
             clearance_joint::model::spatial::SpatialModel::steel(play * 1e-3, 2.0 * PIN_RADIUS),
         ),
-        None => ClearanceModel::Compliant,
+        _ => ClearanceModel::Compliant,
     }
 }
 
@@ -201,7 +207,7 @@ impl Arm {
                         .friction(FrictionModel::Coulomb(Coulomb::new(MU, 1e-4)?))
                         .integration(integration)
                         .sub_cycle_techniques(techniques)
-                        .model(spatial_pins())
+                        .model(spatial_pins(["shoulder", "elbow"][i]))
                         .name(["shoulder", "elbow"][i])
                         .joint(a1, a2, Vector::Z, Vector::Z)?;
                     handles.push(world.insert_clearance(b1, b2, joint)?);
@@ -330,13 +336,11 @@ fn run(
     rate: f64,
     control: StepControl,
 ) -> clearance_joint::Result<Outcome> {
-    run_with(
-        pins,
-        clearance,
-        rate,
-        control,
-        SubCycleTechniques::default(),
-    )
+    // `SCARA_UNCOUPLED=1`: each spatial pin sub-cycled on its own (diagnosis: the two pins
+    // in series then diverge).
+    let uncoupled = std::env::var("SCARA_UNCOUPLED").is_ok();
+    let techniques = SubCycleTechniques::default().spatial_coupling(!uncoupled);
+    run_with(pins, clearance, rate, control, techniques)
 }
 
 fn run_with(
@@ -350,7 +354,12 @@ fn run_with(
     let scale = f64::from_bits(GAIN_SCALE.load(std::sync::atomic::Ordering::Relaxed));
     let gains = gains(tick).map(|(kp, kd)| (kp * scale, kd * scale));
     let mut arm = Arm::new(pins, clearance, control, techniques)?;
-    let ticks = (END / tick).round() as u64;
+    // `SCARA_END=0.1`: a shorter run (s; diagnosis of the first impacts).
+    let end = std::env::var("SCARA_END")
+        .ok()
+        .and_then(|t| t.parse().ok())
+        .unwrap_or(END);
+    let ticks = (end / tick).round() as u64;
     let mut o = Outcome::default();
     let clock = Instant::now();
     // `SCARA_TRACE=path`: each tick's state of each pin, as the sub-cycle ended it and as

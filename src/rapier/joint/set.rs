@@ -248,9 +248,10 @@ impl ClearanceJointSet {
     }
 
     /// After Rapier's pass `pass.pass` of a step: at pass 0 the sub-cycled joints run their
-    /// sub-cycles (the planar joints of one island together, `subcycle::plan_cycles`; each
-    /// spatial joint on its own) and the set asks for pass 1 with their deliveries when one has
-    /// an impulse to deliver; later passes stand.
+    /// sub-cycles (the planar joints of one island together, `subcycle::plan_cycles`; the
+    /// spatial joints of one island together, `spatial::subcycle::plan_spatial_cycles`) and
+    /// the set asks for pass 1 with their deliveries when one has an impulse to deliver; later
+    /// passes stand.
     pub(crate) fn resolve_step(
         &mut self,
         bodies: &RigidBodySet,
@@ -263,11 +264,13 @@ impl ClearanceJointSet {
         }
         self.planned.clear();
         let mut joints: Vec<&mut ClearanceJoint> = self.joints.values_mut().collect();
-        // The planar joints of one island together; each spatial joint on its own.
+        // The planar joints of one island together, and the spatial joints of one island
+        // together.
         let mut deliveries = subcycle::plan_cycles(&mut joints, bodies, pass, iterations);
-        for (joint, deliver) in joints.iter_mut().zip(deliveries.iter_mut()) {
-            if joint.spatial.is_some() {
-                *deliver = joint.plan_spatial_cycle(bodies, pass, iterations);
+        let spatial = spatial::subcycle::plan_spatial_cycles(&mut joints, bodies, pass, iterations);
+        for (deliver, s) in deliveries.iter_mut().zip(spatial) {
+            if s.is_some() {
+                *deliver = s;
             }
         }
         for (joint, deliver) in joints.iter().zip(deliveries) {
@@ -503,10 +506,30 @@ impl StepHooks for ClearanceJointSet {
         }
     }
     fn joints_of(&self, body: RigidBodyHandle, names: &mut Vec<String>) {
-        for (_, j) in self.iter() {
-            if j.body1() == body || j.body2() == body {
-                names.push(format!("clearance joint `{}`", j.name()));
-            }
+        let on_body = || {
+            self.iter()
+                .map(|(_, j)| j)
+                .filter(move |j| j.body1() == body || j.body2() == body)
+        };
+        // Sub-cycled spatial and planar joints on one body are integrated apart, each one's
+        // contact reaching the other's pair through Rapier's pass 1 only: say so, and what to do.
+        let sub_cycled =
+            |spatial: bool| on_body().any(|j| j.sub_cycled() && j.spatial.is_some() == spatial);
+        let apart = sub_cycled(true) && sub_cycled(false);
+        for j in on_body() {
+            let kinds = ["planar", "spatial"];
+            let (kind, other) = match j.spatial.is_some() {
+                true => (kinds[1], kinds[0]),
+                false => (kinds[0], kinds[1]),
+            };
+            let note = match apart && j.sub_cycled() {
+                true => format!(
+                    " ({kind}, sub-cycled apart from the {other} sub-cycled joints on this body: \
+                     make them all spatial or all planar, or integrate them `Explicit`)"
+                ),
+                false => String::new(),
+            };
+            names.push(format!("clearance joint `{}`{note}", j.name()));
         }
     }
     fn check_bodies(&self, bodies: &RigidBodySet) -> Result<()> {

@@ -228,7 +228,7 @@ pub(crate) fn plan_cycles(
 
 /// The members of `planned` in groups whose pairs move each other (a block of
 /// `cycle.coupled`), each in the set's order.
-pub(super) fn islands(joints: &[&mut ClearanceJoint], planned: &[usize]) -> Vec<Vec<usize>> {
+pub(crate) fn islands(joints: &[&mut ClearanceJoint], planned: &[usize]) -> Vec<Vec<usize>> {
     let mut group: Vec<usize> = (0..planned.len()).collect();
     pub(super) fn root(group: &mut [usize], mut i: usize) -> usize {
         while group[i] != i {
@@ -397,7 +397,8 @@ pub(super) fn plan_group(
         })
         .collect();
     for (a, run) in runs.iter_mut().enumerate() {
-        run.start_correction = attributed(a, &members, &starts[a], &cross, &beyond);
+        let own = starts[a].moved_by(&beyond[a]);
+        run.start_correction = attributed(a, &members, own, &cross, &beyond);
     }
     for ((a, &i), mut run) in group.iter().enumerate().zip(runs) {
         let mut left = held[a];
@@ -411,21 +412,21 @@ pub(super) fn plan_group(
 }
 
 /// Member `a`'s share of the velocity correction its pair's bodies have from the impulses
-/// `beyond` of the group's `members` (`cross`: each member's mobilities from the others'
+/// `beyond` of the group's `members` (`own`: its own impulse moved through its pair's mobility) (`cross`: each member's mobilities from the others'
 /// impulses): its own impulse on its pair, and another member's impulse on a body of `a`'s pair
 /// only where that body is in neither the other member's pair nor the pair of an earlier member
 /// that the impulse moves too. Readers add the corrections of all joints per body
 /// ([`ClearanceJoint::start_velocity_correction`]); a body two pairs share (the yoke between a
 /// deployable array's root and its next hinge) would otherwise have every impulse's velocity
 /// twice: `moved` gives each pair the whole correction of its bodies.
-fn attributed(
+pub(crate) fn attributed(
     a: usize,
     members: &[&ClearanceJoint],
-    start: &PairStart,
+    own: Pair12,
     cross: &[Vec<(usize, [f64; 144])>],
     beyond: &[Pair12],
 ) -> Pair12 {
-    let mut v = start.moved_by(&beyond[a]);
+    let mut v = own;
     let pair = |m: &ClearanceJoint| [m.body1, m.body2];
     let moves = |e: usize, b: usize| cross[e].iter().any(|(x, _)| *x == b);
     for (b, p) in &cross[a] {

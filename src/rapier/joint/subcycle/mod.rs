@@ -56,7 +56,7 @@ mod techniques;
 #[cfg(test)]
 mod tests;
 
-pub(crate) use group::plan_cycles;
+pub(crate) use group::{attributed, islands, plan_cycles};
 pub(crate) use pair::PairStart;
 pub(crate) use pair::{Pair12, axpy, dot, load, mul, part, put, rotate};
 pub(crate) use steps::SubCycle;
@@ -230,7 +230,7 @@ impl ClearanceJoint {
 
     /// The mobility from `other`'s contact loads to this joint's pair, when the two are
     /// sub-cycled in one island (taken with the start, [`ClearanceJoint::take_coupling`]).
-    fn coupling_to(&self, other: &ClearanceJoint) -> Option<[f64; 144]> {
+    pub(crate) fn coupling_to(&self, other: &ClearanceJoint) -> Option<[f64; 144]> {
         let pair = [other.body1, other.body2];
         self.cycle
             .coupled
@@ -248,7 +248,7 @@ impl ClearanceJoint {
         partners: impl Iterator<Item = [RigidBodyHandle; 2]>,
     ) {
         self.cycle.coupled.clear();
-        if self.cycle.start.is_none() {
+        if self.cycle.start.is_none() && self.cycle.spatial_start.is_none() {
             return;
         }
         for pair in partners {

@@ -51,6 +51,11 @@ pub struct SubCycleTechniques {
     /// zero Jacobian, ROS2 explicit: the sub-steps are then held by stability, up to the cap of
     /// 100,000 a world step.
     pub implicit_spatial: bool,
+    /// Spatial: the spatial joints of one island (two pins sharing a body) integrated as one
+    /// system, each contact's stiffness implicit on every pair it moves. Off: each spatial
+    /// joint on its own, the others' contacts left to Rapier's pass 1 (two pins in series then
+    /// overshoot on the body they share: the SCARA arm on two spatial pins diverges).
+    pub spatial_coupling: bool,
 }
 
 impl Default for SubCycleTechniques {
@@ -63,6 +68,7 @@ impl Default for SubCycleTechniques {
             stabilisation: true,
             jacobian_reuse: true,
             implicit_spatial: true,
+            spatial_coupling: true,
         }
     }
 }
@@ -103,13 +109,18 @@ impl SubCycleTechniques {
         self.implicit_spatial = on;
         self
     }
+    /// Sets [`spatial_coupling`](Self::spatial_coupling).
+    pub fn spatial_coupling(mut self, on: bool) -> Self {
+        self.spatial_coupling = on;
+        self
+    }
     /// Whether every technique is on (the default).
     pub fn all_on(&self) -> bool {
         *self == Self::default()
     }
     /// The switches by name (`implicit_friction`, ...), as the scenes' `run.sub_cycle` spells
     /// them, each with its setting.
-    pub fn switches(&self) -> [(&'static str, bool); 7] {
+    pub fn switches(&self) -> [(&'static str, bool); 8] {
         [
             ("implicit_friction", self.implicit_friction),
             ("implicit_damping", self.implicit_damping),
@@ -118,6 +129,7 @@ impl SubCycleTechniques {
             ("stabilisation", self.stabilisation),
             ("jacobian_reuse", self.jacobian_reuse),
             ("implicit_spatial", self.implicit_spatial),
+            ("spatial_coupling", self.spatial_coupling),
         ]
     }
 }

@@ -1,7 +1,7 @@
 //! The spatial sub-cycle's integrator: each region's clock, the load, the
 //! linearly implicit Rosenbrock step ([`SpatialCycle`]).
 
-use super::factor::{Factor, Impulses, Slopes};
+use super::factor::{Slopes, through};
 use super::*;
 
 /// One region's memory inside the sub-cycle.
@@ -114,13 +114,13 @@ impl SpatialCycle<'_> {
         }
     }
 
-    /// The pair's position increments and velocities at `t` with the impulses `y`.
-    pub(super) fn kinematics(&self, t: f64, y: &Impulses) -> (Pair12, Pair12) {
-        let p = &self.start.mobility;
-        let mut x = mul(p, &y.pi);
+    /// The pair's position increments and velocities at `t` with the impulses moved through
+    /// the mobilities from every pair of the group, `moved` (`sum_b P_ab Pi_b`, then the same of
+    /// `Gamma`).
+    pub(super) fn kinematics(&self, t: f64, moved: (Pair12, Pair12)) -> (Pair12, Pair12) {
+        let (mut x, mut v) = moved;
         axpy(&mut x, t, &self.u0);
         axpy(&mut x, 0.5 * t * t, &self.accel);
-        let mut v = mul(p, &y.gamma);
         axpy(&mut v, 1.0, &self.u0);
         axpy(&mut v, t, &self.accel);
         (x, v)
@@ -292,72 +292,12 @@ impl SpatialCycle<'_> {
         }
         parts.base_places = base_places;
         let p = &self.start.mobility;
-        let through = |l: &Square| -> Square {
-            std::array::from_fn(|i| {
-                let (r, c) = (i / 12, i % 12);
-                (0..12).map(|k| l[r * 12 + k] * p[k * 12 + c]).sum()
-            })
-        };
         Slopes {
-            a: through(&lx),
-            b: through(&lv),
+            a: through(&lx, p),
+            b: through(&lv, p),
             lx,
             lv,
         }
-    }
-
-    /// One ROS2 sub-step of `s` from `t`, `y` (load `f0` there): the new state, the load at its
-    /// second stage's point is not kept. Returns the state and its scaled error (accept at or
-    /// below 1); `None` when the linear system is singular.
-    pub(super) fn ros2(
-        &self,
-        parts: &mut SpatialParts,
-        (t, y, f0): (f64, &Impulses, &Pair12),
-        slopes: &Slopes,
-        s: f64,
-        clocks: &[RegionClock; 4],
-    ) -> Option<(Impulses, f64)> {
-        let factor = Factor::of(slopes, s)?;
-        // The load's change with time along the reference motion: dx/dt = u0 + a t, dv/dt = a.
-        let mut drift = self.u0;
-        axpy(&mut drift, t, &self.accel);
-        let mut ft = mul(&slopes.lx, &drift);
-        axpy(&mut ft, 1.0, &mul(&slopes.lv, &self.accel));
-        let gs = GAMMA * s;
-        let mut r1 = Impulses {
-            pi: y.gamma,
-            gamma: *f0,
-        };
-        axpy(&mut r1.gamma, -1.0, &self.held);
-        axpy(&mut r1.gamma, gs, &ft);
-        let k1 = factor.solve(slopes, &r1);
-        let mut y1 = *y;
-        axpy(&mut y1.pi, s, &k1.pi);
-        axpy(&mut y1.gamma, s, &k1.gamma);
-        let (x1, v1) = self.kinematics(t + s, &y1);
-        let f1 = self.load(parts, &x1, &v1, clocks);
-        let mut r2 = Impulses {
-            pi: y1.gamma,
-            gamma: f1,
-        };
-        axpy(&mut r2.gamma, -1.0, &self.held);
-        axpy(&mut r2.pi, -2.0, &k1.pi);
-        axpy(&mut r2.gamma, -2.0, &k1.gamma);
-        axpy(&mut r2.gamma, -gs, &ft);
-        let k2 = factor.solve(slopes, &r2);
-        let mut next = *y;
-        let mut err = Impulses::default();
-        for (n, e, a, b) in [
-            (&mut next.pi, &mut err.pi, &k1.pi, &k2.pi),
-            (&mut next.gamma, &mut err.gamma, &k1.gamma, &k2.gamma),
-        ] {
-            axpy(n, 1.5 * s, a);
-            axpy(n, 0.5 * s, b);
-            axpy(e, 0.5 * s, a);
-            axpy(e, 0.5 * s, b);
-        }
-        let (_, v_new) = self.kinematics(t + s, &next);
-        Some((next, self.error(&err, &v_new)))
     }
 
     /// The largest error against the tolerance, body by body: displacements (of the centre of
@@ -366,20 +306,21 @@ impl SpatialCycle<'_> {
     /// across the axis against their scale (the edges' and faces' depths follow them), rotations
     /// about the axis against the clearance over the journal's radius (they slide the journal
     /// along its wall), velocities against themselves plus [`VELOCITY_SCALE`] of their scale.
-    pub(super) fn error(&self, err: &Impulses, v: &Pair12) -> f64 {
-        let p = &self.start.mobility;
-        let (ex, ev) = (mul(p, &err.pi), mul(p, &err.gamma));
+    ///
+    /// `err` is the pair's error, moved through the mobilities from every pair of the group:
+    /// its positions, then velocities.
+    pub(super) fn error(&self, (ex, ev): (&Pair12, &Pair12), v: &Pair12) -> f64 {
         let g = &self.joint.geometry;
         let axis = self.start.bearing_axis;
         let floor = VELOCITY_SCALE / POSITION_SCALE;
         let tol = self.tolerance;
         let mut worst = 0.0_f64;
         for k in 0..4 {
-            let (e, de, u) = (part(&ex, k), part(&ev, k), part(v, k));
+            let (e, de, u) = (part(ex, k), part(ev, k), part(v, k));
             if k % 2 == 0 {
                 // The contacts follow the bearing's or journal's centre, `anchor` off the centre
                 // of mass: its displacement is judged too.
-                let at_centre = e + part(&ex, k + 1).cross(self.start.anchor[k / 2]);
+                let at_centre = e + part(ex, k + 1).cross(self.start.anchor[k / 2]);
                 worst = worst.max(at_centre.length() / (tol * self.scale[3 * k]));
             }
             let scales = if k % 2 == 0 {
@@ -408,121 +349,6 @@ impl SpatialCycle<'_> {
             }
         }
         worst
-    }
-
-    /// Integrates the step from the joint's `history` and `before` (the state at the step's
-    /// start) and the regions' `clocks`, with a first sub-step of `guess` (s); fills `out` and
-    /// returns the last accepted sub-step (the next step's guess).
-    pub(super) fn run(
-        &mut self,
-        parts: &mut SpatialParts,
-        (history, before): (ContactHistory, &JournalState),
-        clocks: &mut [RegionClock; 4],
-        guess: f64,
-        out: &mut SubCycle,
-    ) -> f64 {
-        let j = self.joint;
-        out.samples.clear();
-        out.dissipated = 0.0;
-        let mut hist = history;
-        let mut prev = *before;
-        let mut y = Impulses::default();
-        let mut t = 0.0;
-        let (x, v) = self.kinematics(0.0, &y);
-        let mut here = self.eval(parts, &x, &v, clocks);
-        // The load balancing the free acceleration held over the step.
-        self.held = balancing_load(&self.start.mobility, &self.accel);
-        axpy(&mut self.accel, 1.0, &mul(&self.start.mobility, &self.held));
-        let mut s = if guess > 0.0 {
-            guess.min(self.h)
-        } else {
-            self.h
-        }
-        .min(self.impact_bound(parts, &x, clocks));
-        let mut slopes = self.slopes(parts, (&x, &v), &here.load, clocks);
-        let mut count = 0u32;
-        let mut accepted = s;
-        // Accepted sub-steps since the Jacobian was taken, and the regions in contact there.
-        let (mut age, mut contacts, mut taken_at) = (0u32, contact_set(&here), here.load);
-        while t < self.h {
-            let left = self.h - t;
-            // No sliver of a last sub-step.
-            let step = if s >= 0.95 * left || count >= MAX_SUBSTEPS {
-                left
-            } else {
-                s
-            };
-            let trial = self.ros2(parts, (t, &y, &here.load), &slopes, step, clocks);
-            let floor = 1e-9 * self.h;
-            let (next, err) = match trial {
-                Some((next, err)) if err.is_finite() => (next, err),
-                _ if step > floor => {
-                    s = 0.5 * step;
-                    continue;
-                }
-                _ => (y, 0.0),
-            };
-            if err > 1.0 && step > floor && count < MAX_SUBSTEPS {
-                s = step * (0.9 / err.sqrt()).clamp(0.1, 0.9);
-                if age > 0 {
-                    // A Jacobian of an earlier state may be what failed: retake it here.
-                    let (x, v) = self.kinematics(t, &y);
-                    slopes = self.slopes(parts, (&x, &v), &here.load, clocks);
-                    (age, taken_at) = (0, here.load);
-                }
-                continue;
-            }
-            let t_next = if step == left { self.h } else { t + step };
-            let (x, v) = self.kinematics(t_next, &next);
-            let at = self.eval(parts, &x, &v, clocks);
-            if step > floor
-                && count < MAX_SUBSTEPS
-                && let Some(shorter) = self.onset_retry(parts, &x, (&here, &at), clocks, step)
-            {
-                s = shorter;
-                continue;
-            }
-            count += 1;
-            accepted = step;
-            out.dissipated += 0.5 * step * (here.dissipation + at.dissipation);
-            self.advance(clocks, &at.states, step);
-            let state = at.states[at.deepest()];
-            let onset = hist.advance(Some(&prev), &state, j.min_impact_speed, j.min_separation);
-            out.samples.push(SubStep {
-                t: t_next,
-                state,
-                force: at.force,
-                onset: onset.onset,
-                impact: onset.impact,
-                approach_speed: onset.approach_speed,
-                onset_fraction: onset.fraction,
-            });
-            prev = state;
-            (t, y, here) = (t_next, next, at);
-            s = step * (0.9 / err.max(1e-12).sqrt()).clamp(0.2, 4.0);
-            s = s.min(self.impact_bound(parts, &x, clocks));
-            age += 1;
-            let touching = contact_set(&here);
-            let moved = changed(&here.load, &taken_at);
-            // With the reuse off (for comparison) the Jacobian is retaken at every sub-step.
-            let max_age = if j.techniques.jacobian_reuse {
-                JACOBIAN_AGE
-            } else {
-                1
-            };
-            if t < self.h && (age >= max_age || touching != contacts || moved) {
-                slopes = self.slopes(parts, (&x, &v), &here.load, clocks);
-                (age, contacts, taken_at) = (0, touching, here.load);
-            }
-        }
-        let (_, v) = self.kinematics(self.h, &y);
-        let h = self.h;
-        out.impulse = std::array::from_fn(|i| y.gamma[i] + self.held[i] * h);
-        out.mean = std::array::from_fn(|i| y.pi[i] / h + 0.5 * self.held[i] * h);
-        out.end_velocity = v;
-        out.history = hist;
-        out.substeps = count;
-        accepted
     }
 
     /// Each region's history moved to the accepted `states` after a sub-step of `step` (s); a

@@ -39,7 +39,8 @@
 //! speed.
 
 use super::super::subcycle::{
-    MAX_SUBSTEPS, Pair12, PairStart, SubCycle, SubStep, axpy, dot, load, mul, part, put, rotate,
+    MAX_SUBSTEPS, Pair12, PairStart, SubCycle, SubStep, attributed, axpy, dot, islands, load, mul,
+    part, put, rotate,
 };
 use super::super::{ClearanceJoint, ContactHistory, Mechanism, motion};
 use super::{Mobility, Pair, Places, SpatialParts, Totals, load_region};
@@ -188,10 +189,174 @@ impl SpatialStart {
 }
 
 mod factor;
+mod group;
 mod impact;
 mod integrator;
 
+use group::SpatialGroup;
 use integrator::{Eval, RegionClock, SpatialCycle};
+
+/// The planar joints' `subcycle::plan_cycles` for the spatial joints: after Rapier's pass 0,
+/// the rest of the world's acceleration, the sub-cycles of each island's spatial sub-cycled
+/// joints together ([`SpatialGroup`]), and the impulse pass 1 delivers for each (`None`: nothing
+/// to deliver, or not a spatial sub-cycled joint).
+pub(in crate::rapier::joint) fn plan_spatial_cycles(
+    joints: &mut [&mut ClearanceJoint],
+    bodies: &RigidBodySet,
+    pass: &StepPass,
+    iterations: usize,
+) -> Vec<Option<Pair12>> {
+    let mut deliveries = vec![None; joints.len()];
+    let planned: Vec<usize> = (0..joints.len())
+        .filter(|&i| {
+            let j = &joints[i];
+            j.spatial.is_some()
+                && j.cycle.spatial_start.is_some()
+                && PairStart::velocity_now(j, bodies).is_some()
+        })
+        .collect();
+    for group in islands(joints, &planned) {
+        // With the coupling off (for comparison) each joint on its own.
+        if group.iter().all(|&i| joints[i].techniques.spatial_coupling) {
+            plan_group(joints, &group, bodies, pass, iterations, &mut deliveries);
+        } else {
+            for i in group {
+                plan_group(joints, &[i], bodies, pass, iterations, &mut deliveries);
+            }
+        }
+    }
+    deliveries
+}
+
+/// Runs the sub-cycle of the spatial joints `group` (indices into `joints`, one island) and
+/// fills their `deliveries`.
+fn plan_group(
+    joints: &mut [&mut ClearanceJoint],
+    group: &[usize],
+    bodies: &RigidBodySet,
+    pass: &StepPass,
+    iterations: usize,
+    deliveries: &mut [Option<Pair12>],
+) {
+    let (h, kick) = (pass.dt, pass.kick);
+    let c_n = crate::rapier::pipeline::stepper::substep_share(iterations);
+    let mut parts: Vec<SpatialParts> = group
+        .iter()
+        .map(|&i| {
+            joints[i]
+                .spatial
+                .take()
+                .expect("a planned joint is spatial")
+        })
+        .collect();
+    let mut clocks: Vec<[RegionClock; 4]> = parts
+        .iter()
+        .map(|p| {
+            p.patches.map(|p| RegionClock {
+                history: p.contact,
+                state: p.state,
+                impact_rate: p.impact_rate,
+                impact: p.impact,
+            })
+        })
+        .collect();
+    let mut runs: Vec<SubCycle> = group
+        .iter()
+        .map(|&i| std::mem::take(&mut joints[i].cycle.run))
+        .collect();
+    let shared: &[&mut ClearanceJoint] = joints;
+    let members: Vec<&ClearanceJoint> = group.iter().map(|&i| &*shared[i]).collect();
+    let starts: Vec<SpatialStart> = members
+        .iter()
+        .map(|j| j.cycle.spatial_start.expect("a planned joint has a start"))
+        .collect();
+    let cross: Vec<Vec<(usize, Square)>> = members
+        .iter()
+        .enumerate()
+        .map(|(a, j)| {
+            let others = members.iter().enumerate().filter(|(b, _)| *b != a);
+            others
+                .filter_map(|(b, other)| j.coupling_to(other).map(|p| (b, p)))
+                .collect()
+        })
+        .collect();
+    // The impulses held from the step before, each moving every pair it reaches.
+    let held: Vec<Pair12> = members.iter().map(|j| j.cycle.held).collect();
+    let moved = |a: usize, impulses: &[Pair12]| {
+        let mut v = mul(&starts[a].mobility, &impulses[a]);
+        for (b, p) in &cross[a] {
+            axpy(&mut v, 1.0, &mul(p, &impulses[*b]));
+        }
+        v
+    };
+    let cycles: Vec<SpatialCycle> = (0..group.len())
+        .map(|a| {
+            let start = &starts[a];
+            let now =
+                PairStart::velocity_now(members[a], bodies).expect("a planned joint's bodies");
+            let a_free: Pair12 = std::array::from_fn(|i| (now[i] - start.velocity[i]) / kick);
+            let mut u0 = start.velocity;
+            axpy(&mut u0, c_n * kick - 0.5 * h, &a_free);
+            axpy(&mut u0, 1.0, &moved(a, &held));
+            SpatialCycle::new(members[a], start, (u0, a_free), h, pass.tolerance)
+        })
+        .collect();
+    let before: Vec<(ContactHistory, JournalState)> = members
+        .iter()
+        .map(|j| (j.contact, j.report.state))
+        .collect();
+    // The shortest of the members' last sub-steps (0: none yet).
+    let guess = members
+        .iter()
+        .map(|j| j.cycle.substep_guess)
+        .filter(|g| *g > 0.0)
+        .fold(f64::INFINITY, f64::min);
+    let guess = if guess.is_finite() { guess } else { 0.0 };
+    let mut cycle = SpatialGroup {
+        cycles,
+        cross: &cross,
+    };
+    let last = cycle.run(&mut parts, &before, &mut clocks, guess, &mut runs);
+    let deliver: Vec<Pair12> = (0..group.len())
+        .map(|a| {
+            let mut d = held[a];
+            axpy(&mut d, 1.0, &runs[a].mean);
+            d.map(|q| q / c_n)
+        })
+        .collect();
+    // The state's velocity beyond the Verlet reading of Rapier's velocities around it (as
+    // the planar sub-cycle's), each impulse's share of a shared body in one member's.
+    let w = (2.0 * kick - h) / (2.0 * kick);
+    let beyond: Vec<Pair12> = (0..group.len())
+        .map(|a| {
+            let mut b = held[a];
+            axpy(&mut b, -w, &deliver[a]);
+            b
+        })
+        .collect();
+    for (a, run) in runs.iter_mut().enumerate() {
+        let own = mul(&starts[a].mobility, &beyond[a]);
+        run.start_correction = attributed(a, &members, own, &cross, &beyond);
+    }
+    let rest = parts.into_iter().zip(clocks).zip(runs);
+    for ((a, &i), ((mut parts, clocks), run)) in group.iter().enumerate().zip(rest) {
+        let joint = &mut *joints[i];
+        joint.cycle.spatial_impacts = clocks.map(|c| c.impact);
+        for (patch, clock) in parts.patches.iter_mut().zip(clocks) {
+            patch.contact = clock.history;
+            patch.state = clock.state;
+            patch.impact_rate = clock.impact_rate;
+        }
+        joint.spatial = Some(parts);
+        joint.cycle.substep_guess = last;
+        let mut left = held[a];
+        axpy(&mut left, 1.0, &run.impulse);
+        axpy(&mut left, -1.0, &deliver[a]);
+        joint.cycle.run = run;
+        joint.cycle.pending = Some(left);
+        deliveries[i] = deliver[a].iter().any(|q| *q != 0.0).then_some(deliver[a]);
+    }
+}
 
 impl ClearanceJoint {
     /// Takes a spatial sub-cycled joint's pair before the next step (at each evaluation).
@@ -205,59 +370,6 @@ impl ClearanceJoint {
         } else {
             None
         };
-    }
-
-    /// The planar joints' `subcycle::plan_cycles` for the spatial joint: after Rapier's pass 0,
-    /// the rest of the world's acceleration, the sub-cycle, and the impulse pass 1 delivers.
-    pub(in crate::rapier::joint) fn plan_spatial_cycle(
-        &mut self,
-        bodies: &RigidBodySet,
-        pass: &StepPass,
-        iterations: usize,
-    ) -> Option<Pair12> {
-        let start = self.cycle.spatial_start?;
-        let now = PairStart::velocity_now(self, bodies)?;
-        let (h, kick) = (pass.dt, pass.kick);
-        let c_n = crate::rapier::pipeline::stepper::substep_share(iterations);
-        let a_free: Pair12 = std::array::from_fn(|i| (now[i] - start.velocity[i]) / kick);
-        let mut u0 = start.velocity;
-        axpy(&mut u0, c_n * kick - 0.5 * h, &a_free);
-        axpy(&mut u0, 1.0, &mul(&start.mobility, &self.cycle.held));
-        let mut parts = self.spatial.take()?;
-        let mut clocks = parts.patches.map(|p| RegionClock {
-            history: p.contact,
-            state: p.state,
-            impact_rate: p.impact_rate,
-            impact: p.impact,
-        });
-        let mut run = std::mem::take(&mut self.cycle.run);
-        let mut cycle = SpatialCycle::new(self, &start, (u0, a_free), h, pass.tolerance);
-        let before = (self.contact, &self.report.state);
-        let guess = self.cycle.substep_guess;
-        let last = cycle.run(&mut parts, before, &mut clocks, guess, &mut run);
-        self.cycle.spatial_impacts = clocks.map(|c| c.impact);
-        for (patch, clock) in parts.patches.iter_mut().zip(clocks) {
-            patch.contact = clock.history;
-            patch.state = clock.state;
-            patch.impact_rate = clock.impact_rate;
-        }
-        self.spatial = Some(parts);
-        self.cycle.substep_guess = last;
-        let mut deliver = self.cycle.held;
-        axpy(&mut deliver, 1.0, &run.mean);
-        deliver.iter_mut().for_each(|q| *q /= c_n);
-        let mut held = self.cycle.held;
-        axpy(&mut held, 1.0, &run.impulse);
-        axpy(&mut held, -1.0, &deliver);
-        // The state's velocity beyond the Verlet reading of Rapier's velocities around it (as
-        // the planar sub-cycle's).
-        let w = (2.0 * kick - h) / (2.0 * kick);
-        let mut beyond = self.cycle.held;
-        axpy(&mut beyond, -w, &deliver);
-        run.start_correction = mul(&start.mobility, &beyond);
-        self.cycle.run = run;
-        self.cycle.pending = Some(held);
-        deliver.iter().any(|q| *q != 0.0).then_some(deliver)
     }
 
     /// [`finish_cycle`](ClearanceJoint::finish_cycle) for the spatial joint: the regions

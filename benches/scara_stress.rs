@@ -47,7 +47,6 @@
 //! `examples/robot_backlash.rs` has 0.001), `SCARA_PLANE=1` (each arm's largest drop of the
 //! lower link's centre of mass out of the arm's plane and its largest spin about its length), `SCARA_SPATIAL=0.1`
 //! (both pins spatial, with 0.1 mm of axial play and collars of twice the pin's radius;
-//! `SCARA_SPATIAL_ONLY=shoulder` or `elbow` that pin only, the other planar;
 //! `SCARA_UNCOUPLED=1` each spatial pin sub-cycled on its own), `SCARA_END=0.1` (a shorter
 //! run, s).
 
@@ -121,28 +120,25 @@ struct Arm {
     filtered: [Option<f64>; 2],
 }
 
+/// `SCARA_SPATIAL=0.1`: the pins spatial, with that axial play in mm and collars of twice the
+/// pin's radius; unset, planar.
+fn spatial_pins() -> ClearanceModel {
+    match std::env::var("SCARA_SPATIAL")
+        .ok()
+        .and_then(|t| t.parse::<f64>().ok())
+    {
+        Some(play) => ClearanceModel::Spatial(
+            clearance_joint::model::spatial::SpatialModel::steel(play * 1e-3, 2.0 * PIN_RADIUS),
+        ),
+        None => ClearanceModel::Compliant,
+    }
+}
+
 /// The links' inertia about their length over the transverse one (`SCARA_AXIAL`). At a
 /// thousandth (the example's slender links) Rapier's joints do not hold the lower link in the
 /// arm's plane at 60 and 120 Hz, the ideal arm's too (its centre of mass leaves the plane by
 /// up to 0.21 and 0.08 m, spinning across it at up to 230 and 26 rad/s); at a tenth the ideal
 /// arm's stays within 2 mm of the plane at 60 Hz.
-/// `SCARA_SPATIAL=0.1`: the pins spatial, with that axial play in mm and collars of twice the
-/// pin's radius; unset, planar.
-/// `SCARA_SPATIAL_ONLY=shoulder` (or `elbow`): that pin spatial, the other planar (a mixed
-/// arm).
-fn spatial_pins(pin: &str) -> ClearanceModel {
-    let only = std::env::var("SCARA_SPATIAL_ONLY").unwrap_or_else(|_| pin.to_string());
-    match std::env::var("SCARA_SPATIAL")
-        .ok()
-        .and_then(|t| t.parse::<f64>().ok())
-    {
-        Some(play) if only == pin => ClearanceModel::Spatial(
-            clearance_joint::model::spatial::SpatialModel::steel(play * 1e-3, 2.0 * PIN_RADIUS),
-        ),
-        _ => ClearanceModel::Compliant,
-    }
-}
-
 fn axial_inertia() -> f64 {
     std::env::var("SCARA_AXIAL")
         .ok()
@@ -207,7 +203,7 @@ impl Arm {
                         .friction(FrictionModel::Coulomb(Coulomb::new(MU, 1e-4)?))
                         .integration(integration)
                         .sub_cycle_techniques(techniques)
-                        .model(spatial_pins(["shoulder", "elbow"][i]))
+                        .model(spatial_pins())
                         .name(["shoulder", "elbow"][i])
                         .joint(a1, a2, Vector::Z, Vector::Z)?;
                     handles.push(world.insert_clearance(b1, b2, joint)?);

@@ -437,7 +437,8 @@ impl StepHooks for ClearanceJointSet {
         ClearanceJointSet::restore_state(self);
     }
     fn check_world(&self, params: &IntegrationParameters) -> Result<()> {
-        self.check_substeps(params)
+        self.check_substeps(params)?;
+        spatial::subcycle::check_apart(&self.iter().map(|(_, j)| j).collect::<Vec<_>>())
     }
     fn step_limit(&self, step: &StepContext) -> f64 {
         self.adaptive_step(step.tolerance, step.last_dt)
@@ -506,30 +507,10 @@ impl StepHooks for ClearanceJointSet {
         }
     }
     fn joints_of(&self, body: RigidBodyHandle, names: &mut Vec<String>) {
-        let on_body = || {
-            self.iter()
-                .map(|(_, j)| j)
-                .filter(move |j| j.body1() == body || j.body2() == body)
-        };
-        // Sub-cycled spatial and planar joints on one body are integrated apart, each one's
-        // contact reaching the other's pair through Rapier's pass 1 only: say so, and what to do.
-        let sub_cycled =
-            |spatial: bool| on_body().any(|j| j.sub_cycled() && j.spatial.is_some() == spatial);
-        let apart = sub_cycled(true) && sub_cycled(false);
-        for j in on_body() {
-            let kinds = ["planar", "spatial"];
-            let (kind, other) = match j.spatial.is_some() {
-                true => (kinds[1], kinds[0]),
-                false => (kinds[0], kinds[1]),
-            };
-            let note = match apart && j.sub_cycled() {
-                true => format!(
-                    " ({kind}, sub-cycled apart from the {other} sub-cycled joints on this body: \
-                     make them all spatial or all planar, or integrate them `Explicit`)"
-                ),
-                false => String::new(),
-            };
-            names.push(format!("clearance joint `{}`{note}", j.name()));
+        for (_, j) in self.iter() {
+            if j.body1() == body || j.body2() == body {
+                names.push(format!("clearance joint `{}`", j.name()));
+            }
         }
     }
     fn check_bodies(&self, bodies: &RigidBodySet) -> Result<()> {

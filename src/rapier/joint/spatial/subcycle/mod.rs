@@ -196,6 +196,38 @@ mod integrator;
 use group::SpatialGroup;
 use integrator::{Eval, RegionClock, SpatialCycle};
 
+/// Refuses a body that carries a spatial and a planar sub-cycled joint. The two are integrated
+/// apart (a [`SpatialGroup`] holds the spatial joints only), each one's contact reaching the
+/// other's pair through Rapier's delivery pass alone, and their stiff contacts then fight over
+/// the shared body: the SCARA arm so built left the physical range, or struck at hundreds of
+/// kN, at every world rate measured (docs/sub-cycled-contact.md, limits).
+pub(in crate::rapier::joint) fn check_apart(joints: &[&ClearanceJoint]) -> crate::Result<()> {
+    let sub_cycled = |spatial: bool| {
+        joints
+            .iter()
+            .filter(move |j| j.sub_cycled() && j.spatial.is_some() == spatial)
+    };
+    let planar: std::collections::HashMap<_, &&ClearanceJoint> = sub_cycled(false)
+        .flat_map(|j| [(j.body1(), j), (j.body2(), j)])
+        .collect();
+    for s in sub_cycled(true) {
+        if let Some(p) = [s.body1(), s.body2()].iter().find_map(|b| planar.get(b)) {
+            return Err(crate::Error::invalid(
+                format!("clearance joint `{}`", s.name()),
+                format!(
+                    "is spatial and sub-cycled on a body that the planar sub-cycled joint `{}` \
+                     also joins: the two would be integrated apart, and their contacts fight \
+                     over the shared body. Make the joints that share a body all spatial or all \
+                     planar (`HingeDesign::model`), or integrate one of them explicitly \
+                     (`ContactIntegration::Explicit`, with one solver iteration)",
+                    p.name()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
 /// The planar joints' `subcycle::plan_cycles` for the spatial joints: after Rapier's pass 0,
 /// the rest of the world's acceleration, the sub-cycles of each island's spatial sub-cycled
 /// joints together ([`SpatialGroup`]), and the impulse pass 1 delivers for each (`None`: nothing

@@ -185,14 +185,11 @@ fn a_users_own_loop_steps_the_default_joint_as_the_explicit_one() {
         world.integration_parameters.dt = dt;
         let (mut states, mut deepest) = (Vec::new(), 0.0_f64);
         for _ in 0..steps {
-            let r = set.apply(
+            set.apply(
                 &mut world.bodies,
                 &world.impulse_joints,
                 &world.integration_parameters,
-            );
-            if let Err(e) = r {
-                return Err(e);
-            }
+            )?;
             world.step();
             let (_, joint) = set.iter().next().unwrap();
             assert_eq!(joint.integration(), ContactIntegration::Explicit);
@@ -200,7 +197,7 @@ fn a_users_own_loop_steps_the_default_joint_as_the_explicit_one() {
             let arm = world.bodies.iter().find(|(_, b)| b.is_dynamic()).unwrap().1;
             states.push((*arm.position(), arm.linvel(), arm.angvel()));
         }
-        Ok((states, deepest))
+        Ok::<_, Error>((states, deepest))
     };
     let (_, set) = pendulum(default(), 1);
     let (_, joint) = set.iter().next().unwrap();

@@ -23,7 +23,6 @@ use clearance_joint::rapier::sources::drive::TorsionSpring;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{
     MassProperties, PhysicsWorld, RevoluteJointBuilder, RigidBodyBuilder, RigidBodyHandle,
-    RigidBodySet,
 };
 use std::process::ExitCode;
 
@@ -139,14 +138,17 @@ fn add_twin(world: &mut ClearanceWorld, with_clearance: bool) -> Result<Twin> {
 /// Total linear and angular momentum (about the origin) of the twin's two bodies, and the
 /// largest of each for a single body. From the scene's masses and inertias: Rapier's own mass
 /// properties are only filled in at the first step.
-fn momentum(bodies: &RigidBodySet, twin: &Twin) -> (Vector, Vector, f64, f64) {
+fn momentum(world: &ClearanceWorld, twin: &Twin) -> (Vector, Vector, f64, f64) {
     let (mut p, mut l, mut max_p, mut max_l) = (Vector::ZERO, Vector::ZERO, 0.0f64, 0.0f64);
     for (h, (mass, inertia, _)) in [(twin.satellite, SATELLITE), (twin.panel, PANEL)] {
-        let rb = &bodies[h];
+        let rb = &world.rapier.bodies[h];
         let q = *rb.rotation();
+        // The velocities at the state: after a sub-cycled step Rapier's hold only part of the
+        // step's contact impulse.
+        let (v, w) = world.velocity_at_state(h).expect("in the world");
         // The body frame is at the centre of mass, along the principal axes.
-        let iw = q * (Vector::from(inertia) * (q.inverse() * rb.angvel()));
-        let pb = mass * rb.linvel();
+        let iw = q * (Vector::from(inertia) * (q.inverse() * w));
+        let pb = mass * v;
         let lb = rb.translation().cross(pb) + iw;
         p += pb;
         l += lb;
@@ -161,8 +163,13 @@ pub fn run() -> Result<(Outcome, Outcome)> {
     let mut rapier = PhysicsWorld::new();
     rapier.gravity = Vector::ZERO;
     rapier.integration_parameters.dt = DT;
-    rapier.integration_parameters.num_solver_iterations = 1; // the hook's force is constant over a step
-    let mut world = ClearanceWorld::new(rapier, StepControl::fixed(DT));
+    rapier.integration_parameters.num_solver_iterations = 1; // as the scenes run (sub-cycled, the default, takes any)
+    // The scene's tolerance, which also sizes the sub-cycled contact's sub-steps.
+    let control = StepControl {
+        tolerance: 0.0075,
+        ..StepControl::fixed(DT)
+    };
+    let mut world = ClearanceWorld::new(rapier, control);
     let [ideal, clear] = [add_twin(&mut world, false)?, add_twin(&mut world, true)?];
     // The ideal hinge's exact reaction at each state (not a momentum difference over a step).
     prepare_mass_properties(&mut world.rapier.bodies);
@@ -178,12 +185,14 @@ pub fn run() -> Result<(Outcome, Outcome)> {
     let mut out = [Outcome::default(), Outcome::default()];
     let mut angles = [[UnwrappedAngle::default(); 3]; 2];
     let mut p0 = [None; 2];
+    // The start of the step that led to the current state, s.
+    let mut t_prev = 0.0;
     let (mut dp, mut dl, mut sp, mut sl) = ([0.0f64; 2], [0.0f64; 2], [0.0f64; 2], [0.0f64; 2]);
     loop {
         // The state at the world's time, with the forces the next step applies.
         let t = world.time();
         for (k, twin) in [&ideal, &clear].into_iter().enumerate() {
-            let (p, l, mp, ml) = momentum(&world.rapier.bodies, twin);
+            let (p, l, mp, ml) = momentum(&world, twin);
             let (p_start, l_start) = *p0[k].get_or_insert((p, l));
             dp[k] = dp[k].max((p - p_start).length());
             dl[k] = dl[k].max((l - l_start).length());
@@ -196,13 +205,30 @@ pub fn run() -> Result<(Outcome, Outcome)> {
                     .solve_reactions(&mut reactions, &ideal_hinge)
                     .map_or(0.0, |f| f[0].length()),
                 Some(c) => {
-                    let r = world.clearance.get(c).expect("inserted").report();
-                    if r.onset {
-                        o.onsets += 1;
-                        o.first_impact_s.get_or_insert(t);
+                    let j = world.clearance.get(c).expect("inserted");
+                    let r = j.report();
+                    // The states of the step that led here: a sub-cycled joint's sub-steps (the
+                    // last is this state), where it resolved the step's contacts; else this one.
+                    let here = [(t, r.onset, r.state.penetration, r.force.on_journal)];
+                    let inside = j.substeps().iter().map(|s| {
+                        let at = t_prev + s.t;
+                        (at, s.onset, s.state.penetration, s.force.on_journal)
+                    });
+                    let states: Vec<_> = if j.substeps().is_empty() {
+                        here.to_vec()
+                    } else {
+                        inside.collect()
+                    };
+                    let mut peak = 0.0f64;
+                    for (at, onset, penetration, force) in states {
+                        if onset {
+                            o.onsets += 1;
+                            o.first_impact_s.get_or_insert(at);
+                        }
+                        o.max_penetration_um = o.max_penetration_um.max(penetration * 1e6);
+                        peak = peak.max(force.length());
                     }
-                    o.max_penetration_um = o.max_penetration_um.max(r.state.penetration * 1e6);
-                    r.force.on_journal.length()
+                    peak
                 }
             };
             o.peak_force_n = o.peak_force_n.max(force);
@@ -222,6 +248,7 @@ pub fn run() -> Result<(Outcome, Outcome)> {
         if t >= END {
             break;
         }
+        t_prev = t;
         world.step(END)?;
     }
     for k in 0..2 {

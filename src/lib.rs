@@ -12,21 +12,22 @@
 //!
 //! # 1. One hinge in your Rapier loop
 //!
-//! Keep your world and your loop. Two changes make a loop clearance-ready: one solver iteration
-//! (the hook's force is constant over a step; Rapier's substeps would make every impact gain
-//! energy), and a [`ClearanceWorld`](rapier::pipeline::world::ClearanceWorld) around your `PhysicsWorld`,
+//! Keep your world and your loop. One change makes a loop clearance-ready: a
+//! [`ClearanceWorld`](rapier::pipeline::world::ClearanceWorld) around your `PhysicsWorld`,
 //! whose [`step`](rapier::pipeline::world::ClearanceWorld::step) takes the place of `world.step()`: it
 //! evaluates the joints' and drives' forces, chooses the step (adaptive by default, or fixed with
 //! a stability check), takes it with every joint set's hooks, judges it and retries it if a
-//! contact was entered blindly, and keeps the run's guards. Then one call turns a revolute joint
-//! you already have into a clearance joint:
+//! contact was entered blindly, and keeps the run's guards. The joint sub-cycles its contact
+//! inside each step (the default) and takes any number of solver iterations; the explicit joint
+//! (`ContactIntegration::Explicit`) needs one. Then one call turns a revolute joint you already
+//! have into a clearance joint:
 //!
 //! ```
 //! use clearance_joint::prelude::*;
 //! use rapier3d_f64::prelude::*;
 //!
 //! let mut rapier = PhysicsWorld::new(); // gravity -9.81 m/s^2 along y
-//! rapier.integration_parameters.num_solver_iterations = 1;
+//! rapier.integration_parameters.num_solver_iterations = 1; // as the scenes run (any works)
 //! let base = rapier.bodies.insert(RigidBodyBuilder::fixed());
 //! let arm = rapier.bodies.insert(
 //!     RigidBodyBuilder::dynamic()
@@ -106,7 +107,9 @@
 //!
 //! - The **compliant** clearance joint ([`rapier::joint`]) resolves each impact: peak and fatigue
 //!   loads, impact counts and timing, penetration, stick-slip with a specific friction law. Its
-//!   contact is stiff, so it needs short steps (chosen by the stepper) and one solver iteration.
+//!   contact is stiff: by default the joint sub-cycles it inside each world step
+//!   ([`ContactIntegration`](rapier::joint::ContactIntegration)), with any number of solver
+//!   iterations; the explicit joint needs short steps (chosen by the stepper) and one iteration.
 //! - The **large-step** model ([`rapier::large_step`]) solves the play as a constraint inside
 //!   Rapier's solver, for worlds stepped at 1/60 s or 1 kHz with the default four iterations:
 //!   angles, orbits, backlash, settling and sustained loads, not peak forces. One setter chooses

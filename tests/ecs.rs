@@ -23,8 +23,9 @@ fn steps(world: &mut World, schedule: &mut Schedule, n: usize) -> Result<()> {
 
 #[test]
 fn the_papers_scene_through_the_ecs_is_the_runners() {
-    // Both twins of the paper's scene as entities, 1 s at the paper's fixed step: the ECS
-    // layer makes the same Rapier calls in the same order as the runner, to the last bit.
+    // Both twins of the paper's scene as entities, 1 s at the paper's fixed step, the contact
+    // sub-cycled (the default): the ECS layer makes the same Rapier calls in the same order as
+    // the runner, to the last bit.
     let mut scene = Scene::solar_panel();
     scene.run.step = StepMode::Fixed;
     scene.run.dt_s = 1e-4;
@@ -42,7 +43,9 @@ fn the_papers_scene_through_the_ecs_is_the_runners() {
 
     let mut world = World::new();
     let mut physics = Physics::new(1e-4, Vector::ZERO);
-    // The compliant model's need, as the runner's world has it.
+    // The runner's step control: the tolerance also sizes a sub-cycled contact's sub-steps.
+    physics.set_step_control(scene.run.step_control());
+    // One iteration, as the runner's world has it.
     physics
         .world
         .rapier

@@ -58,8 +58,12 @@ fn run_scene(
     Simulation::new(scene, RunOptions::default())?.run()
 }
 
+/// The pin with explicit contact: the step refusals below are the explicit joint's (a
+/// sub-cycled joint, the default, adds no stability limit in a `ClearanceWorld`).
 fn steel() -> HingeDesign {
-    HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016).unwrap()
+    HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
+        .unwrap()
+        .integration(ContactIntegration::Explicit)
 }
 
 /// `world` with the joints of `set`, stepped with `control`.
@@ -168,6 +172,47 @@ fn the_force_hook_in_a_users_own_loop_names_rapiers_dt() {
     );
     assert!(m.contains("smaller `dt`"), "{m}");
     assert_plain(&m);
+}
+
+#[test]
+fn a_users_own_loop_steps_the_default_joint_as_the_explicit_one() {
+    // The default joint is sub-cycled, which needs the ClearanceWorld's two passes a step. A loop
+    // of the user's own holds `apply`'s forces over Rapier's step: the joint is the explicit one
+    // there, its states and its refusals included, never a sub-cycled joint stepped blind.
+    let default = || HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016).unwrap();
+    let run = |design: HingeDesign, iterations: usize, dt: f64, steps: usize| {
+        let (mut world, mut set) = pendulum(design, iterations);
+        world.integration_parameters.dt = dt;
+        let (mut states, mut deepest) = (Vec::new(), 0.0_f64);
+        for _ in 0..steps {
+            set.apply(
+                &mut world.bodies,
+                &world.impulse_joints,
+                &world.integration_parameters,
+            )?;
+            world.step();
+            let (_, joint) = set.iter().next().unwrap();
+            assert_eq!(joint.integration(), ContactIntegration::Explicit);
+            deepest = deepest.max(joint.report().state.penetration);
+            let arm = world.bodies.iter().find(|(_, b)| b.is_dynamic()).unwrap().1;
+            states.push((*arm.position(), arm.linvel(), arm.angvel()));
+        }
+        Ok::<_, Error>((states, deepest))
+    };
+    let (_, set) = pendulum(default(), 1);
+    let (_, joint) = set.iter().next().unwrap();
+    assert_eq!(joint.integration(), ContactIntegration::SubCycled);
+    // 20 ms at 2 us: the journal crosses the gap and strikes (after about 6 ms).
+    let (states, deepest) = run(default(), 1, 2e-6, 10_000).unwrap();
+    assert!(deepest > 1e-7, "no contact: deepest {deepest} m");
+    assert!(states == run(steel(), 1, 2e-6, 10_000).unwrap().0);
+    // Rapier's four iterations and a step beyond the contact's limit are refused as for `steel()`.
+    for (iterations, dt) in [(4, 2e-6), (1, 1e-3)] {
+        let e = run(default(), iterations, dt, 1000).expect_err("refused");
+        let explicit = run(steel(), iterations, dt, 1000).expect_err("refused");
+        assert_eq!(e.to_string(), explicit.to_string());
+        assert_plain(&e.to_string());
+    }
 }
 
 #[test]
@@ -379,11 +424,12 @@ fn rapiers_default_iterations_suggest_the_large_step_model() {
 
 #[test]
 fn a_stall_names_the_api() {
-    // The stiffest Hertz contact the ranges accept, with a step floor of 1 us: no step
+    // The stiffest Hertz contact the ranges accept, with a step floor of 1 us: no explicit step
     // resolves it.
     let geometry = BearingGeometry::from_clearance(0.010, 0.2e-3, 0.016).unwrap();
     let law = NormalModel::Hertz(Hertz::new(1e16, 1.5).unwrap());
-    let (world, set) = pendulum(HingeDesign::new(geometry, law), 1);
+    let design = HingeDesign::new(geometry, law).integration(ContactIntegration::Explicit);
+    let (world, set) = pendulum(design, 1);
     let control = StepControl {
         min_dt: 1e-6,
         ..StepControl::adaptive(1e-3, 0.0075)
@@ -417,9 +463,14 @@ fn a_strict_guard_names_the_joint() {
 #[test]
 fn the_scene_layer_names_the_scene_fields() {
     // The same kind of error through the scene runner: the scene's step field and the hinge's
-    // clearance fields, but no option of the app.
+    // clearance fields, but no option of the app (the explicit joint's step limit).
     let scene = Scene::solar_panel()
-        .with_overrides(&["run.step=Fixed", "run.dt_s=1e-3", "run.end_s=0.2"])
+        .with_overrides(&[
+            "run.contact_integration=Explicit",
+            "run.step=Fixed",
+            "run.dt_s=1e-3",
+            "run.end_s=0.2",
+        ])
         .unwrap();
     let e = run_scene(&scene).unwrap_err();
     let m = e.to_string();
@@ -440,8 +491,9 @@ fn the_scene_layer_names_the_scene_fields() {
     assert!(!m.contains("--"), "{m}");
 }
 
-/// A face law whose restitution is tiny stalls at the door's first face knock: its hysteresis
-/// damping, growing with the penetration, stiffens the contact 10^6 times past its spring. The
+/// A face law whose restitution is tiny stalls the explicit joint at the door's first face knock:
+/// its hysteresis damping, growing with the penetration, stiffens the contact 10^6 times past its
+/// spring (the sub-cycled default integrates that damping implicitly). The
 /// stall names the face and its restitution, not the stiffness (unchecked, it read "too stiff
 /// ... check the law's stiffness").
 #[test]
@@ -452,7 +504,11 @@ fn a_face_restitution_that_stalls_is_named() {
         );
         let scene = Scene::load(std::path::Path::new("assets/door_hinge.ron"))
             .unwrap()
-            .with_overrides(&["run.end_s=0.02", face.as_str()])
+            .with_overrides(&[
+                "run.contact_integration=Explicit",
+                "run.end_s=0.02",
+                face.as_str(),
+            ])
             .unwrap();
         let e = run_scene(&scene).unwrap_err();
         let m = e.to_string();
@@ -584,13 +640,15 @@ fn a_stall_of_the_turn_bound_names_the_tolerance() {
 /// A fixed step refused at an impact advises from the impact as a short enough step resolves it
 /// (the approach speed at the crossing, its kinetic energy stored in the law's spring), not from
 /// the depth the step too long pressed to: the step it suggests runs through the impact, and one
-/// twice as long is refused again. (From the pressed depth, the paper's scene at 1 ms suggested
-/// 2.6e-5 s, five times shorter than needed.)
+/// twice as long is refused again (the explicit joint: a sub-cycled one has no step limit). (From
+/// the pressed depth, the paper's scene at 1 ms suggested 2.6e-5 s, five times shorter than
+/// needed.)
 #[test]
 fn a_refused_fixed_step_suggests_the_step_the_impact_needs() {
     let run = |dt: f64| {
         let scene = Scene::solar_panel()
             .with_overrides(&[
+                "run.contact_integration=Explicit".to_string(),
                 "run.step=Fixed".to_string(),
                 format!("run.dt_s={dt}"),
                 "run.end_s=0.2".to_string(),

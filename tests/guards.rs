@@ -93,9 +93,12 @@ fn run_arm(
 
 #[test]
 fn penetration_guard_reports_the_worst_depth_when_and_how_often() {
-    // A validity limit of 0.2 um: the first impact passes it by far.
+    // A validity limit of 0.2 um: the first impact passes it by far. Explicit: the test tracks
+    // the states at the steps' ends, which the explicit joint's guard counts (a sub-cycled
+    // joint's counts the steps whose sub-steps pass it).
     let clearance = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
+        .integration(clearance_joint::rapier::joint::ContactIntegration::Explicit)
         .max_valid_penetration(0.2e-6);
     let (world, seen, pin) = run_arm(clearance, StepControl::adaptive(1e-3, 0.02), 0.1);
     let g = world.guards();
@@ -118,6 +121,7 @@ fn penetration_guard_reports_the_worst_depth_when_and_how_often() {
     // Under strict the run fails at the first violating state, naming it.
     let clearance = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
+        .integration(clearance_joint::rapier::joint::ContactIntegration::Explicit)
         .max_valid_penetration(0.2e-6);
     let (mut world, _) = arm_world(
         clearance,
@@ -142,8 +146,10 @@ fn penetration_guard_reports_the_worst_depth_when_and_how_often() {
 
 #[test]
 fn friction_guard_reports_the_worst_ratio_of_a_fixed_step_too_long() {
+    // The explicit joint's guard: a sub-cycled joint's friction is implicit, with no limit.
     let clearance = HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
+        .integration(clearance_joint::rapier::joint::ContactIntegration::Explicit)
         .friction(clearance_joint::model::laws::FrictionModel::Bai(
             clearance_joint::model::laws::Bai::DRY,
         ));
@@ -295,7 +301,11 @@ fn stall_of(scene: &Scene) -> String {
 
 #[test]
 fn a_stall_names_its_cause_for_inputs_that_name_no_contact() {
-    let end = ["run.end_s=0.3".to_string()];
+    // The explicit joint's stall: its steps shrink to the contact's limit and stop at the floor.
+    let end = [
+        "run.end_s=0.3".to_string(),
+        "run.contact_integration=Explicit".to_string(),
+    ];
     // Kelvin-Voigt damping at its documented maximum, on the paper's scene.
     let kv = scene_with(
         "solar_panel.ron",
@@ -354,7 +364,10 @@ fn a_stalled_run_keeps_what_it_computed_marked_incomplete() {
         LIU,
         "contact: KelvinVoigt(stiffness: 1e9, damping: 1e12),",
     )
-    .with_overrides(&["run.end_s=0.3".to_string()])
+    .with_overrides(&[
+        "run.end_s=0.3".to_string(),
+        "run.contact_integration=Explicit".to_string(),
+    ])
     .unwrap();
     let r = Simulation::new(&kv, RunOptions::default())
         .unwrap()

@@ -102,15 +102,19 @@ fn energy_is_conserved_without_damping_and_friction() {
     );
 }
 
-/// The adaptive step puts no energy into the contacts. With damping and friction off, the default
-/// run's energy holds to 3.3e-7 of its scale over the 5 s (growth 2.8e-7, measured). A contact
+/// The adaptive step puts no energy into the explicit joint's contacts. With damping and friction
+/// off, its run's energy holds to 3.3e-7 of its scale over the 5 s (growth 2.8e-7, measured). A contact
 /// step that grew as the journal left the wall and shrank as it pressed in (the kinetic energy of
 /// the approach only) pumped energy into every contact: the energy grew by 1.4e-5
 /// (docs/stepper-and-accuracy.md, "Steps in a long contact").
 #[test]
 fn adaptive_steps_put_no_energy_into_the_contacts() {
     let s = clearance_summary(&run(
-        &["hinge.eta_s=0", "hinge.friction=None"],
+        &[
+            "hinge.eta_s=0",
+            "hinge.friction=None",
+            "run.contact_integration=Explicit",
+        ],
         Twins::ClearanceOnly,
     ));
     assert!(s.onsets > 5, "{} onsets", s.onsets);
@@ -211,9 +215,11 @@ fn default_run_matches_paper_conclusion_one() {
 fn first_impact_peak_converges_at_second_order() {
     // The contact laws get the penetration rate at the state, not Rapier's stored velocities
     // (half a step old, which made the peak first order: 185.43, 181.37, 180.29 N at 2e-5, 1e-5,
-    // 5e-6 s). The first 0.1 s holds the first impact; 6.25e-7 s is the reference.
+    // 5e-6 s). The first 0.1 s holds the first impact; 6.25e-7 s is the reference. The explicit
+    // joint: its steps resolve the impact.
     let peak = |dt: f64| {
         let set = [
+            "run.contact_integration=Explicit".into(),
             "run.step=Fixed".into(),
             format!("run.dt_s={dt:e}"),
             "run.end_s=0.1".into(),
@@ -383,9 +389,15 @@ fn identical_runs_are_bit_identical() {
 #[test]
 fn adaptive_steps_resolve_contact_onset() {
     // Fixed 1e-4 s steps over the first contact: it starts wherever the step lands. Adaptive steps
-    // shrink on approach so the contact begins at a small fraction of its peak penetration.
+    // shrink on approach so the contact begins at a small fraction of its peak penetration (the
+    // explicit joint, whose steps resolve the contact).
     let onset_and_peak = |step: &str| {
-        let set = [step, "run.end_s=0.1", "run.output_interval_s=1e-3"];
+        let set = [
+            step,
+            "run.end_s=0.1",
+            "run.output_interval_s=1e-3",
+            "run.contact_integration=Explicit",
+        ];
         let scene = Scene::solar_panel().with_overrides(&set).unwrap();
         let mut sim = Simulation::new(
             &scene,

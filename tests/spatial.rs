@@ -45,9 +45,16 @@ fn body(mass: f64, inertia: f64) -> RigidBodyBuilder {
         .can_sleep(false)
 }
 
+/// The steel improved-Liu pin with explicit contact: these tests read the joint's report at each
+/// step's end, which resolves every contact only when the steps do (a sub-cycled joint, the
+/// default, resolves its contacts inside the steps: `tests/spatial_sub_cycling.rs`).
+fn steel_liu() -> clearance_joint::Result<HingeDesign> {
+    Ok(HingeDesign::steel_improved_liu(R, C, L)?.integration(ContactIntegration::Explicit))
+}
+
 /// Steel improved-Liu bore, steel shoulders.
 fn steel_spatial() -> HingeDesign {
-    HingeDesign::steel_improved_liu(R, C, L)
+    steel_liu()
         .unwrap()
         .model(ClearanceModel::Spatial(SpatialModel::steel(PLAY, COLLAR)))
 }
@@ -246,9 +253,7 @@ fn free_floating_pair_conserves_momentum() {
 #[test]
 fn axial_knock_restitution_is_the_face_law_s() {
     let model = SpatialModel::steel(PLAY, COLLAR);
-    let clearance = HingeDesign::steel_improved_liu(R, C, L)
-        .unwrap()
-        .model(ClearanceModel::Spatial(model));
+    let clearance = steel_liu().unwrap().model(ClearanceModel::Spatial(model));
     let (mut world, pin, h) = fixed_bearing(&clearance, StepControl::adaptive(1e-3, 0.005));
     let (mass, speed) = (0.5, 0.2);
     world.rapier.bodies[pin].set_linvel(Vector::new(0.0, 0.0, speed), true);
@@ -353,7 +358,7 @@ impl ArmRun {
 #[test]
 fn aligned_spatial_joint_is_the_planar_joint() {
     let control = StepControl::adaptive(1e-3, 0.0075);
-    let steel = || HingeDesign::steel_improved_liu(R, C, L).unwrap();
+    let steel = || steel_liu().unwrap();
     let model = ClearanceModel::Spatial(SpatialModel::steel(PLAY, COLLAR));
     let until = 0.3;
     let spatial = arm(steel().model(model), 0.0, control).run(until);
@@ -389,11 +394,7 @@ fn aligned_spatial_joint_is_the_planar_joint() {
 /// the peaks were 6e-5 and 2.7e-4 off.)
 #[test]
 fn aligned_spatial_joint_with_friction_stays_planar() {
-    let steel = || {
-        HingeDesign::steel_improved_liu(R, C, L)
-            .unwrap()
-            .friction(FrictionModel::Bai(Bai::DRY))
-    };
+    let steel = || steel_liu().unwrap().friction(FrictionModel::Bai(Bai::DRY));
     let model = ClearanceModel::Spatial(SpatialModel::steel(PLAY, COLLAR));
     let until = 0.3;
     let control = StepControl::adaptive(1e-3, 0.0075);
@@ -415,7 +416,7 @@ fn aligned_spatial_joint_with_friction_stays_planar() {
 /// its weight makes a moment across the hinge, the journal tilts and loads the bore's edges.
 /// Metrics at `tolerance` over `until` s.
 fn tilted_arm(tolerance: f64, until: f64) -> ArmResult {
-    let clearance = HingeDesign::steel_improved_liu(R, C, L)
+    let clearance = steel_liu()
         .unwrap()
         .friction(FrictionModel::Bai(Bai::DRY))
         .model(ClearanceModel::Spatial(SpatialModel::steel(PLAY, COLLAR)));
@@ -475,7 +476,7 @@ fn soft_face_trips_the_penetration_guard() {
         stiffness: 1e3,
         restitution: 0.9,
     });
-    let clearance = HingeDesign::steel_improved_liu(R, C, L)
+    let clearance = steel_liu()
         .unwrap()
         .model(ClearanceModel::Spatial(model))
         .name("soft faces");
@@ -499,7 +500,7 @@ fn soft_face_trips_the_penetration_guard() {
 #[ignore]
 fn tilted_arm_tolerance_table() {
     let run = |tol: f64| {
-        let clearance = HingeDesign::steel_improved_liu(R, C, L)
+        let clearance = steel_liu()
             .unwrap()
             .friction(FrictionModel::Bai(Bai::DRY))
             .model(ClearanceModel::Spatial(SpatialModel::steel(PLAY, COLLAR)));

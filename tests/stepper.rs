@@ -5,7 +5,7 @@
 use clearance_joint::error::Error;
 use clearance_joint::model::laws::{BearingGeometry, Hertz, NormalModel};
 use clearance_joint::rapier::hinge::design::HingeDesign;
-use clearance_joint::rapier::joint::ClearanceJointSet;
+use clearance_joint::rapier::joint::{ClearanceJointSet, ContactIntegration};
 use clearance_joint::rapier::observers::reaction::{
     IdealJoint, ReactionSolver, prepare_mass_properties,
 };
@@ -197,9 +197,15 @@ fn an_ideal_mechanism_conserves_energy_under_adaptive_steps() {
 #[test]
 fn a_fixed_step_never_passes_the_end_and_its_last_step_is_checked() {
     // A 1 s step asked for a 0.5 s run: the step is shortened to land on 0.5 s, and the contact
-    // it ends in (hundreds of um deep) is refused, never written with exit 0.
+    // it ends in (hundreds of um deep) is refused, never written with exit 0 (the explicit
+    // joint's limit: a sub-cycled contact has none).
     let scene = Scene::solar_panel()
-        .with_overrides(&["run.step=Fixed", "run.dt_s=1", "run.end_s=0.5"])
+        .with_overrides(&[
+            "run.contact_integration=Explicit",
+            "run.step=Fixed",
+            "run.dt_s=1",
+            "run.end_s=0.5",
+        ])
         .unwrap();
     let e = Simulation::new(&scene, RunOptions::default())
         .unwrap()
@@ -286,7 +292,11 @@ struct CrankRun {
 
 fn crank_run(control: StepControl, end: f64) -> clearance_joint::Result<CrankRun> {
     let (rapier, joints, _) =
-        crank_mechanism(HingeDesign::steel_improved_liu(0.010, 0.5e-3, 0.016)?);
+        // Explicit: the run reads the contact at each step's end.
+        crank_mechanism(
+            HingeDesign::steel_improved_liu(0.010, 0.5e-3, 0.016)?
+                .integration(ContactIntegration::Explicit),
+        );
     let mut world = ClearanceWorld::new(rapier, control);
     world.clearance = joints;
     let (mut first, mut contacts, mut onset_ratio) = (0.0f64, 0u32, 0.0f64);
@@ -386,7 +396,8 @@ fn a_contact_no_step_can_resolve_stops_with_a_named_error() {
     // stable only far below the floor, so no step resolves it.
     let geometry = BearingGeometry::from_clearance(0.010, 0.5e-3, 0.016).unwrap();
     let law = NormalModel::Hertz(Hertz::new(1e16, 1.5).unwrap());
-    let (rapier, joints, _) = crank_mechanism(HingeDesign::new(geometry, law));
+    let explicit = HingeDesign::new(geometry, law).integration(ContactIntegration::Explicit);
+    let (rapier, joints, _) = crank_mechanism(explicit);
     let control = StepControl {
         min_dt: 1e-6,
         ..StepControl::adaptive(1e-3, 0.0075)

@@ -212,7 +212,10 @@ fn the_scenes_sub_cycle_switches_reach_the_joint() {
     }
     let wrong = base.with_overrides(&["run.sub_cycle.implicit_frictoin=false"]);
     assert!(wrong.is_err());
-    let unread = base.with_overrides(&["run.sub_cycle.implicit_friction=false"]);
+    let unread = base.with_overrides(&[
+        "run.contact_integration=Explicit",
+        "run.sub_cycle.implicit_friction=false",
+    ]);
     let message = unread.expect_err("refused on an explicit run").to_string();
     assert!(message.contains("run.sub_cycle"), "{message}");
 }

@@ -1,5 +1,5 @@
 //! Whole-process CPU time of the paper's scene, side by side in one run: the app at its
-//! default (explicit contact), sub-cycled, and at the paper's fixed 1e-4 s, each a separate
+//! default (sub-cycled contact), explicit, and at the paper's fixed 1e-4 s, each a separate
 //! process writing its whole result set (`--no-check`), plus the independent scipy RK45 model
 //! (`benches/reference/solar_panel_rk45.py`, rtol 1e-4) when Python has scipy.
 //! `cargo bench --bench paper_cost [-- RUNS]` writes `bench_out/paper_cost.md`.
@@ -94,14 +94,18 @@ fn main() {
         }
     };
     let mut configs = vec![
-        app_config("explicit (default)", &[]),
+        app_config("sub-cycled (default)", &[]),
+        app_config("explicit", &["--set", "run.contact_integration=Explicit"]),
         app_config(
-            "sub-cycled",
-            &["--set", "run.contact_integration=SubCycled"],
-        ),
-        app_config(
-            "fixed 1e-4 s",
-            &["--set", "run.step=Fixed", "--set", "run.dt_s=1e-4"],
+            "fixed 1e-4 s, explicit",
+            &[
+                "--set",
+                "run.step=Fixed",
+                "--set",
+                "run.dt_s=1e-4",
+                "--set",
+                "run.contact_integration=Explicit",
+            ],
         ),
     ];
     let script = root.join("benches/reference/solar_panel_rk45.py");
@@ -133,7 +137,7 @@ fn main() {
             .find(|(c, s)| c.name == name && !s.is_empty())
             .map(|(_, s)| median(s.clone()))
     };
-    let fixed = median_of("fixed 1e-4 s");
+    let fixed = median_of("fixed 1e-4 s, explicit");
     let scipy = median_of("scipy RK45, rtol 1e-4");
     let ratio = |t: f64, of: Option<f64>| of.map_or("-".to_string(), |r| format!("{:.2}", t / r));
     let mut md = format!(

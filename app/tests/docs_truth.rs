@@ -214,8 +214,15 @@ fn the_default_run_is_as_the_readme_says() {
 #[test]
 fn quoted_messages_are_what_the_commands_print() {
     let out = scratch("messages");
+    // The explicit joint's refusals and guards (a sub-cycled contact has no step limit and an
+    // implicit friction), as the docs' commands say.
+    let explicit = ["--set", "run.contact_integration=Explicit"];
     let refused = run(
-        &["--set", "run.step=Fixed", "--dt", "1e-3", "--end", "0.2"],
+        &[
+            &explicit[..],
+            &["--set", "run.step=Fixed", "--dt", "1e-3", "--end", "0.2"],
+        ]
+        .concat(),
         &out,
     );
     for quote in [
@@ -239,7 +246,14 @@ damping ratio 0.2573). Use `run.dt_s` below 1.308e-4 s",
     ] {
         assert_same("docs/reliability.md", quote, &memory);
     }
-    let pendulum = run(&["--scene", "assets/pendulum.ron", "--end", "0.3"], &out);
+    let pendulum = run(
+        &[
+            &explicit[..],
+            &["--scene", "assets/pendulum.ron", "--end", "0.3"],
+        ]
+        .concat(),
+        &out,
+    );
     assert_same(
         "docs/stepper-and-accuracy.md",
         "WARNING: joint `pivot`: the fixed step is longer than friction's limit near zero slip, worst \

@@ -269,8 +269,13 @@ fn a_divergence_names_the_body_as_the_scene_does() {
 
 #[test]
 fn step_too_large_for_the_contact_stiffness() {
+    // The explicit joint's stability limit (a sub-cycled contact has none).
     let scene = Scene::solar_panel()
-        .with_overrides(&["run.step=Fixed", "run.dt_s=5e-4"])
+        .with_overrides(&[
+            "run.contact_integration=Explicit",
+            "run.step=Fixed",
+            "run.dt_s=5e-4",
+        ])
         .unwrap();
     let e = Simulation::new(&scene, RunOptions::default())
         .unwrap()
@@ -292,8 +297,17 @@ fn bin() -> Command {
 #[test]
 fn cli_refuses_without_writing_anything() {
     let dir = std::env::temp_dir().join(format!("cj-refused-{}", std::process::id()));
+    // The explicit joint's step limit refuses the run.
     let out = bin()
-        .args(["--set", "run.step=Fixed", "--dt", "1e-3", "--out"])
+        .args([
+            "--set",
+            "run.contact_integration=Explicit",
+            "--set",
+            "run.step=Fixed",
+            "--dt",
+            "1e-3",
+            "--out",
+        ])
         .arg(&dir)
         .output()
         .unwrap();

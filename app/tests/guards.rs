@@ -45,6 +45,9 @@ fn a_stalled_run_writes_an_incomplete_set_and_fails() {
         .arg("--scene")
         .arg(&scene)
         .args([
+            // The explicit joint's stall (its steps shrink to the contact's limit).
+            "--set",
+            "run.contact_integration=Explicit",
             "--end",
             "0.3",
             "--no-figures",
@@ -101,11 +104,14 @@ fn a_stalled_run_writes_an_incomplete_set_and_fails() {
 
 #[test]
 fn the_console_shows_the_worst_violation_and_strict_fails() {
-    // The pendulum at its fixed 2e-5 s step: friction's limit near zero slip is far shorter.
+    // The pendulum at its fixed 2e-5 s step with the explicit joint: friction's limit near zero
+    // slip is far shorter (a sub-cycled joint's friction is implicit, with no limit).
     let pendulum = format!("{}/../assets/pendulum.ron", env!("CARGO_MANIFEST_DIR"));
     let dir = temp("worst");
     let out = bin()
         .args([
+            "--set",
+            "run.contact_integration=Explicit",
             "--scene",
             &pendulum,
             "--end",
@@ -135,6 +141,8 @@ fn the_console_shows_the_worst_violation_and_strict_fails() {
     );
     let out = bin()
         .args([
+            "--set",
+            "run.contact_integration=Explicit",
             "--scene",
             &pendulum,
             "--end",

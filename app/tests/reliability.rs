@@ -430,7 +430,13 @@ fn names_paths_fixed_bodies_and_warnings() {
 /// program; the program adds its options.
 #[test]
 fn step_limit_messages() {
-    let args = ["run.step=Fixed", "run.dt_s=1e-3", "run.end_s=0.2"];
+    // The explicit joint's step limit (a sub-cycled contact has none).
+    let args = [
+        "run.contact_integration=Explicit",
+        "run.step=Fixed",
+        "run.dt_s=1e-3",
+        "run.end_s=0.2",
+    ];
     let scene = Scene::solar_panel().with_overrides(&args).unwrap();
     let e = Simulation::new(&scene, RunOptions::default())
         .unwrap()
@@ -453,7 +459,16 @@ fn step_limit_messages() {
     assert!(longest_digit_run(&lib) <= 5, "{lib}");
     // From a real run at the paper's scene, fixed 1e-3 s: the CLI adds its options.
     let o = bin()
-        .args(["--set", "run.step=Fixed", "--dt", "1e-3", "--end", "0.2"])
+        .args([
+            "--set",
+            "run.contact_integration=Explicit",
+            "--set",
+            "run.step=Fixed",
+            "--dt",
+            "1e-3",
+            "--end",
+            "0.2",
+        ])
         .arg("--out")
         .arg(scratch("steplimit"))
         .output()

@@ -260,8 +260,12 @@ fn a_bad_sweep_value_fails_before_anything_runs() {
     let unstable = Sweep::new(
         "test",
         Scene::solar_panel(),
-        vec!["run.step=Fixed".into(), "run.end_s=0.1".into()],
-        // 2e-4 s is beyond the first impact's stability limit (about 1.1e-4 s): refused.
+        vec![
+            "run.contact_integration=Explicit".into(),
+            "run.step=Fixed".into(),
+            "run.end_s=0.1".into(),
+        ],
+        // 2e-4 s is beyond the explicit first impact's stability limit (about 1.1e-4 s): refused.
         Grid::new(vec![Axis::new("run.dt_s", ["5e-5", "2e-4"])]).unwrap(),
     );
     let outcome = unstable.run(&out, Shard::ALL, quiet()).unwrap();

@@ -141,9 +141,11 @@ impl Hinge {
 pub struct IdealHinge;
 
 /// Makes a [`Hinge`] a clearance joint with these laws (takes precedence over [`IdealHinge`]).
-/// [`HingeDesign::model`] chooses the model: the compliant contact law (the default; it needs small
-/// steps and a world with `num_solver_iterations = 1`, which you set: a world with more is
-/// refused, see the [module docs](super)) or the large-step constraint,
+/// [`HingeDesign::model`] chooses the model: the compliant contact law (the default, its contact
+/// sub-cycled inside each step with any number of solver iterations; with
+/// `ContactIntegration::Explicit` it needs small steps and a world with
+/// `num_solver_iterations = 1`, which you set: a world with more is refused, see the
+/// [module docs](super)) or the large-step constraint,
 /// `ClearanceHinge(HingeDesign::steel_improved_liu(..)?.model(ClearanceModel::LargeStep))`, for 1/60 s or 1 kHz
 /// worlds with any number of solver iterations. The spatial model,
 /// `.model(ClearanceModel::Spatial(SpatialModel::steel(axial_play, collar_radius)))`, frees the

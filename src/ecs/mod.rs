@@ -38,15 +38,19 @@
 //! # The world's settings are yours
 //!
 //! The layer never changes the Rapier world's settings ([`Physics::new`] keeps Rapier's
-//! defaults but `dt` and gravity; [`Physics::from_world`] keeps the world as it comes). The
-//! compliant model needs one thing of them: `integration_parameters.num_solver_iterations = 1`.
-//! Its contact force is evaluated once per step and held over the step; Rapier's substeps would
-//! make every impact gain energy. The setting is the whole world's: every other body then gets
+//! defaults but `dt` and gravity; [`Physics::from_world`] keeps the world as it comes). A
+//! compliant hinge sub-cycles its contact by default (integrated inside each step,
+//! [`ContactIntegration`](crate::rapier::joint::ContactIntegration)) and takes any number of
+//! solver iterations. The explicit one (`ContactIntegration::Explicit`) needs one thing of them:
+//! `integration_parameters.num_solver_iterations = 1`. Its contact force is evaluated once per
+//! step and held over the step; Rapier's substeps would make every impact gain energy. The
+//! setting is the whole world's: every other body then gets
 //! one solver iteration too, and stacks of resting bodies lose the stiffness Rapier's default
 //! iterations give them (a stack of eight 0.5 m boxes at 60 Hz stands with Rapier's 4 and has
-//! fallen within 10 s with one). A compliant [`ClearanceHinge`] in a world with more iterations is refused
-//! with an error that says so; nothing is changed. A game world that keeps its iterations gives
-//! its hinges the large-step model, which works with any number. One substep is also one
+//! fallen within 10 s with one). An explicit compliant [`ClearanceHinge`] in a world with more
+//! iterations is refused with an error that says so; nothing is changed. A game world that keeps
+//! its iterations keeps its hinges sub-cycled, or gives them the large-step model, which works
+//! with any number. One substep is also one
 //! Gauss-Seidel sweep over the ideal joints a step: a chain with a light body between stiff joints
 //! (a motor-driven crank carrying a heavier coupler) wants more sweeps,
 //! `integration_parameters.num_internal_pgs_iterations` (see
@@ -61,7 +65,8 @@
 //!
 //! let mut world = World::new();
 //! let mut physics = Physics::new(1e-5, Vector::new(0.0, -9.81, 0.0));
-//! // The compliant model's one need, for the whole world (see above).
+//! // One substep a step, as the scenes run (the explicit model's need; the sub-cycled
+//! // default takes any number, see above).
 //! physics.world.rapier.integration_parameters.num_solver_iterations = 1;
 //! world.insert_resource(physics);
 //! let base = world.spawn(Body::new(RigidBodyBuilder::fixed())).id();
@@ -96,11 +101,13 @@
 //! [`Physics::from_world`] wraps a `PhysicsWorld` you built: its settings, bodies, colliders and
 //! joints stay, and [`Body::from_handle`] makes one of its bodies an entity's. Here a game world
 //! at 60 Hz with Rapier's 4 solver iterations (its stacks stay stiff) hangs a sign on a
-//! large-step clearance hinge; the same hinge with the compliant model is refused.
+//! large-step clearance hinge; the same hinge with the explicit compliant model is refused (the
+//! sub-cycled one, the default, would step it).
 //!
 //! ```
 //! use bevy_ecs::prelude::*;
 //! use clearance_joint::rapier::hinge::design::{HingeDesign, ClearanceModel};
+//! use clearance_joint::rapier::joint::ContactIntegration;
 //! use clearance_joint::ecs::*;
 //! use rapier3d_f64::math::Vector;
 //! use rapier3d_f64::prelude::{MassProperties, PhysicsWorld, RigidBodyBuilder};
@@ -122,11 +129,11 @@
 //! let hinge = world
 //!     .spawn((
 //!         Hinge::new(post, sign, Vector::Z).local_anchor2(Vector::new(0.0, 0.3, 0.0)),
-//!         ClearanceHinge(clearance.clone()),
+//!         ClearanceHinge(clearance.clone().integration(ContactIntegration::Explicit)),
 //!     ))
 //!     .id();
 //! let mut schedule = physics_schedule();
-//! // The compliant model needs one solver iteration; the world is left as it is.
+//! // The explicit compliant model needs one solver iteration; the world is left as it is.
 //! let refused = run_step(&mut world, &mut schedule).unwrap_err().to_string();
 //! assert!(refused.contains("num_solver_iterations") && refused.contains("LargeStep"), "{refused}");
 //! assert_eq!(world.resource::<Physics>().world.rapier.integration_parameters.num_solver_iterations, 4);

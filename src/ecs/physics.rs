@@ -87,8 +87,9 @@ pub struct Physics {
 
 impl Physics {
     /// An empty Rapier world stepping by `dt` (s) under `gravity` (m/s^2), with Rapier's
-    /// defaults otherwise (4 solver iterations): ready for ideal and large-step hinges. The
-    /// compliant clearance model needs one solver iteration; set
+    /// defaults otherwise (4 solver iterations): ready for ideal, large-step and sub-cycled
+    /// compliant hinges (the default). An explicit compliant hinge
+    /// (`ContactIntegration::Explicit`) needs one solver iteration; set
     /// `world.rapier.integration_parameters.num_solver_iterations = 1` yourself before spawning such a
     /// hinge (see the [module docs](super) for why and what it costs the world's other bodies).
     pub fn new(dt: f64, gravity: Vector) -> Self {

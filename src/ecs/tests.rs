@@ -12,7 +12,14 @@ use bevy_ecs::prelude::*;
 use rapier3d_f64::math::Vector;
 use rapier3d_f64::prelude::{MassProperties, PhysicsWorld, RigidBodyBuilder};
 
+/// The compliant hinge with explicit contact: the tests below read its per-step forces, limits
+/// and refusals (the sub-cycled default's are `sub_cycled_compliant_hinge_at_game_rate`'s).
 fn clearance() -> HingeDesign {
+    default_clearance().integration(crate::rapier::joint::ContactIntegration::Explicit)
+}
+
+/// The same hinge at the library's defaults (sub-cycled contact).
+fn default_clearance() -> HingeDesign {
     HingeDesign::steel_improved_liu(0.010, 0.2e-3, 0.016)
         .unwrap()
         .friction(FrictionModel::Bai(Bai::DRY))
@@ -446,14 +453,16 @@ fn large_step_hinge_at_game_rate_with_rapiers_defaults() {
     );
 }
 
-/// A sub-cycled compliant hinge at 1/60 s with Rapier's four iterations (the explicit one
-/// refuses both): its first impact, inside one frame, is in the hinge state (onset, a peak over
-/// the static load), and the arm comes to hang on the wall with the weight as its force.
+/// A compliant hinge at the defaults (sub-cycled) at 1/60 s with Rapier's four iterations (the
+/// explicit one refuses both): its first impact, inside one frame, is in the hinge state (onset,
+/// a peak over the static load), and the arm comes to hang on the wall with the weight as its
+/// force.
 #[test]
 fn sub_cycled_compliant_hinge_at_game_rate() {
     let (mut world, mut schedule, _, hinge) = game_rate_pendulum();
-    let sub_cycled = clearance().integration(crate::rapier::joint::ContactIntegration::SubCycled);
-    world.entity_mut(hinge).insert(ClearanceHinge(sub_cycled));
+    world
+        .entity_mut(hinge)
+        .insert(ClearanceHinge(default_clearance()));
     steps(&mut world, &mut schedule, 3).unwrap();
     let s = *world.get::<HingeState>(hinge).unwrap();
     assert_eq!(s.mode, HingeMode::Clearance);

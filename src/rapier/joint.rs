@@ -110,6 +110,9 @@ pub struct ClearanceJoint {
     /// The spatial model's stations (`None`: the planar joint).
     spatial: Option<SpatialParts>,
     integration: ContactIntegration,
+    /// Stepped by a loop of the user's own (`ClearanceJointSet::apply_forces`), which holds
+    /// the forces over Rapier's step: explicit whatever `integration` says.
+    plain_loop: bool,
     /// Which of the sub-cycle's techniques a sub-cycled joint uses.
     techniques: SubCycleTechniques,
     /// The sub-cycle's memory and buffers ([`ContactIntegration::SubCycled`]).
@@ -229,9 +232,15 @@ impl ClearanceJoint {
     pub fn lock_handle(&self) -> Option<ImpulseJointHandle> {
         self.lock_handle
     }
-    /// How the contact is integrated ([`ContactIntegration`]).
+    /// How the contact is integrated ([`ContactIntegration`]): as designed, except in a loop of
+    /// your own ([`ClearanceJointSet::apply`]), which holds the forces over Rapier's step and so
+    /// integrates every joint explicitly.
     pub fn integration(&self) -> ContactIntegration {
-        self.integration
+        if self.plain_loop {
+            ContactIntegration::Explicit
+        } else {
+            self.integration
+        }
     }
     /// Which of the sub-cycle's techniques the joint uses ([`SubCycleTechniques`]; read when
     /// it is sub-cycled).
@@ -247,7 +256,7 @@ impl ClearanceJoint {
     }
     /// Whether the contact is sub-cycled ([`ContactIntegration::SubCycled`]).
     fn sub_cycled(&self) -> bool {
-        self.integration == ContactIntegration::SubCycled
+        self.integration() == ContactIntegration::SubCycled
     }
     /// What the hook computed at its last application.
     pub fn report(&self) -> &ClearanceReport {

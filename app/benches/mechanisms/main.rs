@@ -7,7 +7,8 @@
 //! first impacts); any other word keeps only the cases whose name contains it
 //! (`cargo bench --bench mechanisms -- --quick slider`). `MECHANISMS_INTEGRATION=SubCycled` (or
 //! `Explicit`) sets the contact integration of the default runs (the references stay explicit)
-//! and writes `bench_out/mechanisms[_quick]_SubCycled.md`. `MECHANISMS_STUDY` runs every start at
+//! and writes `bench_out/mechanisms[_quick]_SubCycled.md`; unset, each scene keeps its own (the
+//! library's default, `SubCycled`, unless its file chooses `Explicit`). `MECHANISMS_STUDY` runs every start at
 //! each listed stepping instead (`study.rs`).
 //!
 //! Per scene, three fixed steps each half the previous are run; the finest is the reference. The

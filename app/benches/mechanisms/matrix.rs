@@ -360,7 +360,7 @@ pub fn scene(case: &Case, stepping: Stepping, end_s: f64) -> Scene {
                 .map(String::from),
             );
             // The ablation's choice of contact integration (`Explicit` or `SubCycled`), else
-            // the library's default.
+            // the scene's own (the library's default unless its file chooses).
             if let Ok(integration) = std::env::var("MECHANISMS_INTEGRATION") {
                 set.push(format!("run.contact_integration={integration}"));
             }

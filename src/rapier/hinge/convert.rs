@@ -10,7 +10,7 @@
 //! use rapier3d_f64::prelude::*;
 //!
 //! let mut world = PhysicsWorld::new();
-//! world.integration_parameters.num_solver_iterations = 1; // the hook's force is constant over a step
+//! world.integration_parameters.num_solver_iterations = 1; // as the scenes run (sub-cycled, the default, takes any)
 //! let base = world.bodies.insert(RigidBodyBuilder::fixed());
 //! let arm = world.bodies.insert(
 //!     RigidBodyBuilder::dynamic()

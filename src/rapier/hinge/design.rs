@@ -15,7 +15,7 @@ use rapier3d_f64::math::Vector;
 ///
 /// | model | solved | steps it is stable at | what it gives |
 /// |---|---|---|---|
-/// | [`Compliant`](Self::Compliant) | contact law, force hook outside Rapier's solver | about 1e-5..1e-4 s for steel, `num_solver_iterations = 1` | force histories, peak forces, penetrations |
+/// | [`Compliant`](Self::Compliant) | contact law, force hook outside Rapier's solver | sub-cycled (the default, in a `ClearanceWorld`): any step, any iterations, the contact resolved inside it; [`Explicit`](crate::rapier::joint::ContactIntegration::Explicit) (and in a loop of your own): about 1e-5..1e-4 s for steel, `num_solver_iterations = 1` | force histories, peak forces, penetrations |
 /// | [`LargeStep`](Self::LargeStep) | radial limit inside Rapier's solver, Newton restitution, friction moment | any step (1/60 s, 1e-3 s), any iterations | play, rattle, orbit, sustained forces, impulses |
 /// | [`Spatial`](Self::Spatial) | contact laws along the width and on the faces, nothing locked | as `Compliant` | tilt, edge loading, axial knocks, moments across the hinge |
 ///
@@ -105,8 +105,8 @@ pub struct HingeDesign {
     /// The compliant and spatial models take their restitution from their laws:
     /// [`joint`](Self::joint) refuses a set one, naming `restitution`.
     pub(crate) restitution: Option<f64>,
-    /// How the compliant planar joint integrates its contact (default
-    /// [`ContactIntegration::Explicit`](crate::rapier::joint::ContactIntegration::Explicit)).
+    /// How the compliant joint integrates its contact (default
+    /// [`ContactIntegration::SubCycled`](crate::rapier::joint::ContactIntegration::SubCycled)).
     pub(crate) integration: crate::rapier::joint::ContactIntegration,
     /// Which of the sub-cycle's techniques a sub-cycled joint uses (default all).
     pub(crate) techniques: crate::rapier::joint::SubCycleTechniques,
@@ -126,7 +126,7 @@ impl HingeDesign {
             name: None,
             model: ClearanceModel::Compliant,
             restitution: None,
-            integration: crate::rapier::joint::ContactIntegration::Explicit,
+            integration: crate::rapier::joint::ContactIntegration::SubCycled,
             techniques: crate::rapier::joint::SubCycleTechniques::default(),
         }
     }

@@ -34,6 +34,7 @@ impl ClearanceJointBuilder {
                 prepared: false,
                 spatial: None,
                 integration: ContactIntegration::default(),
+                plain_loop: false,
                 techniques: SubCycleTechniques::default(),
                 cycle: CycleState::default(),
             },
@@ -51,7 +52,7 @@ impl ClearanceJointBuilder {
         self
     }
     /// How the contact is integrated over a step ([`ContactIntegration`]; default
-    /// [`ContactIntegration::Explicit`]).
+    /// [`ContactIntegration::SubCycled`]).
     pub(crate) fn integration(mut self, integration: ContactIntegration) -> Self {
         self.joint.integration = integration;
         self

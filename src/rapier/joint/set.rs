@@ -131,7 +131,10 @@ impl ClearanceJointSet {
     /// The force hook: call before every `PhysicsPipeline::step`. It evaluates every joint from
     /// the bodies' current poses and velocities and replaces the forces it applied at the
     /// previous call with the new contact and friction forces (your own user forces are left
-    /// alone).
+    /// alone). The forces are held over your step: every joint is integrated explicitly here, a
+    /// sub-cycled one ([`ContactIntegration::SubCycled`], the default) too, with the explicit
+    /// joint's checks below (its sub-cycle needs the two passes of the
+    /// [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld)'s step).
     ///
     /// Errors (after applying the forces):
     /// - `num_solver_iterations` is not 1: Rapier's substeps hold the hook's force constant
@@ -170,6 +173,12 @@ impl ClearanceJointSet {
     /// the step after seeing the contact state (adaptive stepping) and then check it themselves
     /// ([`StepHooks::check_step`]).
     pub fn apply_forces(&mut self, bodies: &mut RigidBodySet, impulse_joints: &ImpulseJointSet) {
+        // The loop holds these forces over its step: every joint is explicit here, checks and
+        // step bounds included, a sub-cycled one too (no sub-cycle runs, and none is pending).
+        for joint in self.joints.values_mut() {
+            joint.plain_loop = true;
+            joint.cycle.pending = None;
+        }
         self.evaluate(bodies, impulse_joints);
         self.ledger.replace(bodies, self.wrenches.iter().copied());
     }
@@ -305,7 +314,9 @@ impl ClearanceJointSet {
                      `integration_parameters.num_solver_iterations = 1` (every body of the world \
                      then gets one iteration: stacks of resting bodies soften), sub-cycle the \
                      joints' contact (`HingeDesign::integration(ContactIntegration::SubCycled)`, \
-                     the same laws resolved inside each step, with any number of iterations), or \
+                     the default, the same laws resolved inside each step with any number of \
+                     iterations; it needs a ClearanceWorld's step: a loop of your own that calls \
+                     `ClearanceJointSet::apply` holds the forces over the step, explicitly), or \
                      build the hinges with the large-step model, \
                      `HingeDesign::model(ClearanceModel::LargeStep)` into a LargeStepJointSet, which \
                      works with any number of iterations and steps as long as 1/60 s",
@@ -412,6 +423,9 @@ impl std::ops::Deref for ClearanceJointSet {
 
 impl StepHooks for ClearanceJointSet {
     fn evaluate(&mut self, context: EvaluateContext<'_>) {
+        for joint in self.joints.values_mut() {
+            joint.plain_loop = false;
+        }
         self.set_last_step(context.last_step);
         ClearanceJointSet::evaluate(self, context.bodies, context.impulse_joints);
     }

@@ -32,7 +32,9 @@
 //! The scene runner records its hinges with the same [`ImpactRecorder`], so a plain-Rapier loop
 //! that records the same states gets the same numbers. A state is recorded with the step that
 //! follows it: read the joint (a [`ContactObservation`]) before a step, record it with that
-//! step's start and length once the step is taken, and finish with the final state.
+//! step's start and length and the joint's sub-steps once the step is taken
+//! ([`ImpactRecorder::record_step`]; a sub-cycled joint, the default, resolves its contacts
+//! there), and finish with the final state.
 //!
 //! ```
 //! use clearance_joint::rapier::observers::metrics::{ContactObservation, ImpactRecorder};
@@ -64,7 +66,9 @@
 //! while world.time() < 0.1 {
 //!     let before = ContactObservation::of(world.clearance.get(pivot).unwrap());
 //!     let info = world.step(0.1)?;
-//!     recorder.record(info.t0, info.dt, &before);
+//!     // With the step's sub-steps, where a sub-cycled joint (the default) resolved its contacts.
+//!     let substeps = world.clearance.get(pivot).unwrap().substeps();
+//!     recorder.record_step(info.t0, info.dt, &before, substeps);
 //! }
 //! recorder.finish(world.time(), &ContactObservation::of(world.clearance.get(pivot).unwrap()));
 //! // The journal drops through the 0.2 mm gap and bounces on the bearing's floor.

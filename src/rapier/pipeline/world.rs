@@ -12,7 +12,7 @@
 //! // A 2 kg arm on a steel pin with 0.2 mm of play, released horizontal under gravity.
 //! let mut rapier = PhysicsWorld::new();
 //! rapier.gravity = Vector::new(0.0, -9.81, 0.0);
-//! rapier.integration_parameters.num_solver_iterations = 1; // the compliant model needs 1
+//! rapier.integration_parameters.num_solver_iterations = 1; // the explicit joint's need; sub-cycled takes any
 //! let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.02));
 //! let base = world.rapier.bodies.insert(RigidBodyBuilder::fixed());
 //! let arm = world.rapier.bodies.insert(

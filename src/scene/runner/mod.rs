@@ -121,7 +121,8 @@ impl Simulation {
         let mut physics = PhysicsWorld::new();
         physics.gravity = Vector::from(scene.gravity);
         physics.integration_parameters.dt = scene.run.dt_s;
-        // One substep: the hook's force is constant over the step (substeps gain energy).
+        // One substep: an explicit hinge's force is constant over the step (substeps would gain
+        // energy); a sub-cycled one takes any number, and its scene figures are measured at one.
         physics.integration_parameters.num_solver_iterations = 1;
         physics.integration_parameters.num_internal_pgs_iterations = scene.run.solver_sweeps;
         let mut world = ClearanceWorld::new(physics, control);

@@ -94,10 +94,11 @@ pub(crate) fn run(args: &RunArgs) -> clearance_joint::Result<()> {
     let job = SceneRun::prepare(scene, out, args.memory.budget()?, !args.no_replay)?;
     let scene = &job.scene;
     eprintln!(
-        "running `{}`: {}, {} s simulated, ideal and clearance twins",
+        "running `{}`: {}, {} s simulated, contact {:?} (`run.contact_integration`), ideal and clearance twins",
         scene.name,
         scene.run.stepping(),
-        clearance_joint::error::sig4(scene.run.end_s)
+        clearance_joint::error::sig4(scene.run.end_s),
+        scene.run.contact_integration
     );
     let mut progress = RunProgress::new(progress_mode(&args.progress));
     let result = job.execute_recorded(|p| progress.update(p), !args.no_replay);

@@ -74,20 +74,30 @@ use serde::{Deserialize, Serialize};
 
 /// How a compliant clearance joint integrates its contact and friction forces over a step
 /// ([`HingeDesign::integration`](crate::rapier::hinge::design::HingeDesign::integration)).
+///
+/// The default is [`SubCycled`](Self::SubCycled): at the default tolerance it takes fewer world
+/// steps and less time than [`Explicit`](Self::Explicit) wherever the world chooses its steps
+/// (adaptive steps, Rapier's step of a game or a controller). `Explicit` stays for comparison,
+/// and for a loop of your own that calls
+/// [`ClearanceJointSet::apply`](crate::rapier::joint::ClearanceJointSet::apply): that loop gets
+/// the explicit forces whatever the joint's integration (docs/sub-cycled-contact.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[non_exhaustive]
 pub enum ContactIntegration {
     /// The forces are evaluated once per Rapier step at its start and held over it: the step
     /// must resolve every contact (the step control shortens it to a fraction of the contact's
-    /// period and of its stability limit, and of friction's near zero slip).
-    #[default]
+    /// period and of its stability limit, and of friction's near zero slip), and Rapier must
+    /// take it in one substep (`num_solver_iterations = 1`).
     Explicit,
     /// The contact is integrated on the joint's own clock inside each Rapier step, its damping
     /// and friction implicitly; Rapier's step carries the result (two Rapier passes: the rest of
     /// the world's motion, then the contact's impulse; docs/sub-cycled-contact.md). The
-    /// world's step is set by its slow motion: the joint adds no stability limit. Needs the
-    /// [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld) (or a layer built on it); a loop of your own
-    /// that calls `ClearanceJointSet::apply` gets the explicit forces.
+    /// world's step is set by its slow motion: the joint adds no stability limit, and Rapier may
+    /// take any number of solver iterations. Needs the
+    /// [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld) (or a layer built on
+    /// it: the scene runner, the bevy_ecs layer); a loop of your own that calls
+    /// `ClearanceJointSet::apply` gets the explicit forces, with the explicit joint's checks.
+    #[default]
     SubCycled,
 }
 

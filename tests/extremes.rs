@@ -185,6 +185,30 @@ fn a_stability_limit_below_the_smallest_step_is_out_of_reach() {
     }
 }
 
+/// The same contact sub-cycled at a fixed step: no sub-step the cap allows resolves it, and
+/// every world step ends at the sub-cycle's cap. Ten such steps in a row stop the run with the
+/// contact's diagnosis (its damped stability limit, the parameter to change) instead of
+/// crawling on at the cap's cost a step.
+#[test]
+fn a_sub_cycle_at_its_cap_step_after_step_stalls_with_the_contacts_cause() {
+    let contact = r#"hinge.contact={"KelvinVoigt":{"stiffness":1e8,"damping":1e12}}"#;
+    match run(&["run.step=Fixed", "run.dt_s=1e-5", contact]) {
+        Err(e @ Error::Stalled { .. }) => {
+            let msg = e.to_string();
+            println!("{msg}");
+            for words in [
+                "10 world steps in a row at the sub-cycle's cap of 100000 sub-steps",
+                "over-damped",
+                "stable only below 4.1",
+                "`damping`",
+            ] {
+                assert!(msg.contains(words), "{words}: {msg}");
+            }
+        }
+        other => panic!("expected Stalled, got {:?}", other.map(|s| s.onsets)),
+    }
+}
+
 /// A 2 kg arm on a clearance joint (steel, 0.2 mm play) under a fixed pivot, in a plain Rapier
 /// world: the world, the joints, the arm.
 fn api_pendulum() -> (

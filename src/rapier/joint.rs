@@ -21,6 +21,7 @@ mod history;
 mod report;
 mod set;
 mod spatial;
+mod stalled;
 mod step_policy;
 mod subcycle;
 use builder::DEFAULT_VALID_STRAIN;
@@ -38,6 +39,7 @@ pub use spatial::report::{Region, SpatialPoint, SpatialReport};
 use spatial::{SpatialMemory, SpatialParts};
 use step_policy::ContactAhead;
 pub(crate) use step_policy::flight_step;
+pub(crate) use subcycle::MAX_SUBSTEPS;
 pub use subcycle::{ContactIntegration, SubCycleTechniques, SubStep};
 use subcycle::{PairStart, SubCycle};
 

@@ -3,9 +3,7 @@
 
 use super::*;
 use crate::rapier::pipeline::element_set::{ElementHandle, ElementSet};
-use crate::rapier::pipeline::protocol::{
-    BodyShare, GuardKind, GuardReport, StalledContact, Violation,
-};
+use crate::rapier::pipeline::protocol::{GuardKind, GuardReport, StalledContact, Violation};
 use crate::rapier::pipeline::step_hooks::{EvaluateContext, StepContext, StepHooks, StepPass};
 /// Handle of a joint in a [`ClearanceJointSet`], returned by its
 /// [`insert`](ClearanceJointSet::insert): generational, as Rapier's `ImpulseJointHandle`
@@ -215,7 +213,12 @@ impl ClearanceJointSet {
             } else {
                 joint.finish_cycle(bodies)
             };
-            if finished.is_none() {
+            // A re-evaluation between steps (the world's after `get_mut`, or `invalidate`
+            // without a restarted kick) of a joint sub-cycled over the last step keeps what
+            // that step left held: the impulse Rapier's velocities still lack.
+            let carried =
+                joint.sub_cycled() && !joint.cycle.explicit_before && self.last_step > 0.0;
+            if finished.is_none() && !carried {
                 // Explicit, or a sub-cycled joint's first evaluation (velocities its own).
                 joint.cycle.held = [0.0; 12];
                 joint.cycle.shift = [0.0; 12];
@@ -511,7 +514,7 @@ impl StepHooks for ClearanceJointSet {
                 };
                 limit(a).total_cmp(&limit(b))
             })
-            .map(|(h, j)| stalled_contact_of(h, j, bodies))
+            .map(|(h, j)| super::stalled::stalled_contact_of(h, j, bodies))
     }
     fn divergence_causes(&self, body: RigidBodyHandle, causes: &mut Vec<String>) {
         for (_, j) in self.iter() {
@@ -537,68 +540,5 @@ impl StepHooks for ClearanceJointSet {
             )?;
         }
         Ok(())
-    }
-}
-
-/// The numbers of `joint` (with handle `handle`) in `bodies` at its last evaluation, for a
-/// stall's diagnosis.
-fn stalled_contact_of(
-    handle: ClearanceJointHandle,
-    joint: &ClearanceJoint,
-    bodies: &RigidBodySet,
-) -> StalledContact {
-    let r = joint.report();
-    let s = &r.state;
-    let law = joint.governing_law();
-    let m = r.effective_mass;
-    let shares = [joint.body1(), joint.body2()]
-        .into_iter()
-        .filter_map(|h| {
-            let rb = bodies.get(h).filter(|rb| rb.is_dynamic())?;
-            let mp = &rb.mass_properties().local_mprops;
-            let rn = (s.contact_point - world_center_of_mass(rb)).cross(s.normal);
-            let p = mp.principal_inertia();
-            Some(BodyShare {
-                handle: h,
-                mass: mp.mass(),
-                inertia: p.x.min(p.y).min(p.z),
-                rotational_inverse_mass: rn.dot(mp.world_inv_inertia(rb.rotation()) * rn),
-            })
-        })
-        .collect();
-    let energy =
-        0.5 * m * s.penetration_rate.max(0.0).powi(2) + law.elastic_energy(s.penetration.max(0.0));
-    let reach = penetration_for_energy(law, energy, 1e-6).max(s.penetration);
-    let valid = joint.max_valid_penetration();
-    let at_valid = NormalContact {
-        penetration: valid,
-        penetration_rate: s.penetration_rate.max(0.0),
-        impact_rate: r.impact_rate.max(joint.min_impact_speed_floor()),
-    };
-    let (stable_dt_at_valid, _, _) = stable_step(
-        law.tangent_stiffness(valid),
-        law.damping_coefficient(&at_valid),
-        m,
-    );
-    StalledContact {
-        joint: joint.name().to_string(),
-        handle: Some(handle.id()),
-        law: law.kind(),
-        penetration: s.penetration,
-        rate: s.penetration_rate,
-        impact_rate: r.impact_rate,
-        min_impact_speed: joint.min_impact_speed_floor(),
-        zeta: r.zeta,
-        omega: r.omega,
-        elastic_stiffness: law.tangent_stiffness(s.penetration),
-        face: r.spatial.is_some_and(|sp| sp.governed_by_face),
-        stable_dt: r.max_stable_dt,
-        friction_dt: r.friction_stable_dt,
-        normal_force: r.force.normal_force,
-        effective_mass: m,
-        bodies: shares,
-        max_valid_penetration: valid,
-        reachable_penetration: reach,
-        stable_dt_at_valid,
     }
 }

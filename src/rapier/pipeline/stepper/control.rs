@@ -23,6 +23,11 @@ pub enum StepMode {
 /// run with [`Error::Stalled`](crate::Error::Stalled).
 pub(crate) const STALL_STEPS: u64 = 100_000;
 
+/// World steps in a row whose sub-cycle reached its cap of sub-steps that stop the run with
+/// [`Error::Stalled`](crate::Error::Stalled): each such step costs the cap's sub-steps and ends
+/// unresolved, so a contact no sub-step resolves would crawl on at seconds a world step.
+pub(crate) const CAP_STALL_STEPS: u64 = 10;
+
 /// The step control of a [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld):
 /// plain data, as Rapier's `IntegrationParameters`. Start from [`fixed`](Self::fixed) or
 /// [`adaptive`](Self::adaptive) and set the other fields with struct update syntax:

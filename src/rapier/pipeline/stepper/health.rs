@@ -1,7 +1,7 @@
 //! The step control's checks and diagnoses: the world's and bodies' state before a step, the
 //! guards after it, and the words of a divergence or a stall.
 
-use super::{GuardKind, STALL_STEPS, StepMode, Stepper, Violation};
+use super::{CAP_STALL_STEPS, GuardKind, STALL_STEPS, StepMode, Stepper, Violation};
 use crate::error::{Divergence, Error, Result};
 use crate::rapier::observers::stall::{Stall, StallCause};
 use crate::rapier::pipeline::step_hooks::{StepContext, StepHooks};
@@ -82,6 +82,38 @@ impl Stepper {
         Ok(())
     }
 
+    /// Counts world steps in a row whose sub-cycle reached its cap of sub-steps (`capped`);
+    /// [`CAP_STALL_STEPS`] of them stop the run: the contact's numbers say why no sub-step the
+    /// cap allows (`dt` over the cap, the floor the diagnosis reads) resolves it.
+    fn count_cap(
+        &mut self,
+        world: &PhysicsWorld,
+        sources: &[&mut dyn StepHooks],
+        dt: f64,
+        capped: bool,
+    ) -> Result<()> {
+        self.cap_run = if capped { self.cap_run + 1 } else { 0 };
+        if self.cap_run < CAP_STALL_STEPS {
+            return Ok(());
+        }
+        let cap = crate::rapier::joint::MAX_SUBSTEPS;
+        let floor = dt / f64::from(cap);
+        let seen = format!(
+            "{} world steps in a row at the sub-cycle's cap of {cap} sub-steps (sub-steps of {} s \
+             at most)",
+            self.cap_run,
+            crate::error::sig4(floor)
+        );
+        let contact = sources
+            .iter()
+            .filter_map(|s| s.stalled_contact(&world.bodies))
+            .min_by(|a, b| a.stable_dt.total_cmp(&b.stable_dt));
+        Err(Error::Stalled {
+            t: self.t,
+            stall: Box::new(Stall::at_contact(seen, contact, floor)),
+        })
+    }
+
     /// Non-physical bodies are errors; penetrations beyond validity are recorded.
     pub(super) fn check_health(
         &mut self,
@@ -106,9 +138,18 @@ impl Stepper {
             }
         }
         let step = self.step_context(self.t, dt);
+        let capped = |g: &crate::rapier::pipeline::protocol::GuardReport| -> u64 {
+            let sub_steps = g
+                .violations
+                .iter()
+                .filter(|v| v.kind == GuardKind::SubSteps);
+            sub_steps.map(|v| v.count).sum()
+        };
+        let capped_before = capped(&self.guards);
         for s in sources {
             s.record_guards(&step, &mut self.guards);
         }
+        self.count_cap(world, sources, dt, capped(&self.guards) > capped_before)?;
         if self.control.strict && !self.guards.is_clean() {
             return Err(Error::Guard {
                 t: self.t,

@@ -60,7 +60,7 @@ use health::{check_body_states, check_gravity, check_joint_bodies};
 use pass::{BodySnapshot, snapshot_bodies};
 use rapier3d_f64::prelude::PhysicsWorld;
 
-pub(crate) use control::STALL_STEPS;
+pub(crate) use control::{CAP_STALL_STEPS, STALL_STEPS};
 pub use control::{StepControl, StepMode};
 pub(crate) use health::left_physical_range;
 
@@ -103,6 +103,8 @@ pub(crate) struct Stepper {
     steps: u64,
     prepared: bool,
     floor_run: u64,
+    /// World steps in a row whose sub-cycle reached its cap ([`CAP_STALL_STEPS`]).
+    cap_run: u64,
     saved: Vec<BodySnapshot>,
     guards: GuardReport,
     correction: JointCorrection,
@@ -119,6 +121,7 @@ impl Stepper {
             steps: 0,
             prepared: false,
             floor_run: 0,
+            cap_run: 0,
             saved: Vec::new(),
             guards: GuardReport::default(),
             correction: JointCorrection::default(),

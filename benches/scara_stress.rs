@@ -38,6 +38,9 @@
 //! run in turn three times. `SCARA_TRACE=/tmp/arm` (every mode) writes, per arm, each tick's
 //! state of each pin (at the joint's report and from Rapier's bodies), each step's first
 //! sub-step and every impact to `/tmp/arm_<arm>_<clearance in um>_<world steps>.csv`.
+//! `SCARA_DETAIL=0.007,0.0075` (every mode) prints on stderr each world step's report of each
+//! pin inside that window (s): penetration, rates, forces, effective mass, tilt, axial offset,
+//! each region's force, and a sub-cycled pin's sub-steps.
 //!
 //! Knobs for diagnosis (environment): `SCARA_RATES=60,1000` (world rates, Hz),
 //! `SCARA_TOLERANCE` (the sub-cycled arms' tolerance, default 0.0075), `SCARA_PINS=shoulder` or
@@ -296,6 +299,7 @@ impl Arm {
             for (k, h) in self.pins.iter().enumerate() {
                 let j = self.world.clearance.get(*h).expect("inserted");
                 self.recorders[k].record_step(info.t0, info.dt, &before[k], j.substeps());
+                detail(j, k, info.t0 + info.dt);
             }
         }
         Ok(())
@@ -498,6 +502,60 @@ fn trace_tick(arm: &Arm, t: f64, out: &mut String) {
             b1.angvel().z,
             b2.angvel().z
         ));
+    }
+}
+
+/// `SCARA_DETAIL=t0,t1` (s): each world step's state of each pin inside that window, on
+/// stderr: penetration (um) and its rate, the law's rates, forces, effective mass, tilt, axial
+/// offset and each region's force; a sub-cycled joint's sub-steps too.
+fn detail(j: &ClearanceJoint, k: usize, t: f64) {
+    let Some(w) = std::env::var("SCARA_DETAIL").ok() else {
+        return;
+    };
+    let b: Vec<f64> = w.split(',').filter_map(|x| x.parse().ok()).collect();
+    if b.len() != 2 || t < b[0] || t > b[1] {
+        return;
+    }
+    let r = j.report();
+    let s = &r.state;
+    let sp = r.spatial.unwrap_or_default();
+    eprintln!(
+        "D {t:.7} {k} pen {:.4} rate {:.5} crate {:.5} irate {:.5} FN {:.2} Ff {:.2} m {:.4} tilt {:.3e} {:.3e} ax {:.3e} edge {:.2} {:.2} len {:.3e} {:.3e} face {:.2} {:.2} n {:.4} {:.4} {:.4} pt {:.5} {:.5} {:.5}",
+        s.penetration * 1e6,
+        s.penetration_rate,
+        r.contact_rate,
+        r.impact_rate,
+        r.force.normal_force,
+        r.force.friction_force,
+        r.effective_mass,
+        sp.tilt[0],
+        sp.tilt[1],
+        sp.axial_offset,
+        sp.edge_force[0],
+        sp.edge_force[1],
+        sp.edge_length[0],
+        sp.edge_length[1],
+        sp.face_force[0],
+        sp.face_force[1],
+        s.normal.x,
+        s.normal.y,
+        s.normal.z,
+        s.contact_point.x,
+        s.contact_point.y,
+        s.contact_point.z,
+    );
+    for q in j.substeps() {
+        eprintln!(
+            "S {:.7} {k} pen {:.4} rate {:.5} FN {:.2} Ff {:.2} F {:.2} {:.2} {:.2}",
+            t - j.substeps().last().map_or(0.0, |l| l.t) + q.t,
+            q.state.penetration * 1e6,
+            q.state.penetration_rate,
+            q.force.normal_force,
+            q.force.friction_force,
+            q.force.on_journal.x,
+            q.force.on_journal.y,
+            q.force.on_journal.z
+        );
     }
 }
 

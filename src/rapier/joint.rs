@@ -158,6 +158,11 @@ struct CycleState {
     /// A spatial joint's regions' impact clocks at the sub-cycle's end, for the evaluation at
     /// the step's end (Rapier's pass 1 starts from the regions as pass 0 found them).
     spatial_impacts: [Option<f64>; 4],
+    /// A spatial joint's regions' contact histories, deepest states and impact rates at the
+    /// sub-cycle's end, for the same evaluation: restored with the rest of the joint before
+    /// pass 1, the regions would otherwise meet their contacts again at the step's end and read
+    /// `delta_dot0` across the whole step, not at the sub-step that crossed.
+    spatial_regions: Option<[(ContactHistory, Option<JournalState>, f64); 4]>,
     /// Whether the joint was explicit at its last evaluation (its force then held over the
     /// step after it; [`ClearanceJoint::set_integration`]).
     explicit_before: bool,

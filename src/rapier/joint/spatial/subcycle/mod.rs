@@ -374,6 +374,7 @@ fn plan_group(
     for ((a, &i), ((mut parts, clocks), run)) in group.iter().enumerate().zip(rest) {
         let joint = &mut *joints[i];
         joint.cycle.spatial_impacts = clocks.map(|c| c.impact);
+        joint.cycle.spatial_regions = Some(clocks.map(|c| (c.history, c.state, c.impact_rate)));
         for (patch, clock) in parts.patches.iter_mut().zip(clocks) {
             patch.contact = clock.history;
             patch.state = clock.state;
@@ -425,6 +426,13 @@ impl ClearanceJoint {
         let pose = self.spatial_pose(rb1, rb2, transverse);
         self.contact = self.cycle.run.history;
         self.report.state = end.state;
+        // The regions go on from the sub-cycle's end (Rapier's pass 1 restored them as pass 0
+        // found them).
+        if let Some(ends) = self.cycle.spatial_regions.take() {
+            for (patch, (contact, state, rate)) in parts.patches.iter_mut().zip(ends) {
+                (patch.contact, patch.state, patch.impact_rate) = (contact, state, rate);
+            }
+        }
         let result = self.evaluate_regions(&mut parts, &pose, [&m1, &m2], &pair, [0.0, 0.0]);
         // The regions' impact clocks go on from the sub-cycle's end into the next step.
         for (patch, impact) in parts.patches.iter_mut().zip(self.cycle.spatial_impacts) {

@@ -386,16 +386,7 @@ pub(super) fn plan_group(
             d
         })
         .collect();
-    // The state's velocity beyond the Verlet reading of Rapier's velocities around it,
-    // `u_before + w (u_after - u_before)`, `w = h_prev/(h_prev + h)`: `P (H - w Q kick)`.
-    let w = (2.0 * kick - h) / (2.0 * kick);
-    let beyond: Vec<Pair12> = (0..group.len())
-        .map(|a| {
-            let mut b = held[a];
-            axpy(&mut b, -w, &deliver[a]);
-            b
-        })
-        .collect();
+    let beyond = beyond_verlet(&held, &deliver, kick, h);
     for (a, run) in runs.iter_mut().enumerate() {
         let own = starts[a].moved_by(&beyond[a]);
         run.start_correction = attributed(a, &members, own, &cross, &beyond);
@@ -409,6 +400,22 @@ pub(super) fn plan_group(
         joint.cycle.pending = Some(left);
         deliveries[i] = deliver[a].iter().any(|q| *q != 0.0).then_some(deliver[a]);
     }
+}
+
+/// Each member's impulse beyond the Verlet reading of Rapier's velocities around the state,
+/// `u_before + w (u_after - u_before)`, `w = h_prev/(h_prev + h)`: `H - w Q kick`, from the
+/// impulses `held` at the step's start and the deliveries `deliver` over a step `h` whose
+/// kick is `kick` (the state's velocity is this moved through the pair's mobility).
+pub(crate) fn beyond_verlet(held: &[Pair12], deliver: &[Pair12], kick: f64, h: f64) -> Vec<Pair12> {
+    let w = (2.0 * kick - h) / (2.0 * kick);
+    held.iter()
+        .zip(deliver)
+        .map(|(held, deliver)| {
+            let mut b = *held;
+            axpy(&mut b, -w, deliver);
+            b
+        })
+        .collect()
 }
 
 /// Member `a`'s share of the velocity correction its pair's bodies have from the impulses

@@ -39,8 +39,8 @@
 //! speed.
 
 use super::super::subcycle::{
-    MAX_SUBSTEPS, Pair12, PairStart, SubCycle, SubStep, attributed, axpy, dot, islands, load, mul,
-    part, put, rotate,
+    MAX_SUBSTEPS, Pair12, PairStart, SubCycle, SubStep, attributed, axpy, beyond_verlet, dot,
+    islands, load, mul, part, put, rotate,
 };
 use super::super::{ClearanceJoint, ContactHistory, Mechanism, motion};
 use super::{Mobility, Pair, Places, SpatialParts, Totals, load_region};
@@ -358,14 +358,7 @@ fn plan_group(
         .collect();
     // The state's velocity beyond the Verlet reading of Rapier's velocities around it (as
     // the planar sub-cycle's), each impulse's share of a shared body in one member's.
-    let w = (2.0 * kick - h) / (2.0 * kick);
-    let beyond: Vec<Pair12> = (0..group.len())
-        .map(|a| {
-            let mut b = held[a];
-            axpy(&mut b, -w, &deliver[a]);
-            b
-        })
-        .collect();
+    let beyond = beyond_verlet(&held, &deliver, kick, h);
     for (a, run) in runs.iter_mut().enumerate() {
         let own = mul(&starts[a].mobility, &beyond[a]);
         run.start_correction = attributed(a, &members, own, &cross, &beyond);

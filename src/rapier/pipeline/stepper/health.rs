@@ -84,7 +84,7 @@ impl Stepper {
 
     /// Counts world steps in a row whose sub-cycle reached its cap of sub-steps (`capped`);
     /// [`CAP_STALL_STEPS`] of them stop the run: the contact's numbers say why no sub-step the
-    /// cap allows (`dt` over the cap, the floor the diagnosis reads) resolves it.
+    /// cap allows (`dt` over the cap) resolves it.
     fn count_cap(
         &mut self,
         world: &PhysicsWorld,
@@ -110,7 +110,7 @@ impl Stepper {
             .min_by(|a, b| a.stable_dt.total_cmp(&b.stable_dt));
         Err(Error::Stalled {
             t: self.t,
-            stall: Box::new(Stall::at_contact(seen, contact, floor)),
+            stall: Box::new(Stall::at_contact(seen, contact, self.control.min_dt)),
         })
     }
 

@@ -280,16 +280,7 @@ pub(super) fn plan_group(
         .collect();
     let mut held: Vec<Pair12> = members.iter().map(|j| j.cycle.held).collect();
     let mut shift: Vec<Pair12> = members.iter().map(|j| j.cycle.shift).collect();
-    let cross: Vec<Vec<(usize, [f64; 144])>> = members
-        .iter()
-        .enumerate()
-        .map(|(a, j)| {
-            let others = members.iter().enumerate().filter(|(b, _)| *b != a);
-            others
-                .filter_map(|(b, other)| j.coupling_to(other).map(|p| (b, p)))
-                .collect()
-        })
-        .collect();
+    let cross = cross_mobilities(&members);
     // The velocity change of each pair from impulses on every pair of the group.
     let moved = |a: usize, impulses: &[Pair12]| {
         let mut v = starts[a].moved_by(&impulses[a]);
@@ -400,6 +391,21 @@ pub(super) fn plan_group(
         joint.cycle.pending = Some(left);
         deliveries[i] = deliver[a].iter().any(|q| *q != 0.0).then_some(deliver[a]);
     }
+}
+
+/// For each member of a group, the other members whose pairs move its pair: `(b, P_ab)`, how
+/// member `b`'s impulse moves member `a`'s pair (`ClearanceJoint::coupling_to`).
+pub(crate) fn cross_mobilities(members: &[&ClearanceJoint]) -> Vec<Vec<(usize, [f64; 144])>> {
+    members
+        .iter()
+        .enumerate()
+        .map(|(a, j)| {
+            let others = members.iter().enumerate().filter(|(b, _)| *b != a);
+            others
+                .filter_map(|(b, other)| j.coupling_to(other).map(|p| (b, p)))
+                .collect()
+        })
+        .collect()
 }
 
 /// Each member's impulse beyond the Verlet reading of Rapier's velocities around the state,

@@ -56,7 +56,7 @@ mod techniques;
 #[cfg(test)]
 mod tests;
 
-pub(crate) use group::{attributed, beyond_verlet, islands, plan_cycles};
+pub(crate) use group::{attributed, beyond_verlet, cross_mobilities, islands, plan_cycles};
 pub(crate) use pair::PairStart;
 pub(crate) use pair::{Pair12, axpy, dot, load, mul, part, put, rotate};
 pub(crate) use steps::SubCycle;

@@ -39,8 +39,8 @@
 //! speed.
 
 use super::super::subcycle::{
-    MAX_SUBSTEPS, Pair12, PairStart, SubCycle, SubStep, attributed, axpy, beyond_verlet, dot,
-    islands, load, mul, part, put, rotate,
+    MAX_SUBSTEPS, Pair12, PairStart, SubCycle, SubStep, attributed, axpy, beyond_verlet,
+    cross_mobilities, dot, islands, load, mul, part, put, rotate,
 };
 use super::super::{ClearanceJoint, ContactHistory, Mechanism, motion};
 use super::{Mobility, Pair, Places, SpatialParts, Totals, load_region};
@@ -302,16 +302,7 @@ fn plan_group(
         .iter()
         .map(|j| j.cycle.spatial_start.expect("a planned joint has a start"))
         .collect();
-    let cross: Vec<Vec<(usize, Square)>> = members
-        .iter()
-        .enumerate()
-        .map(|(a, j)| {
-            let others = members.iter().enumerate().filter(|(b, _)| *b != a);
-            others
-                .filter_map(|(b, other)| j.coupling_to(other).map(|p| (b, p)))
-                .collect()
-        })
-        .collect();
+    let cross: Vec<Vec<(usize, Square)>> = cross_mobilities(&members);
     // The impulses held from the step before, each moving every pair it reaches.
     let held: Vec<Pair12> = members.iter().map(|j| j.cycle.held).collect();
     let moved = |a: usize, impulses: &[Pair12]| {

@@ -1,7 +1,7 @@
 //! `ClearanceWorld`: the one world type. Its step runs every set's hooks (the large-step joints'
 //! included, which a bare `world.step()` loop can forget), it steps to the bit the same whether a
 //! set is filled through its methods or its public field, and it notices a compliant joint added
-//! through that field.
+//! through that field, and a body moved or given a velocity by hand between steps.
 
 use clearance_joint::model::laws::BearingGeometry;
 use clearance_joint::prelude::*;
@@ -139,6 +139,68 @@ fn a_joint_added_through_the_field_is_noticed() {
         .unwrap();
     let e = world.step(2e-4).unwrap_err().to_string();
     assert!(e.contains("num_solver_iterations"), "{e}");
+}
+
+/// The arm on `pin` stepped to 0.02 s, then edited by `edit` between steps, told with `told`
+/// (or not), then stepped to 0.05 s: the arm's final state and the steps taken.
+fn edited_run(
+    pin: ClearanceJoint,
+    edit: fn(&mut RigidBody),
+    told: Option<bool>,
+) -> (Vector, Vector, Vector, u64) {
+    let (rapier, base, arm) = arm_world(1);
+    let mut world = ClearanceWorld::new(rapier, StepControl::adaptive(1e-3, 0.0075));
+    world.insert_clearance(base, arm, pin).unwrap();
+    world.step_to(0.02).unwrap();
+    edit(&mut world.rapier.bodies[arm]);
+    if let Some(restart_kick) = told {
+        world.invalidate(restart_kick);
+    }
+    world.step_to(0.05).unwrap();
+    let rb = &world.rapier.bodies[arm];
+    (rb.translation(), rb.linvel(), rb.angvel(), world.steps())
+}
+
+/// A velocity set by hand between steps is noticed: the run is the one told with
+/// `invalidate(true)`, to the bit, for the explicit and the sub-cycled joint, and so is the run
+/// told only `invalidate(false)` (the edit asks for the kick's restart).
+#[test]
+fn a_velocity_set_by_hand_is_noticed() {
+    let kick = |rb: &mut RigidBody| {
+        let v = rb.linvel() + Vector::new(0.0, 0.05, 0.0);
+        rb.set_linvel(v, true);
+    };
+    for pin in [compliant_pin, explicit_pin] {
+        let told = edited_run(pin(), kick, Some(true));
+        assert_eq!(edited_run(pin(), kick, None), told);
+        assert_eq!(edited_run(pin(), kick, Some(false)), told);
+    }
+}
+
+/// A body moved by hand between steps is noticed: the run is the one told with
+/// `invalidate(false)`, to the bit; a velocity left as it was is no edit (the run with
+/// `set_linvel` to the same velocity is the run without it).
+#[test]
+fn a_body_moved_by_hand_is_noticed() {
+    let nudge = |rb: &mut RigidBody| {
+        let p = rb.translation() + Vector::new(0.0, 2e-5, 0.0);
+        rb.set_translation(p, true);
+    };
+    let same = |rb: &mut RigidBody| {
+        let v = rb.linvel();
+        rb.set_linvel(v, true);
+    };
+    let nothing = |_: &mut RigidBody| {};
+    for pin in [compliant_pin, explicit_pin] {
+        assert_eq!(
+            edited_run(pin(), nudge, None),
+            edited_run(pin(), nudge, Some(false))
+        );
+        assert_eq!(
+            edited_run(pin(), same, None),
+            edited_run(pin(), nothing, None)
+        );
+    }
 }
 
 /// The reaction solve knows the large-step joints through their constraint forces: a link hanging

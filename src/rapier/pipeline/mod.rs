@@ -9,6 +9,7 @@
 //! - [`element_set`]: the generic set of force elements behind typed generational handles.
 
 pub(crate) mod arena;
+pub(crate) mod body_edits;
 pub mod element_set;
 pub(crate) mod joint_correction;
 pub(crate) mod ledger;

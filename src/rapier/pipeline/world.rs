@@ -51,6 +51,7 @@ use crate::error::Result;
 use crate::rapier::joint::{ClearanceJoint, ClearanceJointHandle, ClearanceJointSet};
 use crate::rapier::large_step::{LargeStepJoint, LargeStepJointHandle, LargeStepJointSet};
 use crate::rapier::observers::reaction::{IdealJoint, KinematicState, ReactionSolver};
+use crate::rapier::pipeline::body_edits::{BodyEdit, BodyEdits};
 use crate::rapier::pipeline::protocol::Wrench;
 use crate::rapier::pipeline::step_hooks::StepHooks;
 use crate::rapier::pipeline::stepper::{GuardReport, StepControl, StepInfo, Stepper};
@@ -66,8 +67,12 @@ use rapier3d_f64::prelude::{PhysicsWorld, RigidBodyHandle};
 /// control when forces must be evaluated again), drives with the drive set's own
 /// [`insert`](DriveSet::insert) and [`remove`](DriveSet::remove) (they have no Rapier part). A
 /// compliant joint or a drive added, removed or edited through the fields is noticed at the
-/// next step (by the sets' revisions, [`ElementSet::revision`](crate::rapier::pipeline::element_set::ElementSet::revision));
-/// after moving bodies or setting velocities by hand between steps, call
+/// next step (by the sets' revisions, [`ElementSet::revision`](crate::rapier::pipeline::element_set::ElementSet::revision)),
+/// and so is a dynamic body moved or given a velocity by hand between steps (its pose and
+/// velocities against those the last step left: the joints are evaluated at the new state, and
+/// after a velocity set by hand the kick restarts as after
+/// [`invalidate(true)`](Self::invalidate)). After an edit the world cannot see (your own
+/// participant's state, Rapier's joints or mass properties), call
 /// [`invalidate`](Self::invalidate).
 ///
 /// Force sources of your own take part in the steps through
@@ -94,6 +99,9 @@ pub struct ClearanceWorld {
     revisions: Option<[u64; 2]>,
     /// Scratch: the sources' wrenches for a reaction solve.
     wrenches: Vec<Wrench>,
+    /// The dynamic bodies as the last step left them: a pose or a velocity set by hand between
+    /// steps is noticed at the next.
+    edits: BodyEdits,
 }
 
 impl ClearanceWorld {
@@ -110,6 +118,7 @@ impl ClearanceWorld {
             stepper: Stepper::new(control),
             revisions: None,
             wrenches: Vec::new(),
+            edits: BodyEdits::default(),
         }
     }
 
@@ -222,7 +231,9 @@ impl ClearanceWorld {
         }
         self.follow_changes();
         let (stepper, physics, mut hooks) = self.parts(user);
-        stepper.step(physics, &mut hooks, until)
+        let result = stepper.step(physics, &mut hooks, until);
+        self.edits.record(&self.rapier.bodies);
+        result
     }
 
     /// Steps until the clock reaches `until` (s, finite; at or before the current time nothing is
@@ -259,7 +270,9 @@ impl ClearanceWorld {
     pub fn prepare_with(&mut self, user: &mut dyn StepHooks) -> Result<()> {
         self.follow_changes();
         let (stepper, physics, mut hooks) = self.parts(user);
-        stepper.prepare(physics, &mut hooks)
+        let result = stepper.prepare(physics, &mut hooks);
+        self.edits.record(&self.rapier.bodies);
+        result
     }
 
     /// Takes a step of the last step's size (or `dt` before the first: > 0 and at most the
@@ -284,13 +297,16 @@ impl ClearanceWorld {
     ) -> Result<R> {
         self.follow_changes();
         let (stepper, physics, mut hooks) = self.parts(user);
-        stepper.peek(physics, &mut hooks, dt, read)
+        let result = stepper.peek(physics, &mut hooks, dt, read);
+        self.edits.record(&self.rapier.bodies);
+        result
     }
 
     /// Forgets the evaluation of the joints and drives, after you changed the world between
-    /// steps by hand (bodies moved, sets edited through their fields): the next step evaluates
+    /// steps in a way it does not notice by itself (your own participant's state, Rapier's joints
+    /// or mass properties; a body moved or given a velocity is noticed): the next step evaluates
     /// them again first. With `restart_kick` the next step's kick is a first step's again, as from
-    /// a new initial state (after setting velocities by hand), and the clearance joints' contact laws
+    /// a new initial state (as after setting velocities by hand), and the clearance joints' contact laws
     /// get the stored rate at that evaluation. Without it they carry the rate to the state with
     /// its change since their last evaluation, across your edit: off by at most half that
     /// change, once
@@ -413,6 +429,11 @@ impl ClearanceWorld {
     /// (the joints' reports would lose the onset they flagged), and the other sets carry no
     /// forces to evaluate.
     fn follow_changes(&mut self) {
+        match self.edits.since(&self.rapier.bodies) {
+            BodyEdit::None => {}
+            BodyEdit::Moved => self.stepper.invalidate(false),
+            BodyEdit::Velocity => self.stepper.invalidate(true),
+        }
         let revisions = [self.clearance.revision(), self.drives.revision()];
         if self.revisions != Some(revisions) {
             if self.revisions.is_some() {

@@ -120,6 +120,15 @@ pub trait StepHooks {
         None
     }
 
+    /// The shortest damped stability limit of this participant's sub-cycled contacts at the
+    /// state, s; infinite when none is in contact. Sub-steps resolve such a contact, but they
+    /// follow that limit: the adaptive step control stops a run whose contact stays stable only
+    /// below its floor `min_dt`, as it stops an explicit one. This crate's compliant joint set
+    /// reports its sub-cycled joints; a participant of your own keeps the default: none.
+    fn sub_cycled_limit(&self) -> f64 {
+        f64::INFINITY
+    }
+
     /// Names (in words) this participant's joints that join `body`, for a divergence's message.
     /// Default: none.
     fn joints_of(&self, _body: RigidBodyHandle, _names: &mut Vec<String>) {}

@@ -1,7 +1,9 @@
 //! The step control's checks and diagnoses: the world's and bodies' state before a step, the
 //! guards after it, and the words of a divergence or a stall.
 
-use super::{CAP_STALL_STEPS, GuardKind, STALL_STEPS, StepMode, Stepper, Violation};
+use super::{
+    CAP_STALL_STEPS, GuardKind, LIMIT_STALL_STEPS, STALL_STEPS, StepMode, Stepper, Violation,
+};
 use crate::error::{Divergence, Error, Result};
 use crate::rapier::observers::stall::{Stall, StallCause};
 use crate::rapier::pipeline::step_hooks::{StepContext, StepHooks};
@@ -80,6 +82,50 @@ impl Stepper {
             self.floor_run = 0;
         }
         Ok(())
+    }
+
+    /// Counts adaptive world steps that end in a sub-cycled contact stable only below the floor
+    /// `min_dt` (a step ending in a sub-cycled contact above it starts the count again; one out
+    /// of contact leaves it, as a contact that sticks to its wall chatters in and out);
+    /// [`LIMIT_STALL_STEPS`] of them stop the run, as the explicit joint's rejections stop it at
+    /// the first: the sub-steps follow that limit, and the world's step would sit at the floor.
+    pub(super) fn count_limit(
+        &mut self,
+        world: &PhysicsWorld,
+        sources: &[&mut dyn StepHooks],
+    ) -> Result<()> {
+        if self.control.mode != StepMode::Adaptive {
+            return Ok(());
+        }
+        let limit = sources
+            .iter()
+            .map(|s| s.sub_cycled_limit())
+            .fold(f64::INFINITY, f64::min);
+        if limit >= self.control.min_dt {
+            if limit.is_finite() {
+                self.limit_run = 0;
+            }
+            return Ok(());
+        }
+        self.limit_run += 1;
+        if self.limit_run < LIMIT_STALL_STEPS {
+            return Ok(());
+        }
+        let seen = format!(
+            "{} world steps ended in a sub-cycled contact stable only below {} s, under the \
+             floor: its sub-steps resolve it but follow that limit, so the world's step sits at \
+             the floor and the run crawls",
+            self.limit_run,
+            crate::error::sig4(limit)
+        );
+        let contact = sources
+            .iter()
+            .filter_map(|s| s.stalled_contact(&world.bodies))
+            .min_by(|a, b| a.stable_dt.total_cmp(&b.stable_dt));
+        Err(Error::Stalled {
+            t: self.t,
+            stall: Box::new(Stall::at_contact(seen, contact, self.control.min_dt)),
+        })
     }
 
     /// Counts world steps in a row whose sub-cycle reached its cap of sub-steps (`capped`);

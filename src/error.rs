@@ -54,7 +54,7 @@ pub enum Error {
     },
     /// The step control could not make progress: every step it tried was rejected, it stayed
     /// at its floor without advancing the simulated time, a sub-cycle stayed at its cap of
-    /// sub-steps, or a sub-cycled contact was stable only below the floor.
+    /// sub-steps, or a sub-cycled contact asked for steps below the floor.
     #[error("the step control stalled at t = {t:.6} s: {stall}")]
     Stalled {
         /// Simulated time when detected.

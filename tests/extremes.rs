@@ -210,9 +210,10 @@ fn a_sub_cycle_at_its_cap_step_after_step_stalls_with_the_contacts_cause() {
 }
 
 /// The same contact sub-cycled at the default adaptive steps: the sub-steps resolve it but
-/// follow its damped limit (4.1e-12 s), so the world's step sits at the floor (1e-10 s) and the
-/// run would crawl. Ten world steps ending in it stop the run at its first contact, as the
-/// explicit joint stops at it, with the same diagnosis.
+/// follow its damped limit (4.1e-12 s), so it asks for world steps (ten sub-steps) below the
+/// floor (1e-10 s), the world's step sits there and the run would crawl. Ten world steps ending
+/// in it stop the run at its first contact, as the explicit joint stops at it, with the same
+/// diagnosis.
 #[test]
 fn a_sub_cycled_contact_stable_only_below_the_floor_stalls_at_its_first_contact() {
     // The first contact of the default law: the free flight before it is the same.
@@ -231,8 +232,9 @@ fn a_sub_cycled_contact_stable_only_below_the_floor_stalls_at_its_first_contact(
             let msg = e.to_string();
             println!("first contact at {first} s, stalled at {t} s: {msg}");
             for words in [
-                "10 world steps ended in a sub-cycled contact stable only below 4.1",
+                "10 world steps ended in a sub-cycled contact that asks for world steps of 3.1",
                 "under the floor",
+                "stable only below 4.1",
                 "joint `hinge`",
                 "over-damped",
                 "`damping`",

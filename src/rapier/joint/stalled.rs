@@ -38,7 +38,20 @@ pub(super) fn stalled_contact_of(
         penetration_rate: s.penetration_rate.max(0.0),
         impact_rate: r.impact_rate.max(joint.min_impact_speed_floor()),
     };
-    let stable_dt = joint.damped_limit();
+    // A sub-cycled joint has no step limit of its own (its report's is infinite): the message
+    // reads the contact's damped stability limit here, the scale its sub-steps follow.
+    let here = NormalContact {
+        penetration: s.penetration.max(0.0),
+        penetration_rate: s.penetration_rate,
+        impact_rate: r.impact_rate.max(joint.min_impact_speed_floor()),
+    };
+    let stable_dt = match r.max_stable_dt.is_finite() {
+        true => r.max_stable_dt,
+        false => {
+            let k = law.tangent_stiffness(here.penetration);
+            stable_step(k, law.damping_coefficient(&here), m).0
+        }
+    };
     let (stable_dt_at_valid, _, _) = stable_step(
         law.tangent_stiffness(valid),
         law.damping_coefficient(&at_valid),
@@ -64,34 +77,5 @@ pub(super) fn stalled_contact_of(
         max_valid_penetration: valid,
         reachable_penetration: reach,
         stable_dt_at_valid,
-    }
-}
-
-impl ClearanceJoint {
-    /// The contact's damped stability limit at the last evaluation, s: the report's for an
-    /// explicit joint; a sub-cycled joint has no step limit of its own (its report's is
-    /// infinite), so it is read from the governing law at the state, the scale its sub-steps
-    /// follow.
-    fn damped_limit(&self) -> f64 {
-        let r = self.report();
-        if r.max_stable_dt.is_finite() {
-            return r.max_stable_dt;
-        }
-        let s = &r.state;
-        let law = self.governing_law();
-        let here = NormalContact {
-            penetration: s.penetration.max(0.0),
-            penetration_rate: s.penetration_rate,
-            impact_rate: r.impact_rate.max(self.min_impact_speed_floor()),
-        };
-        let k = law.tangent_stiffness(here.penetration);
-        stable_step(k, law.damping_coefficient(&here), r.effective_mass).0
-    }
-
-    /// A sub-cycled joint in contact: its contact's damped stability limit, s, for the adaptive
-    /// step control's check against its floor (`None` for an explicit joint, whose steps the
-    /// control rejects down to that limit, and out of contact).
-    pub(crate) fn sub_cycled_limit(&self) -> Option<f64> {
-        (self.sub_cycled() && self.report().state.penetration > 0.0).then(|| self.damped_limit())
     }
 }

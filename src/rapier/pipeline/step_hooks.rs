@@ -120,12 +120,13 @@ pub trait StepHooks {
         None
     }
 
-    /// The shortest damped stability limit of this participant's sub-cycled contacts at the
-    /// state, s; infinite when none is in contact. Sub-steps resolve such a contact, but they
-    /// follow that limit: the adaptive step control stops a run whose contact stays stable only
-    /// below its floor `min_dt`, as it stops an explicit one. This crate's compliant joint set
-    /// reports its sub-cycled joints; a participant of your own keeps the default: none.
-    fn sub_cycled_limit(&self) -> f64 {
+    /// The shortest world step this participant's sub-cycled contacts ask for at the state
+    /// (`step.tolerance`, `step.last_dt` the step just taken), s; infinite when none does. Below
+    /// the floor `min_dt` the world's step sits at the floor while the contact lasts, and the
+    /// adaptive step control stops such a run, as its retries stop an explicit contact below
+    /// the floor. This crate's compliant joint set reports its planar sub-cycled joints in
+    /// contact; a participant of your own keeps the default: none.
+    fn sub_cycled_contact_step(&self, _step: &StepContext) -> f64 {
         f64::INFINITY
     }
 

@@ -2,7 +2,8 @@
 //! guards after it, and the words of a divergence or a stall.
 
 use super::{
-    CAP_STALL_STEPS, GuardKind, LIMIT_STALL_STEPS, STALL_STEPS, StepMode, Stepper, Violation,
+    CAP_STALL_STEPS, CONTACT_FLOOR_STALL_STEPS, GuardKind, STALL_STEPS, StepMode, Stepper,
+    Violation,
 };
 use crate::error::{Divergence, Error, Result};
 use crate::rapier::observers::stall::{Stall, StallCause};
@@ -84,12 +85,12 @@ impl Stepper {
         Ok(())
     }
 
-    /// Counts adaptive world steps that end in a sub-cycled contact stable only below the floor
-    /// `min_dt` (a step ending in a sub-cycled contact above it starts the count again; one out
-    /// of contact leaves it, as a contact that sticks to its wall chatters in and out);
-    /// [`LIMIT_STALL_STEPS`] of them stop the run, as the explicit joint's rejections stop it at
-    /// the first: the sub-steps follow that limit, and the world's step would sit at the floor.
-    pub(super) fn count_limit(
+    /// Counts adaptive world steps that end in a sub-cycled contact asking for world steps below
+    /// the floor `min_dt` (a step ending in one that asks for more starts the count again; one
+    /// out of contact leaves it, as a journal held on its wall chatters in and out);
+    /// [`CONTACT_FLOOR_STALL_STEPS`] of them stop the run, as the explicit joint's retries stop
+    /// at such a contact at once: the world's step sits at the floor while it lasts.
+    pub(super) fn count_contact_floor(
         &mut self,
         world: &PhysicsWorld,
         sources: &[&mut dyn StepHooks],
@@ -97,26 +98,27 @@ impl Stepper {
         if self.control.mode != StepMode::Adaptive {
             return Ok(());
         }
-        let limit = sources
+        let step = self.step_context(self.t, 0.0);
+        let asked = sources
             .iter()
-            .map(|s| s.sub_cycled_limit())
+            .map(|s| s.sub_cycled_contact_step(&step))
             .fold(f64::INFINITY, f64::min);
-        if limit >= self.control.min_dt {
-            if limit.is_finite() {
-                self.limit_run = 0;
+        if asked >= self.control.min_dt {
+            if asked.is_finite() {
+                self.contact_floor_run = 0;
             }
             return Ok(());
         }
-        self.limit_run += 1;
-        if self.limit_run < LIMIT_STALL_STEPS {
+        self.contact_floor_run += 1;
+        if self.contact_floor_run < CONTACT_FLOOR_STALL_STEPS {
             return Ok(());
         }
         let seen = format!(
-            "{} world steps ended in a sub-cycled contact stable only below {} s, under the \
-             floor: its sub-steps resolve it but follow that limit, so the world's step sits at \
-             the floor and the run crawls",
-            self.limit_run,
-            crate::error::sig4(limit)
+            "{} world steps ended in a sub-cycled contact that asks for world steps of {} s, \
+             under the floor: its sub-steps resolve it, but the world's step sits at the floor \
+             and the run crawls",
+            self.contact_floor_run,
+            crate::error::sig4(asked)
         );
         let contact = sources
             .iter()

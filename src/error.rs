@@ -52,8 +52,9 @@ pub enum Error {
         /// What diverged (in words through its `Display`).
         what: Box<Divergence>,
     },
-    /// The step control could not make progress: every step it tried was rejected, or it stayed
-    /// at its floor without advancing the simulated time.
+    /// The step control could not make progress: every step it tried was rejected, it stayed
+    /// at its floor without advancing the simulated time, a sub-cycle stayed at its cap of
+    /// sub-steps, or a sub-cycled contact asked for steps below the floor.
     #[error("the step control stalled at t = {t:.6} s: {stall}")]
     Stalled {
         /// Simulated time when detected.

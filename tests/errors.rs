@@ -606,6 +606,26 @@ fn a_spatial_model_without_its_settings_says_how_it_is_written() {
     );
 }
 
+/// The same face sub-cycled (the default) runs to its end: a spatial joint's sub-steps
+/// integrate the damping implicitly under error control, and its world step follows the
+/// regions' paths, not the contact, so the stall guard on a sub-cycled contact that asks for
+/// world steps below the floor leaves it alone (the face is stable only below 4.2e-11 s).
+#[test]
+fn a_face_restitution_that_stalls_the_explicit_joint_runs_sub_cycled() {
+    let face = r#"hinge.model={"Spatial":{"geometry":{"axial_play":3e-4,"collar_radius":0.010},"face":{"stiffness":3e9,"restitution":1e-6}}}"#;
+    let scene = Scene::load(std::path::Path::new("assets/door_hinge.ron"))
+        .unwrap()
+        .with_overrides(&["run.end_s=0.02", face])
+        .unwrap();
+    let r = run_scene(&scene).unwrap();
+    let s = r.summary();
+    assert!(
+        s.complete && s.twins["clearance"].onsets > 0,
+        "{:?}",
+        s.error
+    );
+}
+
 /// A stall that the turn bound causes (a body spinning so fast that `tolerance/8` rad a step needs
 /// steps at the floor) says so and names `tolerance`, not "a body moved by hand".
 #[test]

@@ -209,6 +209,48 @@ fn a_sub_cycle_at_its_cap_step_after_step_stalls_with_the_contacts_cause() {
     }
 }
 
+/// The same contact sub-cycled at the default adaptive steps: the sub-steps resolve it but
+/// follow its damped limit (4.1e-12 s), so it asks for world steps (ten sub-steps) below the
+/// floor (1e-10 s), the world's step sits there and the run would crawl. Ten world steps ending
+/// in it stop the run at its first contact, as the explicit joint stops at it, with the same
+/// diagnosis.
+#[test]
+fn a_sub_cycled_contact_stable_only_below_the_floor_stalls_at_its_first_contact() {
+    // The first contact of the default law: the free flight before it is the same.
+    let first = run(&["run.end_s=0.1"])
+        .unwrap()
+        .first_impact_t_s
+        .expect("a contact before 0.1 s");
+    let contact = r#"hinge.contact={"KelvinVoigt":{"stiffness":1e8,"damping":1e12}}"#;
+    // An end 20 us after the contact: a run that crawled would reach it (in tens of seconds).
+    let end = format!("run.end_s={}", first + 2e-5);
+    match run(&[contact, &end]) {
+        Err(e @ Error::Stalled { .. }) => {
+            let Error::Stalled { t, .. } = &e else {
+                unreachable!()
+            };
+            let msg = e.to_string();
+            println!("first contact at {first} s, stalled at {t} s: {msg}");
+            for words in [
+                "10 world steps ended in a sub-cycled contact that asks for world steps of 3.1",
+                "under the floor",
+                "stable only below 4.1",
+                "joint `hinge`",
+                "over-damped",
+                "`damping`",
+            ] {
+                assert!(msg.contains(words), "{words}: {msg}");
+            }
+            // Ten world steps at the floor after the first contact, not a crawl through it.
+            assert!(
+                *t >= first - 1e-9 && *t - first < 1e-8,
+                "stalled at {t} s, first contact at {first} s"
+            );
+        }
+        other => panic!("expected Stalled, got {:?}", other.map(|s| s.onsets)),
+    }
+}
+
 /// A 2 kg arm on a clearance joint (steel, 0.2 mm play) under a fixed pivot, in a plain Rapier
 /// world: the world, the joints, the arm.
 fn api_pendulum() -> (

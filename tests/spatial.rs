@@ -248,25 +248,39 @@ fn free_floating_pair_conserves_momentum() {
     assert!(dl < 1e-12 * l0.length(), "angular momentum drifted by {dl}");
 }
 
-/// The journal knocks a face axially (aligned, centred, no gravity, bearing fixed): its
-/// restitution is the face law's for the journal's mass and approach speed.
-#[test]
-fn axial_knock_restitution_is_the_face_law_s() {
+/// The journal knocks a face axially (aligned, centred, no gravity, bearing fixed), integrated
+/// as `integration`: its restitution is the face law's for the journal's mass and approach speed
+/// (returned: measured, the law's). Read one world step after the contact's end, in free flight:
+/// a sub-cycled joint's Rapier velocities at a step's end are the mean over the step, and the
+/// part of the knock's impulse they do not carry is delivered with the next step (read at the
+/// contact's end, 0.858 against the law's 0.894).
+fn axial_knock(integration: ContactIntegration) -> (f64, f64) {
     let model = SpatialModel::steel(PLAY, COLLAR);
-    let clearance = steel_liu().unwrap().model(ClearanceModel::Spatial(model));
+    let clearance = steel_liu()
+        .unwrap()
+        .integration(integration)
+        .model(ClearanceModel::Spatial(model));
     let (mut world, pin, h) = fixed_bearing(&clearance, StepControl::adaptive(1e-3, 0.005));
     let (mass, speed) = (0.5, 0.2);
     world.rapier.bodies[pin].set_linvel(Vector::new(0.0, 0.0, speed), true);
+    // Whether the last step touched the face: at its end, or at a sub-step's.
+    let touching = |world: &ClearanceWorld| {
+        let j = world.clearance.get(h).unwrap();
+        j.report().spatial.unwrap().face_force[0] > 0.0
+            || j.substeps().iter().any(|s| s.force.normal_force > 0.0)
+    };
     let mut touched = false;
     while world.time() < 0.02 {
         world.step(0.02).unwrap();
-        let r = world.clearance.get(h).unwrap().report().spatial.unwrap();
-        touched |= r.face_force[0] > 0.0;
-        if touched && r.points_in_contact == 0 {
+        let now = touching(&world);
+        touched |= now;
+        if touched && !now {
             break;
         }
     }
     assert!(touched, "the shoulder never met the face");
+    world.step(0.02).unwrap();
+    assert!(!touching(&world), "the journal met a face again");
     let v = world.rapier.bodies[pin].linvel();
     assert!(
         v.x.abs() + v.y.abs() < 1e-12,
@@ -274,11 +288,19 @@ fn axial_knock_restitution_is_the_face_law_s() {
     );
     let measured = -v.z / speed;
     let expected = impact_restitution(&model.face.law().unwrap(), mass, speed);
-    println!("restitution measured {measured}, law {expected}");
-    assert!(
-        (measured - expected).abs() < 0.01 * expected,
-        "measured {measured}, the face law's {expected}"
-    );
+    println!("{integration:?}: restitution measured {measured}, law {expected}");
+    (measured, expected)
+}
+
+#[test]
+fn axial_knock_restitution_is_the_face_law_s() {
+    for integration in [ContactIntegration::Explicit, ContactIntegration::SubCycled] {
+        let (measured, expected) = axial_knock(integration);
+        assert!(
+            (measured - expected).abs() < 0.01 * expected,
+            "{integration:?}: measured {measured}, the face law's {expected}"
+        );
+    }
 }
 
 /// The shared arm (`tests/support/arm.rs`) with friction on its pin, ready to run.

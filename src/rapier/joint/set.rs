@@ -516,6 +516,11 @@ impl StepHooks for ClearanceJointSet {
             })
             .map(|(h, j)| super::stalled::stalled_contact_of(h, j, bodies))
     }
+    fn sub_cycled_contact_step(&self, step: &StepContext) -> f64 {
+        self.iter()
+            .filter_map(|(_, j)| j.contact_world_step(step.tolerance, step.last_dt))
+            .fold(f64::INFINITY, f64::min)
+    }
     fn divergence_causes(&self, body: RigidBodyHandle, causes: &mut Vec<String>) {
         for (_, j) in self.iter() {
             if j.body1() == body || j.body2() == body {

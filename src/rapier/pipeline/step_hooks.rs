@@ -120,6 +120,16 @@ pub trait StepHooks {
         None
     }
 
+    /// The shortest world step this participant's sub-cycled contacts ask for at the state
+    /// (`step.tolerance`, `step.last_dt` the step just taken), s; infinite when none does. Below
+    /// the floor `min_dt` the world's step sits at the floor while the contact lasts, and the
+    /// adaptive step control stops such a run, as its retries stop an explicit contact below
+    /// the floor. This crate's compliant joint set reports its planar sub-cycled joints in
+    /// contact; a participant of your own keeps the default: none.
+    fn sub_cycled_contact_step(&self, _step: &StepContext) -> f64 {
+        f64::INFINITY
+    }
+
     /// Names (in words) this participant's joints that join `body`, for a divergence's message.
     /// Default: none.
     fn joints_of(&self, _body: RigidBodyHandle, _names: &mut Vec<String>) {}

@@ -226,6 +226,17 @@ impl ClearanceJoint {
         })
     }
 
+    /// A planar sub-cycled joint in contact: the world step its contact asks for
+    /// ([`world_contact_step`](Self::world_contact_step)), s, for the adaptive step control's
+    /// check against its floor. `None` out of contact, for an explicit joint (its steps are
+    /// rejected down to its contact's limit) and for a spatial one (its world step follows the
+    /// regions' paths, not the contact: its sub-steps alone resolve it, under error control).
+    pub(crate) fn contact_world_step(&self, tolerance: f64, last_dt: f64) -> Option<f64> {
+        let planar = self.sub_cycled() && self.spatial.is_none();
+        (planar && self.report.state.penetration > 0.0)
+            .then(|| self.world_contact_step(tolerance, last_dt))
+    }
+
     /// The gap's closing acceleration at the last step's end, m/s^2: over its last sub-step
     /// when that was in free flight, else over the last step when it was in free flight
     /// throughout (0 when neither is known).

@@ -28,6 +28,13 @@ pub(crate) const STALL_STEPS: u64 = 100_000;
 /// unresolved, so a contact no sub-step resolves would crawl on at seconds a world step.
 pub(crate) const CAP_STALL_STEPS: u64 = 10;
 
+/// Adaptive world steps ending in a sub-cycled contact that asks for world steps below the
+/// floor `min_dt` (no step between them ending in one that asks for more) that stop the run with
+/// [`Error::Stalled`](crate::Error::Stalled), as the explicit joint's retries stop at such a
+/// contact at once: the world's step would sit at the floor while it lasts. Ten, not one: a
+/// count that a lone state cannot reach, as [`CAP_STALL_STEPS`].
+pub(crate) const CONTACT_FLOOR_STALL_STEPS: u64 = 10;
+
 /// The step control of a [`ClearanceWorld`](crate::rapier::pipeline::world::ClearanceWorld):
 /// plain data, as Rapier's `IntegrationParameters`. Start from [`fixed`](Self::fixed) or
 /// [`adaptive`](Self::adaptive) and set the other fields with struct update syntax:
@@ -59,7 +66,8 @@ pub struct StepControl {
     /// journal's centre relative to its bearing's by at most this fraction of the clearance.
     pub tolerance: f64,
     /// Adaptive: the smallest step, s (the floor; 100,000 steps at it in a row
-    /// without progress stall the run).
+    /// without progress stall the run, and so does a contact that needs steps below it, explicit
+    /// or sub-cycled).
     pub min_dt: f64,
     /// Adaptive: the largest ratio of a step to the one before it. Steps that change abruptly
     /// make Rapier's constrained velocities (which it evaluates at the step's start) disagree

@@ -1,7 +1,10 @@
 //! The step control's checks and diagnoses: the world's and bodies' state before a step, the
 //! guards after it, and the words of a divergence or a stall.
 
-use super::{CAP_STALL_STEPS, GuardKind, STALL_STEPS, StepMode, Stepper, Violation};
+use super::{
+    CAP_STALL_STEPS, CONTACT_FLOOR_STALL_STEPS, GuardKind, STALL_STEPS, StepMode, Stepper,
+    Violation,
+};
 use crate::error::{Divergence, Error, Result};
 use crate::rapier::observers::stall::{Stall, StallCause};
 use crate::rapier::pipeline::step_hooks::{StepContext, StepHooks};
@@ -80,6 +83,51 @@ impl Stepper {
             self.floor_run = 0;
         }
         Ok(())
+    }
+
+    /// Counts adaptive world steps that end in a sub-cycled contact asking for world steps below
+    /// the floor `min_dt` (a step ending in one that asks for more starts the count again; one
+    /// out of contact leaves it, as a journal held on its wall chatters in and out);
+    /// [`CONTACT_FLOOR_STALL_STEPS`] of them stop the run, as the explicit joint's retries stop
+    /// at such a contact at once: the world's step sits at the floor while it lasts.
+    pub(super) fn count_contact_floor(
+        &mut self,
+        world: &PhysicsWorld,
+        sources: &[&mut dyn StepHooks],
+    ) -> Result<()> {
+        if self.control.mode != StepMode::Adaptive {
+            return Ok(());
+        }
+        let step = self.step_context(self.t, 0.0);
+        let asked = sources
+            .iter()
+            .map(|s| s.sub_cycled_contact_step(&step))
+            .fold(f64::INFINITY, f64::min);
+        if asked >= self.control.min_dt {
+            if asked.is_finite() {
+                self.contact_floor_run = 0;
+            }
+            return Ok(());
+        }
+        self.contact_floor_run += 1;
+        if self.contact_floor_run < CONTACT_FLOOR_STALL_STEPS {
+            return Ok(());
+        }
+        let seen = format!(
+            "{} world steps ended in a sub-cycled contact that asks for world steps of {} s, \
+             under the floor: its sub-steps resolve it, but the world's step sits at the floor \
+             and the run crawls",
+            self.contact_floor_run,
+            crate::error::sig4(asked)
+        );
+        let contact = sources
+            .iter()
+            .filter_map(|s| s.stalled_contact(&world.bodies))
+            .min_by(|a, b| a.stable_dt.total_cmp(&b.stable_dt));
+        Err(Error::Stalled {
+            t: self.t,
+            stall: Box::new(Stall::at_contact(seen, contact, self.control.min_dt)),
+        })
     }
 
     /// Counts world steps in a row whose sub-cycle reached its cap of sub-steps (`capped`);

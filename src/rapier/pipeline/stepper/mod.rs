@@ -45,8 +45,9 @@
 //! - **Guards** ([`GuardReport`]): a body that left the physical range is an error
 //!   ([`Error::Diverged`]); a contact deeper than its law's validity and runs of steps at the step
 //!   floor are recorded (and fail the run under [`StepControl::strict`]); a step control that
-//!   cannot make progress (no accepted step above the floor for 100,000 steps) is an
-//!   [`Error::Stalled`].
+//!   cannot make progress (no accepted step above the floor for 100,000 steps; ten world steps
+//!   in a row at a sub-cycle's cap of sub-steps; ten adaptive world steps ending in a
+//!   sub-cycled contact that asks for world steps below the floor) is an [`Error::Stalled`].
 
 mod control;
 mod health;
@@ -60,7 +61,7 @@ use health::{check_body_states, check_gravity, check_joint_bodies};
 use pass::{BodySnapshot, snapshot_bodies};
 use rapier3d_f64::prelude::PhysicsWorld;
 
-pub(crate) use control::{CAP_STALL_STEPS, STALL_STEPS};
+pub(crate) use control::{CAP_STALL_STEPS, CONTACT_FLOOR_STALL_STEPS, STALL_STEPS};
 pub use control::{StepControl, StepMode};
 pub(crate) use health::left_physical_range;
 
@@ -105,6 +106,9 @@ pub(crate) struct Stepper {
     floor_run: u64,
     /// World steps in a row whose sub-cycle reached its cap ([`CAP_STALL_STEPS`]).
     cap_run: u64,
+    /// Adaptive world steps ending in a sub-cycled contact that asks for world steps below the
+    /// floor ([`CONTACT_FLOOR_STALL_STEPS`]).
+    contact_floor_run: u64,
     saved: Vec<BodySnapshot>,
     guards: GuardReport,
     correction: JointCorrection,
@@ -122,6 +126,7 @@ impl Stepper {
             prepared: false,
             floor_run: 0,
             cap_run: 0,
+            contact_floor_run: 0,
             saved: Vec::new(),
             guards: GuardReport::default(),
             correction: JointCorrection::default(),
@@ -333,6 +338,7 @@ impl Stepper {
                     }
                     self.check_health(world, sources, dt)?;
                     self.count_floor(world, sources, dt)?;
+                    self.count_contact_floor(world, sources)?;
                     return Ok(info);
                 }
                 Some(shorter) => {

@@ -558,3 +558,41 @@ fn a_spatial_journal_out_of_its_bore_is_refused_naming_the_axis() {
         .unwrap();
     world.step_to(0.01).unwrap();
 }
+
+/// A floor `min_dt` raised above the world steps a sub-cycled contact asks for is the user's
+/// choice, and the sub-cycle resolves the contact inside the floor's steps: the arm strikes and
+/// rests on its pin for 0.3 s at steps of at least 1e-4 s, without a stall (the steps at the floor
+/// are recorded, as the guards record any), its peak the one at the default floor within 2 %.
+#[test]
+fn a_raised_floor_is_stepped_by_the_sub_cycle() {
+    let peak_at = |min_dt: f64| {
+        let (rapier, base, arm) = arm_world(1);
+        let mut control = StepControl::adaptive(1e-3, 0.0075);
+        control.min_dt = min_dt;
+        let mut world = ClearanceWorld::new(rapier, control);
+        let pin = world.insert_clearance(base, arm, compliant_pin()).unwrap();
+        let mut peak: f64 = 0.0;
+        while world.time() < 0.3 {
+            world.step(0.3).unwrap();
+            let j = world.clearance.get(pin).unwrap();
+            peak = j
+                .substeps()
+                .iter()
+                .fold(peak, |p, s| p.max(s.force.normal_force));
+        }
+        let g = world.guards();
+        assert!(min_dt > 1e-10 || g.is_clean(), "{g:?}");
+        (peak, world.steps())
+    };
+    let (raised, steps) = peak_at(1e-4);
+    let (floor, _) = peak_at(1e-10);
+    assert!(
+        steps <= 3001,
+        "{steps} steps for 0.3 s at steps of at least 1e-4 s"
+    );
+    assert!(floor > 19.62, "no impact: {floor} N");
+    assert!(
+        (raised / floor - 1.0).abs() < 0.02,
+        "peak {raised} N at the raised floor against {floor} N"
+    );
+}

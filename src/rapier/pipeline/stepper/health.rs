@@ -2,8 +2,8 @@
 //! guards after it, and the words of a divergence or a stall.
 
 use super::{
-    CAP_STALL_STEPS, CONTACT_FLOOR_STALL_STEPS, GuardKind, STALL_STEPS, StepMode, Stepper,
-    Violation,
+    CAP_STALL_STEPS, CONTACT_FLOOR_STALL_STEPS, GuardKind, STALL_STEPS, StepControl, StepMode,
+    Stepper, Violation,
 };
 use crate::error::{Divergence, Error, Result};
 use crate::rapier::observers::stall::{Stall, StallCause};
@@ -86,7 +86,7 @@ impl Stepper {
     }
 
     /// Counts adaptive world steps that end in a sub-cycled contact asking for world steps below
-    /// the floor `min_dt` (a step ending in one that asks for more starts the count again; one
+    /// the floor `min_dt`, or the default floor where `min_dt` is raised above it (a step ending in one that asks for more starts the count again; one
     /// out of contact leaves it, as a journal held on its wall chatters in and out);
     /// [`CONTACT_FLOOR_STALL_STEPS`] of them stop the run, as the explicit joint's retries stop
     /// at such a contact at once: the world's step sits at the floor while it lasts.
@@ -103,7 +103,10 @@ impl Stepper {
             .iter()
             .map(|s| s.sub_cycled_contact_step(&step))
             .fold(f64::INFINITY, f64::min);
-        if asked >= self.control.min_dt {
+        // The default floor, not a raised one: steps of a floor you raised are your choice, and
+        // the sub-cycle resolves the contact inside them.
+        let floor = self.control.min_dt.min(StepControl::SMALLEST_STEP);
+        if asked >= floor {
             if asked.is_finite() {
                 self.contact_floor_run = 0;
             }

@@ -35,7 +35,14 @@
 //! perturbations, `SCARA_REFERENCE=none` leaves the reference out,
 //! `SCARA_IDEAL_STEPS_PER_TICK=40` steps the ideal arm's world 40 times per tick, and
 //! `SCARA_COST=3` only times a world step of the sub-cycled arm against the ideal arm's, the two
-//! run in turn three times. `SCARA_TRACE=/tmp/arm` (every mode) writes, per arm, each tick's
+//! run in turn three times (each tolerance of `SCARA_TOLERANCE`; the fastest of the three
+//! too). A list `SCARA_TOLERANCE=0.0075,0.02,0.05` runs one sub-cycled arm per tolerance
+//! against the same references and ends each clearance with a work-precision table: per
+//! tolerance, sub-steps per world step, cost per world step over the ideal arm's (the fastest
+//! start's over the fastest of five ideal runs), the peaks', depths' and hand offset's means
+//! against the references' (flagged more than 5 % outside their range), guard messages.
+//! `SCARA_CLOCK=cpu` times every cost by the process's CPU time instead of the wall clock
+//! (a shared machine's other work then lengthens neither arm). `SCARA_TRACE=/tmp/arm` (every mode) writes, per arm, each tick's
 //! state of each pin (at the joint's report and from Rapier's bodies), each step's first
 //! sub-step and every impact to `/tmp/arm_<arm>_<clearance in um>_<world steps>.csv`.
 //! `SCARA_DETAIL=0.007,0.0075` (every mode) prints on stderr each world step's report of each
@@ -321,6 +328,8 @@ struct Outcome {
     /// Sub-steps over the run, both pins.
     substeps: u64,
     wall_s: f64,
+    /// The process's CPU time over the run, s ([`cpu_seconds`]).
+    cpu_s: f64,
     /// The guards' messages (empty: the run stayed valid).
     guards: Vec<String>,
     /// The lower link's largest drop out of the arm's plane (m) and spin about the plane's
@@ -362,6 +371,7 @@ fn run_with(
     let ticks = (end / tick).round() as u64;
     let mut o = Outcome::default();
     let clock = Instant::now();
+    let cpu = cpu_seconds();
     // `SCARA_TRACE=path`: each tick's state of each pin, as the sub-cycle ended it and as
     // Rapier's bodies have it, written to `path`.
     let mut trace = std::env::var("SCARA_TRACE").ok().map(|_| String::new());
@@ -388,6 +398,7 @@ fn run_with(
         }
     }
     o.wall_s = clock.elapsed().as_secs_f64();
+    o.cpu_s = cpu_seconds() - cpu;
     if let (Some(out), Ok(path)) = (trace, std::env::var("SCARA_TRACE")) {
         let path = format!(
             "{path}_{pins:?}_{}_{}.csv",
@@ -560,6 +571,19 @@ fn detail(j: &ClearanceJoint, k: usize, t: f64) {
 }
 
 /// RMS distance between two arms' hands, mm.
+/// The CPU time the process's threads have run, s (Linux's `schedstat`; 0 elsewhere): unlike
+/// the wall clock, not lengthened by the time other work on a shared machine holds the core.
+fn cpu_seconds() -> f64 {
+    let Ok(tasks) = std::fs::read_dir("/proc/self/task") else {
+        return 0.0;
+    };
+    tasks
+        .filter_map(|t| std::fs::read_to_string(t.ok()?.path().join("schedstat")).ok())
+        .filter_map(|s| s.split_whitespace().next()?.parse::<f64>().ok())
+        .sum::<f64>()
+        * 1e-9
+}
+
 fn rms_offset(a: &Outcome, b: &Outcome) -> f64 {
     let sq: f64 = a
         .hands
@@ -842,8 +866,10 @@ fn ensemble() {
     let rates = list("SCARA_RATES", &[1000.0]);
     // `SCARA_COST=n`: the cost of a world step against the ideal arm's, the two run in turn
     // n times (timings on a shared machine are noisy), then nothing else.
-    // Each run's wall time per world step (of the whole run).
-    let per_step = |o: &Outcome| o.wall_s / o.steps as f64;
+    // Each run's wall time per world step (of the whole run); `SCARA_CLOCK=cpu`: its CPU
+    // time ([`cpu_seconds`]).
+    let cpu = std::env::var("SCARA_CLOCK").is_ok_and(|c| c == "cpu");
+    let per_step = |o: &Outcome| if cpu { o.cpu_s } else { o.wall_s } / o.steps as f64;
     if let Some(&n) = list("SCARA_COST", &[]).first() {
         for &rate in &rates {
             for &mm in &clearances {

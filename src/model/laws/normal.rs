@@ -56,7 +56,10 @@ pub trait NormalForceLaw {
     /// [`elastic_force`](Self::elastic_force) by 16-point Gauss-Legendre after the substitution
     /// `delta = penetration s^2`, which removes the `sqrt` behaviour at 0.
     fn elastic_energy(&self, penetration: f64) -> f64 {
-        quadrature_energy(self, penetration)
+        if penetration <= 0.0 {
+            return 0.0;
+        }
+        gauss_legendre_16(|s| self.elastic_force(penetration * s * s) * 2.0 * penetration * s)
     }
 
     /// Whether the law reads `impact_rate` (the hysteresis laws).
@@ -100,38 +103,6 @@ pub fn penetration_for_energy(law: &impl NormalForceLaw, energy: f64, guess: f64
         }
     }
     d
-}
-
-/// The elastic energy of `law` at `penetration` by 16-point Gauss-Legendre after the substitution
-/// `delta = penetration s^2` (0 for `penetration <= 0`).
-fn quadrature_energy<L: NormalForceLaw + ?Sized>(law: &L, penetration: f64) -> f64 {
-    if penetration <= 0.0 {
-        return 0.0;
-    }
-    gauss_legendre_16(|s| law.elastic_force(penetration * s * s) * 2.0 * penetration * s)
-}
-
-/// `integral_0^x t^1.5/sqrt(1 + t) dt`, the improved law's elastic energy at `n = 1` over
-/// `scale c^2/sqrt(2)` at `x = delta/c`: below `x = 1/4` by its series (the closed form's two
-/// terms there cancel to a result `2 x^2.5/5` of theirs), above by the closed form
-/// `(2x - 3) sqrt(x (1 + x))/4 + 3 asinh(sqrt x)/4`.
-fn liu_energy_integral(x: f64) -> f64 {
-    if x < 0.25 {
-        // (1 + t)^(-1/2) = sum a_k t^k, integrated term by term: sum a_k x^(k + 5/2)/(k + 5/2).
-        let (mut sum, mut a, mut power) = (0.0, 1.0, 1.0);
-        for k in 0..60 {
-            let term = a * power / (f64::from(k) + 2.5);
-            sum += term;
-            if term.abs() <= 1e-17 * sum {
-                break;
-            }
-            a *= -f64::from(2 * k + 1) / f64::from(2 * k + 2);
-            power *= x;
-        }
-        sum * x * x * x.sqrt()
-    } else {
-        0.25 * (2.0 * x - 3.0) * (x * (1.0 + x)).sqrt() + 0.75 * x.sqrt().asinh()
-    }
 }
 
 /// `integral_0^1 f(s) ds` by 16-point Gauss-Legendre.
@@ -467,9 +438,6 @@ impl NormalForceLaw for LiuEtAl {
     fn elastic_force(&self, delta: f64) -> f64 {
         self.0.elastic_force(delta)
     }
-    fn elastic_energy(&self, delta: f64) -> f64 {
-        self.0.elastic_energy(delta)
-    }
     fn tangent_stiffness(&self, delta: f64) -> f64 {
         self.0.tangent_stiffness(delta)
     }
@@ -578,16 +546,5 @@ impl NormalForceLaw for ImprovedLiu {
     }
     fn damping_coefficient(&self, c: &NormalContact) -> f64 {
         step(c.penetration, 0.0, 0.0, self.delta_max, self.d_max)
-    }
-    /// In closed form at `n = 1` (every step of a contact reads it); by quadrature otherwise.
-    fn elastic_energy(&self, delta: f64) -> f64 {
-        if delta <= 0.0 {
-            return 0.0;
-        }
-        if self.exponent != 1.0 {
-            return quadrature_energy(self, delta);
-        }
-        let c = self.clearance;
-        self.scale * c * c * std::f64::consts::FRAC_1_SQRT_2 * liu_energy_integral(delta / c)
     }
 }

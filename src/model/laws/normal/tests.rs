@@ -164,30 +164,3 @@ fn invalid_parameters_are_named() {
         .to_string();
     assert!(err.contains("clearance") && err.contains("NaN"), "{err}");
 }
-
-/// The improved law's energy at `n = 1` in closed form (its series below `delta/c = 1/4`)
-/// against the quadrature it replaces, from `delta/c = 1e-9` to 10, and its integral against
-/// mpmath's (40 digits) at both sides of the switch.
-#[test]
-fn improved_law_energy_in_closed_form_is_the_quadratures() {
-    for (x, mp) in [
-        (1e-6, 3.999998571429404e-16),
-        (0.1, 0.0012222035681640111),
-        (0.25, 0.011523247310360446),
-        (1.0, 0.3074767996713835),
-        (10.0, 45.975789388056036),
-    ] {
-        let i = super::liu_energy_integral(x);
-        assert!((i - mp).abs() <= 5e-15 * mp, "x {x}: {i:e} against {mp:e}");
-    }
-    let c = 1e-4;
-    let law = ImprovedLiu::new(1e11, 0.01, c, 1.0, 1e-4, MaxDamping::Eta(0.01)).unwrap();
-    for x in [1e-9, 1e-6, 1e-3, 0.1, 0.2499, 0.25, 0.5, 1.0, 10.0] {
-        let closed = law.elastic_energy(x * c);
-        let quadrature = super::quadrature_energy(&law, x * c);
-        assert!(
-            (closed - quadrature).abs() <= 1e-13 * quadrature,
-            "delta/c {x}: {closed:e} against {quadrature:e}"
-        );
-    }
-}

@@ -29,6 +29,12 @@ pub trait FrictionLaw {
     fn sliding_coefficient(&self) -> f64 {
         self.coefficient(1e3)
     }
+    /// The slip speed `x >= 0` with `x + k mu(x) = target` (`target > 0`, `k > 0`: friction
+    /// taken at the slip it leaves, as an implicit step takes it), where the law gives it in
+    /// closed form; `None` (the default) leaves it to a numerical root.
+    fn closed_form_slip(&self, _target: f64, _k: f64) -> Option<f64> {
+        None
+    }
 }
 
 /// Regularised Coulomb: `mu = mu_d min(1, v/v_eps)`.
@@ -54,6 +60,17 @@ impl FrictionLaw for Coulomb {
     }
     fn max_coefficient(&self) -> f64 {
         self.mu_d
+    }
+    /// `x + k mu_d x/v_eps = target` below `v_eps`, `x + k mu_d = target` above: the two
+    /// linear pieces solved directly (a bracketed root takes several of the law's evaluations
+    /// to reach the same value within its width, 1e-14 of `target`).
+    fn closed_form_slip(&self, target: f64, k: f64) -> Option<f64> {
+        let friction = k * self.mu_d;
+        Some(if target <= self.v_eps + friction {
+            target / (1.0 + friction / self.v_eps)
+        } else {
+            target - friction
+        })
     }
 }
 
@@ -239,6 +256,13 @@ impl FrictionLaw for FrictionModel {
             FrictionModel::Threlfall(l) => l.max_coefficient(),
             FrictionModel::Ambrosio(l) => l.max_coefficient(),
             FrictionModel::Bai(l) => l.max_coefficient(),
+        }
+    }
+    fn closed_form_slip(&self, target: f64, k: f64) -> Option<f64> {
+        match self {
+            FrictionModel::None => Some(target),
+            FrictionModel::Coulomb(l) => l.closed_form_slip(target, k),
+            _ => None,
         }
     }
 }

@@ -131,11 +131,11 @@ pub(crate) const MAX_SUBSTEPS: u32 = 100_000;
 const APPROACH_FRACTION: f64 = 0.5;
 
 /// The fraction of a contact's damped stability limit one sub-step may cover, per unit of
-/// tolerance: `10 tol` (0.075 at the default 0.0075). The damping is implicit, so the limit is
-/// no bound here; a heavily damped contact relaxes at about `2/limit`, and a sub-step that
-/// covers a fifth of what the explicit step may (`50 tol`) resolves that relaxation to the
-/// tolerance (the improved law's single impact: its depth within 1e-3 of its ODE at the
-/// default, `tests/references.rs`).
+/// tolerance: `10 tol` (0.075 at the default 0.0075), at most 0.8 (the kick's elastic force is
+/// explicit). A heavily damped contact relaxes at about `2/limit`, and a sub-step that covers
+/// a fifth of what the explicit step may (`50 tol`) resolves that relaxation to the tolerance
+/// (the improved law's single impact: its depth within 1e-3 of its ODE at the default,
+/// `tests/references.rs`).
 const STABLE_FRACTION_PER_TOLERANCE: f64 = 10.0;
 
 /// Sub-steps of a contact one world step may cover in or on the way into contact

@@ -240,7 +240,12 @@ impl Cycle<'_> {
                 min_impact_speed: j.min_impact_speed,
             };
             let elastic = j.normal_law.elastic_energy(depth);
-            let stable = STABLE_FRACTION_PER_TOLERANCE * self.tolerance;
+            // Capped as the explicit step's is: from a tolerance of 0.08 on, `10 tol` of the
+            // damped limit is no bound, and the period's `2 tol` alone passes the kick's
+            // stability limit from 0.16 (`omega s = 4 pi tol > 2`: the SCARA arm at 0.2
+            // rattled with penetrations 2 to 6 times the reference's and no guard tripped).
+            let stable = (STABLE_FRACTION_PER_TOLERANCE * self.tolerance)
+                .min(super::super::step_policy::STABILITY_SAFETY);
             contact.resolving_step(&j.normal_law, elastic, self.tolerance, stable)
         };
         let s = if st.penetration > 0.0 {
@@ -448,6 +453,11 @@ pub(super) fn implicit_slip(law: &impl FrictionLaw, c0: f64, k: f64) -> f64 {
     }
     let sign = c0.signum();
     let target = c0.abs();
+    // A law linear in pieces (Coulomb's) gives the root directly: the bracket below was most
+    // of a kick's cost on the SCARA arm's pins.
+    if let Some(x) = law.closed_form_slip(target, k) {
+        return sign * x;
+    }
     // g(x) = x + k mu(x) - target over [0, target]: g(0) <= 0 <= g(target).
     let g = |x: f64| x + k * law.coefficient(x) - target;
     let (mut lo, mut hi) = (0.0, target);

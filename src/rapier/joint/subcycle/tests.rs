@@ -19,6 +19,39 @@ fn implicit_slip_by_hand() {
     assert_eq!(implicit_slip(&law, 0.0, 0.5), 0.0);
 }
 
+/// Coulomb's slip in closed form is the root the bracket finds without it, across the stick
+/// and the sliding piece and the kink between them.
+#[test]
+fn coulombs_closed_form_slip_is_the_bracketed_root() {
+    use crate::model::laws::FrictionLaw;
+    // The law without its closed form: the bracket solves it.
+    struct Bracketed(Coulomb);
+    impl FrictionLaw for Bracketed {
+        fn coefficient(&self, v: f64) -> f64 {
+            self.0.coefficient(v)
+        }
+        fn max_coefficient(&self) -> f64 {
+            self.0.max_coefficient()
+        }
+    }
+    let law = Coulomb::new(0.1, 1e-4).unwrap();
+    assert!(law.closed_form_slip(1e-3, 0.01).is_some());
+    for c0 in [1e-7, 1e-5, 9e-5, 1e-4, 1.0001e-4, 3e-4, 1e-3, 1e-2, 1.0] {
+        for k in [1e-6, 1e-4, 1e-3, 1e-2, 0.1, 10.0] {
+            for sign in [1.0, -1.0] {
+                let x = implicit_slip(&law, sign * c0, k);
+                let root = implicit_slip(&Bracketed(law), sign * c0, k);
+                assert!(
+                    (x - root).abs() <= 2e-14 * c0,
+                    "c0 {c0} k {k}: closed form {x:e}, bracket {root:e}"
+                );
+                let residual = x.abs() + k * law.coefficient(x.abs()) - c0;
+                assert!(residual.abs() <= 1e-15 * c0, "c0 {c0} k {k}: {residual:e}");
+            }
+        }
+    }
+}
+
 /// The implicit slip under the paper's dry law (Bai's: steep below 0.1 mm/s, falling to `mu_d`
 /// above) reaches its bracket's width in a few of the law's evaluations, from the stick region
 /// to sliding: it is solved at every sub-step in contact.

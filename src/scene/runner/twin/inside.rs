@@ -12,9 +12,10 @@
 //!
 //! The sub-steps' eccentricities are read in the bearing's directions at the step's end, as the
 //! replay's frames inside a step are. A spatial joint's sub-steps carry its deepest station's
-//! state and the total force, not its mid-plane eccentricity nor its load's moment: its force,
-//! penetration and contact flag come from them, its eccentricity, tilt, axial offset, forces by
-//! contact kind and the bodies' accelerations stay interpolated between the states.
+//! state, not its mid-plane eccentricity: its force, penetration, contact flag and the bodies'
+//! accelerations come from them, its eccentricity, tilt, axial offset and forces by contact kind
+//! stay interpolated between the states. So do every body's angle, rate, position and velocity,
+//! the hinges' angles and rates, the other joints' forces and the motors' torques.
 
 use super::*;
 
@@ -30,8 +31,8 @@ struct Knot {
     penetration_um: f64,
     contact: bool,
     /// The contact's load on the journal: force, N, and its moment about the world's origin,
-    /// N m (`None`: not resolved).
-    load: Option<[Vector; 2]>,
+    /// N m.
+    load: [Vector; 2],
 }
 
 /// A hinge's sub-steps inside the step between the rows' states, and inside the step just taken.
@@ -60,13 +61,12 @@ pub(super) struct InsideRows {
     loads: Vec<(RigidBodyHandle, Vector, Vector)>,
 }
 
-/// The load a planar clearance joint applies to its journal at its last evaluation: force and
-/// moment about the world's origin (`None` for a spatial joint, whose report's point does not
-/// carry its stations' moment).
-fn planar_load(j: &ClearanceJoint) -> Option<[Vector; 2]> {
-    let r = j.report();
-    let f = r.force.on_journal;
-    r.spatial.is_none().then(|| [f, r.force.point.cross(f)])
+/// The load a clearance joint applied to its journal at its last evaluation (what the reaction
+/// solve at the state holds): force and moment about the world's origin (`journal_com` the
+/// journal's centre of mass at the state).
+fn state_load(j: &ClearanceJoint, journal_com: Vector) -> Option<[Vector; 2]> {
+    let [_, w] = j.last_wrenches()?;
+    Some([w.force, w.torque + journal_com.cross(w.force)])
 }
 
 impl InsideRows {
@@ -77,14 +77,14 @@ impl InsideRows {
         k: usize,
         col: usize,
         bodies: [RigidBodyHandle; 2],
-        joint: Option<&ClearanceJoint>,
+        joint: Option<(&ClearanceJoint, Vector)>,
     ) {
         if self.hinges.len() <= k {
             self.hinges.resize_with(k + 1, HingeInside::default);
         }
         let h = &mut self.hinges[k];
         (h.col, h.bodies) = (col, bodies);
-        h.load = [h.load[1], joint.and_then(planar_load)];
+        h.load = [h.load[1], joint.and_then(|(j, com)| state_load(j, com))];
     }
 
     /// Notes a dynamic body's first acceleration column (`fill_row`, at the first state).
@@ -128,7 +128,7 @@ impl InsideRows {
                 ecc: planar.then(|| [e.dot(u) * 1e3, e.dot(v) * 1e3]),
                 penetration_um: s.state.penetration.max(0.0) * 1e6,
                 contact: s.state.penetration > 0.0,
-                load: planar.then(|| [f, s.force.point.cross(f)]),
+                load: [f, s.moment],
             }
         }));
     }
@@ -154,7 +154,7 @@ impl InsideRows {
                 ecc: Some([s[h.col + 3], s[h.col + 4]]),
                 penetration_um: s[h.col + 5],
                 contact: s[h.col + 6] > 0.5,
-                load: None,
+                load: [Vector::ZERO; 2],
             };
             let (a, b) = match (i.checked_sub(1).map(|k| &h.knots[k]), h.knots.get(i)) {
                 (Some(a), Some(b)) => (*a, *b),
@@ -185,18 +185,11 @@ impl InsideRows {
             }
             // The load's departure from the one the interpolated accelerations hold (the
             // states' loads, interpolated as the rows are).
-            let (Some(la), Some(lb), Some(l0), Some(l1)) = (
-                if i == 0 { h.load[0] } else { a.load },
-                if i == h.knots.len() {
-                    h.load[1]
-                } else {
-                    b.load
-                },
-                h.load[0],
-                h.load[1],
-            ) else {
+            let [Some(l0), Some(l1)] = h.load else {
                 continue;
             };
+            let la = if i == 0 { l0 } else { a.load };
+            let lb = if i == h.knots.len() { l1 } else { b.load };
             let d = [0, 1].map(|k| (la[k] + (lb[k] - la[k]) * s) - (l0[k] + (l1[k] - l0[k]) * w));
             if d[0] != Vector::ZERO || d[1] != Vector::ZERO {
                 self.loads.push((h.bodies[1], d[0], d[1]));

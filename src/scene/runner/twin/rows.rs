@@ -50,6 +50,8 @@ impl Twin {
                 HingeJoint::Clearance(c) => world.clearance.get(c),
                 HingeJoint::Ideal | HingeJoint::LargeStep(_) => None,
             };
+            let com = crate::rapier::pipeline::ledger::world_center_of_mass(r2);
+            let joint = joint.map(|j| (j, com));
             self.inside.note_hinge(k, v.len(), handles, joint);
             let axis = *r1.rotation() * h.local_axis1;
             v.push(h.angle.value().to_degrees());

@@ -313,7 +313,7 @@ impl Twin {
         let joints = &world.rapier.impulse_joints;
         self.update_force_metrics(world, info.t0, info.dt);
         if self.rows {
-            self.record_inside(world, info.t0);
+            self.record_inside(world, (info.t0, info.dt));
         }
         self.update_invariants(world, info);
         // The motors' work over the step: the angular or linear impulse Rapier's motor row

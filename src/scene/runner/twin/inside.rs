@@ -103,12 +103,12 @@ impl InsideRows {
         }
     }
 
-    /// After the step from `t0`: hinge `k`'s sub-steps in it (none for an explicit joint), in
-    /// the bearing's directions `u`, `v` at the step's end.
+    /// After the step of `dt` from `t0`: hinge `k`'s sub-steps in it (none for an explicit
+    /// joint), in the bearing's directions `u`, `v` at the step's end.
     pub(super) fn record(
         &mut self,
         k: usize,
-        t0: f64,
+        (t0, dt): (f64, f64),
         j: &ClearanceJoint,
         (u, v): (Vector, Vector),
     ) {
@@ -116,9 +116,13 @@ impl InsideRows {
             return;
         };
         h.next.clear();
-        let Some((_, inside)) = j.substeps().split_last() else {
+        let Some((last, inside)) = j.substeps().split_last() else {
             return;
         };
+        // Only the sub-steps of this step: they end at its end.
+        if (last.t - dt).abs() > 1e-9 * dt {
+            return;
+        }
         let planar = j.report().spatial.is_none();
         h.next.extend(inside.iter().map(|s| {
             let (e, f) = (s.state.eccentricity, s.force.on_journal);

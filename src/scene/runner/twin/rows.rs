@@ -147,9 +147,9 @@ impl Twin {
         }
     }
 
-    /// After the step from `t0`: the sub-steps of this twin's sub-cycled hinges in it, for the
-    /// rows inside it (written at the next state).
-    pub(super) fn record_inside(&mut self, world: &ClearanceWorld, t0: f64) {
+    /// After the step of `dt` from `t0`: the sub-steps of this twin's sub-cycled hinges in it,
+    /// for the rows inside it (written at the next state).
+    pub(super) fn record_inside(&mut self, world: &ClearanceWorld, (t0, dt): (f64, f64)) {
         let bodies = &world.rapier.bodies;
         for (k, h) in self.hinges.iter().enumerate() {
             let HingeJoint::Clearance(c) = h.joint else {
@@ -160,7 +160,7 @@ impl Twin {
             };
             let rot = *bodies[self.bodies[h.bearing].handle].rotation();
             self.inside
-                .record(k, t0, j, (rot * h.local_u1, rot * h.local_v1));
+                .record(k, (t0, dt), j, (rot * h.local_u1, rot * h.local_v1));
         }
     }
 }

@@ -803,7 +803,7 @@ fn the_rows_inside_a_sub_cycled_step_follow_its_impact() {
         let c = table.column("hinge_contact").unwrap();
         window.iter().filter(|&&k| c[k] == 1.0).count()
     };
-    let (ca, cb) = (contact(&a), contact(&b));
+    let (ca, cb) = (contact(a), contact(b));
     assert!(
         cb > 40 && ca.abs_diff(cb) <= 1,
         "rows in contact {ca} vs {cb}"

@@ -250,9 +250,9 @@ pub struct Twin {
     row_cur: Vec<f64>,
     /// Columns holding a contact flag (taken from the nearer state, not interpolated).
     contact_columns: Vec<usize>,
-    /// What the rows inside a sub-cycled step read from its sub-steps, and whether rows are
-    /// kept.
+    /// What the rows inside a sub-cycled step read from its sub-steps.
     inside: inside::InsideRows,
+    /// Rows are kept (the last state read said so): the steps' sub-steps are then recorded.
     rows: bool,
     /// Invariants and energy over every step.
     pub invariants: Invariants,

@@ -255,13 +255,10 @@ fn replay_opens_in_chromium_at_an_impact_and_matches_the_csv() {
     };
     let dir = std::env::temp_dir().join(format!("cj-replay-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
-    // The explicit joint: its frames and the CSV rows interpolate the same step states. Sub-cycled
-    // (the default) the page and the rows differ by 6.8e-5 mm at the first impact's first row in
-    // contact (not traced: the frames hold the sub-steps).
+    // The sub-cycled joint (the default): its frames and the CSV rows inside a world step read the
+    // same sub-steps.
     let status = Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
         .args([
-            "--set",
-            "run.contact_integration=Explicit",
             "--end",
             "0.12",
             "--no-figures",
@@ -323,7 +320,8 @@ fn replay_opens_in_chromium_at_an_impact_and_matches_the_csv() {
         j["ecc_u_mm"].as_f64().unwrap(),
         j["ecc_v_mm"].as_f64().unwrap(),
     );
-    // Same states, same linear interpolation; the page's numbers carry 7 digits.
+    // Same states, same linear interpolation (1.8e-8 mm apart here); the page's numbers carry 7
+    // digits.
     for (page_mm, csv_mm, what) in [(pu, row[eu], "u"), (pv, row[ev], "v")] {
         assert!(
             (page_mm - csv_mm).abs() < 1e-5,
@@ -424,8 +422,6 @@ fn replay_opens_in_chromium_at_an_impact_and_matches_the_csv() {
     let clear = std::fs::read(dir.join("clearance.csv")).unwrap();
     let run = Command::new(env!("CARGO_BIN_EXE_clearance_joint"))
         .args([
-            "--set",
-            "run.contact_integration=Explicit",
             "--end",
             "0.12",
             "--no-figures",

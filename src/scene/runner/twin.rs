@@ -1,6 +1,7 @@
 //! A twin: its bodies, hinges, joints and drives built from the scene, tracked, and its rows.
 
 mod build;
+mod inside;
 mod rows;
 
 use super::HingeMetrics;
@@ -249,6 +250,10 @@ pub struct Twin {
     row_cur: Vec<f64>,
     /// Columns holding a contact flag (taken from the nearer state, not interpolated).
     contact_columns: Vec<usize>,
+    /// What the rows inside a sub-cycled step read from its sub-steps.
+    inside: inside::InsideRows,
+    /// Rows are kept (the last state read said so): the steps' sub-steps are then recorded.
+    rows: bool,
     /// Invariants and energy over every step.
     pub invariants: Invariants,
 }
@@ -293,9 +298,11 @@ impl Twin {
         }
         self.solve_ideal_reactions(world)?;
         self.source_energy_before = self.source_energy(world);
+        self.rows = rows;
         if rows {
             std::mem::swap(&mut self.row_prev, &mut self.row_cur);
             self.fill_row(t, world);
+            self.inside.advance();
         }
         Ok(())
     }
@@ -305,6 +312,9 @@ impl Twin {
     pub(super) fn after_step(&mut self, world: &ClearanceWorld, info: &StepInfo) {
         let joints = &world.rapier.impulse_joints;
         self.update_force_metrics(world, info.t0, info.dt);
+        if self.rows {
+            self.record_inside(world, (info.t0, info.dt));
+        }
         self.update_invariants(world, info);
         // The motors' work over the step: the angular or linear impulse Rapier's motor row
         // applied to body 2 (minus its stored impulse) times the joint's speed at the state the

@@ -178,6 +178,7 @@ impl Group<'_> {
                 outs[k].samples.push(SubStep {
                     t: tau,
                     state,
+                    moment: force.point.cross(force.on_journal),
                     force,
                     onset: onset.onset,
                     impact: onset.impact,

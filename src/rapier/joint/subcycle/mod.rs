@@ -111,6 +111,10 @@ pub struct SubStep {
     pub state: JournalState,
     /// The contact force pair at the state.
     pub force: ForcePair,
+    /// The moment of the contact's load on the journal about the world's origin at the state,
+    /// N m (the bearing takes its negative): with `force.on_journal` the whole load, a spatial
+    /// joint's stations' sum included, which `force.point` alone does not carry.
+    pub moment: Vector,
     /// Whether a contact began at this state (an onset; see
     /// [`ClearanceReport::onset`](super::ClearanceReport::onset)).
     pub onset: bool,

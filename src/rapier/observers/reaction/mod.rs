@@ -135,6 +135,10 @@ pub struct ReactionSolver {
     /// Per joint with a motor: the relative speed along its axis at the state.
     motor_rates: Vec<f64>,
     extra: Vec<Wrench>,
+    /// The bodies' acceleration change under the loads of the last
+    /// [`load_response`](Self::load_response), per body of the solve, and its multipliers.
+    response: Vec<(Vector, Vector)>,
+    b_load: Vec<f64>,
     /// Why the last solve returned `None`.
     failure: Option<ReactionFailure>,
 }
@@ -258,6 +262,14 @@ impl ReactionSolver {
     /// Why the last solve returned `None` (`None` after a solve that succeeded or before any).
     pub fn failure(&self) -> Option<ReactionFailure> {
         self.failure
+    }
+
+    /// The change in `body`'s accelerations (centre of mass m/s^2, angular rad/s^2) under the
+    /// loads of the last [`load_response`](Self::load_response). `None` for a body not in the
+    /// solve.
+    pub(crate) fn response(&self, body: RigidBodyHandle) -> Option<(Vector, Vector)> {
+        let i = self.entries.iter().position(|e| e.handle == body)?;
+        self.response.get(i).copied()
     }
 
     fn entry(&self, body: RigidBodyHandle) -> Option<&Entry> {

@@ -3,7 +3,7 @@
 use super::lu::{factor_regularised, lu_solve};
 use super::{IdealJoint, ReactionFailure, ReactionSolver};
 use rapier3d_f64::math::Vector;
-use rapier3d_f64::prelude::RigidBodySet;
+use rapier3d_f64::prelude::{RigidBodyHandle, RigidBodySet};
 
 impl ReactionSolver {
     pub(super) fn solve_joints_inner(
@@ -81,6 +81,51 @@ impl ReactionSolver {
             self.forces.push(f);
         }
         Some(())
+    }
+
+    /// The change in every body's accelerations under further `loads` (body, force N, moment
+    /// about the world's origin N m) at the state of the last solve, read with
+    /// [`response`](Self::response): `M^-1 (dF + J^T dlambda)` with `A dlambda = -J M^-1 dF`,
+    /// the last solve's factors reused (the accelerations are linear in the applied loads at
+    /// given velocities). A load on a body outside the solve is left out. What the rows of a
+    /// sub-cycled step add for its contact's force between the states: the state's reactions
+    /// hold the contact's force at the state only.
+    pub(crate) fn load_response(&mut self, loads: &[(RigidBodyHandle, Vector, Vector)]) {
+        self.response.clear();
+        self.response.extend(self.entries.iter().map(|e| {
+            let (mut f, mut m) = (Vector::ZERO, Vector::ZERO);
+            for (_, lf, lm) in loads.iter().filter(|l| l.0 == e.handle) {
+                f += *lf;
+                m += *lm;
+            }
+            // A prescribed body keeps its motion whatever the load.
+            if e.prescribed.is_some() {
+                return (Vector::ZERO, Vector::ZERO);
+            }
+            e.apply_inv_mass(f, m - e.com.cross(f))
+        }));
+        let n = self.rows.len();
+        if n == 0 || self.lu.len() != n * n {
+            return;
+        }
+        self.b_load.clear();
+        for r in &self.rows {
+            let rhs = if self.inert(r) {
+                0.0
+            } else {
+                -r.dot(self.response[r.b1], self.response[r.b2])
+            };
+            self.b_load.push(rhs);
+        }
+        lu_solve(&self.lu, &self.piv, &mut self.b_load, &mut self.scratch, n);
+        for (r, &lambda) in self.rows.iter().zip(&self.b_load) {
+            for (b, side) in [(r.b1, 0usize), (r.b2, 2)] {
+                let e = &self.entries[b];
+                let (da, dalpha) = e.apply_inv_mass(r.jac[side] * lambda, r.jac[side + 1] * lambda);
+                self.response[b].0 += da;
+                self.response[b].1 += dalpha;
+            }
+        }
     }
 
     /// Whether row `r` joins two bodies that no force moves (fixed, kinematic): it carries no

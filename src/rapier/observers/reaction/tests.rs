@@ -2,6 +2,7 @@
 
 use super::lu::{lu_factor, lu_solve};
 use super::*;
+use crate::rapier::pipeline::ledger::world_center_of_mass;
 use rapier3d_f64::math::Rotation;
 use rapier3d_f64::prelude::{
     ColliderBuilder, FixedJointBuilder, GenericJoint, GenericJointBuilder, ImpulseJointSet,
@@ -835,4 +836,71 @@ fn ideal_joints_the_solve_cannot_hold_are_refused() {
         e.contains("handle") && e.contains("not in the impulse joint set"),
         "{e}"
     );
+}
+
+#[test]
+fn load_response_is_the_difference_of_two_solves() {
+    // A spinning arm on its pivot under gravity, a ball-jointed second arm at its tip, and a
+    // free body beside them: the response to a force pair between the second arm and the free
+    // body (a contact's load, at a point off both centres of mass) is what a full solve with
+    // the pair as applied wrenches adds to the accelerations.
+    let (mut bodies, j) = arm_at(0.4, 3.0);
+    let tip = Rotation::from_rotation_z(0.4) * Vector::new(0.6, 0.0, 0.0);
+    let mass = MassProperties::new(Vector::ZERO, 0.7, Vector::new(0.004, 0.005, 0.006));
+    let second = bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(tip + Vector::new(0.0, -0.2, 0.05))
+            .additional_mass_properties(mass),
+    );
+    let free = bodies.insert(
+        RigidBodyBuilder::dynamic()
+            .translation(Vector::new(1.0, 0.5, 0.0))
+            .additional_mass_properties(mass),
+    );
+    prepare_mass_properties(&mut bodies);
+    let ball = IdealSpherical {
+        body1: j.body2,
+        body2: second,
+        local_anchor1: Vector::new(0.3, 0.0, 0.0),
+        local_anchor2: Vector::new(0.0, 0.2, -0.05),
+    };
+    let joints = [
+        IdealJoint(JointModel::Revolute(j)),
+        IdealJoint(JointModel::Spherical(ball)),
+    ];
+    let g = Vector::new(0.0, -9.81, 0.0);
+    let (f, p) = (Vector::new(3.0, -1.0, 2.0), Vector::new(0.9, 0.1, 0.3));
+    let com = |h| world_center_of_mass(&bodies[h]);
+    let pair = [
+        Wrench {
+            body: second,
+            force: f,
+            torque: (p - com(second)).cross(f),
+        },
+        Wrench {
+            body: free,
+            force: -f,
+            torque: (p - com(free)).cross(-f),
+        },
+    ];
+    let mut solver = ReactionSolver {
+        track: vec![free],
+        ..Default::default()
+    };
+    let handles = [j.body2, second, free];
+    solver.solve_with(&bodies, &joints, g, &pair).unwrap();
+    let loaded: Vec<_> = handles.map(|h| solver.acceleration(h).unwrap()).into();
+    solver.solve_with(&bodies, &joints, g, &[]).unwrap();
+    solver.load_response(&[(second, f, p.cross(f)), (free, -f, p.cross(-f))]);
+    for (k, h) in handles.into_iter().enumerate() {
+        let (a, alpha) = solver.acceleration(h).unwrap();
+        let (da, dalpha) = solver.response(h).unwrap();
+        let (ea, ealpha) = (loaded[k].0 - a, loaded[k].1 - alpha);
+        assert!(ea.length() > 0.1, "body {k}: the load moves it");
+        assert!((da - ea).length() < 1e-9 * ea.length(), "{da:?} vs {ea:?}");
+        assert!(
+            (dalpha - ealpha).length() < 1e-9 * ealpha.length().max(1.0),
+            "{dalpha:?} vs {ealpha:?}"
+        );
+    }
 }

@@ -62,6 +62,8 @@ impl Twin {
             table: Table::new(columns),
             row_prev: Vec::new(),
             row_cur: Vec::new(),
+            inside: Default::default(),
+            rows: false,
             invariants: Invariants::new(
                 scene.gravity == [0.0; 3]
                     && scene.bodies.iter().all(|b| !b.fixed && b.motion.is_none()),

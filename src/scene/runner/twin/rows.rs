@@ -34,6 +34,7 @@ impl Twin {
                         (rb.linvel() + w.cross(r), w.cross(w.cross(r)))
                     }
                     (None, false) => {
+                        self.inside.note_acceleration(b.handle, v.len() + 6);
                         let (vel, _) = self.reactions.velocity(b.handle).unwrap_or_default();
                         let (acc, _) = self.reactions.acceleration(b.handle).unwrap_or_default();
                         (vel, acc)
@@ -42,11 +43,16 @@ impl Twin {
                 v.extend_from_slice(&[p.x, p.y, p.z, vel.x, vel.y, vel.z, acc.x, acc.y, acc.z]);
             }
         }
-        for h in &self.hinges {
-            let (r1, r2) = (
-                &bodies[self.bodies[h.bearing].handle],
-                &bodies[self.bodies[h.journal].handle],
-            );
+        for (k, h) in self.hinges.iter().enumerate() {
+            let handles = [self.bodies[h.bearing].handle, self.bodies[h.journal].handle];
+            let (r1, r2) = (&bodies[handles[0]], &bodies[handles[1]]);
+            let joint = match h.joint {
+                HingeJoint::Clearance(c) => world.clearance.get(c),
+                HingeJoint::Ideal | HingeJoint::LargeStep(_) => None,
+            };
+            let com = crate::rapier::pipeline::ledger::world_center_of_mass(r2);
+            let joint = joint.map(|j| (j, com));
+            self.inside.note_hinge(k, v.len(), handles, joint);
             let axis = *r1.rotation() * h.local_axis1;
             v.push(h.angle.value().to_degrees());
             v.push((r2.angvel() - r1.angvel()).dot(axis).to_degrees());
@@ -110,10 +116,13 @@ impl Twin {
 
     /// Appends the row at time `t`, `w` of the way from the previous state to the current one
     /// (linear; the contact flag from the nearer state).
+    /// Inside a sub-cycled step, its sub-steps around `t` replace the interpolation where
+    /// they resolve it ([`inside`](super::inside)).
     pub(in crate::scene::runner) fn write_row(&mut self, t: f64, w: f64) {
         let contact_cols = &self.contact_columns;
         let (prev, cur) = (&self.row_prev, &self.row_cur);
         let v = &mut self.table.values;
+        let start = v.len();
         v.push(t);
         for (i, &b) in cur.iter().enumerate().skip(1) {
             let a = prev.get(i).copied().unwrap_or(b);
@@ -126,6 +135,32 @@ impl Twin {
             } else {
                 a + (b - a) * w
             });
+        }
+        if w > 0.0 && w < 1.0 {
+            self.inside.correct(
+                &mut v[start..],
+                (t, w),
+                (prev, cur),
+                &mut self.reactions,
+                self.body_motion,
+            );
+        }
+    }
+
+    /// After the step of `dt` from `t0`: the sub-steps of this twin's sub-cycled hinges in it,
+    /// for the rows inside it (written at the next state).
+    pub(super) fn record_inside(&mut self, world: &ClearanceWorld, (t0, dt): (f64, f64)) {
+        let bodies = &world.rapier.bodies;
+        for (k, h) in self.hinges.iter().enumerate() {
+            let HingeJoint::Clearance(c) = h.joint else {
+                continue;
+            };
+            let Some(j) = world.clearance.get(c) else {
+                continue;
+            };
+            let rot = *bodies[self.bodies[h.bearing].handle].rotation();
+            self.inside
+                .record(k, (t0, dt), j, (rot * h.local_u1, rot * h.local_v1));
         }
     }
 }

@@ -316,6 +316,7 @@ impl SpatialGroup<'_> {
                     t: t_next,
                     state,
                     force: at.force,
+                    moment: at.moment,
                     onset: onset.onset,
                     impact: onset.impact,
                     approach_speed: onset.approach_speed,

@@ -35,6 +35,8 @@ pub(super) struct Eval {
     /// Each region's deepest point.
     pub(super) states: [JournalState; 4],
     pub(super) force: ForcePair,
+    /// The load's moment on the journal about the world's origin, N m.
+    pub(super) moment: Vector,
     /// Power the damping and friction dissipate, W.
     pub(super) dissipation: f64,
 }
@@ -241,6 +243,7 @@ impl SpatialCycle<'_> {
             normal_force: totals.normal.length(),
             friction_force: totals.friction.length(),
         };
+        out.moment = totals.torque[1] + centres[1].cross(totals.force);
         out.dissipation = totals.dissipation;
         out
     }

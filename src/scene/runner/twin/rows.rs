@@ -10,10 +10,32 @@ impl Twin {
         let v = &mut self.row_cur;
         v.clear();
         v.push(t);
+        // The impulse a sub-cycled joint still holds at the state, on each body of its pair,
+        // after a step in which it touched: Rapier's velocities after such a step are the mean
+        // over it, short of that impulse (of an impact inside the step, most of it). Steps
+        // without contact are left as they are, so the twins' rows keep one convention (Rapier's
+        // velocities; the solve's for the centres of mass).
+        let held = |h: RigidBodyHandle| -> Option<(Vector, Vector)> {
+            let touched = |j: &crate::rapier::joint::ClearanceJoint| {
+                j.substeps().iter().any(|s| s.force.normal_force > 0.0)
+            };
+            let (_, v, w) = world
+                .clearance
+                .iter()
+                .filter(|(_, j)| touched(j))
+                .filter_map(|(_, j)| j.state_velocity())
+                .flatten()
+                .find(|(b, _, _)| *b == h)?;
+            let rb = &bodies[h];
+            Some((v - rb.linvel(), w - rb.angvel()))
+        };
+        let rate = |h: RigidBodyHandle| {
+            let w = bodies[h].angvel();
+            held(h).map_or(w, |x| w + x.1)
+        };
         for b in &self.bodies {
-            let rb = &bodies[b.handle];
             v.push(b.angle.value().to_degrees());
-            v.push(rb.angvel().dot(axis_ref).to_degrees());
+            v.push(rate(b.handle).dot(axis_ref).to_degrees());
         }
         if self.body_motion {
             for b in self.bodies.iter().filter(|b| b.moves) {
@@ -35,8 +57,11 @@ impl Twin {
                     }
                     (None, false) => {
                         self.inside.note_acceleration(b.handle, v.len() + 6);
-                        let (vel, _) = self.reactions.velocity(b.handle).unwrap_or_default();
+                        let (mut vel, _) = self.reactions.velocity(b.handle).unwrap_or_default();
                         let (acc, _) = self.reactions.acceleration(b.handle).unwrap_or_default();
+                        if let Some((dv, _)) = held(b.handle) {
+                            vel += dv;
+                        }
                         (vel, acc)
                     }
                 };
@@ -55,7 +80,7 @@ impl Twin {
             self.inside.note_hinge(k, v.len(), handles, joint);
             let axis = *r1.rotation() * h.local_axis1;
             v.push(h.angle.value().to_degrees());
-            v.push((r2.angvel() - r1.angvel()).dot(axis).to_degrees());
+            v.push((rate(handles[1]) - rate(handles[0])).dot(axis).to_degrees());
             v.push(h.force);
             match h.joint {
                 HingeJoint::Clearance(c) => {

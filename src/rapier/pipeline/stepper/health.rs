@@ -86,8 +86,9 @@ impl Stepper {
     }
 
     /// Counts adaptive world steps that end in a sub-cycled contact asking for world steps below
-    /// the floor `min_dt`, or the default floor where `min_dt` is raised above it (a step ending in one that asks for more starts the count again; one
-    /// out of contact leaves it, as a journal held on its wall chatters in and out);
+    /// the floor `min_dt`, or the default floor where `min_dt` is raised above it (a step
+    /// ending in one that asks for more starts the count again; one out of contact leaves it,
+    /// as a journal held on its wall chatters in and out);
     /// [`CONTACT_FLOOR_STALL_STEPS`] of them stop the run, as the explicit joint's retries stop
     /// at such a contact at once: the world's step sits at the floor while it lasts.
     pub(super) fn count_contact_floor(
@@ -123,14 +124,7 @@ impl Stepper {
             self.contact_floor_run,
             crate::error::sig4(asked)
         );
-        let contact = sources
-            .iter()
-            .filter_map(|s| s.stalled_contact(&world.bodies))
-            .min_by(|a, b| a.stable_dt.total_cmp(&b.stable_dt));
-        Err(Error::Stalled {
-            t: self.t,
-            stall: Box::new(Stall::at_contact(seen, contact, self.control.min_dt)),
-        })
+        Err(self.stalled_at_contact(seen, world, sources))
     }
 
     /// Counts world steps in a row whose sub-cycle reached its cap of sub-steps (`capped`);
@@ -155,14 +149,25 @@ impl Stepper {
             self.cap_run,
             crate::error::sig4(floor)
         );
+        Err(self.stalled_at_contact(seen, world, sources))
+    }
+
+    /// The stall `seen`, diagnosed at the stiffest contact the sources report (the one whose
+    /// stable step is the shortest).
+    fn stalled_at_contact(
+        &self,
+        seen: String,
+        world: &PhysicsWorld,
+        sources: &[&mut dyn StepHooks],
+    ) -> Error {
         let contact = sources
             .iter()
             .filter_map(|s| s.stalled_contact(&world.bodies))
             .min_by(|a, b| a.stable_dt.total_cmp(&b.stable_dt));
-        Err(Error::Stalled {
+        Error::Stalled {
             t: self.t,
             stall: Box::new(Stall::at_contact(seen, contact, self.control.min_dt)),
-        })
+        }
     }
 
     /// Non-physical bodies are errors; penetrations beyond validity are recorded.

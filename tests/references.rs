@@ -1052,9 +1052,10 @@ fn the_arms_first_impact_sub_cycled_in_millisecond_steps_matches_its_ode() {
 /// A journal resting on its wall under its weight (the free journal of the single impacts,
 /// Hertz's law, gravity across the pin, no damping, no friction), sub-cycled in steps of 1 ms
 /// at loose tolerances: it stays at the depth where `K delta^1.5 = m g` (the closed form,
-/// about 37 nm) within 1 % over 50 ms. A sub-step of `2 tol` of the contact's period passes
+/// about 37 nm) within 1 % over 50 ms. A sub-step of `2 tol` of the contact's period would pass
 /// the kick's stability limit (`omega s = 2`) from the tolerance 0.16: at 0.2 and 0.3 the
-/// sub-steps stay within it, or round-off grows into a rattle.
+/// sub-steps stay within it (the sub-cycle resolves to at most 0.05, and within 0.8 of the
+/// limit), or round-off grows into a rattle.
 #[test]
 fn a_resting_journal_sub_cycled_at_loose_tolerances_stays_at_its_static_depth() {
     let g = 9.81;

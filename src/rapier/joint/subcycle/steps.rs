@@ -240,10 +240,8 @@ impl Cycle<'_> {
                 min_impact_speed: j.min_impact_speed,
             };
             let elastic = j.normal_law.elastic_energy(depth);
-            // Capped as the explicit step's is: from a tolerance of 0.08 on, `10 tol` of the
-            // damped limit is no bound, and the period's `2 tol` alone passes the kick's
-            // stability limit from 0.16 (`omega s = 4 pi tol > 2`: the SCARA arm at 0.2
-            // rattled with penetrations 2 to 6 times the reference's and no guard tripped).
+            // Capped as the explicit step's is, at 0.8 of the damped limit (the sub-cycle's
+            // tolerance, at most `MAX_SUBCYCLE_TOLERANCE`, keeps `10 tol` below it).
             let stable = (STABLE_FRACTION_PER_TOLERANCE * self.tolerance)
                 .min(super::super::step_policy::STABILITY_SAFETY);
             contact.resolving_step(&j.normal_law, elastic, self.tolerance, stable)

@@ -81,6 +81,19 @@ pub(super) const STABILITY_SAFETY: f64 = 0.8;
 /// matrix (docs/stepper-and-accuracy.md, `cargo bench --bench mechanisms`) shows the rest.
 const STABLE_FRACTION_PER_TOLERANCE: f64 = 50.0;
 
+/// The loosest tolerance a contact is resolved to, however loose the step control's, explicit
+/// or sub-cycled: a step (or sub-step) in contact covers at most a tenth of its period (five or
+/// more an impact), a free one moves the journal by at most 0.05 of the clearance. The elastic
+/// kick is explicit, and an impact of two or three kicks hands back more energy than it took:
+/// a rattle of small clearance runs away (docs/sub-cycled-contact.md, "Cost against accuracy").
+pub(crate) const MAX_CONTACT_TOLERANCE: f64 = 0.05;
+
+/// The tolerance a contact is resolved to when the step control asks for `tolerance`: at most
+/// [`MAX_CONTACT_TOLERANCE`].
+pub(crate) fn contact_tolerance(tolerance: f64) -> f64 {
+    tolerance.min(MAX_CONTACT_TOLERANCE)
+}
+
 /// The fraction of a contact's damped stability limit an adaptive step may take at `tolerance`
 /// ([`STABLE_FRACTION_PER_TOLERANCE`], [`STABILITY_SAFETY`]).
 fn stable_fraction(tolerance: f64) -> f64 {
@@ -156,6 +169,7 @@ impl ClearanceJoint {
     ///   the step covers at most 10 of the sub-steps the contact needs (`20 tolerance` of its
     ///   period) and half the time to the wall.
     pub fn adaptive_step(&self, tolerance: f64, last_dt: f64) -> f64 {
+        let tolerance = contact_tolerance(tolerance);
         let r = &self.report;
         let m = r.effective_mass;
         if !(m > 0.0 && m.is_finite()) {
@@ -266,6 +280,7 @@ impl ClearanceJoint {
     ///   (`2 tolerance` of its period) would have let it: the step crossed the onset blind;
     /// - the step was longer than friction's limit ([`ClearanceReport::friction_stable_dt`]).
     pub fn judge_step(&self, dt: f64, tolerance: f64, was_in_contact: bool) -> Option<f64> {
+        let tolerance = contact_tolerance(tolerance);
         let r = &self.report;
         let delta = r.state.penetration;
         if !(delta > 0.0) || self.sub_cycled() {

@@ -325,7 +325,7 @@ pub(super) fn plan_group(
             a_free,
             stabilisation,
             h,
-            tolerance: super::subcycle_tolerance(pass.tolerance),
+            tolerance: crate::rapier::joint::step_policy::contact_tolerance(pass.tolerance),
         }
     };
     // After a step long against its contact (more than `LONG_STEP_SUBSTEPS` sub-steps), each

@@ -12,7 +12,7 @@
 //! with sub-steps sized by the tolerance: `2 tol` of the contact's period and `10 tol` of its
 //! damped stability limit in contact ([`ContactAhead::resolving_step`]), halving the time to
 //! contact on approach and landing on the wall, and moving the journal by at most `tol` of the
-//! clearance in free flight, `tol` taken at most 0.05 (`MAX_SUBCYCLE_TOLERANCE`). A sub-step is a
+//! clearance in free flight, `tol` taken at most 0.05 (`MAX_CONTACT_TOLERANCE`). A sub-step is a
 //! velocity-Verlet step whose elastic force is taken at the sub-step's position and whose
 //! dissipative forces (the law's damping, friction) at the velocity of the state, solved
 //! implicitly (a trapezoidal rule in the velocity: stable at any sub-step, second order). The
@@ -142,19 +142,6 @@ const APPROACH_FRACTION: f64 = 0.5;
 /// `tests/references.rs`).
 const STABLE_FRACTION_PER_TOLERANCE: f64 = 10.0;
 
-/// The loosest tolerance a sub-cycle resolves to, however loose the step control's: a
-/// contact's sub-step covers at most a tenth of its period (five or more sub-steps an
-/// impact), a free one moves the journal by at most 0.05 of the clearance. The elastic kick is
-/// explicit, and an impact of two or three kicks hands back more energy than it took: a rattle
-/// of small clearance runs away (docs/sub-cycled-contact.md, "Cost against accuracy").
-const MAX_SUBCYCLE_TOLERANCE: f64 = 0.05;
-
-/// The tolerance a sub-cycle resolves to when asked for `tolerance`: at most
-/// [`MAX_SUBCYCLE_TOLERANCE`].
-pub(super) fn subcycle_tolerance(tolerance: f64) -> f64 {
-    tolerance.min(MAX_SUBCYCLE_TOLERANCE)
-}
-
 /// Sub-steps of a contact one world step may cover in or on the way into contact
 /// ([`ClearanceJoint::world_contact_step`]): 10, `20 tol` of the contact's period and `100 tol`
 /// of its damped stability limit. Rapier hands a step's impulse to the rest of the mechanism as
@@ -226,7 +213,10 @@ impl ClearanceJoint {
                 min_impact_speed: self.min_impact_speed,
             };
             let elastic = self.normal_law.elastic_energy(depth.max(0.0));
-            let (k, tolerance) = (WORLD_SUBSTEPS_IN_CONTACT, subcycle_tolerance(tolerance));
+            let (k, tolerance) = (
+                WORLD_SUBSTEPS_IN_CONTACT,
+                super::step_policy::contact_tolerance(tolerance),
+            );
             let stable = k * STABLE_FRACTION_PER_TOLERANCE * tolerance;
             contact.resolving_step(&self.normal_law, elastic, k * tolerance, stable)
         };

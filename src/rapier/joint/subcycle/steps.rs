@@ -241,7 +241,7 @@ impl Cycle<'_> {
             };
             let elastic = j.normal_law.elastic_energy(depth);
             // Capped as the explicit step's is, at 0.8 of the damped limit (the sub-cycle's
-            // tolerance, at most `MAX_SUBCYCLE_TOLERANCE`, keeps `10 tol` below it).
+            // tolerance, at most `MAX_CONTACT_TOLERANCE`, keeps `10 tol` below it).
             let stable = (STABLE_FRACTION_PER_TOLERANCE * self.tolerance)
                 .min(super::super::step_policy::STABILITY_SAFETY);
             contact.resolving_step(&j.normal_law, elastic, self.tolerance, stable)

@@ -15,19 +15,23 @@ impl Twin {
         // over it, short of that impulse (of an impact inside the step, most of it). Steps
         // without contact are left as they are, so the twins' rows keep one convention (Rapier's
         // velocities; the solve's for the centres of mass).
-        let held = |h: RigidBodyHandle| -> Option<(Vector, Vector)> {
-            let touched = |j: &crate::rapier::joint::ClearanceJoint| {
-                j.substeps().iter().any(|s| s.force.normal_force > 0.0)
-            };
-            let (_, v, w) = world
-                .clearance
+        // Found once for the state: each such body with its velocities' shortfall.
+        let touched = |j: &crate::rapier::joint::ClearanceJoint| {
+            j.substeps().iter().any(|s| s.force.normal_force > 0.0)
+        };
+        let shortfalls: Vec<(RigidBodyHandle, Vector, Vector)> = world
+            .clearance
+            .iter()
+            .filter(|(_, j)| touched(j))
+            .filter_map(|(_, j)| j.state_velocity())
+            .flatten()
+            .map(|(h, v, w)| (h, v - bodies[h].linvel(), w - bodies[h].angvel()))
+            .collect();
+        let held = |h: RigidBodyHandle| {
+            shortfalls
                 .iter()
-                .filter(|(_, j)| touched(j))
-                .filter_map(|(_, j)| j.state_velocity())
-                .flatten()
-                .find(|(b, _, _)| *b == h)?;
-            let rb = &bodies[h];
-            Some((v - rb.linvel(), w - rb.angvel()))
+                .find(|(b, _, _)| *b == h)
+                .map(|&(_, dv, dw)| (dv, dw))
         };
         let rate = |h: RigidBodyHandle| {
             let w = bodies[h].angvel();

@@ -705,31 +705,41 @@ struct Bounces {
 }
 
 /// A journal dropped from the centre of its bearing (Hertz, no damping, no friction) bouncing
-/// for 0.1 s at world steps of 1 ms with Rapier's four iterations, at `tolerance`: its energy
-/// `v^2/2 + g e_y` (0 in closed form) at every free step end after the first bounce. The
-/// guards stay clean.
+/// for 0.1 s at world steps of 1 ms with Rapier's four iterations, sub-cycled at `tolerance`
+/// ([`bounce_with`]).
 fn bounce(tolerance: f64) -> Bounces {
     let control = StepControl {
         tolerance,
         ..StepControl::fixed(1e-3)
     };
-    let (mut world, base, journal) = journal_world(control, 4);
-    let pin = sub_cycled_hertz_pin(1e10);
+    bounce_with(control, 4, sub_cycled_hertz_pin(1e10))
+}
+
+/// The journal of [`bounce`] on `pin`, stepped by `control` with `iterations` solver
+/// iterations: its energy `v^2/2 + g e_y` (0 in closed form) at every free step end after the
+/// first bounce, from the velocity at the state (a sub-cycled joint's, Rapier's for an explicit
+/// one) and from Rapier's. The guards stay clean.
+fn bounce_with(control: StepControl, iterations: usize, pin: ClearanceJoint) -> Bounces {
+    let (mut world, base, journal) = journal_world(control, iterations);
     let pin = world.insert_clearance(base, journal, pin).unwrap();
     let (mut state_worst, mut rapier_worst, mut free_ends, mut bounces) = (0.0f64, 0.0f64, 0, 0);
     while world.time() < 0.1 {
         world.step(0.1).unwrap();
         let joint = world.clearance.get(pin).unwrap();
-        bounces += joint.substeps().iter().filter(|s| s.onset).count();
+        // A sub-cycled step's onsets are its sub-steps'; an explicit step's, its report's.
+        bounces += match joint.substeps() {
+            [] => usize::from(joint.report().onset),
+            steps => steps.iter().filter(|s| s.onset).count(),
+        };
         let st = joint.report().state;
         if bounces == 0 || st.penetration > 0.0 {
             continue;
         }
         free_ends += 1;
-        let [_, (body, _, w)] = joint.state_velocity().expect("a sub-cycled step");
-        assert_eq!(body, journal);
         let (v, spin) = world.velocity_at_state(journal).unwrap();
-        assert_eq!(spin, w);
+        if let Some([_, (body, _, w)]) = joint.state_velocity() {
+            assert_eq!((body, spin), (journal, w));
+        }
         let rapier = world.rapier.bodies[journal].linvel();
         let energy = |v: Vector| (0.5 * v.length_squared() + G * st.eccentricity.y).abs() / (G * C);
         state_worst = state_worst.max(energy(v));
@@ -907,26 +917,17 @@ fn a_loose_tolerance_still_resolves_each_explicit_impact() {
     use clearance_joint::model::laws::{BearingGeometry, Hertz, NormalModel};
     let mut worsts = Vec::new();
     for tolerance in [0.0075, 0.02, 0.05, 0.1, 0.2] {
-        let (mut world, base, journal) = journal_world(StepControl::adaptive(1e-3, tolerance), 1);
         let hertz = NormalModel::Hertz(Hertz::new(1e10, 1.5).unwrap());
         let pin = HingeDesign::new(BearingGeometry::new(R_B, R_B - C, 0.016).unwrap(), hertz)
             .integration(ContactIntegration::Explicit)
             .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
             .unwrap();
-        let pin = world.insert_clearance(base, journal, pin).unwrap();
-        let (mut worst, mut free_ends, mut onsets) = (0.0f64, 0, 0);
-        while world.time() < 0.1 {
-            world.step(0.1).unwrap();
-            let r = world.clearance.get(pin).unwrap().report();
-            onsets += usize::from(r.onset);
-            if onsets == 0 || r.state.penetration > 0.0 {
-                continue;
-            }
-            free_ends += 1;
-            let v = world.rapier.bodies[journal].linvel();
-            let energy = (0.5 * v.length_squared() + G * r.state.eccentricity.y) / (G * C);
-            worst = worst.max(energy.abs());
-        }
+        let Bounces {
+            bounces: onsets,
+            free_ends,
+            state_worst: worst,
+            ..
+        } = bounce_with(StepControl::adaptive(1e-3, tolerance), 1, pin);
         println!(
             "tolerance {tolerance}: {onsets} onsets, {free_ends} free step ends: energy off by at \
              most {worst:.2e} of g c"
@@ -935,7 +936,6 @@ fn a_loose_tolerance_still_resolves_each_explicit_impact() {
             onsets >= 5 && free_ends > 40,
             "{onsets} onsets, {free_ends} ends"
         );
-        assert!(world.guards().is_clean(), "{:?}", world.guards());
         worsts.push((tolerance, worst));
     }
     for (tolerance, worst) in worsts {

@@ -1069,8 +1069,9 @@ pub fn rim_start(h: &Hinge, tilt: f64) -> f64 {
 /// turns about `x` only: two degrees of freedom `(z, theta)`,
 /// `m z'' = F_z`, `I theta'' = M_x` (about the centre of mass), integrated by the classical
 /// Runge-Kutta with `dt` (s) until the shoulder leaves the face. Returns the peak face force
-/// (sampled every step, refined by a parabola through the three samples about the peak) and the
-/// time of the peak and of separation.
+/// (sampled every step, refined by a parabola through the three samples about the peak), the
+/// time of the peak and of separation, and the journal's velocity after it (free flight: its
+/// axial speed along `z`, m/s, and its spin about `x`, rad/s).
 pub fn rim_strike(
     h: &Hinge,
     mass: f64,
@@ -1078,7 +1079,7 @@ pub fn rim_strike(
     tilt: f64,
     speed: f64,
     dt: f64,
-) -> (f64, f64, f64) {
+) -> (f64, f64, f64, [f64; 2]) {
     let pose = rim_pose;
     let accel = |y: [f64; 4]| {
         let p = pose(y[0], y[1]);
@@ -1131,7 +1132,7 @@ pub fn rim_strike(
         0.0
     };
     let peak = f1 - 0.25 * (f0 - f2) * x;
-    (peak, hist[i].0 + x * dt, t)
+    (peak, hist[i].0 + x * dt, t, [y[2], y[3]])
 }
 
 /// Checks of the reference against closed forms and brute force (panics on a failure; returns

@@ -315,7 +315,8 @@ impl ClearanceWorld {
         self.stepper.invalidate(restart_kick);
     }
 
-    /// The velocity (linear, angular) of `body` at the world's state: a sub-cycled joint's
+    /// The velocity (linear, angular) of `body` at the world's state: a sub-cycled joint's,
+    /// planar or spatial
     /// ([`ClearanceJoint::state_velocity`](crate::rapier::joint::ClearanceJoint::state_velocity))
     /// where one ended its last step on a pair with the body, Rapier's otherwise (`None` for a
     /// body not in the world): after a sub-cycled step Rapier's velocities hold only part of the

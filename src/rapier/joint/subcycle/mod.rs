@@ -408,16 +408,21 @@ impl ClearanceJoint {
     }
 
     /// The velocity (linear, angular) of the bearing's body and of the journal's at the state
-    /// the last step ended at, as the joint's sub-cycle ended it (`None` for an explicit or
-    /// spatial joint, and when no sub-cycle ran). Rapier's velocities after a sub-cycled step
-    /// are the mean over the step and do not yet hold the part of the step's contact impulse
-    /// delivered with the next step (of an impact inside the step, up to most of it): read the
-    /// bodies' velocity at the state here, for their momentum and energy at it or a force of
-    /// yours that acts on it
+    /// the last step ended at, as the joint's sub-cycle ended it (`None` for an explicit joint,
+    /// and when no sub-cycle ran): the pair's velocity at the step's start carried over the step
+    /// by the rest of the world's acceleration and, through the pair's mobility, the step's
+    /// contact impulse (`u0 + a h + P Gamma`), at the end of a planar joint's sub-steps or of a
+    /// spatial joint's integration of its impulse alike. Rapier's velocities after a sub-cycled
+    /// step are the mean over the step and do not yet hold the part of the step's contact
+    /// impulse delivered with the next step (of an impact inside the step, up to most of it):
+    /// read the bodies' velocity at the state here, for their momentum and energy at it or a
+    /// force of yours that acts on it
     /// ([`ClearanceWorld::velocity_at_state`](crate::rapier::pipeline::world::ClearanceWorld::velocity_at_state)
-    /// for any body). Each impulse of the joints sub-cycled together is in every pair it moves.
+    /// for any body). It is the state's whole velocity: Rapier's lag behind the state, which
+    /// the reaction solve carries its velocities over, is in it already. Each impulse of the
+    /// joints sub-cycled together is in every pair it moves.
     pub fn state_velocity(&self) -> Option<[(RigidBodyHandle, Vector, Vector); 2]> {
-        let v = self.cycle.end_velocity.filter(|_| self.spatial.is_none())?;
+        let v = self.cycle.end_velocity?;
         Some([(self.body1, 0), (self.body2, 2)].map(|(b, k)| (b, part(&v, k), part(&v, k + 1))))
     }
 

@@ -63,8 +63,11 @@ impl Twin {
                         self.inside.note_acceleration(b.handle, v.len() + 6);
                         let (mut vel, _) = self.reactions.velocity(b.handle).unwrap_or_default();
                         let (acc, _) = self.reactions.acceleration(b.handle).unwrap_or_default();
+                        // After a step in which a sub-cycled joint of the body touched: the
+                        // joint's velocity at the state, not the solve's (Rapier's advanced
+                        // over their lag, which the joint's already holds).
                         if let Some((dv, _)) = held(b.handle) {
-                            vel += dv;
+                            vel = rb.linvel() + dv;
                         }
                         (vel, acc)
                     }

@@ -397,7 +397,11 @@ impl ClearanceJoint {
         bodies: &RigidBodySet,
         mechanism: &Mechanism,
     ) -> Option<(Wrench, Wrench)> {
-        let held = self.cycle.pending.take()?;
+        let Some(held) = self.cycle.pending.take() else {
+            // No sub-cycle ran: the state's velocity is Rapier's (`state_velocity` says none).
+            self.cycle.end_velocity = None;
+            return None;
+        };
         let end = *self.cycle.run.samples.last()?;
         let (rb1, rb2) = (bodies.get(self.body1)?, bodies.get(self.body2)?);
         let v = self.cycle.run.end_velocity;

@@ -135,6 +135,17 @@ impl Simulation {
         for &kind in kinds {
             twins.push(Twin::build(scene, kind, &mut world)?);
         }
+        if !options.skip_rows {
+            // The rows' values in one allocation of their final size (the rows are known from
+            // the start): grown by doubling, a table is copied as it grows and may hold up to
+            // twice its values. A row at each multiple of the interval below the end, and one
+            // at the end (the scene's check bounds their number).
+            let rows = (scene.run.end_s / scene.run.output_interval_s).ceil() as usize + 1;
+            for twin in &mut twins {
+                let n = twin.table.columns.len();
+                twin.table.values.reserve_exact(rows.saturating_mul(n));
+            }
+        }
         // Mass properties before the first step (Rapier computes them in it; the reactions and
         // the hooks need them at the initial state).
         crate::rapier::observers::reaction::prepare_mass_properties(&mut world.rapier.bodies);

@@ -156,17 +156,33 @@ impl Twin {
         let v = &mut self.table.values;
         let start = v.len();
         v.push(t);
-        for (i, &b) in cur.iter().enumerate().skip(1) {
-            let a = prev.get(i).copied().unwrap_or(b);
-            v.push(if w >= 1.0 {
-                b
-            } else if w <= 0.0 {
-                a
-            } else if contact_cols.contains(&i) {
-                if w >= 0.5 { b } else { a }
-            } else {
-                a + (b - a) * w
-            });
+        let (a, b) = (prev.get(1..).unwrap_or(&[]), cur.get(1..).unwrap_or(&[]));
+        // The row's columns at once, not a test of `w` and of the contact columns per value
+        // (rows outnumber the states several times over in an adaptive run).
+        if w >= 1.0 {
+            v.extend_from_slice(b);
+        } else if a.len() != b.len() {
+            // No previous state with these columns: the current one's values.
+            v.extend(b.iter().enumerate().map(|(i, &y)| {
+                let x = a.get(i).copied().unwrap_or(y);
+                if w <= 0.0 {
+                    x
+                } else if contact_cols.contains(&(i + 1)) {
+                    if w >= 0.5 { y } else { x }
+                } else {
+                    x + (y - x) * w
+                }
+            }));
+        } else if w <= 0.0 {
+            v.extend_from_slice(a);
+        } else {
+            v.extend(a.iter().zip(b).map(|(&x, &y)| x + (y - x) * w));
+            // The contact flags from the nearer state.
+            for &i in contact_cols {
+                if let (Some(&x), Some(&y)) = (prev.get(i), cur.get(i)) {
+                    v[start + i] = if w >= 0.5 { y } else { x };
+                }
+            }
         }
         if w > 0.0 && w < 1.0 {
             self.inside.correct(

@@ -78,7 +78,18 @@ impl Figure<'_> {
 
     /// Writes `<dir>/<stem>.png` and `<dir>/<stem>.svg` (each whole or not at all); returns both paths.
     pub fn write(&self, dir: &Path, stem: &str) -> Result<[PathBuf; 2]> {
-        write_both(self, dir, stem)
+        write_both(self, dir, stem, &mut Vec::new())
+    }
+
+    /// As [`write`](Self::write), the PNG's pixels drawn in `raster` (a buffer reused from
+    /// figure to figure).
+    pub fn write_reusing(
+        &self,
+        dir: &Path,
+        stem: &str,
+        raster: &mut Vec<u8>,
+    ) -> Result<[PathBuf; 2]> {
+        write_both(self, dir, stem, raster)
     }
 
     fn error(&self, format: &str, e: Box<dyn std::error::Error>) -> Error {

@@ -18,7 +18,7 @@
 //! - [`ticks`]: the axes' tick labels.
 //!
 //! Files: `figure.rs` (the figure kinds, [`Figure`]), `xy.rs` ([`XyFigure`]), `render.rs` (PNG,
-//! SVG, the font), `panel.rs` (a panel of curves), `angles_rates.rs`, `force.rs`, `trajectory.rs`
+//! SVG, the font), `tee.rs` (one drawing into both), `panel.rs` (a panel of curves), `angles_rates.rs`, `force.rs`, `trajectory.rs`
 //! (each kind's drawing), `cases.rs` (what they read of the cases), `decimate.rs`.
 
 mod angles_rates;
@@ -31,6 +31,7 @@ mod panel;
 mod render;
 pub mod run;
 pub mod series;
+mod tee;
 pub mod text;
 pub mod ticks;
 mod trajectory;

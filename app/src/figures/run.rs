@@ -44,6 +44,8 @@ pub fn draw_run_figures(
         Some(r) => case.with_contacts(r.contacts()),
         None => case,
     }];
+    // One pixel buffer for every figure's PNG.
+    let mut raster = Vec::new();
     // Driven mechanisms: each moving body's x acceleration against the driver's angle over
     // the last turn, ideal against clearance.
     if let (Some(period), true) = (scene.drive_period(), scene.run.body_motion) {
@@ -104,7 +106,7 @@ pub fn draw_run_figures(
                 y_label: "acceleration along x (m/s^2)",
                 curves: &curves,
             }
-            .write(out, &format!("{}_acceleration", b.name))?;
+            .write_reusing(out, &format!("{}_acceleration", b.name), &mut raster)?;
             for p in paths {
                 written(&p);
             }
@@ -117,7 +119,7 @@ pub fn draw_run_figures(
             title: &title,
             cases: &series,
         }
-        .write(out, kind.stem())?;
+        .write_reusing(out, kind.stem(), &mut raster)?;
         for p in paths {
             written(&p);
         }

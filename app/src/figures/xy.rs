@@ -19,7 +19,18 @@ pub struct XyFigure<'a> {
 impl XyFigure<'_> {
     /// Writes `<dir>/<stem>.png` and `<dir>/<stem>.svg`; returns both paths.
     pub fn write(&self, dir: &Path, stem: &str) -> Result<[PathBuf; 2]> {
-        write_both(self, dir, stem)
+        write_both(self, dir, stem, &mut Vec::new())
+    }
+
+    /// As [`write`](Self::write), the PNG's pixels drawn in `raster` (a buffer reused from
+    /// figure to figure).
+    pub fn write_reusing(
+        &self,
+        dir: &Path,
+        stem: &str,
+        raster: &mut Vec<u8>,
+    ) -> Result<[PathBuf; 2]> {
+        write_both(self, dir, stem, raster)
     }
 }
 

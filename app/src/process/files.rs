@@ -65,6 +65,13 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     write_all_atomic(&[(path, bytes)])
 }
 
+/// Writes the file `path` atomically as [`write_atomic`] does, its bytes streamed into it by
+/// `render` (no copy of them is held).
+pub fn write_atomic_with(path: &Path, render: impl Fn(&mut dyn Write) -> Result<()>) -> Result<()> {
+    let render: Render = Box::new(render);
+    write_set(&[(path, render)], &STAGING)
+}
+
 /// Writes several files as one set ([`write_set`], through [`STAGING`]).
 pub fn write_all_atomic(files: &[(&Path, &[u8])]) -> Result<()> {
     let renders: Vec<(&Path, Render)> = files

@@ -11,11 +11,11 @@ const JSON_CHARS: u64 = 14;
 
 /// The memory a replay of `scene` holds at its peak, bytes, an upper bound: [`MAX_FRAMES`]
 /// frames of the tracked bodies (both twins') and journals, as the recorder stores them (a pose
-/// of 7 numbers per body, 6 numbers, 2 flags and room for a spatial part per journal), the page's
-/// flattened copy of them,
-/// and its JSON text held three times while the page is built (the JSON, its escaped copy, the
-/// page). Measured: the paper's scene at 5 times its torque keeps 10,914 frames and peaks 17.5 MB
-/// above its run without a replay, 1.6 kB a frame, against 2.7 kB a frame here.
+/// of 7 numbers per body, 6 numbers, 2 flags and room for a spatial part per journal), and room
+/// for a flattened copy of them and their JSON text three times over (the page is streamed
+/// from the frames into its file and holds neither: room to spare). Measured: the paper's scene
+/// at 5 times its torque keeps 10,914 frames and peaks 17.5 MB above its run without a replay,
+/// 1.6 kB a frame, against 2.7 kB a frame here.
 pub fn memory_bytes(scene: &Scene) -> u64 {
     let bodies = 2 * scene.bodies.len() as u64;
     let journals = scene

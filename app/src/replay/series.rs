@@ -43,26 +43,21 @@ impl Line {
         column: &str,
         points: &[(f64, f64)],
     ) -> Option<Line> {
-        // Both columns in one pass over the rows, and no merged copy when there is nothing to
-        // merge (a run's rows are megabytes).
-        let mut columns = table.columns(&["t_s", column])?;
-        let (v, t) = (columns.pop()?, columns.pop()?);
+        let (t, v) = (table.column_index("t_s")?, table.column_index(column)?);
         let (t, v) = if points.is_empty() {
-            (t, v)
+            // Thinned straight from the rows: no copy of a column (a run's rows are
+            // megabytes).
+            let (at, n) = (rows_of(table), table.rows());
+            min_max_thin_by(n, |i| at(i, t), |i| at(i, v), SERIES_BUCKETS)
         } else {
-            crate::figures::series::merge_points(&t, &v, points)
+            let mut columns = table.columns(&["t_s", column])?;
+            let (v, t) = (columns.pop()?, columns.pop()?);
+            let (t, v) = crate::figures::series::merge_points(&t, &v, points);
+            min_max_thin(&t, &v, SERIES_BUCKETS)
         };
-        let (t, v) = min_max_thin(&t, &v, SERIES_BUCKETS);
-        Some(Line {
-            label: label.into(),
-            group: group.into(),
-            t,
-            v: v.into_iter().map(|x| round_sig(x, 7)).collect(),
-        })
+        Some(Line::rounded(label, group, t, v))
     }
-}
 
-impl Line {
     /// `f` of columns `columns` of `table` per row against its `t_s`, thinned as
     /// [`from_table`](Self::from_table) (`None` when a column is missing).
     pub fn derived(
@@ -72,48 +67,78 @@ impl Line {
         columns: &[&str],
         f: impl Fn(&[f64]) -> f64,
     ) -> Option<Line> {
-        let mut cols = table.columns(&[&["t_s"], columns].concat())?;
-        let t = cols.remove(0);
-        let mut x = vec![0.0; cols.len()];
-        let v: Vec<f64> = (0..t.len())
+        let t = table.column_index("t_s")?;
+        let index: Vec<usize> = columns
+            .iter()
+            .map(|c| table.column_index(c))
+            .collect::<Option<_>>()?;
+        let (at, n) = (rows_of(table), table.rows());
+        let mut x = vec![0.0; index.len()];
+        let v: Vec<f64> = (0..n)
             .map(|i| {
-                for (x, c) in x.iter_mut().zip(&cols) {
-                    *x = c[i];
+                for (x, &j) in x.iter_mut().zip(&index) {
+                    *x = at(i, j);
                 }
                 f(&x)
             })
             .collect();
-        let (t, v) = min_max_thin(&t, &v, SERIES_BUCKETS);
-        Some(Line {
+        let (t, v) = min_max_thin_by(n, |i| at(i, t), |i| v[i], SERIES_BUCKETS);
+        Some(Line::rounded(label, group, t, v))
+    }
+
+    /// The line of thinned `t` and `v`, values to 7 significant digits.
+    fn rounded(label: &str, group: &str, t: Vec<f64>, v: Vec<f64>) -> Line {
+        Line {
             label: label.into(),
             group: group.into(),
             t,
             v: v.into_iter().map(|x| round_sig(x, 7)).collect(),
-        })
+        }
     }
+}
+
+/// The value of `table` at row `i` and column `j`, read in place.
+fn rows_of(table: &Table) -> impl Fn(usize, usize) -> f64 + '_ {
+    let width = table.columns.len();
+    move |i, j| table.values[i * width + j]
 }
 
 /// Keeps, per bucket of `buckets` equal time spans, the samples with the smallest and the
 /// largest value (in time order): peaks survive any thinning.
 pub fn min_max_thin(t: &[f64], v: &[f64], buckets: usize) -> (Vec<f64>, Vec<f64>) {
     let n = t.len().min(v.len());
+    min_max_thin_by(n, |i| t[i], |i| v[i], buckets)
+}
+
+/// [`min_max_thin`] of the `n` samples `(t(i), v(i))`, read where they are.
+fn min_max_thin_by(
+    n: usize,
+    t: impl Fn(usize) -> f64,
+    v: impl Fn(usize) -> f64,
+    buckets: usize,
+) -> (Vec<f64>, Vec<f64>) {
     if n <= 2 * buckets || n < 2 {
-        return (t[..n].to_vec(), v[..n].to_vec());
+        return ((0..n).map(&t).collect(), (0..n).map(&v).collect());
     }
-    let (t0, t1) = (t[0], t[n - 1]);
+    let (t0, t1) = (t(0), t(n - 1));
     let span = (t1 - t0).max(f64::MIN_POSITIVE);
+    // `as usize` truncates, and takes what is below 0 (and NaN) to 0: the floor's bucket
+    // without its library call.
+    let bucket = |x: f64| (((x - t0) / span) * buckets as f64) as usize;
     let mut keep = Vec::with_capacity(2 * buckets + 2);
     let mut i = 0;
     while i < n {
-        let b = (((t[i] - t0) / span) * buckets as f64).floor() as usize;
+        let b = bucket(t(i));
         let (mut lo, mut hi) = (i, i);
+        let (mut v_lo, mut v_hi) = (v(i), v(i));
         let mut j = i;
-        while j < n && ((((t[j] - t0) / span) * buckets as f64).floor() as usize) == b {
-            if v[j] < v[lo] {
-                lo = j;
+        while j < n && bucket(t(j)) == b {
+            let vj = v(j);
+            if vj < v_lo {
+                (lo, v_lo) = (j, vj);
             }
-            if v[j] > v[hi] {
-                hi = j;
+            if vj > v_hi {
+                (hi, v_hi) = (j, vj);
             }
             j += 1;
         }
@@ -124,8 +149,8 @@ pub fn min_max_thin(t: &[f64], v: &[f64], buckets: usize) -> (Vec<f64>, Vec<f64>
         i = j;
     }
     (
-        keep.iter().map(|&k| t[k]).collect(),
-        keep.iter().map(|&k| v[k]).collect(),
+        keep.iter().map(|&k| t(k)).collect(),
+        keep.iter().map(|&k| v(k)).collect(),
     )
 }
 
@@ -164,11 +189,19 @@ pub(super) fn round_decimals(x: f64, decimals: usize) -> f64 {
 /// rounded across one).
 fn scaled_round(x: f64, scale: i32) -> Option<f64> {
     let p = x * pow10(scale)?;
-    let whole = p.abs().floor();
-    if !(p.abs() < 2f64.powi(31)) || (p.abs() - whole - 0.5).abs() < 1e-6 {
+    let a = p.abs();
+    if !(a < 2f64.powi(31)) {
         return None;
     }
-    Some(p.round() / pow10(scale)?)
+    // Below 2^31 the integer conversion truncates to `floor(a)`, and `a - floor(a)` is exact:
+    // `p.round()` without the two library calls the target's floating point would make.
+    let whole = f64::from(a as u32);
+    let frac = a - whole;
+    if (frac - 0.5).abs() < 1e-6 {
+        return None;
+    }
+    let rounded = (whole + if frac > 0.5 { 1.0 } else { 0.0 }).copysign(p);
+    Some(rounded / pow10(scale)?)
 }
 
 /// `10^k` for the `k` whose power is exact in `f64` (0 to 22).

@@ -105,6 +105,13 @@ pub struct ReplayRecorder {
     last_kept: f64,
     /// Frames kept at most (see the module docs' cap).
     max_frames: usize,
+    /// Frames no longer held (a replaced pending or peak state), whose vectors the next states
+    /// reuse: recording a state allocates only when the state is kept.
+    spare: Vec<ReplayFrame>,
+    /// The state at a step's end and a state inside the step, reused from step to step.
+    scratch: [ReplayFrame; 2],
+    /// The sub-step times of the step being recorded, reused from step to step.
+    times: Vec<f64>,
 }
 
 #[cfg(test)]

@@ -33,6 +33,9 @@ impl ReplayRecorder {
             onset: f64::NEG_INFINITY,
             last_kept: f64::NEG_INFINITY,
             max_frames: usize::MAX,
+            spare: Vec::new(),
+            scratch: [empty_frame(), empty_frame()],
+            times: Vec::new(),
         })
     }
 
@@ -136,76 +139,83 @@ impl ReplayRecorder {
     /// Records the state at time `t` (call after each step; `sets` as given to
     /// [`track_journal`](Self::track_journal)). Keeps it or not by the thinning rule.
     pub fn record(&mut self, t: f64, bodies: &RigidBodySet, sets: &[&ClearanceJointSet]) {
-        let frame = self.frame(t, bodies, sets);
-        for inside in self.inside_frames(&frame, bodies, sets) {
-            self.record_frame(inside);
-        }
-        self.record_frame(frame);
+        // The states are built in the recorder's scratch frames, which the thinning keeps or
+        // trades for spare ones: a step's states allocate nothing once it has spares.
+        let [mut end, mut inside] =
+            std::mem::replace(&mut self.scratch, [empty_frame(), empty_frame()]);
+        self.fill_frame(&mut end, t, bodies, sets);
+        self.record_inside(&end, &mut inside, bodies, sets);
+        self.record_frame(&mut end);
+        self.scratch = [end, inside];
     }
 
-    fn frame(&self, t: f64, bodies: &RigidBodySet, sets: &[&ClearanceJointSet]) -> ReplayFrame {
-        let poses = self
-            .handles
-            .iter()
-            .map(|&h| match bodies.get(h) {
+    /// Sets `frame` to the state at time `t`.
+    fn fill_frame(
+        &self,
+        frame: &mut ReplayFrame,
+        t: f64,
+        bodies: &RigidBodySet,
+        sets: &[&ClearanceJointSet],
+    ) {
+        frame.t = t;
+        // Exact capacities: a kept frame keeps its vectors (`extend` into an empty vector
+        // would reserve room for 4 journals where there is 1).
+        frame.poses.clear();
+        frame.poses.reserve_exact(self.handles.len());
+        frame
+            .poses
+            .extend(self.handles.iter().map(|&h| match bodies.get(h) {
                 Some(rb) => {
                     let (p, q) = (rb.translation(), *rb.rotation());
                     [p.x, p.y, p.z, q.x, q.y, q.z, q.w]
                 }
                 None => [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0],
-            })
-            .collect();
-        let journals = self
-            .joints
-            .iter()
-            .zip(&self.recording.journals)
-            .map(|(&(set, h), track)| {
-                let Some(joint) = sets.get(set).and_then(|s| s.get(h)) else {
-                    return JournalFrame::default();
-                };
-                journal_frame(joint, bodies, track)
-            })
-            .collect();
-        ReplayFrame { t, poses, journals }
+            }));
+        frame.journals.clear();
+        frame.journals.reserve_exact(self.joints.len());
+        frame
+            .journals
+            .extend(
+                self.joints
+                    .iter()
+                    .zip(&self.recording.journals)
+                    .map(|(&(set, h), track)| {
+                        let Some(joint) = sets.get(set).and_then(|s| s.get(h)) else {
+                            return JournalFrame::default();
+                        };
+                        journal_frame(joint, bodies, track)
+                    }),
+            );
     }
 
-    /// The states inside the step that led to `end` of the sub-cycled joints
-    /// ([`ClearanceJoint::substeps`]), in time order: each such joint at its sub-step, the other
-    /// journals as at the step's end (or at their own latest sub-step before), the bodies drawn
-    /// at the step's end (they move little within a step against the journal in its play).
-    fn inside_frames(
-        &self,
+    /// Records the states inside the step that led to `end` of the sub-cycled joints
+    /// ([`ClearanceJoint::substeps`]), in time order (each built in `inside`): each such joint
+    /// at its sub-step, the other journals as at the step's end (or at their own latest
+    /// sub-step before), the bodies drawn at the step's end (they move little within a step
+    /// against the journal in its play).
+    fn record_inside(
+        &mut self,
         end: &ReplayFrame,
+        inside: &mut ReplayFrame,
         bodies: &RigidBodySet,
         sets: &[&ClearanceJointSet],
-    ) -> Vec<ReplayFrame> {
+    ) {
         let joint = |&(set, h): &(usize, ClearanceJointHandle)| sets.get(set)?.get(h);
-        let mut times: Vec<f64> = Vec::new();
+        let mut times = std::mem::take(&mut self.times);
+        times.clear();
         for j in self.joints.iter().filter_map(joint) {
-            if let Some((last, inside)) = j.substeps().split_last() {
+            if let Some((last, within)) = j.substeps().split_last() {
                 let start = end.t - last.t;
-                times.extend(inside.iter().map(|s| start + s.t));
+                times.extend(within.iter().map(|s| start + s.t));
             }
         }
-        if times.is_empty() {
-            return Vec::new();
-        }
-        times.sort_by(f64::total_cmp);
-        times.dedup();
-        let rotation = |j: &ClearanceJoint| -> Rotation {
-            bodies
-                .get(j.body1())
-                .map(|rb| *rb.rotation())
-                .unwrap_or_default()
-        };
-        times
-            .into_iter()
-            .map(|t| {
-                let mut frame = ReplayFrame {
-                    t,
-                    poses: end.poses.clone(),
-                    journals: end.journals.clone(),
-                };
+        if !times.is_empty() {
+            times.sort_by(f64::total_cmp);
+            times.dedup();
+            for &t in &times {
+                inside.t = t;
+                copy_into(&mut inside.poses, &end.poses);
+                copy_into(&mut inside.journals, &end.journals);
                 for ((k, id), track) in self.joints.iter().enumerate().zip(&self.recording.journals)
                 {
                     let Some(j) = joint(id) else { continue };
@@ -214,12 +224,17 @@ impl ReplayRecorder {
                     };
                     let start = end.t - last.t;
                     if let Some(s) = j.substeps().iter().rev().find(|s| start + s.t <= t) {
-                        frame.journals[k] = substep_frame(s, rotation(j), track);
+                        let rotation: Rotation = bodies
+                            .get(j.body1())
+                            .map(|rb| *rb.rotation())
+                            .unwrap_or_default();
+                        inside.journals[k] = substep_frame(s, rotation, track);
                     }
                 }
-                frame
-            })
-            .collect()
+                self.record_frame(inside);
+            }
+        }
+        self.times = times;
     }
 
     /// The frames kept so far.
@@ -234,4 +249,21 @@ impl ReplayRecorder {
         }
         self.recording
     }
+}
+
+/// A frame of no state, whose vectors a recorded state fills.
+pub(super) fn empty_frame() -> ReplayFrame {
+    ReplayFrame {
+        t: 0.0,
+        poses: Vec::new(),
+        journals: Vec::new(),
+    }
+}
+
+/// Sets `to` to `from`, in `to`'s memory when it is large enough, else in memory of exactly
+/// `from`'s length (a kept frame's vectors hold no spare room).
+pub(super) fn copy_into<T: Copy>(to: &mut Vec<T>, from: &[T]) {
+    to.clear();
+    to.reserve_exact(from.len());
+    to.extend_from_slice(from);
 }

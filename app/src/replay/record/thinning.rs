@@ -1,10 +1,14 @@
 //! The recorder's thinning: which states a replay keeps, and its cap on frames.
 
+use super::recorder::{copy_into, empty_frame};
 use super::*;
 
 impl ReplayRecorder {
-    /// Records one state (thinned as [`record`](Self::record) says).
-    pub(super) fn record_frame(&mut self, frame: ReplayFrame) {
+    /// Records one state (thinned as [`record`](Self::record) says). Where the state is held
+    /// (kept or pending) it is moved out of `frame`, which is left with a spare frame's vectors
+    /// to be filled again: a state costs no copy, and no allocation once the recorder has
+    /// spares.
+    pub(super) fn record_frame(&mut self, frame: &mut ReplayFrame) {
         let t = frame.t;
         let contact = frame.journals.iter().any(|j| j.contact);
         let onset = contact && !self.in_contact;
@@ -23,14 +27,40 @@ impl ReplayRecorder {
         }
         self.in_contact = contact;
         if keep {
-            self.pending = None;
+            if let Some(old) = self.pending.take() {
+                self.spare.push(old);
+            }
+            let frame = self.take(frame);
             self.push_after_peak(frame);
         } else {
-            if self.peak.as_ref().is_none_or(|p| force(&frame) > force(p)) {
-                self.peak = Some(frame.clone());
+            if self.peak.as_ref().is_none_or(|p| force(frame) > force(p)) {
+                let peak = self.copy(frame);
+                if let Some(old) = self.peak.replace(peak) {
+                    self.spare.push(old);
+                }
             }
-            self.pending = Some(frame);
+            let pending = self.take(frame);
+            if let Some(old) = self.pending.replace(pending) {
+                self.spare.push(old);
+            }
         }
+    }
+
+    /// The state in `frame`, which is left with a spare frame's vectors (or none).
+    fn take(&mut self, frame: &mut ReplayFrame) -> ReplayFrame {
+        let spare = self.spare.pop().unwrap_or_else(empty_frame);
+        std::mem::replace(frame, spare)
+    }
+
+    /// A copy of `frame`, in a spare frame's vectors when there is one.
+    fn copy(&mut self, frame: &ReplayFrame) -> ReplayFrame {
+        let Some(mut copy) = self.spare.pop() else {
+            return frame.clone();
+        };
+        copy.t = frame.t;
+        copy_into(&mut copy.poses, &frame.poses);
+        copy_into(&mut copy.journals, &frame.journals);
+        copy
     }
 
     /// Keeps `frame`, after the state of largest force skipped since the last kept one when
@@ -41,6 +71,8 @@ impl ReplayRecorder {
             let before = self.recording.frames.last().map_or(0.0, force);
             if peak.t < frame.t && force(&peak) > before.max(force(&frame)) {
                 self.push(peak);
+            } else {
+                self.spare.push(peak);
             }
         }
         self.push(frame);

@@ -14,8 +14,9 @@ const JSON_CHARS: u64 = 14;
 /// of 7 numbers per body, 6 numbers, 2 flags and room for a spatial part per journal), and room
 /// for a flattened copy of them and their JSON text three times over (the page is streamed
 /// from the frames into its file and holds neither: room to spare). Measured: the paper's scene
-/// at 5 times its torque keeps 10,914 frames and peaks 17.5 MB above its run without a replay,
-/// 1.6 kB a frame, against 2.7 kB a frame here.
+/// at 5 times its torque for 3 s keeps 10,914 frames and peaks 6.6 MB above its run without a
+/// replay (both `--no-figures`; 5.4 MB with the figures), 0.6 kB a frame, against 2.7 kB a frame
+/// here.
 pub fn memory_bytes(scene: &Scene) -> u64 {
     let bodies = 2 * scene.bodies.len() as u64;
     let journals = scene

@@ -144,11 +144,10 @@ const STABLE_FRACTION_PER_TOLERANCE: f64 = 10.0;
 
 /// Sub-steps of a contact one world step may cover in or on the way into contact
 /// ([`ClearanceJoint::world_contact_step`]): 10, `20 tol` of the contact's period and `100 tol`
-/// of its damped stability limit. Rapier hands a step's impulse to the rest of the mechanism as
-/// one constant wrench, so a world step spanning whole impacts gives the bodies beyond the pair
-/// only their mean, and the sub-cycle holds the rest of the world's acceleration of the pair
-/// over the step, which a step spanning a flight and a landing does not keep (the deployable
-/// array's window statistics, the panel at 5T: docs/sub-cycled-contact.md, "The world's step").
+/// of its damped stability limit. A world step spanning whole impacts gives the bodies beyond
+/// the pair only their mean (Rapier's one constant wrench), and the pair the rest of the world's
+/// acceleration held across a flight and a landing (docs/sub-cycled-contact.md, "The world's
+/// step": the deployable array's window statistics, the panel at 5T).
 const WORLD_SUBSTEPS_IN_CONTACT: f64 = 10.0;
 
 impl ClearanceJoint {

@@ -145,9 +145,9 @@ const STABLE_FRACTION_PER_TOLERANCE: f64 = 10.0;
 /// Sub-steps of a contact one world step may cover in or on the way into contact
 /// ([`ClearanceJoint::world_contact_step`]): 10, `20 tol` of the contact's period and `100 tol`
 /// of its damped stability limit. A world step spanning whole impacts gives the bodies beyond
-/// the pair only their mean (Rapier's one constant wrench), and the pair the rest of the world's
-/// acceleration held across a flight and a landing (docs/sub-cycled-contact.md, "The world's
-/// step": the deployable array's window statistics, the panel at 5T).
+/// the pair only their mean (Rapier's one constant wrench); a pair that moves no other body
+/// needs the bound too, measured (docs/sub-cycled-contact.md, "The world's step": the deployable
+/// array's window statistics, the panel at 5T, the damped slider-crank).
 const WORLD_SUBSTEPS_IN_CONTACT: f64 = 10.0;
 
 impl ClearanceJoint {

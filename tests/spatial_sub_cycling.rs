@@ -285,13 +285,19 @@ fn cantilever(integration: &str, overrides: &[&str]) -> RunResult {
         "run.end_s=0.05".to_string(),
     ];
     set.extend(overrides.iter().map(|s| s.to_string()));
+    run_cantilever(&set, true)
+}
+
+/// `assets/cantilever.ron` with `set`, the scene runner's clearance twin, its rows skipped or
+/// kept.
+fn run_cantilever(set: &[String], skip_rows: bool) -> RunResult {
     let scene = Scene::load(std::path::Path::new("assets/cantilever.ron"))
         .unwrap()
-        .with_overrides(&set)
+        .with_overrides(set)
         .unwrap();
     let options = RunOptions {
         twins: Twins::ClearanceOnly,
-        skip_rows: true,
+        skip_rows,
     };
     Simulation::new(&scene, options).unwrap().run().unwrap()
 }
@@ -413,15 +419,7 @@ fn cantilever_states(sub_cycled: bool) -> (Vec<f64>, Vec<Vector>) {
         ]
     });
     let set: Vec<String> = set.iter().map(|s| s.to_string()).collect();
-    let scene = Scene::load(std::path::Path::new("assets/cantilever.ron"))
-        .unwrap()
-        .with_overrides(&set)
-        .unwrap();
-    let options = RunOptions {
-        twins: Twins::ClearanceOnly,
-        skip_rows: false,
-    };
-    let result = Simulation::new(&scene, options).unwrap().run().unwrap();
+    let result = run_cantilever(&set, false);
     let table = &result.twins[0].table;
     let v = table
         .columns(&["shaft_vx_m_s", "shaft_vy_m_s", "shaft_vz_m_s"])

@@ -20,15 +20,24 @@ const C: f64 = 0.2e-3;
 const MU: f64 = 0.3;
 const V_EPS: f64 = 1e-4;
 
-/// The journal's sub-cycled pin in its bearing (16 mm wide), Hertz's law of stiffness `k`
-/// (N/m^1.5) with no damping and no friction, centred on both bodies' origins.
-fn sub_cycled_hertz_pin(k: f64) -> ClearanceJoint {
+/// The journal's bearing (16 mm wide) with Hertz's law of stiffness `k` (N/m^1.5), no damping
+/// and no friction.
+fn hertz_design(k: f64) -> HingeDesign {
     use clearance_joint::model::laws::{BearingGeometry, Hertz, NormalModel};
     let hertz = NormalModel::Hertz(Hertz::new(k, 1.5).unwrap());
     HingeDesign::new(BearingGeometry::new(R_B, R_B - C, 0.016).unwrap(), hertz)
-        .integration(ContactIntegration::SubCycled)
+}
+
+/// The pin of `design` centred on both bodies' origins.
+fn centred(design: HingeDesign) -> ClearanceJoint {
+    design
         .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
         .unwrap()
+}
+
+/// The journal's sub-cycled pin of [`hertz_design`].
+fn sub_cycled_hertz_pin(k: f64) -> ClearanceJoint {
+    centred(hertz_design(k).integration(ContactIntegration::SubCycled))
 }
 
 /// A rattle's energy check: more than ten onsets, the largest gain below `bound` (J), the
@@ -931,14 +940,9 @@ fn a_loose_tolerance_still_resolves_each_impact() {
 /// steps of `2 tol` of the period ended the bounces 0.25 (0.1) and 15 (0.2) times `g c` off.
 #[test]
 fn a_loose_tolerance_still_resolves_each_explicit_impact() {
-    use clearance_joint::model::laws::{BearingGeometry, Hertz, NormalModel};
     let mut worsts = Vec::new();
     for tolerance in [0.0075, 0.02, 0.05, 0.1, 0.2] {
-        let hertz = NormalModel::Hertz(Hertz::new(1e10, 1.5).unwrap());
-        let pin = HingeDesign::new(BearingGeometry::new(R_B, R_B - C, 0.016).unwrap(), hertz)
-            .integration(ContactIntegration::Explicit)
-            .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
-            .unwrap();
+        let pin = centred(hertz_design(1e10).integration(ContactIntegration::Explicit));
         let Bounces {
             bounces: onsets,
             free_ends,
@@ -972,23 +976,17 @@ fn a_loose_tolerance_still_resolves_each_explicit_impact() {
 /// tolerance 1e-3 (measured 1.3e-9 and 1.8e-5), without spin.
 #[test]
 fn a_spatial_pin_without_tilt_has_the_planar_pins_velocity_at_the_state() {
-    use clearance_joint::model::laws::{BearingGeometry, Hertz, NormalModel};
     use clearance_joint::model::spatial::SpatialModel;
     let spatial_pin = || {
-        let hertz = NormalModel::Hertz(Hertz::new(1e10, 1.5).unwrap());
-        HingeDesign::new(BearingGeometry::new(R_B, R_B - C, 0.016).unwrap(), hertz)
-            .integration(ContactIntegration::SubCycled)
-            .model(ClearanceModel::Spatial(SpatialModel::steel(0.3e-3, 0.015)))
-            .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
-            .unwrap()
+        centred(
+            hertz_design(1e10)
+                .integration(ContactIntegration::SubCycled)
+                .model(ClearanceModel::Spatial(SpatialModel::steel(0.3e-3, 0.015))),
+        )
     };
     // The reference: the explicit pin at fixed 1 us steps, read at 8 ms.
     let reference = {
-        let hertz = NormalModel::Hertz(Hertz::new(1e10, 1.5).unwrap());
-        let pin = HingeDesign::new(BearingGeometry::new(R_B, R_B - C, 0.016).unwrap(), hertz)
-            .integration(ContactIntegration::Explicit)
-            .joint(Vector::ZERO, Vector::ZERO, Vector::Z, Vector::Z)
-            .unwrap();
+        let pin = centred(hertz_design(1e10).integration(ContactIntegration::Explicit));
         let (mut world, base, journal) = journal_world(StepControl::fixed(1e-6), 1);
         world.insert_clearance(base, journal, pin).unwrap();
         while world.time() < 8e-3 - 1e-12 {
